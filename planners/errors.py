@@ -1,0 +1,45 @@
+"""Typed planning failures, after nav2_core's planner exceptions.
+
+Every failure a planner can report is a :class:`PlanningError`; the CLI maps
+them to exit code 3.  Bad *input* (a malformed scenario, an unknown parameter)
+is a :class:`ConfigError` instead and maps to exit code 2.
+"""
+
+from __future__ import annotations
+
+
+class ConfigError(ValueError):
+    """Invalid user input: a scenario field, a planner parameter, a CLI option.
+
+    Attributes:
+        source: the file (or other origin) the value came from, if known.
+        field: dotted path of the offending field, e.g. ``obstacles[2].radius_m``.
+        problem: what is wrong with it, in a few words.
+    """
+
+    def __init__(self, field: str, problem: str, source: str | None = None):
+        self.source = source
+        self.field = field
+        self.problem = problem
+        where = f"{source}: " if source else ""
+        super().__init__(f"{where}{field}: {problem}")
+
+
+class PlanningError(RuntimeError):
+    """Base class of every planner failure."""
+
+
+class StartBlocked(PlanningError):
+    """The start lies inside an (inflated) obstacle or outside the bounds."""
+
+
+class GoalBlocked(PlanningError):
+    """The goal lies inside an (inflated) obstacle or outside the bounds."""
+
+
+class NoPathFound(PlanningError):
+    """The planner finished without a collision-free path."""
+
+
+class BudgetExceeded(PlanningError):
+    """The planner ran out of its time or evaluation budget."""
