@@ -1,0 +1,365 @@
+"""Scenarios are data: TOML files under ``models/scenarios/``, validated on load.
+
+Every problem in a file raises :class:`planners.errors.ConfigError` naming the
+file, the field (a dotted path such as ``obstacles[3].motion.kind``) and what is
+wrong.  The schema is documented in the README; units are in the field names.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path as FilePath
+from typing import Any
+
+import numpy as np
+
+from models.obstacle_motion import LinearMotion, RandomWalkMotion, Stationary, WaypointMotion
+from planners.errors import ConfigError
+from planners.problem import Box, Disc, OccupancyGrid, Pose2D, Problem, Rect
+
+SCENARIO_DIR = FilePath(__file__).resolve().parent / "scenarios"
+MOTION_KINDS = ("linear", "random_walk", "waypoints")
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """A cylinder; ``motion`` is None for static obstacles."""
+
+    x_m: float
+    y_m: float
+    radius_m: float
+    height_m: float
+    motion: LinearMotion | RandomWalkMotion | WaypointMotion | None = None
+
+    @property
+    def moving(self) -> bool:
+        return self.motion is not None
+
+    def trajectory(self):
+        return self.motion if self.motion is not None else Stationary((self.x_m, self.y_m))
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    timestep_s: float = 0.002
+    control_hz: float = 50.0
+    stop_on_collision: bool = False
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """A validated scenario.  ``source_text`` is the TOML as read (logged with every run)."""
+
+    name: str
+    description: str
+    seed: int
+    time_limit_s: float
+    arena_width_m: float
+    arena_height_m: float
+    walls: bool
+    robot_radius_m: float
+    max_speed_m_s: float
+    clearance_m: float
+    start: Pose2D
+    goal: Pose2D
+    goal_tolerance_m: float
+    sensor_count: int
+    sensor_range_m: float
+    planner_name: str
+    planner_params: dict[str, Any]
+    obstacles: tuple[Obstacle, ...]
+    sim: SimSettings
+    cell_m: float
+    source_text: str
+    source_path: str
+    boxes: tuple[Box, ...] = ()
+    map_grid: OccupancyGrid | None = field(default=None, repr=False)
+
+    @property
+    def bounds(self) -> Rect:
+        """The arena, [0, width] x [0, height]."""
+        return Rect(0.0, 0.0, self.arena_width_m, self.arena_height_m)
+
+    def planning_bounds(self, inflation_m: float) -> Rect:
+        """Where the robot's centre may go: the arena, shrunk by ``inflation_m`` when it has walls."""
+        if not self.walls:
+            return self.bounds
+        return Rect(inflation_m, inflation_m, self.arena_width_m - inflation_m,
+                    self.arena_height_m - inflation_m)
+
+    def discs_at(self, time_s: float = 0.0) -> tuple[Disc, ...]:
+        """Every obstacle's footprint at a given time."""
+        out = []
+        for ob in self.obstacles:
+            x, y = ob.trajectory().positions_at(np.array([time_s]))[0]
+            out.append(Disc(float(x), float(y), ob.radius_m))
+        return tuple(out)
+
+    def to_problem(self, cell_m: float | None = None, at_time_s: float = 0.0,
+                   clearance_m: float | None = None) -> Problem:
+        """The planning problem with obstacles frozen at ``at_time_s``."""
+        clearance_m = self.clearance_m if clearance_m is None else clearance_m
+        return Problem(start=self.start, goal=self.goal,
+                       bounds=self.planning_bounds(self.robot_radius_m + clearance_m),
+                       obstacles=self.discs_at(at_time_s), robot_radius_m=self.robot_radius_m,
+                       clearance_m=clearance_m,
+                       boxes=self.boxes, cell_m=cell_m or self.cell_m, grid_override=self.map_grid)
+
+
+class _Table:
+    """Typed access to one TOML table that remembers where it is, for error messages."""
+
+    def __init__(self, data: Any, where: str, source: str):
+        self.where = where
+        self.source = source
+        if not isinstance(data, dict):
+            self.fail("", f"expected a table, got {type(data).__name__}")
+        self.data = data
+        self.used: set[str] = set()
+
+    def path(self, key: str) -> str:
+        return f"{self.where}.{key}" if self.where and key else (self.where or key)
+
+    def fail(self, key: str, problem: str):
+        raise ConfigError(self.path(key), problem, self.source)
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def raw(self, key: str, default: Any = ..., ) -> Any:
+        self.used.add(key)
+        if key not in self.data:
+            if default is ...:
+                self.fail(key, "is required")
+            return default
+        return self.data[key]
+
+    def number(self, key: str, default: Any = ..., *, positive: bool = False,
+               non_negative: bool = False) -> float:
+        value = self.raw(key, default)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(key, f"expected a number, got {value!r}")
+        value = float(value)
+        if not math.isfinite(value):
+            self.fail(key, f"must be finite, got {value}")
+        if positive and value <= 0:
+            self.fail(key, f"must be positive, got {value:g}")
+        if non_negative and value < 0:
+            self.fail(key, f"must not be negative, got {value:g}")
+        return value
+
+    def integer(self, key: str, default: Any = ..., *, minimum: int | None = None) -> int:
+        value = self.raw(key, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            self.fail(key, f"expected an integer, got {value!r}")
+        if minimum is not None and value < minimum:
+            self.fail(key, f"must be at least {minimum}, got {value}")
+        return int(value)
+
+    def boolean(self, key: str, default: Any = ...) -> bool:
+        value = self.raw(key, default)
+        if not isinstance(value, bool):
+            self.fail(key, f"expected true or false, got {value!r}")
+        return value
+
+    def string(self, key: str, default: Any = ..., choices: tuple[str, ...] | None = None) -> str:
+        value = self.raw(key, default)
+        if not isinstance(value, str):
+            self.fail(key, f"expected a string, got {value!r}")
+        if choices is not None and value not in choices:
+            self.fail(key, f"unknown value {value!r} (expected one of: {', '.join(choices)})")
+        return value
+
+    def table(self, key: str, default: Any = ...) -> "_Table":
+        return _Table(self.raw(key, default), self.path(key), self.source)
+
+    def close(self) -> None:
+        """Reject keys that were never read."""
+        unknown = sorted(set(self.data) - self.used)
+        if unknown:
+            self.fail(unknown[0], "unknown key")
+
+
+def list_scenarios() -> list[str]:
+    """Names of the bundled scenarios (file stems under models/scenarios/)."""
+    return sorted(p.stem for p in SCENARIO_DIR.glob("*.toml"))
+
+
+def resolve_scenario_path(name_or_path: str) -> FilePath:
+    """A bundled scenario name, or a path to a .toml file."""
+    candidate = FilePath(name_or_path)
+    if candidate.suffix == ".toml" or candidate.exists() or "/" in name_or_path:
+        if not candidate.is_file():
+            raise ConfigError("scenario", "file does not exist", str(candidate))
+        return candidate
+    bundled = SCENARIO_DIR / f"{name_or_path}.toml"
+    if not bundled.is_file():
+        raise ConfigError("scenario", f"no bundled scenario named {name_or_path!r} "
+                          f"(see `swarmnav scenarios`)", name_or_path)
+    return bundled
+
+
+def load_scenario(name_or_path: str) -> Scenario:
+    """Read and validate a scenario.
+
+    Raises:
+        ConfigError: the file is missing, is not valid TOML, or breaks the schema.
+    """
+    path = resolve_scenario_path(str(name_or_path))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError("scenario", f"cannot be read ({exc})", str(path)) from None
+    return parse_scenario(text, str(path))
+
+
+def parse_scenario(text: str, source: str = "<string>") -> Scenario:
+    """Validate scenario TOML text (see :func:`load_scenario`)."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError("toml", f"malformed TOML ({exc})", source) from None
+    top = _Table(data, "", source)
+
+    name = top.string("name")
+    description = top.string("description", "")
+    seed = top.integer("seed", 0, minimum=0)
+    time_limit_s = top.number("time_limit_s", 150.0, positive=True)
+
+    arena = top.table("arena")
+    width_m = arena.number("width_m", positive=True)
+    height_m = arena.number("height_m", positive=True)
+    walls = arena.boolean("walls", False)
+    arena.close()
+
+    robot = top.table("robot", {})
+    robot_radius_m = robot.number("radius_m", 0.15, positive=True)
+    max_speed_m_s = robot.number("max_speed_m_s", 0.2, positive=True)
+    clearance_m = robot.number("clearance_m", 0.05, non_negative=True)
+    robot.close()
+
+    def pose(key: str) -> tuple[Pose2D, _Table]:
+        t = top.table(key)
+        x, y = t.number("x"), t.number("y")
+        return Pose2D(x, y, math.radians(t.number("heading_deg", 0.0))), t
+
+    start, start_t = pose("start")
+    start_t.close()
+    goal, goal_t = pose("goal")
+    tolerance_m = goal_t.number("tolerance_m", 0.1, positive=True)
+    goal_t.close()
+
+    sensors = top.table("sensors", {})
+    sensor_count = sensors.integer("count", 12, minimum=1)
+    sensor_range_m = sensors.number("range_m", 0.4, positive=True)
+    sensors.close()
+
+    planner = top.table("planner", {})
+    planner_name = planner.string("name", "astar")
+    params = planner.raw("params", {})
+    if not isinstance(params, dict):
+        planner.fail("params", "expected a table")
+    planner.close()
+    from planners import PLANNERS
+    if planner_name not in PLANNERS:
+        raise ConfigError("planner.name", f"unknown planner {planner_name!r} "
+                          f"(known: {', '.join(sorted(PLANNERS))})", source)
+
+    sim_t = top.table("sim", {})
+    sim = SimSettings(timestep_s=sim_t.number("timestep_s", 0.002, positive=True),
+                      control_hz=sim_t.number("control_hz", 50.0, positive=True),
+                      stop_on_collision=sim_t.boolean("stop_on_collision", False))
+    cell_m = sim_t.number("cell_m", 0.05, positive=True)
+    sim_t.close()
+    steps_per_control = 1.0 / (sim.control_hz * sim.timestep_s)
+    if abs(steps_per_control - round(steps_per_control)) > 1e-9 or round(steps_per_control) < 1:
+        raise ConfigError("sim.control_hz", "the control period must be a whole number of physics "
+                          f"timesteps (got {steps_per_control:g} steps)", source)
+
+    raw_obstacles = top.raw("obstacles", [])
+    if not isinstance(raw_obstacles, list):
+        top.fail("obstacles", "expected an array of tables ([[obstacles]])")
+    static_tables = []
+    for i, raw in enumerate(raw_obstacles):
+        t = _Table(raw, f"obstacles[{i}]", source)
+        static_tables.append(t)
+    static_centres = []
+    static_radii = []
+    parsed = []
+    for i, t in enumerate(static_tables):
+        x, y = t.number("x"), t.number("y")
+        radius = t.number("radius_m", positive=True)
+        height = t.number("height_m", 0.5, positive=True)
+        motion_raw = t.raw("motion", None)
+        parsed.append((t, x, y, radius, height, motion_raw))
+        if motion_raw is None:
+            static_centres.append((x, y))
+            static_radii.append(radius)
+    static_centres_arr = np.array(static_centres, dtype=float).reshape(-1, 2)
+    static_radii_arr = np.array(static_radii, dtype=float)
+
+    obstacles = []
+    for i, (t, x, y, radius, height, motion_raw) in enumerate(parsed):
+        motion = None
+        if motion_raw is not None:
+            m = _Table(motion_raw, f"obstacles[{i}].motion", source)
+            kind = m.string("kind", choices=MOTION_KINDS)
+            # Centres stay inside the arena: seed 004 places obstacles on its edge.
+            lower = (0.0, 0.0)
+            upper = (width_m, height_m)
+            if kind == "linear":
+                motion = LinearMotion((x, y), m.number("speed_m_s", non_negative=True),
+                                      math.radians(m.number("heading_deg")),
+                                      m.string("at_edge", choices=("reflect", "stop")), lower, upper)
+            elif kind == "random_walk":
+                motion = RandomWalkMotion.draw(
+                    (x, y), radius, m.number("step_m", positive=True), m.number("period_s", positive=True),
+                    time_limit_s, lower, upper, static_centres_arr, static_radii_arr,
+                    seed=seed * 1000 + i)
+            else:
+                points = m.raw("points")
+                if (not isinstance(points, list) or not points
+                        or not all(isinstance(p, list) and len(p) == 2 for p in points)):
+                    m.fail("points", "expected a non-empty array of [x, y] pairs")
+                arr = np.array(points, dtype=float)
+                if not np.all(np.isfinite(arr)):
+                    m.fail("points", "must be finite")
+                motion = WaypointMotion(np.vstack([[x, y], arr]), m.number("speed_m_s", positive=True))
+            m.close()
+        t.close()
+        obstacles.append(Obstacle(x, y, radius, height, motion))
+
+    top.close()
+
+    scenario = Scenario(
+        name=name, description=description, seed=seed, time_limit_s=time_limit_s,
+        arena_width_m=width_m, arena_height_m=height_m, walls=walls,
+        robot_radius_m=robot_radius_m, max_speed_m_s=max_speed_m_s, clearance_m=clearance_m,
+        start=start, goal=goal, goal_tolerance_m=tolerance_m,
+        sensor_count=sensor_count, sensor_range_m=sensor_range_m,
+        planner_name=planner_name, planner_params=dict(params), obstacles=tuple(obstacles),
+        sim=sim, cell_m=cell_m, source_text=text, source_path=source)
+    _check_endpoints(scenario, source)
+    return scenario
+
+
+def _check_endpoints(scenario: Scenario, source: str) -> None:
+    """Start and goal must lie in the arena and outside every obstacle grown by the robot radius."""
+    bounds = scenario.planning_bounds(scenario.robot_radius_m)
+    for key, pose in (("start", scenario.start), ("goal", scenario.goal)):
+        if not bounds.contains(pose.x_m, pose.y_m):
+            raise ConfigError(key, f"({pose.x_m:g}, {pose.y_m:g}) is outside the arena "
+                              f"[{bounds.x_min_m:g}, {bounds.x_max_m:g}] x [{bounds.y_min_m:g}, "
+                              f"{bounds.y_max_m:g}] (walls keep the robot's centre a radius away)", source)
+        for i, disc in enumerate(scenario.discs_at(0.0)):
+            gap = math.hypot(pose.x_m - disc.x_m, pose.y_m - disc.y_m) - disc.radius_m - scenario.robot_radius_m
+            if gap < 0:
+                raise ConfigError(key, f"({pose.x_m:g}, {pose.y_m:g}) is inside obstacles[{i}] grown by "
+                                  f"the robot radius (by {-gap:.3f} m)", source)
+        for i, box in enumerate(scenario.boxes):
+            dx = max(box.x_min_m - pose.x_m, pose.x_m - box.x_max_m, 0.0)
+            dy = max(box.y_min_m - pose.y_m, pose.y_m - box.y_max_m, 0.0)
+            if math.hypot(dx, dy) < scenario.robot_radius_m:
+                raise ConfigError(key, f"({pose.x_m:g}, {pose.y_m:g}) is inside a map obstacle", source)
