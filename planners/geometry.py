@@ -62,3 +62,47 @@ def polyline_length_m(waypoints: np.ndarray) -> float:
     if pts.shape[0] < 2:
         return 0.0
     return float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1)))
+
+
+def segment_box_distances(a: np.ndarray, b: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """Distance from each segment to each axis-aligned box (0 where they touch or cross).
+
+    Two disjoint convex sets are closest at a vertex of one of them, so the
+    distance is the smallest of: each segment end to the box, and each box
+    corner to the segment.  Crossing is found with the slab test.
+
+    Args:
+        a: (S, 2) segment start points in metres.
+        b: (S, 2) segment end points in metres.
+        boxes: (B, 4) rows of (x_min, y_min, x_max, y_max).
+
+    Returns:
+        (S, B) Euclidean distance from segment s to box k.
+    """
+    a = np.asarray(a, dtype=float).reshape(-1, 2)
+    b = np.asarray(b, dtype=float).reshape(-1, 2)
+    boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
+    lo = boxes[None, :, 0:2]                               # (1, B, 2)
+    hi = boxes[None, :, 2:4]
+
+    def point_box(p: np.ndarray) -> np.ndarray:           # (S, 2) -> (S, B)
+        d = np.maximum(np.maximum(lo - p[:, None, :], p[:, None, :] - hi), 0.0)
+        return np.hypot(d[..., 0], d[..., 1])
+
+    best = np.minimum(point_box(a), point_box(b))
+    corners = np.stack([boxes[:, [0, 1]], boxes[:, [2, 1]], boxes[:, [0, 3]], boxes[:, [2, 3]]], axis=1)
+    for k in range(4):                                     # box corners to segments
+        dist = segment_disc_distances(a, b, corners[:, k, :])
+        best = np.minimum(best, dist)
+    # Slab test: the segment a + t (b - a), t in [0, 1], crosses the box.
+    d = (b - a)[:, None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t1 = (lo - a[:, None, :]) / d
+        t2 = (hi - a[:, None, :]) / d
+    parallel = d == 0.0
+    inside_slab = (a[:, None, :] >= lo) & (a[:, None, :] <= hi)
+    t_near = np.where(parallel, np.where(inside_slab, -np.inf, np.inf), np.minimum(t1, t2))
+    t_far = np.where(parallel, np.where(inside_slab, np.inf, -np.inf), np.maximum(t1, t2))
+    enter = np.maximum(np.max(t_near, axis=-1), 0.0)
+    leave = np.minimum(np.min(t_far, axis=-1), 1.0)
+    return np.where(enter <= leave, 0.0, best)

@@ -13,7 +13,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from planners.geometry import polyline_clearance_m, polyline_length_m
+from planners.geometry import polyline_clearance_m, polyline_length_m, segment_box_distances
 
 
 @dataclass(frozen=True)
@@ -187,9 +187,26 @@ class Problem:
         d = np.hypot(self.disc_centres_m[:, 0] - x_m, self.disc_centres_m[:, 1] - y_m)
         return float(np.min(d - self.inflated_radii_m))
 
+    @cached_property
+    def box_array_m(self) -> np.ndarray:
+        """(B, 4) box footprints as rows of (x_min, y_min, x_max, y_max), not inflated."""
+        return np.array([[b.x_min_m, b.y_min_m, b.x_max_m, b.y_max_m] for b in self.boxes],
+                        dtype=float).reshape(-1, 4)
+
     def path_clearance_m(self, waypoints: np.ndarray) -> float:
-        """Exact smallest gap between a polyline and the inflated discs (segment-disc distance)."""
-        return polyline_clearance_m(waypoints, self.disc_centres_m, self.inflated_radii_m)
+        """Exact smallest gap between a polyline and the inflated discs and boxes.
+
+        Discs by segment-disc distance, boxes by segment-box distance; a segment
+        crossing a box scores ``-inflation_m``.
+        """
+        gap = polyline_clearance_m(waypoints, self.disc_centres_m, self.inflated_radii_m)
+        if self.boxes:
+            pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+            if pts.shape[0] == 1:
+                pts = np.vstack([pts, pts])
+            dist = segment_box_distances(pts[:-1], pts[1:], self.box_array_m)
+            gap = min(gap, float(np.min(dist)) - self.inflation_m)
+        return gap
 
     def is_collision_free(self, waypoints: np.ndarray, tolerance_m: float = 1e-6) -> bool:
         """Exact check: inside the bounds and clear of every inflated disc."""
