@@ -1,0 +1,187 @@
+"""Compose the MuJoCo scene for a scenario with ``MjSpec``.
+
+``models/diff_drive/scene.xml`` (which includes ``robot.xml``) is the base.  We
+resize the robot to the scenario's radius and rangefinder setup, then add the
+arena: walls, static cylinders (plain geoms), moving cylinders (mocap bodies,
+moved kinematically by the runner) and box obstacles from grid maps.  Every
+element gets a name.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path as FilePath
+
+import mujoco
+import numpy as np
+
+from controllers.kinematics import DriveGeometry
+from models.scenario import Scenario
+
+MODEL_DIR = FilePath(__file__).resolve().parent.parent / "models" / "diff_drive"
+SCENE_XML = MODEL_DIR / "scene.xml"
+ROBOT_BODIES = ("base_link", "left_wheel", "right_wheel")
+STATIC_RGBA = (0.55, 0.45, 0.38, 1.0)
+MOVING_RGBA = (0.95, 0.55, 0.1, 1.0)
+WALL_RGBA = (0.4, 0.4, 0.45, 1.0)
+WALL_THICKNESS_M = 0.1
+WALL_HEIGHT_M = 0.3
+
+
+@dataclass(frozen=True)
+class ObstacleGeom:
+    """A compiled obstacle: its geom id, and its mocap index when it moves (else -1)."""
+
+    name: str
+    geom_id: int
+    mocap_index: int
+    scenario_index: int  # index in Scenario.obstacles, -1 for walls and boxes
+
+
+@dataclass(frozen=True, eq=False)
+class CompiledScene:
+    """The compiled model and every index the runner needs, looked up once."""
+
+    model: mujoco.MjModel
+    xml: str
+    drive: DriveGeometry
+    free_qpos_adr: int
+    free_qvel_adr: int
+    wheel_qvel_adr: tuple[int, int]
+    range_sensor_adr: np.ndarray   # (K,) sensordata indices of the rangefinders
+    range_angles_rad: np.ndarray   # (K,) beam directions in base_link
+    range_cutoff_m: float
+    robot_geom_ids: np.ndarray
+    chassis_geom_id: int
+    obstacles: tuple[ObstacleGeom, ...]
+    is_robot_geom: np.ndarray      # (ngeom,) bool
+    is_obstacle_geom: np.ndarray   # (ngeom,) bool
+
+
+def build_spec(scenario: Scenario) -> mujoco.MjSpec:
+    """The scene for a scenario as an editable spec (not yet compiled)."""
+    spec = mujoco.MjSpec.from_file(str(SCENE_XML))
+    spec.modelname = f"swarmnav_{scenario.name}"
+    spec.option.timestep = scenario.sim.timestep_s
+
+    radius = scenario.robot_radius_m
+    spec.geom("chassis").size = [radius, 0.04, 0.0]
+    _set_rangefinders(spec, scenario.sensor_count, radius, scenario.sensor_range_m)
+
+    width, height = scenario.arena_width_m, scenario.arena_height_m
+    floor = spec.geom("floor")
+    floor.size = [width / 2 + 1.0, height / 2 + 1.0, 0.05]
+    floor.pos = [width / 2, height / 2, 0.0]
+    top = spec.camera("top")
+    aspect = 4.0 / 3.0
+    half_extent = max(height / 2, width / 2 / aspect) * 1.08
+    top.pos = [width / 2, height / 2, half_extent / math.tan(math.radians(top.fovy / 2))]
+
+    world = spec.worldbody
+    if scenario.walls:
+        t = WALL_THICKNESS_M
+        for name, cx, cy, hx, hy in (
+                ("wall_south", width / 2, -t / 2, width / 2 + t, t / 2),
+                ("wall_north", width / 2, height + t / 2, width / 2 + t, t / 2),
+                ("wall_west", -t / 2, height / 2, t / 2, height / 2),
+                ("wall_east", width + t / 2, height / 2, t / 2, height / 2)):
+            world.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_BOX, size=[hx, hy, WALL_HEIGHT_M / 2],
+                           pos=[cx, cy, WALL_HEIGHT_M / 2], rgba=list(WALL_RGBA))
+    for i, ob in enumerate(scenario.obstacles):
+        name = f"obstacle_{i:02d}"
+        size = [ob.radius_m, ob.height_m / 2, 0.0]
+        if ob.moving:
+            body = world.add_body(name=f"{name}_body", mocap=True, pos=[ob.x_m, ob.y_m, ob.height_m / 2])
+            body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=size, rgba=list(MOVING_RGBA))
+        else:
+            world.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=size,
+                           pos=[ob.x_m, ob.y_m, ob.height_m / 2], rgba=list(STATIC_RGBA))
+    for k, box in enumerate(scenario.boxes):
+        world.add_geom(name=f"map_box_{k:03d}", type=mujoco.mjtGeom.mjGEOM_BOX,
+                       size=[(box.x_max_m - box.x_min_m) / 2, (box.y_max_m - box.y_min_m) / 2, 0.25],
+                       pos=[(box.x_min_m + box.x_max_m) / 2, (box.y_min_m + box.y_max_m) / 2, 0.25],
+                       rgba=list(STATIC_RGBA))
+    return spec
+
+
+def _set_rangefinders(spec: mujoco.MjSpec, count: int, body_radius_m: float, cutoff_m: float) -> None:
+    """Place ``count`` rangefinders evenly on the rim, pointing outward, above the wheels."""
+    template = spec.site("range_site_00")
+    z = float(template.pos[2])
+    base = spec.body("base_link")
+    existing = [s for s in spec.sites if s.name.startswith("range_site_")]
+    if len(existing) != count:
+        for sensor in [s for s in spec.sensors if s.name.startswith("range_")]:
+            spec.delete(sensor)
+        for site in existing:
+            spec.delete(site)
+        for k in range(count):
+            base.add_site(name=f"range_site_{k:02d}", classname=template.classname if False else spec.default,
+                          size=[0.008, 0, 0], rgba=[1, 0.3, 0.1, 1], group=4)
+            spec.add_sensor(name=f"range_{k:02d}", type=mujoco.mjtSensor.mjSENS_RANGEFINDER,
+                            objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"range_site_{k:02d}")
+    rim = body_radius_m + 0.005
+    for k in range(count):
+        angle = 2.0 * math.pi * k / count
+        site = spec.site(f"range_site_{k:02d}")
+        site.pos = [rim * math.cos(angle), rim * math.sin(angle), z]
+        # z axis outward: rotate +z onto (cos a, sin a, 0).
+        quat = np.zeros(4)
+        mujoco.mju_quatZ2Vec(quat, np.array([math.cos(angle), math.sin(angle), 0.0]))
+        site.quat = quat
+        spec.sensor(f"range_{k:02d}").cutoff = cutoff_m
+
+
+def compile_scene(scenario: Scenario) -> CompiledScene:
+    """Compile the scene and look up every index the runner uses."""
+    spec = build_spec(scenario)
+    model = spec.compile()
+    xml = spec.to_xml()
+    return index_scene(model, xml)
+
+
+def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
+    """Look up the runner's indices in a compiled swarmnav scene (also for replaying a log's MJCF)."""
+    def gid(name: str) -> int:
+        return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
+
+    free = model.joint("base_free")
+    left = model.joint("left_wheel_hinge")
+    right = model.joint("right_wheel_hinge")
+    wheel_radius = float(model.geom("left_wheel_tyre").size[0])
+    track = float(np.linalg.norm(model.body("left_wheel").pos - model.body("right_wheel").pos))
+    max_wheel = float(min(abs(model.actuator("left_wheel_motor").ctrlrange).min(),
+                          abs(model.actuator("right_wheel_motor").ctrlrange).min()))
+    drive = DriveGeometry(wheel_radius_m=wheel_radius, track_m=track, max_wheel_speed_rad_s=max_wheel)
+
+    range_ids = sorted((model.sensor(i).name, i) for i in range(model.nsensor)
+                       if model.sensor_type[i] == mujoco.mjtSensor.mjSENS_RANGEFINDER)
+    range_adr = np.array([model.sensor_adr[i] for _, i in range_ids], dtype=np.int64)
+    angles = []
+    for _, i in range_ids:
+        site = model.sensor_objid[i]
+        p = model.site_pos[site]
+        angles.append(math.atan2(p[1], p[0]))
+    cutoff = float(model.sensor_cutoff[range_ids[0][1]]) if range_ids else 0.0
+
+    robot_bodies = {model.body(n).id for n in ROBOT_BODIES}
+    is_robot = np.array([model.geom_bodyid[g] in robot_bodies and model.geom_contype[g] + model.geom_conaffinity[g] > 0
+                         for g in range(model.ngeom)])
+    obstacles = []
+    is_obstacle = np.zeros(model.ngeom, dtype=bool)
+    for g in range(model.ngeom):
+        name = model.geom(g).name
+        if name.startswith(("obstacle_", "wall_", "map_box_")):
+            is_obstacle[g] = True
+            body = model.geom_bodyid[g]
+            mocap = int(model.body_mocapid[body])
+            index = int(name.split("_")[1]) if name.startswith("obstacle_") else -1
+            obstacles.append(ObstacleGeom(name, g, mocap, index))
+    return CompiledScene(
+        model=model, xml=xml, drive=drive, free_qpos_adr=int(free.qposadr[0]),
+        free_qvel_adr=int(free.dofadr[0]),
+        wheel_qvel_adr=(int(left.dofadr[0]), int(right.dofadr[0])),
+        range_sensor_adr=range_adr, range_angles_rad=np.array(angles), range_cutoff_m=cutoff,
+        robot_geom_ids=np.flatnonzero(is_robot), chassis_geom_id=gid("chassis"),
+        obstacles=tuple(obstacles), is_robot_geom=is_robot, is_obstacle_geom=is_obstacle)
