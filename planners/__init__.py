@@ -13,6 +13,7 @@ import typing
 from typing import Any
 
 from planners.astar import AStarPlanner
+from planners.grid_search import DijkstraPlanner, DStarLitePlanner, ThetaStarPlanner
 from planners.errors import (BudgetExceeded, ConfigError, GoalBlocked, NoPathFound,
                              PlanningError, StartBlocked)
 from planners.problem import Box, Disc, Path, Planner, PlanStats, Pose2D, Problem, Rect
@@ -33,7 +34,7 @@ def register(cls: type) -> type:
     return cls
 
 
-for _cls in (StraightPlanner, AStarPlanner):
+for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner):
     register(_cls)
 
 
