@@ -88,3 +88,39 @@ class Recorder(Protocol):
     def step(self, frame: StepFrame) -> None: ...
     def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None: ...
     def finish(self, summary: dict[str, Any]) -> None: ...
+
+
+class RecorderGroup:
+    """Fans every call out to several recorders (log, video, live view), in order.
+
+    ``finish`` reaches every recorder even when one of them raises.
+    """
+
+    def __init__(self, recorders: list[Recorder]):
+        self.recorders = list(recorders)
+
+    def start(self, context: RunContext) -> None:
+        for r in self.recorders:
+            r.start(context)
+
+    def path(self, time_s: float, waypoints_m: np.ndarray) -> None:
+        for r in self.recorders:
+            r.path(time_s, waypoints_m)
+
+    def step(self, frame: StepFrame) -> None:
+        for r in self.recorders:
+            r.step(frame)
+
+    def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
+        for r in self.recorders:
+            r.event(time_s, kind, details)
+
+    def finish(self, summary: dict[str, Any]) -> None:
+        error: BaseException | None = None
+        for r in self.recorders:
+            try:
+                r.finish(summary)
+            except BaseException as exc:  # keep closing the others
+                error = error or exc
+        if error is not None:
+            raise error

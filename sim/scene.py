@@ -50,7 +50,7 @@ class CompiledScene:
     free_qvel_adr: int
     wheel_qvel_adr: tuple[int, int]
     range_sensor_adr: np.ndarray   # (K,) sensordata indices of the rangefinders
-    range_angles_rad: np.ndarray   # (K,) beam directions in base_link
+    range_angles_rad: np.ndarray   # (K,) beam directions in base_link, in [0, 2 pi), CCW from +x
     range_cutoff_m: float
     robot_geom_ids: np.ndarray
     chassis_geom_id: int
@@ -162,7 +162,7 @@ def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
     for _, i in range_ids:
         site = model.sensor_objid[i]
         p = model.site_pos[site]
-        angles.append(math.atan2(p[1], p[0]))
+        angles.append(math.atan2(p[1], p[0]) % (2.0 * math.pi))
     cutoff = float(model.sensor_cutoff[range_ids[0][1]]) if range_ids else 0.0
 
     robot_bodies = {model.body(n).id for n in ROBOT_BODIES}

@@ -1,0 +1,256 @@
+"""The ``swarmnav`` command line.
+
+Exit codes: 0 the command ran (whether or not the goal was reached); 2 bad
+input (one line on stderr naming the file, the field and the problem); 3 the
+planner found no path.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import math
+import os
+import sys
+import time
+import tomllib
+from pathlib import Path as FilePath
+from typing import Any, Callable
+
+import numpy as np
+
+from planners.errors import ConfigError, PlanningError
+
+EXIT_OK, EXIT_BAD_INPUT, EXIT_NO_PATH = 0, 2, 3
+
+
+class UserError(Exception):
+    """A bad command-line value or file that is not a scenario (exit 2)."""
+
+
+def parse_settings(pairs: list[str] | None) -> dict[str, Any]:
+    """``--set key=value`` pairs; values are read as TOML (numbers, booleans, arrays) or else strings."""
+    params: dict[str, Any] = {}
+    for pair in pairs or []:
+        key, sep, text = pair.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ConfigError("--set", f"expected key=value, got {pair!r}")
+        try:
+            value = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text
+        params[key] = value
+    return params
+
+
+def _load(args: argparse.Namespace):
+    from models.scenario import load_scenario
+    return load_scenario(args.scenario)
+
+
+def _planner_choice(args: argparse.Namespace, scenario) -> tuple[str, dict[str, Any]]:
+    name = args.planner or scenario.planner_name
+    params = dict(scenario.planner_params) if name == scenario.planner_name else {}
+    params.update(parse_settings(args.set))
+    return name, params
+
+
+def plan_summary(scenario, name: str, seed: int, path) -> dict[str, Any]:
+    problem = scenario.to_problem()
+    return {"scenario": scenario.name, "planner": name, "seed": seed,
+            "waypoints": [[float(x), float(y)] for x, y in path.waypoints],
+            "length_m": path.stats.length_m, "plan_time_s": path.stats.plan_time_s,
+            "iterations": path.stats.iterations, "evaluations": path.stats.evaluations,
+            "collision_free": bool(problem.is_collision_free(path.waypoints))}
+
+
+def cmd_scenarios(args: argparse.Namespace) -> int:
+    from models.scenario import list_scenarios, load_scenario
+    rows = []
+    for name in list_scenarios():
+        s = load_scenario(name)
+        moving = sum(ob.moving for ob in s.obstacles)
+        rows.append({"name": name, "obstacles": len(s.obstacles), "moving": moving,
+                     "planner": s.planner_name, "description": s.description})
+    if args.json:
+        print(json.dumps(rows))
+    else:
+        for r in rows:
+            print(f"{r['name']:<24} {r['obstacles']:>3} obstacles ({r['moving']} moving)  {r['description']}")
+    return EXIT_OK
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    from sim.runner import plan_scenario
+    scenario = _load(args)
+    name, params = _planner_choice(args, scenario)
+    path, name, params, seed = plan_scenario(scenario, name, params, args.seed)
+    out = plan_summary(scenario, name, seed, path)
+    if args.json:
+        print(json.dumps(out))
+    else:
+        print(f"{scenario.name}: {name} (seed {seed}) {len(path.waypoints)} waypoints, "
+              f"{out['length_m']:.4f} m in {out['plan_time_s'] * 1000:.1f} ms, "
+              f"{'collision-free' if out['collision_free'] else 'NOT collision-free'}")
+        for x, y in path.waypoints:
+            print(f"  {x:8.4f} {y:8.4f}")
+    return EXIT_OK
+
+
+def _default_log_path(scenario_name: str, planner: str, seed: int) -> FilePath:
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    return FilePath("logs") / f"{scenario_name}_{planner}_seed{seed}_{stamp}.mcap"
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from sim.recording import RecorderGroup
+    from sim.runner import Simulation, plan_scenario
+    scenario = _load(args)
+    name, params = _planner_choice(args, scenario)
+    path, name, params, seed = plan_scenario(scenario, name, params, args.seed)
+    simulation = Simulation(scenario)
+    recorders = []
+    log_path = None
+    if not args.no_log:
+        from sim.mcap_log import McapRecorder
+        log_path = FilePath(args.out) if args.out else _default_log_path(scenario.name, name, seed)
+        if log_path.exists() and not args.overwrite:
+            raise UserError(f"{log_path}: --out: file exists (use --overwrite)")
+        recorders.append(McapRecorder(log_path, live=args.live, overwrite=True))
+    elif args.live:
+        raise UserError("--live: needs the log (drop --no-log)")
+    if args.video:
+        from sim.render import VideoRecorder
+        recorders.append(VideoRecorder(args.video, camera=args.camera, width=args.width,
+                                       height=args.height, fps=args.fps))
+    recorder = RecorderGroup(recorders) if recorders else None
+    context = simulation.context(name, params, seed) if recorder else None
+    result = simulation.run(path, recorder=recorder, context=context,
+                            stop_on_collision=True if args.stop_on_collision else None)
+    out = {"scenario": scenario.name, "planner": name, "seed": seed, **result.summary(),
+           "plan": plan_summary(scenario, name, seed, path),
+           "log": str(log_path) if log_path else None, "video": args.video}
+    if args.json:
+        print(json.dumps(out))
+    else:
+        status = "reached the goal" if result.reached else f"did not reach the goal ({result.outcome})"
+        print(f"{scenario.name}: {name} (seed {seed}) {status} in {result.sim_time_s:.2f} s sim "
+              f"({result.wall_time_s:.2f} s wall); driven {result.path_length_m:.3f} m "
+              f"(planned {path.stats.length_m:.3f} m); collisions {result.collisions}"
+              + (f", first at {result.first_collision_s:.2f} s" if result.first_collision_s is not None else "")
+              + f"; min clearance {result.min_clearance_m:.3f} m")
+        if log_path:
+            print(f"log: {log_path}")
+        if args.video:
+            print(f"video: {args.video}")
+    return EXIT_OK
+
+
+def cmd_bench_sim(args: argparse.Namespace) -> int:
+    from sim.benchmark import benchmark_sim
+    figures = benchmark_sim(args.scenario, duration_s=args.duration, repeats=args.repeats)
+    if args.json:
+        print(json.dumps(figures))
+    else:
+        for key, value in figures.items():
+            print(f"{key:<28} {value:.4g}" if isinstance(value, float) else f"{key:<28} {value}")
+    return EXIT_OK
+
+
+# Subcommands implemented in their own modules (each has add_arguments(parser) and run(args) -> int).
+MODULE_COMMANDS: list[tuple[tuple[str, ...], str, str]] = [
+    (("bench", "planners"), "planners.bench_continuous", "continuous planners against the exact optimum and mealpy"),
+    (("bench", "grid"), "planners.bench_grid", "grid planners, Moving AI optima and the pathfinding peer"),
+    (("bench", "render"), "sim.render_benchmark", "offscreen rendering frames per second"),
+    (("log", "info"), "sim.log_commands", "what a log holds"),
+    (("log", "recover"), "sim.log_commands", "rewrite a truncated log as a complete one"),
+    (("replay",), "sim.replay", "re-render or re-simulate a log"),
+    (("plot",), "sim.plot", "plot a log to PNG"),
+]
+
+
+def _add_run_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scenario", help="bundled scenario name or path to a .toml file")
+    p.add_argument("--planner", help="planner name (default: the scenario's)")
+    p.add_argument("--seed", type=int, help="random seed (default: the scenario's)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="planner parameter (repeatable)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="swarmnav", description=__doc__.splitlines()[0] if __doc__ else None)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    p = sub.add_parser("scenarios", help="list the bundled scenarios")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_scenarios)
+
+    p = sub.add_parser("plan", help="plan a path for a scenario")
+    _add_run_options(p)
+    p.set_defaults(func=cmd_plan)
+
+    p = sub.add_parser("run", help="plan and simulate a scenario in MuJoCo")
+    _add_run_options(p)
+    p.add_argument("--out", help="MCAP log path (default: logs/<scenario>_<planner>_seed<N>_<stamp>.mcap)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
+    p.add_argument("--no-log", action="store_true", help="write no MCAP log")
+    p.add_argument("--live", action="store_true", help="also serve the channels to Foxglove on 127.0.0.1")
+    p.add_argument("--video", help="render an MP4 while running (offscreen EGL)")
+    p.add_argument("--camera", default="top", choices=("top", "chase"))
+    p.add_argument("--width", type=int, default=640)
+    p.add_argument("--height", type=int, default=480)
+    p.add_argument("--fps", type=float, default=30.0)
+    p.add_argument("--stop-on-collision", action="store_true", help="stop at the first collision")
+    p.set_defaults(func=cmd_run)
+
+    groups: dict[str, argparse._SubParsersAction] = {}
+    bench = sub.add_parser("bench", help="benchmarks that print figures")
+    groups["bench"] = bench.add_subparsers(dest="bench_command", required=True, metavar="BENCH")
+    p = groups["bench"].add_parser("sim", help="closed loop vs bare mj_step on the dense 30-cylinder scene")
+    p.add_argument("--scenario", default="dense-field-30")
+    p.add_argument("--duration", type=float, default=20.0, help="simulated seconds per measurement")
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_bench_sim)
+    log = sub.add_parser("log", help="inspect and repair MCAP logs")
+    groups["log"] = log.add_subparsers(dest="log_command", required=True, metavar="LOGCMD")
+
+    for words, module_name, help_text in MODULE_COMMANDS:
+        module_file = FilePath(__file__).resolve().parent.parent / (module_name.replace(".", "/") + ".py")
+        if not module_file.exists():
+            continue
+        module = importlib.import_module(module_name)
+        parent = groups[words[0]] if len(words) > 1 else sub
+        p = parent.add_parser(words[-1], help=help_text)
+        adder = getattr(module, f"add_{words[-1]}_arguments", None) or module.add_arguments
+        runner = getattr(module, f"run_{words[-1]}", None) or module.run
+        adder(p)
+        p.set_defaults(func=runner)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``swarmnav`` console script."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    func: Callable[[argparse.Namespace], int] = args.func
+    try:
+        return int(func(args) or 0)
+    except ConfigError as exc:
+        print(f"swarmnav: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except UserError as exc:
+        print(f"swarmnav: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except PlanningError as exc:
+        print(f"swarmnav: no path: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return EXIT_NO_PATH
+    except KeyboardInterrupt:
+        print("swarmnav: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
