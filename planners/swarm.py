@@ -33,12 +33,15 @@ class SwarmState:
         best_cost: its cost (lower is better).
         evaluations: objective evaluations spent so far.
         data: the algorithm's own arrays (population, pheromone, counters, ...).
+        done: set by ``step`` when the run is complete before the iteration limit
+            (e.g. the ant reached the goal); the loop then stops.
     """
 
     best_solution: Any
     best_cost: float
     evaluations: int = 0
     data: dict[str, Any] = field(default_factory=dict)
+    done: bool = False
 
     def offer(self, solutions: np.ndarray, costs: np.ndarray) -> None:
         """Keep the best of a batch if it beats the current best (ties keep the incumbent)."""
@@ -79,13 +82,20 @@ class SwarmPlanner:
         history = [state.best_cost]
         budget = self.max_evaluations or 0
         done = 0
+        converged_at = 0
         for iteration in range(self.iterations):
             if budget and state.evaluations >= budget:
                 break
             self.step(state, problem, rng, iteration)
+            if state.best_cost < history[-1]:
+                converged_at = iteration + 1
             history.append(state.best_cost)
             done = iteration + 1
+            if state.done:
+                break
         waypoints, extra = self.finish(state, problem)
+        # The iteration (1-based) after which the best cost no longer improved.
+        extra.setdefault("convergence_iteration", converged_at)
         return Path.from_waypoints(waypoints, time.perf_counter() - t0, iterations=done,
                                    evaluations=state.evaluations,
                                    cost_history=tuple(float(c) for c in history), extra=extra)
