@@ -1,0 +1,43 @@
+# Two commands do all set-up on a fresh machine:
+#   make demo   simulate a bundled scenario end to end (log, video, summary)
+#   make test   run the test suite
+# Each creates .venv and installs swarmnav into it on first use.
+
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+DEMO_SCENARIO ?= gwo-scenario-1
+DEMO_PLANNER ?= astar
+export MUJOCO_GL ?= egl
+
+.PHONY: demo test bench install clean
+
+$(STAMP): pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test,bench]'
+	touch $(STAMP)
+
+install: $(STAMP)
+
+demo: $(STAMP)
+	mkdir -p logs
+	$(BIN)/swarmnav run $(DEMO_SCENARIO) --planner $(DEMO_PLANNER) --seed 0 \
+		--out logs/demo.mcap --overwrite --video logs/demo.mp4 --json > logs/demo.json
+	$(BIN)/swarmnav log info logs/demo.mcap
+	$(BIN)/swarmnav plot logs/demo.mcap -o logs/demo.png
+	@echo "summary: logs/demo.json  log: logs/demo.mcap  video: logs/demo.mp4  plot: logs/demo.png"
+	@cat logs/demo.json; echo
+
+test: $(STAMP)
+	$(BIN)/python -m pytest -q
+
+bench: $(STAMP)
+	$(BIN)/swarmnav bench sim
+	$(BIN)/swarmnav bench planners
+	$(BIN)/swarmnav bench grid
+	$(BIN)/swarmnav bench render
+
+clean:
+	rm -rf $(VENV) build *.egg-info

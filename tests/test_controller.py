@@ -1,0 +1,74 @@
+"""Inverse kinematics and the PTP controller, on known cases and in physics."""
+
+import math
+
+import numpy as np
+import pytest
+
+from controllers import DriveGeometry, PointToPointController, body_twist, wheel_speeds
+from planners.problem import Path, Pose2D
+
+GEOMETRY = DriveGeometry(wheel_radius_m=0.04, track_m=0.22, max_wheel_speed_rad_s=10.0)
+
+
+def test_ik_straight_and_spin_are_exact():
+    s = wheel_speeds(0.2, 0.0, GEOMETRY)
+    assert (s.left_rad_s, s.right_rad_s) == (5.0, 5.0)
+    s = wheel_speeds(0.0, 1.0, GEOMETRY)
+    assert s.right_rad_s == pytest.approx(0.11 / 0.04) and s.left_rad_s == pytest.approx(-0.11 / 0.04)
+
+
+def test_ik_arc_matches_the_formula():
+    v, w = 0.15, 0.5
+    s = wheel_speeds(v, w, GEOMETRY)
+    assert s.right_rad_s == pytest.approx((v + w * 0.11) / 0.04)
+    assert s.left_rad_s == pytest.approx((v - w * 0.11) / 0.04)
+    assert body_twist(s, GEOMETRY) == pytest.approx((v, w))
+
+
+def test_saturation_scales_both_wheels_and_keeps_curvature():
+    v, w = 0.5, 2.0
+    s = wheel_speeds(v, w, GEOMETRY)
+    assert max(abs(s.left_rad_s), abs(s.right_rad_s)) == pytest.approx(10.0)
+    v2, w2 = body_twist(s, GEOMETRY)
+    assert v2 / w2 == pytest.approx(v / w)
+    assert v2 < v
+
+
+def test_controller_turns_in_place_toward_a_waypoint_behind():
+    c = PointToPointController(GEOMETRY, max_speed_m_s=0.2)
+    c.reset(np.array([[0.0, 0.0], [-1.0, 0.0]]))
+    cmd = c.command(Pose2D(0.0, 0.0, 0.0))
+    assert cmd.linear_m_s == 0.0 and abs(cmd.angular_rad_s) == pytest.approx(c.max_angular_rad_s)
+    assert cmd.wheels.left_rad_s == pytest.approx(-cmd.wheels.right_rad_s)
+
+
+def test_controller_switches_waypoints_and_stops_at_goal():
+    c = PointToPointController(GEOMETRY, max_speed_m_s=0.2, goal_tolerance_m=0.1)
+    c.reset(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]))
+    assert c.command(Pose2D(0.0, 0.0, 0.0)).waypoint_index == 1
+    assert c.command(Pose2D(0.95, 0.0, 0.0)).waypoint_index == 2
+    stop = c.command(Pose2D(1.0, 0.95, math.pi / 2))
+    assert stop.linear_m_s == 0.0 and stop.wheels.left_rad_s == 0.0 and stop.wheels.right_rad_s == 0.0
+
+
+@pytest.mark.parametrize("target", [(3.0, 1.0), (1.0, 3.0)])
+def test_controller_drives_the_robot_in_physics_to_a_waypoint_2_m_away(target):
+    from models.scenario import parse_scenario
+    from sim.runner import Simulation
+
+    scenario = parse_scenario(f"""
+name = "two-metres"
+time_limit_s = 30.0
+arena = {{ width_m = 4.0, height_m = 4.0 }}
+start = {{ x = 1.0, y = 1.0, heading_deg = 0.0 }}
+goal = {{ x = {target[0]}, y = {target[1]}, tolerance_m = 0.05 }}
+""")
+    path = Path.from_waypoints(np.array([[1.0, 1.0], target]), 0.0)
+    result = Simulation(scenario).run(path)
+    assert result.reached, result.summary()
+    final = result.poses[-1, :2]
+    assert math.dist(final, target) <= 0.05
+    # A 2 m drive at 0.2 m/s, plus turning and slowing down at the end.
+    assert 10.0 <= result.sim_time_s <= 20.0
+    assert result.collisions == 0
