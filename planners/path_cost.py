@@ -1,0 +1,138 @@
+"""Path costs of the continuous planners, vectorised over a whole population.
+
+Every function takes sampled curves ``xs, ys`` of shape ``(P, S)`` (``P``
+candidates, ``S`` samples each, from :class:`planners.via_points.ViaPointCurve`)
+and returns one value per candidate, shape ``(P,)``.
+
+* Length: seed 001 Eq. (1) and seed 004 Eq. (2) (the same sum of chord lengths).
+* Obstacle penalty: seed 001 Eqs. (3)-(5).
+* Smoothness: seed 004 Eqs. (3)-(5).
+* Weighted objective and its fitness: seed 004 Eqs. (6)-(8); seed 001 Eq. (2).
+
+:class:`PathObjective` combines them into the one cost the optimisers minimise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from planners.problem import Rect
+from planners.via_points import ViaPointCurve
+
+
+def sampled_length_m(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """Length of each sampled curve, seed 001 Eq. (1) / seed 004 Eq. (2).
+
+    ``F = sum_i sqrt((x[i+1] - x[i])**2 + (y[i+1] - y[i])**2)`` over the samples.
+    """
+    return np.sum(np.hypot(np.diff(xs, axis=1), np.diff(ys, axis=1)), axis=1)
+
+
+def obstacle_penalty(xs: np.ndarray, ys: np.ndarray, centres_m: np.ndarray,
+                     radii_m: np.ndarray) -> np.ndarray:
+    """Seed 001's obstacle penalty, Eqs. (3)-(5).
+
+    For every obstacle ``j``: ``Dist`` is the distance of each sample to its
+    centre (Eq. 5), ``v = max(1 - Dist / R, 0)`` (Eq. 4), and the penalty grows
+    by ``mean(v)`` over the samples (Eq. 3), i.e. ``$p = sum_j mean_i v_ij``.
+
+    Args:
+        xs, ys: (P, S) sampled curves.
+        centres_m: (C, 2) obstacle centres.
+        radii_m: (C,) radii ``R`` (the caller passes the inflated radii).
+
+    Returns:
+        (P,) penalty, 0 for a candidate whose samples all lie outside every disc.
+    """
+    centres = np.asarray(centres_m, dtype=float).reshape(-1, 2)
+    if centres.shape[0] == 0:
+        return np.zeros(xs.shape[0])
+    radii = np.asarray(radii_m, dtype=float).reshape(-1)
+    dist = np.hypot(xs[:, :, None] - centres[:, 0], ys[:, :, None] - centres[:, 1])  # (P, S, C)
+    violation = np.maximum(1.0 - dist / radii, 0.0)
+    return violation.mean(axis=1).sum(axis=1)
+
+
+def bounds_penalty(xs: np.ndarray, ys: np.ndarray, bounds: Rect, scale_m: float = 1.0) -> np.ndarray:
+    """Mean distance (in units of ``scale_m``) by which the samples leave the workspace.
+
+    Not in the seeds (their splines are not checked against the arena edges);
+    added so that a spline does not buy length by overshooting the bounds.
+    """
+    out_x = np.maximum(bounds.x_min_m - xs, 0.0) + np.maximum(xs - bounds.x_max_m, 0.0)
+    out_y = np.maximum(bounds.y_min_m - ys, 0.0) + np.maximum(ys - bounds.y_max_m, 0.0)
+    return (out_x + out_y).mean(axis=1) / scale_m
+
+
+def wrap_angle_rad(angle_rad: np.ndarray) -> np.ndarray:
+    """Wrap angles to [-pi, pi)."""
+    return (angle_rad + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def smoothness_rad(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """Seed 004's smoothness, Eqs. (3)-(5).
+
+    ``F2 = sum_i |theta(p_i, p_{i+1}) - theta(p_i, p_N)|`` over samples
+    ``i = 1 .. N-1``, where Eq. (4) is the heading of the next step and Eq. (5)
+    the bearing to the goal ``p_N``.  The extraction lost the operator between
+    the two angles; a difference is the only reading that measures "the angular
+    difference between the present and proposed locations".  ``tan^-1`` is taken
+    as the four-quadrant ``arctan2`` and the difference is wrapped to [-pi, pi),
+    so a step straight at the goal costs 0 whatever its direction.
+    """
+    step = np.arctan2(np.diff(ys, axis=1), np.diff(xs, axis=1))                        # (P, S-1)
+    to_goal = np.arctan2(ys[:, -1:] - ys[:, :-1], xs[:, -1:] - xs[:, :-1])              # (P, S-1)
+    return np.sum(np.abs(wrap_angle_rad(step - to_goal)), axis=1)
+
+
+def weighted_objective(length_m: np.ndarray, smoothness: np.ndarray, length_weight: float,
+                       smoothness_weight: float) -> np.ndarray:
+    """Seed 004 Eq. (6): ``F = w1 F1 + w2 F2`` (Eq. (7) only names ``w = w1 + w2``)."""
+    return length_weight * length_m + smoothness_weight * smoothness
+
+
+def inverse_fitness(objective: np.ndarray, epsilon: float = 0.001) -> np.ndarray:
+    """Seed 004 Eq. (8) ``1 / (F + e)``; with ``e = 0`` and ``F`` = length + penalty, seed 001 Eq. (2)."""
+    return 1.0 / (np.asarray(objective, dtype=float) + epsilon)
+
+
+@dataclass(frozen=True, eq=False)
+class PathObjective:
+    """The cost every continuous planner minimises (lower is better).
+
+    ``cost = w1 * length + w2 * smoothness + penalty_weight * (obstacle_penalty + bounds_penalty)``
+
+    With ``w2 = 0`` this is seed 001's ``F + $p`` (Eqs. (1)-(5), the reciprocal
+    of its fitness Eq. (2)) with the penalty scaled; with ``w2 > 0`` it is seed
+    004's Eq. (6) plus that penalty (seed 004 states no obstacle term in its
+    objective).  Minimising the cost is the same as maximising either paper's
+    fitness ``1 / (cost + e)``, Eq. (8).
+
+    Attributes:
+        curve: the encoding that turns decision vectors into samples.
+        centres_m: (C, 2) disc centres.
+        penalty_radii_m: (C,) radii ``R`` used by the penalty (inflated radius plus margin).
+        bounds: the workspace.
+        length_weight, smoothness_weight: ``w1`` and ``w2`` of Eq. (6).
+        penalty_weight: multiplier of the penalty (seed 001 uses 1).
+    """
+
+    curve: ViaPointCurve
+    centres_m: np.ndarray
+    penalty_radii_m: np.ndarray
+    bounds: Rect
+    length_weight: float = 1.0
+    smoothness_weight: float = 0.0
+    penalty_weight: float = 1.0
+
+    def __call__(self, population: np.ndarray) -> np.ndarray:
+        """(P,) costs of a (P, 2k) population, all candidates at once."""
+        xs, ys = self.curve.sample(population)
+        cost = self.length_weight * sampled_length_m(xs, ys)
+        if self.smoothness_weight:
+            cost = cost + self.smoothness_weight * smoothness_rad(xs, ys)
+        penalty = obstacle_penalty(xs, ys, self.centres_m, self.penalty_radii_m)
+        penalty = penalty + bounds_penalty(xs, ys, self.bounds)
+        return cost + self.penalty_weight * penalty
