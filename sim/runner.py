@@ -34,7 +34,7 @@ from planners.problem import Path, Pose2D
 from sim.recording import ObstacleInfo, Recorder, RunContext, StepFrame
 from sim.scene import CompiledScene, compile_scene
 
-CLEARANCE_HORIZON_M = 2.0  # mj_geomDistance search radius; farther obstacles report this value
+CLEARANCE_HORIZON_M = 2.0  # mj_geomDistance search radius: clearances are reported up to this value
 
 
 def yaw_from_quaternion(w: float, x: float, y: float, z: float) -> float:
@@ -76,7 +76,8 @@ class RunResult:
         return {"reached": self.reached, "outcome": self.outcome, "collisions": self.collisions,
                 "first_collision_s": self.first_collision_s, "sim_time_s": round(self.sim_time_s, 6),
                 "wall_time_s": round(self.wall_time_s, 4), "path_length_m": self.path_length_m,
-                "min_clearance_m": self.min_clearance_m}
+                # None when the scene has no obstacle (JSON has no infinity).
+                "min_clearance_m": self.min_clearance_m if math.isfinite(self.min_clearance_m) else None}
 
 
 def versions() -> dict[str, str]:

@@ -47,3 +47,18 @@ def test_every_planner_gives_the_same_path_for_the_same_seed(name):
     a = planner.plan(problem, np.random.default_rng(11))
     b = planner.plan(problem, np.random.default_rng(11))
     assert a.same_as(b)
+
+
+def test_an_empty_arena_reports_no_clearance_rather_than_infinity():
+    import json
+
+    from models.scenario import parse_scenario
+    from sim.runner import Simulation
+    from planners.problem import Path
+
+    scenario = parse_scenario('name = "empty"\narena = { width_m = 3.0, height_m = 3.0 }\n'
+                              'start = { x = 1.0, y = 1.0 }\ngoal = { x = 2.0, y = 1.0 }\n')
+    result = Simulation(scenario).run(Path.from_waypoints(np.array([[1.0, 1.0], [2.0, 1.0]]), 0.0))
+    summary = result.summary()
+    assert result.reached and summary["min_clearance_m"] is None
+    json.loads(json.dumps(summary, allow_nan=False))
