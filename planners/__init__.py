@@ -13,7 +13,11 @@ import typing
 from typing import Any
 
 from planners.astar import AStarPlanner
+from planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
 from planners.grid_search import DijkstraPlanner, DStarLitePlanner, ThetaStarPlanner
+from planners.grey_wolf import GreyWolfPlanner
+from planners.optimal import OptimalPlanner
+from planners.particle_swarm import ParticleSwarmPlanner
 from planners.errors import (BudgetExceeded, ConfigError, GoalBlocked, NoPathFound,
                              PlanningError, StartBlocked)
 from planners.problem import Box, Disc, Path, Planner, PlanStats, Pose2D, Problem, Rect
@@ -34,7 +38,9 @@ def register(cls: type) -> type:
     return cls
 
 
-for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner):
+for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,
+             OptimalPlanner, BeeColonyPlanner, AdaptiveLimitBeeColonyPlanner, GreyWolfPlanner,
+             ParticleSwarmPlanner):
     register(_cls)
 
 
