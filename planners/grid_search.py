@@ -227,6 +227,39 @@ def grid_line_of_sight(free: list[list[bool]], a: Cell, b: Cell) -> bool:
     return True
 
 
+def line_cells(a: Cell, b: Cell) -> list[Cell]:
+    """Cells the segment between the centres of ``a`` and ``b`` enters, in order (a supercover).
+
+    Where the segment passes exactly through a grid corner the two cells beside
+    the corner are listed too.  Cells may lie outside the grid if ``a`` or ``b`` do.
+    """
+    r, c = a
+    dr, dc = b[0] - r, b[1] - c
+    sr = 1 if dr > 0 else -1
+    sc = 1 if dc > 0 else -1
+    adr, adc = abs(dr), abs(dc)
+    ix = iy = 0
+    out = [(r, c)]
+    while ix < adc or iy < adr:
+        across = (2 * ix + 1) * adr
+        down = (2 * iy + 1) * adc
+        if across < down:
+            c += sc
+            ix += 1
+        elif across > down:
+            r += sr
+            iy += 1
+        else:
+            out.append((r, c + sc))
+            out.append((r + sr, c))
+            r += sr
+            c += sc
+            ix += 1
+            iy += 1
+        out.append((r, c))
+    return out
+
+
 def theta_star_cells(occupied: np.ndarray, start: Cell, goal: Cell,
                      line_of_sight: Callable[[Cell, Cell], bool] | None = None
                      ) -> tuple[list[Cell], float, int]:

@@ -1,0 +1,306 @@
+"""IACO: the improved ant colony of Gong, Yang, Yuan & Wang (2022), seed 003.
+
+On the inflated occupancy grid, with the shared colony core
+(:mod:`planners.ant_colony`) and the one optimisation loop:
+
+* **Collar line** (§3.1): a guide polyline from start to goal through feature
+  points of the obstacles it meets; the cells it crosses start with extra pheromone.
+* **Heuristic** (Eq. 6): ``eta_ij = d_ig / (d_ij + d_jg) * (cos(omega) + 1)``,
+  goal guidance times bend suppression.
+* **Pheromone update** (Eqs. 3, 7, 8): only ants that reach the goal deposit
+  ``Q_m / (L_m + turn)`` with ``Q_m = Q * t_c ** ((L_GL - L_m) ** 3)``.
+* **Adaptive parameters** (Eqs. 9-11): alpha rises then falls, beta decays, rho follows
+  the ratio of the collar length to the best length.
+* Roulette selection (Eq. 1) with 50 ants x 100 iterations by default (Table 2).
+
+Readings of the paper where its text is ambiguous (our choices):
+
+* Pheromone sits on cells (the move into cell j reads ``tau_j``), as grid ACO
+  implementations usually store it; the paper writes ``tau_ij``.
+* Feature points (§3.1.1) are taken as the free cell diagonally outside each
+  convex corner of an obstacle (a grid vertex with exactly one of its four cells
+  occupied), so the collar line joins free cell centres.  Rule 2 (concave corners
+  dropped) and rule 4 (map-boundary vertices dropped) follow from that; the
+  U-shape rule 3 depends on a figure missing from the text and is not applied.
+* omega in Eq. (6) is the turning angle between the previous move and the
+  candidate move (0 when going straight on, factor 2; a U-turn gives 0).  The
+  paper's sentence "the closer to 180 degrees, the greater eta" describes the
+  interior angle, which this equals 180 degrees minus.  The first move counts as straight.
+* Eq. (7) is garbled in the text; we read it as ``Q_m = Q * t_c ** ((L_GL - L_m) ** 3)``
+  with lengths in cells, and clip the exponent to +-``exponent_limit`` so that it
+  cannot overflow.  Cells keep at least ``tau_floor`` pheromone so that none underflows.
+* Before any ant has reached the goal, Eqs. (9)-(10) use ``L_GL / (LF_best + L_GL) = 0``
+  and rho keeps its initial value (Table 2: 0.3).
+* An ant never re-enters a cell (tabu list); in a dead end it steps back one
+  cell (the dead end stays tabu).  It fails after ``max_steps`` NumPy steps or
+  once its tour exceeds ``prune_ratio`` x the best length (our additions: the
+  paper does not say how its ants leave dead ends; pruning only saves time).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar
+
+import numpy as np
+from scipy import ndimage
+
+from planners.ant_colony import STEP_LENGTHS, GridGraph, cosine_table, deposit, evaporate, walk_colony
+from planners.errors import NoPathFound
+from planners.grid_search import (Cell, cells_to_waypoints, count_bends, exact_shortcut, grid_endpoints,
+                                  grid_line_of_sight, line_cells)
+from planners.problem import Problem
+from planners.swarm import SwarmPlanner, SwarmState
+
+
+def feature_cells(occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Feature points of the obstacle grids (§3.1.1), as free cells outside convex corners.
+
+    Returns:
+        (cells (K, 2) row/col, their obstacle component labels (K,), the label image).
+    """
+    occ = np.asarray(occupied, dtype=bool)
+    labels, _ = ndimage.label(occ, structure=np.ones((3, 3), dtype=bool))
+    # Interior grid vertices (i, j), 1 <= i < rows, 1 <= j < cols, and their four cells.
+    quad = np.stack([occ[:-1, :-1], occ[:-1, 1:], occ[1:, :-1], occ[1:, 1:]], axis=-1)
+    convex = quad.sum(axis=-1) == 1
+    which = np.argmax(quad, axis=-1)                  # the one occupied cell of the four
+    vi, vj = np.nonzero(convex)
+    k = which[vi, vj]
+    occ_r = vi + (k >= 2)
+    occ_c = vj + (k % 2)
+    free_r = vi + (k < 2)                              # the diagonally opposite cell
+    free_c = vj + (k % 2 == 0)
+    cells = np.column_stack([free_r, free_c])
+    return cells, labels[occ_r, occ_c], labels
+
+
+def collar_line(occupied: np.ndarray, start: Cell, goal: Cell, max_points: int | None = None
+                ) -> tuple[list[Cell], float]:
+    """The collar (leading) line of §3.1.2 from ``start`` to ``goal``.
+
+    From the current point: if the goal is visible, join it.  Otherwise the
+    obstacles crossed by the straight line to the goal join the set of classed
+    obstacles (Class I from the start, Class II later); among their unused
+    feature points visible from the current point, join the one closest to the
+    goal; when none is visible, join the closest one anyway (Fig. 3 b, c).
+
+    Returns:
+        (points from start to goal, length in cells).
+    """
+    occ = np.asarray(occupied, dtype=bool)
+    rows, cols = occ.shape
+    free = (~occ).tolist()
+    features, feature_labels, labels = feature_cells(occ)
+    limit = max_points if max_points is not None else 4 * len(features) + 4
+    points = [start]
+    classed: set[int] = set()
+    used = np.zeros(len(features), dtype=bool)
+    goal_xy = np.array(goal, dtype=float)
+    cur = start
+    for _ in range(limit):
+        if grid_line_of_sight(free, cur, goal):
+            break
+        for r, c in line_cells(cur, goal):
+            if 0 <= r < rows and 0 <= c < cols and labels[r, c]:
+                classed.add(int(labels[r, c]))
+        pool = np.flatnonzero(~used & np.isin(feature_labels, list(classed))
+                              & np.any(features != np.array(cur), axis=1))
+        if pool.size == 0:
+            break
+        visible = [k for k in pool if grid_line_of_sight(free, cur, tuple(features[k]))]
+        if visible:
+            vis = np.array(visible)
+            k = int(vis[np.argmin(np.hypot(*(features[vis] - goal_xy).T))])
+        else:
+            k = int(pool[np.argmin(np.hypot(*(features[pool] - np.array(cur)).T))])
+        used[k] = True
+        cur = (int(features[k, 0]), int(features[k, 1]))
+        points.append(cur)
+    points.append(goal)
+    arr = np.array(points, dtype=float)
+    return points, float(np.sum(np.hypot(*np.diff(arr, axis=0).T)))
+
+
+def iaco_heuristic(d_ig: np.ndarray, d_ij: np.ndarray, d_jg: np.ndarray, cos_omega: np.ndarray) -> np.ndarray:
+    """Eq. (6): ``eta_ij = d_ig / (d_ij + d_jg) * (cos(omega) + 1)``."""
+    return np.asarray(d_ig) / (np.asarray(d_ij) + np.asarray(d_jg)) * (np.asarray(cos_omega) + 1.0)
+
+
+def adaptive_parameters(alpha0: float, beta0: float, delta: float, kappa: float, iteration: int,
+                        iterations: int, collar_length: float, best_length: float | None,
+                        rho0: float) -> tuple[float, float, float]:
+    """Eqs. (9)-(11): alpha, beta and rho for iteration ``Nc = iteration`` (1-based) of ``N``.
+
+    ``x = (Nc / N + L_GL / (LF_best + L_GL)) / 2``;
+    ``alpha = alpha0 + delta * sin(x * pi)``; ``beta = beta0 * exp(-2 x^2)``;
+    ``rho = kappa * L_GL / (L_best + L_GL)``.  Without a best length yet the
+    ratio counts as 0 and rho stays ``rho0``.
+    """
+    ratio = 0.0 if best_length is None else collar_length / (best_length + collar_length)
+    x = (iteration / iterations + ratio) / 2.0
+    alpha = alpha0 + delta * math.sin(x * math.pi)
+    beta = beta0 * math.exp(-2.0 * x * x)
+    rho = rho0 if best_length is None else kappa * ratio
+    return alpha, beta, rho
+
+
+def pheromone_intensity(q: float, t_c: float, collar_length: float, lengths: np.ndarray,
+                        exponent_limit: float = 30.0) -> np.ndarray:
+    """Eq. (7): ``Q_m = Q * t_c ** ((L_GL - L_m) ** 3)``, the exponent clipped to +-``exponent_limit``."""
+    exponent = np.clip((collar_length - np.asarray(lengths, dtype=float)) ** 3, -exponent_limit, exponent_limit)
+    return q * np.power(t_c, exponent)
+
+
+@dataclass
+class ImprovedAntColonyPlanner(SwarmPlanner):
+    """IACO (seed 003).  Defaults are the paper's Table 2.
+
+    Args:
+        ants: colony size m (50).
+        iterations: N (100).
+        alpha, beta: initial alpha and beta of Eqs. (9)-(10) (1 and 5).
+        rho: initial evaporation, until Eq. (11) has a best length (0.3).
+        q: pheromone intensity Q (100).
+        t_c: base of Eq. (7) (1.5).
+        delta: adjustment coefficient of Eq. (9) (2).
+        kappa: adjustment coefficient of Eq. (11) (0.7).
+        initial_pheromone: pheromone on every free cell at the start.
+        collar_pheromone: pheromone added to the cells the collar line crosses.
+        tau_floor: smallest pheromone a cell keeps.
+        exponent_limit: clip of Eq. (7)'s exponent.
+        max_steps: NumPy steps after which an ant fails; 0 means half the number of cells.
+        prune_ratio: an ant whose tour grows past this multiple of the best length so
+            far stops (its Eq. (7) deposit would be negligible); before any best,
+            the limit is 4 x the collar length (at least rows + cols).
+        cell_m: grid resolution; ``None`` keeps the problem's.
+        shortcut: line-of-sight shortcut of the best tour (the raw cells stay in stats).
+    """
+
+    name: ClassVar[str] = "iaco"
+    ants: int = 50
+    iterations: int = 100
+    alpha: float = 1.0
+    beta: float = 5.0
+    rho: float = 0.3
+    q: float = 100.0
+    t_c: float = 1.5
+    delta: float = 2.0
+    kappa: float = 0.7
+    initial_pheromone: float = 1.0
+    collar_pheromone: float = 1.0
+    tau_floor: float = 1e-12
+    exponent_limit: float = 30.0
+    max_steps: int = 0
+    prune_ratio: float = 1.5
+    cell_m: float | None = None
+    shortcut: bool = True
+    max_evaluations: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.ants < 1 or self.iterations < 1:
+            raise ValueError("ants and iterations must be at least 1")
+        if not (0.0 < self.kappa < 1.0):
+            raise ValueError(f"kappa must lie in (0, 1), got {self.kappa}")
+        if not (0.0 <= self.rho < 1.0):
+            raise ValueError(f"rho must lie in [0, 1), got {self.rho}")
+        if self.t_c <= 0 or self.q <= 0:
+            raise ValueError("t_c and q must be positive")
+
+    def _problem(self, problem: Problem) -> Problem:
+        if self.cell_m is not None and self.cell_m != problem.cell_m and problem.grid_override is None:
+            return replace(problem, cell_m=self.cell_m)
+        return problem
+
+    def init_state(self, problem: Problem, rng: np.random.Generator) -> SwarmState:
+        problem = self._problem(problem)
+        grid = problem.grid
+        start, goal = grid_endpoints(problem, grid)
+        graph = GridGraph.of(grid)
+        rows, cols = grid.shape
+        rr, cc = np.divmod(np.arange(rows * cols), cols)
+        d_goal = np.hypot(rr - goal[0], cc - goal[1])
+        points, collar_cells = collar_line(grid.occupied, start, goal)
+        tau = np.where(grid.occupied.ravel(), 0.0, self.initial_pheromone)
+        crossed = {cell for a, b in zip(points[:-1], points[1:]) for cell in line_cells(a, b)}
+        crossed_idx = np.array([r * cols + c for r, c in crossed
+                                if 0 <= r < rows and 0 <= c < cols and not grid.occupied[r, c]], dtype=np.int64)
+        tau[crossed_idx] += self.collar_pheromone
+        data = {"problem": problem, "graph": graph, "start": graph.index(start), "goal": graph.index(goal),
+                "d_goal": d_goal, "cos": cosine_table(), "tau": tau, "collar_length": collar_cells,
+                "collar_points": points, "last_lengths": np.zeros(0), "successes": 0,
+                "params": (self.alpha, self.beta, self.rho),
+                "max_steps": self.max_steps or rows * cols // 2}
+        return SwarmState(best_solution=None, best_cost=math.inf, data=data)
+
+    def step(self, state: SwarmState, problem: Problem, rng: np.random.Generator, iteration: int) -> None:
+        data = state.data
+        best_cells = None if state.best_solution is None else data["best_length_cells"]
+        alpha, beta, rho = adaptive_parameters(self.alpha, self.beta, self.delta, self.kappa, iteration + 1,
+                                               self.iterations, data["collar_length"], best_cells, self.rho)
+        data["params"] = (alpha, beta, rho)
+        tau, d_goal, cos = data["tau"], data["d_goal"], data["cos"]
+        # Eq. (6) split into a per-cell goal-guidance table and a per-turn bend table,
+        # raised to beta once per iteration (alpha and beta are fixed within one).
+        table = data["graph"].table
+        safe_table = np.where(table >= 0, table, 0)
+        guidance = iaco_heuristic(d_goal[:, None], STEP_LENGTHS[None, :], d_goal[safe_table], 0.0)
+        guidance_beta = np.power(guidance, beta)                       # (N, 8)
+        bend_beta = np.power(cos + 1.0, beta)                          # (9, 8)
+        tau_alpha = np.power(tau, alpha)
+
+        def desirability(here, prev_dir, cand, allowed):
+            return tau_alpha[np.where(allowed, cand, 0)] * guidance_beta[here] * bend_beta[prev_dir]
+
+        rows, cols = data["problem"].grid.shape
+        limit = (self.prune_ratio * best_cells if best_cells is not None
+                 else max(4.0 * data["collar_length"], float(rows + cols)))
+        walk = walk_colony(data["graph"], data["start"], data["goal"], self.ants, desirability, rng,
+                           data["max_steps"], max_length=limit)
+        state.evaluations += self.ants
+        arrived = np.flatnonzero(walk.reached)
+        lengths = walk.length_cells[arrived]
+        data["last_lengths"] = lengths
+        data["successes"] += arrived.size
+        # Eq. (3): evaporate, then Eq. (8): each arrived ant deposits Q_m / (L_m + turn) on its cells.
+        evaporate(tau, rho)
+        if arrived.size:
+            q_m = pheromone_intensity(self.q, self.t_c, data["collar_length"], lengths, self.exponent_limit)
+            amounts = q_m / (lengths + walk.turns[arrived])
+            tours = [walk.tour(a)[1:] for a in arrived]
+            deposit(tau, np.concatenate(tours), np.repeat(amounts, [len(t) for t in tours]))
+            best = int(np.argmin(lengths))
+            cost_m = float(lengths[best]) * data["problem"].grid.cell_m
+            if cost_m < state.best_cost:
+                state.best_cost = cost_m
+                state.best_solution = walk.tour(arrived[best]).copy()
+                data["best_length_cells"] = float(lengths[best])
+        free = tau > 0.0
+        np.maximum(tau, self.tau_floor, out=tau, where=free)
+
+    def finish(self, state: SwarmState, problem: Problem) -> tuple[np.ndarray, dict[str, Any]]:
+        data = state.data
+        if state.best_solution is None:
+            raise NoPathFound(f"no ant of {state.evaluations} reached the goal")
+        problem = data["problem"]
+        grid = problem.grid
+        cells = [tuple(int(v) for v in rc) for rc in data["graph"].cells(state.best_solution)]
+        raw = cells_to_waypoints(problem, grid, cells)
+        waypoints = exact_shortcut(problem, raw) if self.shortcut else raw
+        lengths_m = data["last_lengths"] * grid.cell_m
+        alpha, beta, rho = data["params"]
+        extra = {
+            "raw_cells": [list(c) for c in cells],
+            "raw_length_m": state.best_cost,
+            "optimal_length_m": state.best_cost,
+            "mean_length_m": float(np.mean(lengths_m)) if lengths_m.size else math.nan,
+            "std_length_m": float(np.std(lengths_m)) if lengths_m.size else math.nan,
+            "bends": count_bends(cells),
+            "collar_length_m": data["collar_length"] * grid.cell_m,
+            "collar_points": [list(p) for p in data["collar_points"]],
+            "successful_tours": int(data["successes"]),
+            "final_alpha": alpha, "final_beta": beta, "final_rho": rho,
+        }
+        return waypoints, extra
