@@ -279,5 +279,5 @@ def check_endpoints(problem: Problem) -> None:
         for box in problem.boxes:
             dx = max(box.x_min_m - pose.x_m, pose.x_m - box.x_max_m, 0.0)
             dy = max(box.y_min_m - pose.y_m, pose.y_m - box.y_max_m, 0.0)
-            if math.hypot(dx, dy) < problem.inflation_m:
+            if math.hypot(dx, dy) < problem.inflation_m - 1e-9:  # touching is allowed (map cells)
                 raise error(f"{label} ({pose.x_m:g}, {pose.y_m:g}) is inside an inflated box obstacle")
