@@ -130,6 +130,9 @@ class ContinuousPlanner(SwarmPlanner):
 
     # ------------------------------------------------------- the loop's hooks
     def init_state(self, problem: Problem, rng: np.random.Generator) -> SwarmState:
+        if problem.boxes:
+            raise ConfigError("planner.name", f"{self.name} supports disc obstacles only, "
+                              "this problem has box obstacles (a grid map)")
         lower, upper = self.search_bounds(problem)
         state = SwarmState(best_solution=None, best_cost=math.inf,
                            data={"objective": self.objective(problem), "lower": lower, "upper": upper})

@@ -130,6 +130,10 @@ class PathObjective:
     def __call__(self, population: np.ndarray) -> np.ndarray:
         """(P,) costs of a (P, 2k) population, all candidates at once."""
         xs, ys = self.curve.sample(population)
+        return self.cost_from_samples(xs, ys)
+
+    def cost_from_samples(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+        """(P,) costs of curves already sampled, (P, S) each (for peers that sample their own way)."""
         cost = self.length_weight * sampled_length_m(xs, ys)
         if self.smoothness_weight:
             cost = cost + self.smoothness_weight * smoothness_rad(xs, ys)

@@ -1,0 +1,309 @@
+"""``swarmnav bench planners``: the continuous planners against the exact optimum,
+the papers' reported lengths, and mealpy on the same objective.
+
+For every scenario the exact shortest path (:mod:`planners.optimal`) is the
+yardstick.  Every planner runs ``--seeds`` times (seeds 0, 1, ...); the table
+gives best, median and std of the lengths of the paths that were returned (every
+returned path has passed the exact check, and is checked again here), the median
+over the optimum, the mean plan time, the evaluations, the feasible runs, and
+the paper's reported length where a paper reports one, with a note where that
+value is shorter than the exact optimum (physically impossible).
+
+Peers: mealpy's ``OriginalGWO`` and ``OriginalABC`` with the same population and
+iterations, in this process, on the same objective values.  mealpy calls its
+objective one candidate at a time, so the objective is given to it in two forms,
+and both are timed:
+
+* ``scipy``: the curve of each candidate fitted with
+  ``scipy.interpolate.CubicSpline(bc_type="not-a-knot")`` and sampled, then the
+  same cost terms (the straightforward objective a mealpy user writes; the
+  speedup target refers to it);
+* ``basis``: our precomputed-basis :class:`planners.path_cost.PathObjective`
+  called with one candidate, which leaves only mealpy's own loop overhead.
+
+The two give the same cost to 1e-9 (checked on every run).  mealpy is the
+``bench`` extra; without it the peers are skipped with a note.
+
+As in the papers, the problems use the robot radius only (``--clearance-m 0``),
+and moving obstacles are frozen at t = 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import time
+from typing import Any
+
+import numpy as np
+
+from planners import make_planner
+from planners.errors import PlanningError
+from planners.optimal import OptimalPlanner
+from planners.path_cost import PathObjective
+from planners.problem import Problem
+
+DEFAULT_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3",
+                     "adl-abc-path-1", "adl-abc-path-2", "adl-abc-path-3")
+DEFAULT_PLANNERS = ("abc", "adl_abc", "gwo", "pso")
+PEERS = (("gwo", "mealpy.OriginalGWO"), ("abc", "mealpy.OriginalABC"))
+
+# Lengths the papers report for their best path (seed 004 Sects. 6.1-6.3; seed 001 Table 2).
+PAPER_LENGTHS_M: dict[tuple[str, str], float] = {
+    ("gwo-scenario-1", "abc"): 14.255, ("gwo-scenario-1", "gwo"): 14.0541,
+    ("gwo-scenario-2", "abc"): 14.8913, ("gwo-scenario-2", "gwo"): 14.566,
+    ("gwo-scenario-3", "abc"): 14.7233, ("gwo-scenario-3", "gwo"): 14.4361,
+    ("adl-abc-path-1", "abc"): 14.4908, ("adl-abc-path-1", "adl_abc"): 14.4596,
+    ("adl-abc-path-2", "abc"): 15.0817, ("adl-abc-path-2", "adl_abc"): 14.8163,
+    ("adl-abc-path-3", "abc"): 10.3791, ("adl-abc-path-3", "adl_abc"): 10.3736,
+}
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``swarmnav bench planners``."""
+    parser.add_argument("--scenarios", nargs="+", default=list(DEFAULT_SCENARIOS), metavar="NAME")
+    parser.add_argument("--planners", nargs="+", default=list(DEFAULT_PLANNERS), metavar="NAME")
+    parser.add_argument("--seeds", type=int, default=10, help="runs per planner and scenario (default 10)")
+    parser.add_argument("--population", type=int, default=50)
+    parser.add_argument("--iterations", type=int, default=100)
+    parser.add_argument("--clearance-m", type=float, default=0.0,
+                        help="clearance beyond the robot radius (default 0, as in the papers)")
+    parser.add_argument("--peer-scenario", default="gwo-scenario-1")
+    parser.add_argument("--peer-runs", type=int, default=3, help="mealpy runs per peer (0: none)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def load_problem(name: str, clearance_m: float) -> Problem:
+    """A bundled scenario's problem with obstacles at t = 0."""
+    from models.scenario import load_scenario
+    return load_scenario(name).to_problem(clearance_m=clearance_m)
+
+
+def optimum_length_m(problem: Problem) -> float | None:
+    """Exact shortest length, or None when no collision-free path exists."""
+    try:
+        return float(OptimalPlanner().plan(problem, np.random.default_rng(0)).stats.extra["optimum_length_m"])
+    except PlanningError:
+        return None
+
+
+def paper_note(paper_m: float | None, optimum_m: float | None, problem: Problem) -> str:
+    """Why a paper's value cannot be right, or ''."""
+    if paper_m is None:
+        return ""
+    straight_m = float(np.hypot(*(problem.goal.xy - problem.start.xy)))
+    if optimum_m is None:
+        return "paper's path impossible: no collision-free path exists in this instance"
+    if paper_m < straight_m - 1e-9:
+        return (f"paper's value impossible: shorter than the straight line "
+                f"({straight_m:.4f}) and the exact optimum")
+    if paper_m < optimum_m - 1e-9:
+        return "paper's value impossible: shorter than the exact optimum"
+    return ""
+
+
+def run_planner(name: str, params: dict[str, Any], problem: Problem, seeds: int) -> dict[str, Any]:
+    """Run one planner ``seeds`` times; lengths of feasible runs, times and evaluations."""
+    lengths, times, evaluations, feasible = [], [], [], 0
+    for seed in range(seeds):
+        planner = make_planner(name, params)
+        t0 = time.perf_counter()
+        try:
+            path = planner.plan(problem, np.random.default_rng(seed))
+        except PlanningError:
+            times.append(time.perf_counter() - t0)
+            continue
+        times.append(path.stats.plan_time_s)
+        evaluations.append(path.stats.evaluations)
+        if problem.is_collision_free(path.waypoints):
+            feasible += 1
+            lengths.append(path.stats.length_m)
+    return {"lengths": lengths, "times": times, "evaluations": evaluations, "feasible": feasible}
+
+
+def scipy_spline_cost(objective: PathObjective, solution: np.ndarray) -> float:
+    """The cost of one candidate with its spline fitted by scipy (a peer's objective)."""
+    from scipy.interpolate import CubicSpline
+
+    knots = objective.curve.knots(solution)
+    parameters = np.linspace(0.0, 1.0, knots.shape[0])
+    samples = CubicSpline(parameters, knots, bc_type="not-a-knot")(
+        np.linspace(0.0, 1.0, objective.curve.samples))
+    return float(objective.cost_from_samples(samples[None, :, 0], samples[None, :, 1])[0])
+
+
+def peer_runs(planner_name: str, peer: str, problem: Problem, population: int, iterations: int,
+              runs: int, form: str) -> dict[str, Any]:
+    """mealpy's optimiser on our objective in ``form`` ("scipy" or "basis"): times,
+    evaluations, lengths of the feasible bests."""
+    from mealpy import ABC, GWO, FloatVar
+
+    ours = make_planner(planner_name, {"population": population, "iterations": iterations})
+    objective = ours.objective(problem)
+    lower, upper = ours.search_bounds(problem)
+    times, evaluations, lengths = [], [], []
+    for seed in range(runs):
+        count = [0]
+
+        if form == "scipy":
+            def cost(solution: np.ndarray) -> float:
+                count[0] += 1
+                return scipy_spline_cost(objective, np.asarray(solution, dtype=float))
+        else:
+            def cost(solution: np.ndarray) -> float:
+                count[0] += 1
+                return float(objective(np.asarray(solution, dtype=float)[None, :])[0])
+
+        spec = {"bounds": FloatVar(lb=lower.tolist(), ub=upper.tolist()), "minmax": "min",
+                "obj_func": cost, "log_to": None}
+        model = (GWO.OriginalGWO(epoch=iterations, pop_size=population) if peer.endswith("GWO")
+                 else ABC.OriginalABC(epoch=iterations, pop_size=population, n_limits=int(ours.limit)))
+        t0 = time.perf_counter()
+        best = model.solve(spec, seed=seed)
+        times.append(time.perf_counter() - t0)
+        evaluations.append(count[0])
+        solution = np.asarray(best.solution, dtype=float)
+        gap = abs(scipy_spline_cost(objective, solution) - float(objective(solution[None, :])[0]))
+        if gap > 1e-9:
+            raise AssertionError(f"the scipy and basis objectives differ by {gap:g}")
+        waypoints = ours.dense_waypoints(objective, solution)
+        if problem.is_collision_free(waypoints):
+            lengths.append(float(np.sum(np.hypot(*np.diff(waypoints, axis=0).T))))
+    return {"times": times, "evaluations": evaluations, "lengths": lengths}
+
+
+def _median(values: list[float]) -> float | None:
+    return float(statistics.median(values)) if values else None
+
+
+def benchmark(args: argparse.Namespace) -> dict[str, Any]:
+    """All figures of the benchmark as one JSON-ready object."""
+    params = {"population": args.population, "iterations": args.iterations}
+    rows, notes, ours_by_key = [], [], {}
+    for scenario in args.scenarios:
+        problem = load_problem(scenario, args.clearance_m)
+        optimum = optimum_length_m(problem)
+        if optimum is None:
+            notes.append(f"{scenario}: no collision-free path exists (the exact planner proves it); "
+                         f"every planner must fail there")
+        for name in args.planners:
+            result = run_planner(name, params, problem, args.seeds)
+            ours_by_key[(scenario, name)] = result
+            lengths = result["lengths"]
+            median = _median(lengths)
+            paper = PAPER_LENGTHS_M.get((scenario, name))
+            rows.append({
+                "scenario": scenario, "planner": name, "runs": args.seeds,
+                "feasible_runs": result["feasible"],
+                "best_length_m": min(lengths) if lengths else None,
+                "median_length_m": median,
+                "std_length_m": float(np.std(lengths)) if lengths else None,
+                "optimum_length_m": optimum,
+                "ratio_to_optimum": (median / optimum) if (median is not None and optimum) else None,
+                "mean_plan_time_s": float(np.mean(result["times"])) if result["times"] else None,
+                "evaluations": int(round(np.mean(result["evaluations"]))) if result["evaluations"] else None,
+                "paper_length_m": paper,
+                "note": paper_note(paper, optimum, problem),
+            })
+
+    peers = []
+    if args.peer_runs > 0:
+        try:
+            import mealpy  # noqa: F401
+        except ImportError:
+            notes.append("peers skipped: mealpy is not installed (pip install 'swarmnav[bench]')")
+        else:
+            problem = load_problem(args.peer_scenario, args.clearance_m)
+            for name, peer in PEERS:
+                if (args.peer_scenario, name) in ours_by_key:
+                    ours = ours_by_key[(args.peer_scenario, name)]
+                else:
+                    ours = run_planner(name, params, problem, args.seeds)
+                theirs = peer_runs(name, peer, problem, args.population, args.iterations,
+                                   args.peer_runs, "scipy")
+                basis = peer_runs(name, peer, problem, args.population, args.iterations,
+                                  args.peer_runs, "basis")
+                our_time = float(np.mean(ours["times"]))
+                peer_time = float(np.mean(theirs["times"]))
+                basis_time = float(np.mean(basis["times"]))
+                peers.append({
+                    "planner": name, "peer": peer, "scenario": args.peer_scenario,
+                    "evaluations": int(round(np.mean(ours["evaluations"]))) if ours["evaluations"] else None,
+                    "peer_evaluations": int(round(np.mean(theirs["evaluations"]))),
+                    "our_time_s": our_time, "peer_time_s": peer_time,
+                    "speedup": peer_time / our_time if our_time > 0 else math.inf,
+                    "our_median_length_m": _median(ours["lengths"]),
+                    "peer_median_length_m": _median(theirs["lengths"]),
+                    "our_runs": args.seeds, "peer_runs": args.peer_runs,
+                    "peer_feasible_runs": len(theirs["lengths"]),
+                    "peer_objective": "scipy CubicSpline per candidate",
+                    "peer_time_basis_objective_s": basis_time,
+                    "speedup_basis_objective": basis_time / our_time if our_time > 0 else math.inf,
+                })
+    return {"population": args.population, "iterations": args.iterations,
+            "clearance_m": args.clearance_m, "rows": rows, "peers": peers, "notes": notes}
+
+
+def _fmt(value: Any, spec: str = ".4f") -> str:
+    if value is None:
+        return "-"
+    return format(value, spec) if isinstance(value, float) else str(value)
+
+
+def print_table(result: dict[str, Any]) -> None:
+    """The human-readable report."""
+    print(f"continuous planners: population {result['population']} x {result['iterations']} iterations, "
+          f"clearance {result['clearance_m']:g} m beyond the robot radius; lengths in m")
+    header = (f"{'scenario':<16} {'planner':<8} {'feasible':>8} {'best':>8} {'median':>8} {'std':>7} "
+              f"{'optimum':>8} {'ratio':>7} {'time_s':>7} {'evals':>6} {'paper':>8}  note")
+    print(header)
+    print("-" * len(header))
+    for r in result["rows"]:
+        print(f"{r['scenario']:<16} {r['planner']:<8} {r['feasible_runs']:>4}/{r['runs']:<3} "
+              f"{_fmt(r['best_length_m']):>8} {_fmt(r['median_length_m']):>8} "
+              f"{_fmt(r['std_length_m']):>7} {_fmt(r['optimum_length_m']):>8} "
+              f"{_fmt(r['ratio_to_optimum']):>7} {_fmt(r['mean_plan_time_s'], '.3f'):>7} "
+              f"{_fmt(r['evaluations']):>6} {_fmt(r['paper_length_m']):>8}  {r['note']}")
+    if result["peers"]:
+        print()
+        print("peers on the same objective values, same population and iterations "
+              "(peer objective: scipy CubicSpline per candidate):")
+        for p in result["peers"]:
+            print(f"  {p['planner']:<4} vs {p['peer']:<19} on {p['scenario']}: evaluations "
+                  f"{p['evaluations']} vs {p['peer_evaluations']}, time {p['our_time_s']:.3f} s vs "
+                  f"{p['peer_time_s']:.3f} s = {p['speedup']:.1f}x faster; median length "
+                  f"{_fmt(p['our_median_length_m'])} vs {_fmt(p['peer_median_length_m'])} "
+                  f"({p['peer_feasible_runs']}/{p['peer_runs']} peer runs feasible)")
+            print(f"  {'':<4}    (given our basis objective one candidate per call, mealpy takes "
+                  f"{p['peer_time_basis_objective_s']:.3f} s: {p['speedup_basis_objective']:.1f}x, "
+                  f"its loop overhead alone)")
+    print()
+    print("targets:")
+    for p in result["peers"]:
+        verdict = "met" if p["speedup"] >= 10 else "NOT met"
+        print(f"  {p['planner']} >= 10x faster than {p['peer']}: {p['speedup']:.1f}x ({verdict})")
+    for r in result["rows"]:
+        if r["scenario"] == "gwo-scenario-1" and r["ratio_to_optimum"] is not None:
+            ok = r["ratio_to_optimum"] <= 1.02 and r["feasible_runs"] == r["runs"]
+            print(f"  {r['planner']} on gwo-scenario-1: median/optimum {r['ratio_to_optimum']:.4f} <= 1.02, "
+                  f"{r['feasible_runs']}/{r['runs']} feasible ({'met' if ok else 'NOT met'})")
+    for note in result["notes"]:
+        print(f"note: {note}")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Entry point of ``swarmnav bench planners``."""
+    result = benchmark(args)
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print_table(result)
+    return 0
+
+
+if __name__ == "__main__":
+    _parser = argparse.ArgumentParser(prog="python -m planners.bench_continuous", description=__doc__.splitlines()[0])
+    add_arguments(_parser)
+    raise SystemExit(run(_parser.parse_args()))
