@@ -278,6 +278,8 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         raise ConfigError("sim.control_hz", "the control period must be a whole number of physics "
                           f"timesteps (got {steps_per_control:g} steps)", source)
 
+    boxes, map_grid, map_cell_m = _parse_map(top, source, width_m, height_m)
+
     raw_obstacles = top.raw("obstacles", [])
     if not isinstance(raw_obstacles, list):
         top.fail("obstacles", "expected an array of tables ([[obstacles]])")
@@ -332,6 +334,14 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         obstacles.append(Obstacle(x, y, radius, height, motion))
 
     top.close()
+    if map_cell_m is not None:
+        cell_m = map_cell_m
+        if obstacles:
+            # Discs beside a map: rasterise both at the map's resolution (conservative margin).
+            map_grid = None
+        else:
+            from planners.movingai import inflated_map_grid
+            map_grid = inflated_map_grid(map_grid.occupied, map_cell_m, robot_radius_m + clearance_m, boxes)
 
     scenario = Scenario(
         name=name, description=description, seed=seed, time_limit_s=time_limit_s,
@@ -340,9 +350,57 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         start=start, goal=goal, goal_tolerance_m=tolerance_m,
         sensor_count=sensor_count, sensor_range_m=sensor_range_m,
         planner_name=planner_name, planner_params=dict(params), obstacles=tuple(obstacles),
-        sim=sim, cell_m=cell_m, source_text=text, source_path=source)
+        sim=sim, cell_m=cell_m, source_text=text, source_path=source, boxes=boxes, map_grid=map_grid)
     _check_endpoints(scenario, source)
     return scenario
+
+
+def _parse_map(top: _Table, source: str, width_m: float, height_m: float
+               ) -> tuple[tuple[Box, ...], OccupancyGrid | None, float | None]:
+    """The optional ``[map]`` table: a Moving AI ``.map`` file and its cell size.
+
+    ``file`` is looked up beside the scenario, then under ``models/maps/``.  The
+    map must span the arena exactly (map cell (0, 0) of the file is the top-left
+    corner).  Occupied cells become merged box obstacles.  ``pairs`` optionally
+    lists [x0, y0, x1, y1] start/goal cells (column, row counted from the bottom)
+    for ``swarmnav bench grid``.
+
+    Returns:
+        (boxes, the map's world grid before inflation or None, cell_m or None).
+    """
+    if not top.has("map"):
+        return (), None, None
+    from planners.movingai import map_to_grid, merge_boxes, read_map
+
+    t = top.table("map")
+    name = t.string("file")
+    cell_m = t.number("cell_m", positive=True)
+    pairs = t.raw("pairs", [])
+    t.close()
+    if not isinstance(pairs, list) or not all(
+            isinstance(p, list) and len(p) == 4 and all(isinstance(v, int) and not isinstance(v, bool) for v in p)
+            for p in pairs):
+        raise ConfigError("map.pairs", "expected an array of [x0, y0, x1, y1] integer cells", source)
+    here = FilePath(source).resolve().parent if source and not source.startswith("<") else SCENARIO_DIR
+    candidates = [here / name, SCENARIO_DIR.parent / "maps" / name]
+    path = next((c for c in candidates if c.is_file()), None)
+    if path is None:
+        raise ConfigError("map.file", f"no map file {name!r} beside the scenario or under models/maps/", source)
+    try:
+        occupied = read_map(path)
+    except ConfigError as exc:
+        raise ConfigError("map.file", f"{path.name}: {exc.field}: {exc.problem}", source) from None
+    rows, cols = occupied.shape
+    if abs(cols * cell_m - width_m) > 1e-6 or abs(rows * cell_m - height_m) > 1e-6:
+        raise ConfigError("map.cell_m", f"a {cols} x {rows} map at {cell_m:g} m per cell spans "
+                          f"{cols * cell_m:g} x {rows * cell_m:g} m, not the arena's {width_m:g} x {height_m:g} m",
+                          source)
+    for i, (x0, y0, x1, y1) in enumerate(pairs):
+        for x, y in ((x0, y0), (x1, y1)):
+            if not (0 <= x < cols and 0 <= y < rows):
+                raise ConfigError(f"map.pairs[{i}]", f"cell ({x}, {y}) is outside the {cols} x {rows} map", source)
+    grid = map_to_grid(occupied, cell_m)
+    return merge_boxes(grid.occupied, cell_m), grid, cell_m
 
 
 def _check_endpoints(scenario: Scenario, source: str) -> None:
