@@ -17,6 +17,7 @@ from planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
 from planners.grid_search import DijkstraPlanner, DStarLitePlanner, ThetaStarPlanner
 from planners.improved_ant_colony import ImprovedAntColonyPlanner
 from planners.max_min_ant_system import MaxMinAntSystemPlanner
+from planners.waiter_ant_colony import WaiterAntColonyPlanner
 from planners.grey_wolf import GreyWolfPlanner
 from planners.optimal import OptimalPlanner
 from planners.particle_swarm import ParticleSwarmPlanner
@@ -41,7 +42,7 @@ def register(cls: type) -> type:
 
 
 for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,
-             MaxMinAntSystemPlanner, ImprovedAntColonyPlanner,
+             MaxMinAntSystemPlanner, ImprovedAntColonyPlanner, WaiterAntColonyPlanner,
              OptimalPlanner, BeeColonyPlanner, AdaptiveLimitBeeColonyPlanner, GreyWolfPlanner,
              ParticleSwarmPlanner):
     register(_cls)
