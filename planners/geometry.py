@@ -103,6 +103,7 @@ def segment_box_distances(a: np.ndarray, b: np.ndarray, boxes: np.ndarray) -> np
     inside_slab = (a[:, None, :] >= lo) & (a[:, None, :] <= hi)
     t_near = np.where(parallel, np.where(inside_slab, -np.inf, np.inf), np.minimum(t1, t2))
     t_far = np.where(parallel, np.where(inside_slab, np.inf, -np.inf), np.maximum(t1, t2))
-    enter = np.maximum(np.max(t_near, axis=-1), 0.0)
-    leave = np.minimum(np.min(t_far, axis=-1), 1.0)
+    # Element-wise over the two axes: a reduction over a last axis of length 2 is slow in NumPy.
+    enter = np.maximum(np.maximum(t_near[..., 0], t_near[..., 1]), 0.0)
+    leave = np.minimum(np.minimum(t_far[..., 0], t_far[..., 1]), 1.0)
     return np.where(enter <= leave, 0.0, best)

@@ -90,7 +90,12 @@ class _AdjacencyCache:
             self.entries.move_to_end(key)
             return hit
         table = neighbour_table(occ)
-        adjacency = [[(v, w) for v, w in zip(row, STEP_COSTS) if v >= 0] for row in table.tolist()]
+        # Compact per-cell lists of (neighbour, cost): sort each row's legal moves first.
+        order = np.argsort(table < 0, axis=1, kind="stable")
+        legal = (table >= 0).sum(axis=1).tolist()
+        cells = np.take_along_axis(table, order, axis=1).tolist()
+        costs = np.take(np.array(STEP_COSTS), order).tolist()
+        adjacency = [list(zip(c[:k], w[:k])) for c, w, k in zip(cells, costs, legal)]
         self.entries[key] = (table, adjacency)
         if len(self.entries) > self.size:
             self.entries.popitem(last=False)
@@ -554,8 +559,14 @@ def segments_clear(problem: Problem, a: np.ndarray, bs: np.ndarray, tolerance_m:
         d = segment_disc_distances(starts, bs, problem.disc_centres_m)
         ok &= np.all(d - problem.inflated_radii_m[None, :] >= -tolerance_m, axis=1)
     if problem.boxes:
-        d = segment_box_distances(starts, bs, problem.box_array_m)
-        ok &= np.all(d - problem.inflation_m >= -tolerance_m, axis=1)
+        # Only boxes that reach the fan's bounding box (grown by the inflation) can matter.
+        boxes = problem.box_array_m
+        lo = np.minimum(a[0], bs.min(axis=0)) - problem.inflation_m
+        hi = np.maximum(a[0], bs.max(axis=0)) + problem.inflation_m
+        near = (boxes[:, 0] <= hi[0]) & (boxes[:, 2] >= lo[0]) & (boxes[:, 1] <= hi[1]) & (boxes[:, 3] >= lo[1])
+        if near.any():
+            d = segment_box_distances(starts, bs, boxes[near])
+            ok &= (d.min(axis=1) - problem.inflation_m >= -tolerance_m)
     elif problem.grid_override is not None:
         grid = problem.grid
         free = (~grid.occupied).tolist()
@@ -565,12 +576,13 @@ def segments_clear(problem: Problem, a: np.ndarray, bs: np.ndarray, tolerance_m:
     return ok
 
 
-def exact_shortcut(problem: Problem, waypoints: np.ndarray) -> np.ndarray:
+def exact_shortcut(problem: Problem, waypoints: np.ndarray, window: int = 32) -> np.ndarray:
     """Greedy line-of-sight shortcut: from each kept vertex jump to the farthest visible one.
 
-    Visibility is :func:`segments_clear`, evaluated for all later vertices in
-    one NumPy call per kept vertex.  Consecutive vertices are assumed visible
-    (grid moves between free cells are), so this never fails.
+    Visibility is :func:`segments_clear`, evaluated for the next ``window``
+    vertices in one NumPy call per kept vertex (a longer straight run just keeps
+    an extra, nearly collinear vertex).  Consecutive vertices are assumed
+    visible (grid moves between free cells are), so this never fails.
     """
     pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
     if len(pts) <= 2:
@@ -579,7 +591,7 @@ def exact_shortcut(problem: Problem, waypoints: np.ndarray) -> np.ndarray:
     i = 0
     last = len(pts) - 1
     while i < last:
-        visible = np.flatnonzero(segments_clear(problem, pts[i], pts[i + 1:]))
+        visible = np.flatnonzero(segments_clear(problem, pts[i], pts[i + 1:i + 1 + window]))
         j = i + 1 + int(visible[-1]) if visible.size else i + 1
         kept.append(j)
         i = j

@@ -1,0 +1,286 @@
+"""``swarmnav bench grid [--json]``: grid planners on the bundled 50 x 50 maps, Moving AI optima, a peer A*.
+
+Prints (or, with ``--json``, emits one object with):
+
+* ``rows``: per map and planner, ``runs``, ``median_length_m`` (the executed path,
+  shortcut on, as each planner returns it), ``astar_length_m`` (A*'s, the same way),
+  ``ratio_to_astar``, ``mean_plan_time_s``; also the raw (cell path) lengths and
+  their ratio to the A* optimum, and the mean cell clearance of the raw path;
+* ``movingai``: ``scenarios``, ``mismatches``, ``max_abs_error`` of A* and Dijkstra against
+  every optimal length in the Moving AI benchmark folder (``SWARMNAV_MOVINGAI_DIR``
+  or ``<repo>/../shared/benchmarks/movingai``), plus the swarm planners' length
+  ratios to those optima on a sample;
+* ``peers``: our A* against the PyPI ``pathfinding`` A* (``DiagonalMovement.only_when_no_obstacle``)
+  on the same grids in this process, ``speedup`` = their time / ours;
+* ``targets``: the issue's targets and whether they were met on this machine.
+
+Timings are wall-clock on a shared machine: noisy, printed, never asserted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+import tomllib
+from typing import Any
+
+import numpy as np
+from scipy import ndimage
+
+TARGETS = {"astar_plan_s": 0.005, "immas_plan_s": 0.050, "iaco_plan_s": 1.0, "iaco_median_ratio": 1.05}
+GRID_PLANNERS = ("astar", "dijkstra", "theta_star", "dstar_lite", "immas", "iaco")
+SEEDED = {"iaco"}
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--runs", type=int, default=5, help="runs (seeds) per map and planner")
+    parser.add_argument("--maps", nargs="*", help="map scenario names (default: every bundled [map] scenario)")
+    parser.add_argument("--all-pairs", action="store_true",
+                        help="plan every start/goal pair of each map's [map].pairs, not only the scenario's")
+    parser.add_argument("--swarm-sample", type=int, default=20,
+                        help="Moving AI instances per map on which immas and iaco report their ratio")
+
+
+def _map_scenarios(names: list[str] | None):
+    from models.scenario import list_scenarios, load_scenario
+
+    out = []
+    for name in names or list_scenarios():
+        scenario = load_scenario(name)
+        if scenario.boxes and (names or name.startswith(("immas-", "iaco-"))):
+            out.append(scenario)
+    return out
+
+
+def _problems(scenario, all_pairs: bool):
+    """(label, Problem) for the scenario's own start/goal, or for each of its [map].pairs."""
+    from dataclasses import replace
+
+    from planners.problem import Pose2D
+
+    problem = scenario.to_problem()
+    if not all_pairs:
+        return [(scenario.name, problem)]
+    pairs = tomllib.loads(scenario.source_text).get("map", {}).get("pairs", [])
+    cell = scenario.cell_m
+    out = []
+    for x0, y0, x1, y1 in pairs:
+        out.append((f"{scenario.name}:{x0},{y0}->{x1},{y1}",
+                    replace(problem, start=Pose2D((x0 + 0.5) * cell, (y0 + 0.5) * cell),
+                            goal=Pose2D((x1 + 0.5) * cell, (y1 + 0.5) * cell))))
+    return out
+
+
+def _mean_clearance_m(problem, cells) -> float:
+    grid = problem.grid
+    clearance = ndimage.distance_transform_edt(~grid.occupied) * grid.cell_m
+    idx = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+    return float(np.mean(clearance[idx[:, 0], idx[:, 1]]))
+
+
+def bench_maps(args: argparse.Namespace) -> list[dict[str, Any]]:
+    from planners import make_planner
+
+    rows = []
+    for scenario in _map_scenarios(args.maps):
+        for label, problem in _problems(scenario, args.all_pairs):
+            astar = make_planner("astar").plan(problem, np.random.default_rng(0))
+            astar_len = astar.stats.length_m
+            astar_raw = astar.stats.extra["raw_length_m"]
+            for name in GRID_PLANNERS:
+                params = dict(scenario.planner_params) if name == scenario.planner_name else {}
+                planner = make_planner(name, params)
+                lengths, raws, times, clearances, extras = [], [], [], [], []
+                for run in range(args.runs):
+                    path = planner.plan(problem, np.random.default_rng(run))
+                    lengths.append(path.stats.length_m)
+                    raws.append(path.stats.extra["raw_length_m"])
+                    times.append(path.stats.plan_time_s)
+                    clearances.append(_mean_clearance_m(problem, path.stats.extra["raw_cells"]))
+                    extras.append(path.stats.extra)
+                    if not problem.is_collision_free(path.waypoints):
+                        raise AssertionError(f"{name} returned a colliding path on {label}")
+                median = statistics.median(lengths)
+                row = {"map": label, "planner": name, "runs": args.runs, "median_length_m": median,
+                       "astar_length_m": astar_len, "ratio_to_astar": median / astar_len,
+                       "mean_plan_time_s": statistics.fmean(times),
+                       "median_raw_length_m": statistics.median(raws), "astar_raw_length_m": astar_raw,
+                       "raw_ratio_to_astar": statistics.median(raws) / astar_raw,
+                       "mean_cell_clearance_m": statistics.fmean(clearances)}
+                if name == "immas":
+                    row.update(gates_raised=extras[0]["gates_raised"], tunnels_closed=extras[0]["tunnels_closed"],
+                               moves=extras[0]["moves"], total_arc_cost=extras[0]["total_arc_cost"])
+                if name == "iaco":
+                    row.update(convergence_iteration=statistics.median(e["convergence_iteration"] for e in extras),
+                               bends=statistics.median(e["bends"] for e in extras),
+                               std_length_m=statistics.pstdev(raws))
+                rows.append(row)
+    return rows
+
+
+def bench_restaurant(runs: int) -> list[dict[str, Any]]:
+    """M-ACO on its home scenario, with the paper's node baselines' collisions."""
+    from models.scenario import load_scenario
+    from planners import make_planner
+
+    scenario = load_scenario("restaurant-table-2-maco")
+    problem = scenario.to_problem()
+    astar = make_planner("astar").plan(problem, np.random.default_rng(0))
+    planner = make_planner("maco", scenario.planner_params)
+    lengths, times, crashes = [], [], 0
+    for run in range(runs):
+        path = planner.plan(problem, np.random.default_rng(run))
+        lengths.append(path.stats.length_m)
+        times.append(path.stats.plan_time_s)
+        crashes += bool(path.stats.extra.get("dijkstra_colliding_links"))
+    median = statistics.median(lengths)
+    return [{"map": scenario.name, "planner": "maco", "runs": runs, "median_length_m": median,
+             "astar_length_m": astar.stats.length_m, "ratio_to_astar": median / astar.stats.length_m,
+             "mean_plan_time_s": statistics.fmean(times), "node_baseline_runs_colliding": crashes}]
+
+
+def bench_movingai(sample: int) -> dict[str, Any]:
+    from planners.errors import PlanningError
+    from planners.grid_search import astar_cells, dijkstra_cells
+    from planners.improved_ant_colony import ImprovedAntColonyPlanner
+    from planners.max_min_ant_system import MaxMinAntSystemPlanner
+    from planners.movingai import benchmark_sets, benchmarks_dir, map_problem, read_map, read_scenarios
+
+    sets = benchmark_sets()
+    if not sets:
+        return {"scenarios": 0, "mismatches": 0, "max_abs_error": None,
+                "skipped": f"no benchmark files in {benchmarks_dir()}"}
+    count = mismatches = 0
+    worst = 0.0
+    per_map = {}
+    swarm: dict[str, list[float]] = {"immas": [], "iaco": []}
+    failures: dict[str, int] = {"immas": 0, "iaco": 0}
+    t0 = time.perf_counter()
+    for map_path, scen_path in sets:
+        occupied = read_map(map_path)
+        scenarios = [s for s in read_scenarios(scen_path) if s.map_name.endswith(map_path.name)]
+        for s in scenarios:
+            for search in (astar_cells, dijkstra_cells):
+                _, cost, _ = search(occupied, s.start_cell(), s.goal_cell())
+                err = abs(cost - s.optimal_length)
+                worst = max(worst, err)
+                mismatches += err > 1e-4
+                count += 1
+        per_map[map_path.name] = len(scenarios)
+        # The swarm planners on the same instances (world grid: flip rows), raw cell lengths.
+        world = occupied[::-1]
+        height = occupied.shape[0]
+        step = max(1, len(scenarios) // max(1, sample))
+        for s in scenarios[::step][:sample]:
+            if s.optimal_length == 0:
+                continue
+            problem = map_problem(world, 1.0, (height - 1 - s.start_row, s.start_col),
+                                  (height - 1 - s.goal_row, s.goal_col))
+            for name, planner in (("immas", MaxMinAntSystemPlanner()), ("iaco", ImprovedAntColonyPlanner())):
+                try:
+                    path = planner.plan(problem, np.random.default_rng(0))
+                except PlanningError:
+                    failures[name] += 1
+                    continue
+                swarm[name].append(path.stats.extra["raw_length_m"] / s.optimal_length)
+    return {"scenarios": count // 2, "checks": count, "mismatches": mismatches, "max_abs_error": worst,
+            "maps": per_map, "seconds": time.perf_counter() - t0,
+            "swarm_ratio_to_optimum": {name: {"instances": len(v), "failures": failures[name],
+                                              "median": statistics.median(v) if v else None,
+                                              "max": max(v) if v else None} for name, v in swarm.items()}}
+
+
+def bench_peers(names: list[str] | None, repeats: int = 20) -> list[dict[str, Any]] | dict[str, str]:
+    try:
+        from pathfinding.core.diagonal_movement import DiagonalMovement
+        from pathfinding.core.grid import Grid
+        from pathfinding.finder.a_star import AStarFinder
+    except ImportError:
+        return {"skipped": "the pathfinding package is not importable (pip install swarmnav[bench])"}
+    from planners.grid_search import ADJACENCY, astar_cells
+
+    ours_s = theirs_s = ours_cold_s = 0.0
+    plans = 0
+    disagreements = 0
+    for scenario in _map_scenarios(names):
+        problem = scenario.to_problem()
+        occ = problem.grid.occupied
+        start = problem.grid.cell_of(problem.start.x_m, problem.start.y_m)
+        goal = problem.grid.cell_of(problem.goal.x_m, problem.goal.y_m)
+        grid = Grid(matrix=(~occ).astype(int).tolist())
+        finder = AStarFinder(diagonal_movement=DiagonalMovement.only_when_no_obstacle)
+        for _ in range(repeats):
+            grid.cleanup()
+            t = time.perf_counter()
+            nodes, _ = finder.find_path(grid.node(start[1], start[0]), grid.node(goal[1], goal[0]), grid)
+            theirs_s += time.perf_counter() - t
+            t = time.perf_counter()
+            _, cost, _ = astar_cells(occ, start, goal)
+            ours_s += time.perf_counter() - t
+            ADJACENCY.entries.clear()
+            t = time.perf_counter()
+            astar_cells(occ, start, goal)
+            ours_cold_s += time.perf_counter() - t
+            plans += 1
+        xy = np.array([[n.x, n.y] for n in nodes], dtype=float)
+        theirs_len = float(np.sum(np.hypot(*np.diff(xy, axis=0).T)))
+        disagreements += abs(theirs_len - cost) > 1e-6
+    return [{"planner": "astar", "peer": "pathfinding 1.0 AStarFinder (only_when_no_obstacle)",
+             "speedup": theirs_s / ours_s, "plans": plans, "ours_mean_s": ours_s / plans,
+             "peer_mean_s": theirs_s / plans, "length_disagreements": disagreements},
+            {"planner": "astar (neighbour table rebuilt every call)",
+             "peer": "pathfinding 1.0 AStarFinder (only_when_no_obstacle)",
+             "speedup": theirs_s / ours_cold_s, "plans": plans, "ours_mean_s": ours_cold_s / plans,
+             "peer_mean_s": theirs_s / plans}]
+
+
+def _targets(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    def worst(planner: str, key: str) -> float | None:
+        values = [r[key] for r in rows if r["planner"] == planner]
+        return max(values) if values else None
+
+    out = {}
+    for planner, key, target in (("astar", "mean_plan_time_s", TARGETS["astar_plan_s"]),
+                                 ("immas", "mean_plan_time_s", TARGETS["immas_plan_s"]),
+                                 ("iaco", "mean_plan_time_s", TARGETS["iaco_plan_s"]),
+                                 ("iaco", "ratio_to_astar", TARGETS["iaco_median_ratio"])):
+        value = worst(planner, key)
+        out[f"{planner}_{key}_worst_map"] = {"value": value, "target": target,
+                                             "met": value is not None and value < target + (
+                                                 1e-12 if key == "ratio_to_astar" else 0.0)}
+    return out
+
+
+def run(args: argparse.Namespace) -> int:
+    rows = bench_maps(args) + bench_restaurant(args.runs)
+    movingai = bench_movingai(args.swarm_sample)
+    peers = bench_peers(args.maps)
+    result = {"rows": rows, "movingai": movingai, "peers": peers, "targets": _targets(rows)}
+    if args.json:
+        print(json.dumps(result))
+        return 0
+    print(f"{'map':<26} {'planner':<11} {'runs':>4} {'median_m':>9} {'astar_m':>8} {'ratio':>6} "
+          f"{'raw_ratio':>9} {'clear_m':>7} {'plan_ms':>8}")
+    for r in rows:
+        print(f"{r['map']:<26} {r['planner']:<11} {r['runs']:>4} {r['median_length_m']:>9.3f} "
+              f"{r['astar_length_m']:>8.3f} {r['ratio_to_astar']:>6.3f} {r.get('raw_ratio_to_astar', float('nan')):>9.3f} "
+              f"{r.get('mean_cell_clearance_m', float('nan')):>7.3f} {1e3 * r['mean_plan_time_s']:>8.2f}")
+    print("movingai:", json.dumps(movingai))
+    print("peers:", json.dumps(peers))
+    for key, value in result["targets"].items():
+        print(f"target {key}: {value}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="swarmnav bench grid", description=__doc__.splitlines()[0])
+    add_arguments(parser)
+    return run(parser.parse_args(argv))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
