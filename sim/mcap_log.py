@@ -44,6 +44,7 @@ import importlib.metadata
 import json
 import math
 import platform
+import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 from typing import Any
 
@@ -190,6 +191,31 @@ def _yaw_quaternion(yaw_rad: float) -> Quaternion:
     return Quaternion(z=math.sin(0.5 * yaw_rad), w=math.cos(0.5 * yaw_rad))
 
 
+def beam_origin(context: RunContext) -> tuple[float, float]:
+    """(distance from base_link's origin, height) of the rangefinder sites.
+
+    The rangefinders sit on the rim of the body and point outward, so a beam's
+    reading plus this distance is the range from base_link's origin that a
+    LaserScan needs.  Taken from the context when it says so, else from the
+    ``range_site_*`` sites of the attached MJCF (0 when there are none).
+    """
+    if hasattr(context, "sensor_offset_m"):
+        return float(context.sensor_offset_m), float(getattr(context, "sensor_height_m", 0.0))
+    try:
+        root = ElementTree.fromstring(context.mjcf_xml)
+    except ElementTree.ParseError:
+        return 0.0, 0.0
+    positions = [
+        [float(v) for v in site.get("pos", "0 0 0").split()]
+        for site in root.iter("site")
+        if (site.get("name") or "").startswith("range_site_")
+    ]
+    if not positions:
+        return 0.0, 0.0
+    xyz = np.array(positions, dtype=float).reshape(-1, 3)
+    return float(np.mean(np.hypot(xyz[:, 0], xyz[:, 1]))), float(np.mean(xyz[:, 2]))
+
+
 def versions(extra: dict[str, str] | None = None) -> dict[str, str]:
     """Versions worth recording: swarmnav, MuJoCo, Python, the log writer."""
     found = {"python": platform.python_version()}
@@ -288,11 +314,8 @@ class McapRecorder:
             raise ValueError("LaserScan needs evenly spaced sensor angles")
         # Rangefinders sit on the body's rim; a LaserScan has one origin, so ranges
         # are reported from base_link's origin: distance + rim offset.
-        self._beam_offset_m = float(getattr(context, "sensor_offset_m", 0.0))
-        self._scan_pose = Pose(
-            position=Vector3(z=float(getattr(context, "sensor_height_m", 0.0))),
-            orientation=Quaternion(w=1.0),
-        )
+        self._beam_offset_m, height_m = beam_origin(context)
+        self._scan_pose = Pose(position=Vector3(z=height_m), orientation=Quaternion(w=1.0))
         self._moving_infos = tuple(o for o in context.obstacles if o.moving)
         self._static_entities = [
             _obstacle_entity(o, o.position_m[0], o.position_m[1], 0)
@@ -401,7 +424,9 @@ class McapRecorder:
         if self._writer is None:
             return
         try:
-            self._writer.write_metadata("outcome", {k: dumps(v) for k, v in summary.items()})
+            # Wall-clock figures would make two identical runs' logs differ: left out.
+            outcome = {k: dumps(v) for k, v in summary.items() if not k.startswith("wall_")}
+            self._writer.write_metadata("outcome", outcome)
             self._writer.close()
         finally:
             self._writer = None
@@ -435,7 +460,7 @@ class McapRecorder:
                 "physics_dt_s": repr(float(context.physics_dt_s)),
                 "sensor_angles_rad": dumps([float(a) for a in context.sensor_angles_rad]),
                 "sensor_range_m": repr(float(context.sensor_range_m)),
-                "sensor_offset_m": repr(float(getattr(context, "sensor_offset_m", 0.0))),
+                "sensor_offset_m": repr(beam_origin(context)[0]),
                 "arena_size_m": dumps(list(context.arena_size_m)),
                 "obstacles": dumps(
                     [

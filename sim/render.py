@@ -40,8 +40,13 @@ PATH_RGBA = np.array([0.1, 0.75, 0.2, 1.0], dtype=np.float32)
 DRIVEN_RGBA = np.array([0.15, 0.35, 0.9, 0.9], dtype=np.float32)
 BEAM_HIT_RGBA = np.array([1.0, 0.15, 0.1, 1.0], dtype=np.float32)
 BEAM_MISS_RGBA = np.array([1.0, 0.75, 0.2, 0.35], dtype=np.float32)
-PATH_WIDTH_M = 0.025
-BEAM_WIDTH_M = 0.006
+# Lines (widths in pixels) cost ~30 us each to draw, capsules ~200 us: the path,
+# the trail and the beams are lines, and the trail keeps a point per TRAIL_STEP_M.
+PATH_WIDTH_PX = 4.0
+TRAIL_WIDTH_PX = 2.5
+BEAM_WIDTH_PX = 2.0
+TRAIL_STEP_M = 0.05
+MAX_TRAIL_POINTS = 400
 
 
 def expected_frames(duration_s: float, fps: float) -> int:
@@ -119,15 +124,27 @@ class ScenePoser:
         return starts, starts + axes * length[:, None], hit
 
 
-def _add_connector(scene: mujoco.MjvScene, start: np.ndarray, end: np.ndarray, width_m: float, rgba: np.ndarray) -> bool:
+_ZERO3 = np.zeros(3)
+_EYE9 = np.eye(3).ravel()
+
+
+def _add_line(scene: mujoco.MjvScene, start: np.ndarray, end: np.ndarray, width_px: float, rgba: np.ndarray) -> bool:
+    """Append one line segment to the user part of the scene (False when it is full)."""
     if scene.ngeom >= scene.maxgeom:
         return False
     geom = scene.geoms[scene.ngeom]
-    mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, np.zeros(3), np.zeros(3), np.eye(3).ravel(), rgba)
-    mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, width_m, start, end)
+    mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_LINE, _ZERO3, _ZERO3, _EYE9, rgba)
+    mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_LINE, width_px, start, end)
     geom.category = mujoco.mjtCatBit.mjCAT_DECOR
     scene.ngeom += 1
     return True
+
+
+def _add_polyline(scene: mujoco.MjvScene, points_xy: np.ndarray, z_m: float, width_px: float, rgba: np.ndarray) -> None:
+    points = np.column_stack([np.asarray(points_xy, dtype=float)[:, :2], np.full(len(points_xy), z_m)])
+    for a, b in zip(points[:-1], points[1:]):
+        if not _add_line(scene, a, b, width_px, rgba):
+            return
 
 
 class SceneRenderer:
@@ -156,6 +173,7 @@ class SceneRenderer:
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
         self._option = mujoco.MjvOption()
         self._option.sitegroup[:] = 0  # no site spheres; beams are drawn instead
+        self._option.geomgroup[:4] = 1  # the robot's chassis is a collision geom (group 3)
 
     def render(
         self,
@@ -167,18 +185,13 @@ class SceneRenderer:
         """One (height, width, 3) uint8 RGB frame."""
         self._renderer.update_scene(data, camera=self.camera, scene_option=self._option)
         scene = self._renderer.scene
-        if path_m is not None and len(path_m) > 1:
-            z = np.full((len(path_m), 1), 0.01)
-            points = np.hstack([np.asarray(path_m, dtype=float)[:, :2], z])
-            for a, b in zip(points[:-1], points[1:]):
-                _add_connector(scene, a, b, PATH_WIDTH_M, PATH_RGBA)
-        if trail_m is not None and len(trail_m) > 1:
-            points = np.hstack([trail_m[:, :2], np.full((len(trail_m), 1), 0.012)])
-            for a, b in zip(points[:-1], points[1:]):
-                _add_connector(scene, a, b, 0.5 * PATH_WIDTH_M, DRIVEN_RGBA)
         if beams is not None:
             for start, end, hit in zip(*beams):
-                _add_connector(scene, start, end, BEAM_WIDTH_M, BEAM_HIT_RGBA if hit else BEAM_MISS_RGBA)
+                _add_line(scene, start, end, BEAM_WIDTH_PX, BEAM_HIT_RGBA if hit else BEAM_MISS_RGBA)
+        if path_m is not None and len(path_m) > 1:
+            _add_polyline(scene, path_m, 0.01, PATH_WIDTH_PX, PATH_RGBA)
+        if trail_m is not None and len(trail_m) > 1:
+            _add_polyline(scene, trail_m, 0.012, TRAIL_WIDTH_PX, DRIVEN_RGBA)
         return self._renderer.render()
 
     def close(self) -> None:
@@ -268,7 +281,11 @@ class VideoRecorder:
 
     def step(self, frame: StepFrame) -> None:
         if self.trail:
-            self._trail.append(np.asarray(frame.position_m[:2], dtype=float))
+            point = np.array(frame.position_m[:2], dtype=float)
+            if not self._trail or np.hypot(*(point - self._trail[-1])) >= TRAIL_STEP_M:
+                self._trail.append(point)
+                if len(self._trail) > MAX_TRAIL_POINTS:
+                    self._trail = self._trail[::2]
         if frame.time_s + 1e-9 < self._next_frame / self.fps:
             return
         started = time.perf_counter()
@@ -277,7 +294,7 @@ class VideoRecorder:
             self._poser.data,
             path_m=self._path_m,
             beams=self._poser.beams(frame.range_m),
-            trail_m=np.array(self._trail) if self.trail and len(self._trail) > 1 else None,
+            trail_m=np.array(self._trail + [frame.position_m[:2]]) if self.trail and self._trail else None,
         )
         self.render_seconds += time.perf_counter() - started
         while self._next_frame / self.fps <= frame.time_s + 1e-9:

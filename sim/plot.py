@@ -1,0 +1,152 @@
+"""``swarmnav plot LOG -o out.png``: a run at a glance, from its log only.
+
+Top panel: the arena, the obstacles (moving ones as the band they swept), every
+planned path (the last one solid), the driven trajectory, where collisions began
+and where range beams hit something.  Bottom panel: commanded and measured wheel
+speeds over simulated time.  Matplotlib with the Agg backend, so it runs on
+servers without a display.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.collections import PatchCollection  # noqa: E402
+from matplotlib.patches import Circle, Rectangle  # noqa: E402
+
+from sim.log_reader import RunLog, outcome_text, read_log  # noqa: E402
+
+MAX_SWEEP_DISCS = 40
+MAX_SCANS = 400
+
+
+def range_hits_m(log: RunLog, max_scans: int = MAX_SCANS) -> np.ndarray:
+    """World (x, y) of every beam hit, from at most ``max_scans`` evenly spread scans."""
+    if len(log.scan_time_s) == 0 or len(log.time_s) == 0:
+        return np.zeros((0, 2))
+    pick = np.unique(np.linspace(0, len(log.scan_time_s) - 1, min(max_scans, len(log.scan_time_s))).astype(int))
+    pose_index = np.clip(np.searchsorted(log.time_s, log.scan_time_s[pick]), 0, len(log.time_s) - 1)
+    ranges = log.range_m[pick]                                        # (S, K) from base origin
+    bearing = log.heading_rad[pose_index][:, None] + log.scan_angles_rad[None, :]
+    x = log.position_m[pose_index, 0][:, None] + ranges * np.cos(bearing)
+    y = log.position_m[pose_index, 1][:, None] + ranges * np.sin(bearing)
+    hit = np.isfinite(ranges)
+    return np.column_stack([x[hit], y[hit]])
+
+
+def collision_points_m(log: RunLog) -> np.ndarray:
+    """Robot (x, y) at every ``collision_begin`` event."""
+    times = [t for t, kind, _ in log.events if kind == "collision_begin"]
+    if not times or len(log.time_s) == 0:
+        return np.zeros((0, 2))
+    index = np.clip(np.searchsorted(log.time_s, times), 0, len(log.time_s) - 1)
+    return log.position_m[index, :2]
+
+
+def _draw_obstacles(ax, log: RunLog) -> None:
+    static, swept = [], []
+    for ob in log.obstacles:
+        x, y = ob["position_m"][0], ob["position_m"][1]
+        if ob["shape"] == "box":
+            hx, hy = ob["size_m"][0], ob["size_m"][1]
+            static.append(Rectangle((x - hx, y - hy), 2 * hx, 2 * hy))
+            continue
+        radius = ob["size_m"][0]
+        track = log.obstacle_tracks.get(ob["entity_id"])
+        if ob["moving"] and track is not None and len(track[0]) > 1:
+            xy = track[1]
+            for k in np.unique(np.linspace(0, len(xy) - 1, MAX_SWEEP_DISCS).astype(int)):
+                swept.append(Circle(tuple(xy[k]), radius))
+            ax.plot(xy[:, 0], xy[:, 1], color="tab:orange", lw=0.8)
+            ax.add_patch(Circle(tuple(xy[-1]), radius, fill=False, ec="tab:orange", lw=1.2))
+        else:
+            static.append(Circle((x, y), radius))
+    ax.add_collection(PatchCollection(static, fc="saddlebrown", ec="black", lw=0.5, alpha=0.8))
+    if swept:
+        ax.add_collection(PatchCollection(swept, fc="tab:orange", ec="none", alpha=0.08))
+
+
+def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
+    """Draw the two panels of a run into ``out`` (PNG, SVG, PDF by extension)."""
+    fig, (ax, ax_wheels) = plt.subplots(
+        2, 1, figsize=(8, 10.5), gridspec_kw={"height_ratios": [3, 1.1]}, layout="constrained"
+    )
+    width_m, height_m = log.run_value("arena_size_m", [10.0, 10.0])
+    ax.add_patch(Rectangle((0, 0), width_m, height_m, fill=False, ec="black", lw=1.0))
+    _draw_obstacles(ax, log)
+
+    hits = range_hits_m(log)
+    if len(hits):
+        ax.scatter(hits[:, 0], hits[:, 1], s=2, c="tab:red", alpha=0.35, label="range hits", zorder=3)
+    for k, (_, path) in enumerate(log.paths):
+        last = k == len(log.paths) - 1
+        ax.plot(path[:, 0], path[:, 1], color="tab:green", lw=1.6 if last else 0.9,
+                ls="-" if last else "--", marker="." if last else None, ms=4,
+                label="planned path" if last else None, zorder=4)
+    if len(log.time_s):
+        ax.plot(log.position_m[:, 0], log.position_m[:, 1], color="tab:blue", lw=1.4,
+                label="driven", zorder=5)
+        ax.plot(*log.position_m[0, :2], "o", color="tab:blue", ms=6, zorder=6)
+    if log.paths:
+        goal = log.paths[-1][1][-1]
+        ax.plot(goal[0], goal[1], "*", color="tab:green", ms=14, mec="black", label="goal", zorder=6)
+    collisions = collision_points_m(log)
+    if len(collisions):
+        ax.plot(collisions[:, 0], collisions[:, 1], "x", color="red", ms=10, mew=2.5,
+                label=f"collisions ({len(collisions)})", zorder=7)
+    margin = 0.3
+    ax.set_xlim(-margin, width_m + margin)
+    ax.set_ylim(-margin, height_m + margin)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    planner = log.metadata.get("planner", {}).get("name", "?")
+    seed = log.metadata.get("run", {}).get("seed", "?")
+    truncated = "" if log.complete else " (truncated log)"
+    ax.set_title(f"{log.scenario_name} / {planner} / seed {seed}: {outcome_text(log)}, "
+                 f"{log.duration_s:.1f} s{truncated}")
+    ax.legend(loc="upper left", fontsize=8, framealpha=0.85)
+
+    t = log.wheel_time_s
+    for column, side, colour in ((0, "left", "tab:blue"), (1, "right", "tab:orange")):
+        ax_wheels.plot(t, log.wheel_command_rad_s[:, column], color=colour, ls="--", lw=0.9,
+                       label=f"{side} commanded")
+        ax_wheels.plot(t, log.wheel_measured_rad_s[:, column], color=colour, lw=1.1,
+                       label=f"{side} measured")
+    for time_s, kind, _ in log.events:
+        if kind == "collision_begin":
+            ax_wheels.axvline(time_s, color="red", lw=0.6, alpha=0.6)
+    ax_wheels.set_xlabel("simulation time [s]")
+    ax_wheels.set_ylabel("wheel speed [rad/s]")
+    ax_wheels.grid(alpha=0.3)
+    ax_wheels.legend(loc="upper right", fontsize=8, ncol=2)
+
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=dpi)
+    plt.close(fig)
+    return out
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("log", help="an .mcap run log")
+    parser.add_argument("-o", "--out", required=True, help="image to write (.png, .svg, .pdf)")
+    parser.add_argument("--dpi", type=int, default=120)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Plot a log; a truncated log is plotted as far as it goes, with a warning."""
+    log = read_log(args.log, allow_truncated=True)
+    if not log.complete:
+        print(f"warning: {args.log}: {log.raw.recovery_line()}", file=sys.stderr)
+    out = plot_run(log, args.out, dpi=args.dpi)
+    print(out)
+    return 0
