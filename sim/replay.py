@@ -164,12 +164,43 @@ class VerifyReport:
         return out
 
 
+class TrajectoryCapture:
+    """A Recorder that keeps the time and base pose of every step in memory."""
+
+    def __init__(self) -> None:
+        self.times_s: list[float] = []
+        self.positions_m: list[np.ndarray] = []
+        self.quaternions_wxyz: list[np.ndarray] = []
+
+    def start(self, context: RunContext) -> None:
+        pass
+
+    def path(self, time_s: float, waypoints_m: np.ndarray) -> None:
+        pass
+
+    def step(self, frame: StepFrame) -> None:
+        self.times_s.append(frame.time_s)
+        self.positions_m.append(np.array(frame.position_m, dtype=float))
+        self.quaternions_wxyz.append(np.array(frame.quaternion_wxyz, dtype=float))
+
+    def event(self, time_s: float, kind: str, details: dict) -> None:
+        pass
+
+    def finish(self, summary: dict) -> None:
+        pass
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(T,) times, (T, 3) positions, (T, 4) quaternions."""
+        return (np.array(self.times_s, dtype=float),
+                np.array(self.positions_m, dtype=float).reshape(-1, 3),
+                np.array(self.quaternions_wxyz, dtype=float).reshape(-1, 4))
+
+
 def verify_log(log: RunLog) -> VerifyReport:
     """Re-simulate a logged run from the log alone and compare poses step by step."""
     import mujoco
 
     from models.scenario import parse_scenario
-    from sim.recorders import TrajectoryCapture
     from sim.runner import Simulation, plan_scenario
     from sim.scene import index_scene
 

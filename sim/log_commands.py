@@ -1,0 +1,50 @@
+"""``swarmnav log info LOG`` and ``swarmnav log recover IN OUT``.
+
+``info`` prints the scenario, planner, seed, duration, outcome and every channel
+with its message count and schema.  A file without footer (a killed run) is an
+error (exit 2) that says how much of it is readable; ``recover`` turns it into a
+complete, indexed file holding every message up to the writer's last flush.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from sim.log_reader import describe, read_log, recover_log
+
+
+def add_info_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("log", help="an .mcap run log")
+    parser.add_argument("--json", action="store_true", help="print the facts as JSON")
+
+
+def run_info(args: argparse.Namespace) -> int:
+    log = read_log(args.log)
+    if not args.json:
+        print("\n".join(describe(log)))
+        return 0
+    print(json.dumps({
+        "log": str(args.log),
+        "scenario": log.scenario_name,
+        "planner": log.metadata.get("planner", {}).get("name"),
+        "seed": log.metadata.get("run", {}).get("seed"),
+        "duration_s": log.duration_s,
+        "outcome": log.outcome,
+        "events": [{"time_s": t, "kind": k, "details": d} for t, k, d in log.events],
+        "channels": {topic: {"count": count, "schema": log.schema_names.get(topic, "")}
+                     for topic, count in log.counts.items()},
+        "versions": log.metadata.get("versions", {}),
+    }, sort_keys=True))
+    return 0
+
+
+def add_recover_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("source", metavar="IN", help="a (possibly truncated) .mcap file")
+    parser.add_argument("target", metavar="OUT", help="the complete, indexed .mcap file to write")
+
+
+def run_recover(args: argparse.Namespace) -> int:
+    raw = recover_log(args.source, args.target)
+    print(f"{args.target}: {raw.recovery_line()}")
+    return 0
