@@ -436,7 +436,10 @@ class DStarLite:
             k_old, u = self._top()
             if u < 0:
                 break
-            if not (k_old < self._key(s) or rhs[s] > g[s]):
+            # Ties (common on grids with the octile heuristic) are expanded too: a vertex whose
+            # key equals the start's may still lie on the start's path with a stale g.
+            ks = self._key(s)
+            if not (k_old < (ks[0] + 1e-9, ks[1] + 1e-9) or rhs[s] != g[s]):
                 break
             k_new = self._key(u)
             self.expansions += 1

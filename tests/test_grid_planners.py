@@ -1,0 +1,307 @@
+"""Grid planners (A*, Dijkstra, Theta*, D* Lite, IMMAS, IACO, M-ACO), maps and Moving AI checks."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from models.scenario import list_scenarios, load_scenario, parse_scenario
+from planners import PLANNERS, make_planner
+from planners.errors import ConfigError, NoPathFound
+from planners.geometry import segment_box_distances
+from planners.grid_search import DStarLite, astar_cells, dijkstra_cells, grid_line_of_sight, theta_star_cells
+from planners.improved_ant_colony import adaptive_parameters, feature_cells, iaco_heuristic, pheromone_intensity
+from planners.max_min_ant_system import analyse_environment
+from planners.movingai import (benchmark_sets, format_map, map_problem, map_to_grid, merge_boxes, parse_map,
+                               read_map, read_scenarios)
+
+GRID_PLANNERS = ("astar", "dijkstra", "theta_star", "dstar_lite", "immas", "iaco")
+MAP_SCENARIOS = [n for n in list_scenarios() if n.startswith(("immas-", "iaco-"))]
+FAST = {"iaco": {"ants": 20, "iterations": 15}}
+
+
+def draw(rows: list[str]) -> np.ndarray:
+    """A world grid from text drawn top row first ('#' blocked)."""
+    return np.array([[ch == "#" for ch in row] for row in rows], dtype=bool)[::-1]
+
+
+# -- maps ----------------------------------------------------------------------
+
+def test_map_reader_flips_rows_and_merged_boxes_cover_exactly_the_occupied_cells():
+    text = format_map(np.array([[1, 0, 0], [1, 1, 0]], dtype=bool))
+    occ = parse_map(text)
+    assert occ.tolist() == [[True, False, False], [True, True, False]]
+    grid = map_to_grid(occ, 0.5)
+    assert grid.occupied[0].tolist() == [True, True, False]       # the file's last row is y = 0
+    rng = np.random.default_rng(3)
+    world = rng.random((20, 30)) < 0.3
+    boxes = merge_boxes(world, 0.25)
+    covered = np.zeros_like(world, dtype=int)
+    for b in boxes:
+        c0, c1 = round(b.x_min_m / 0.25), round(b.x_max_m / 0.25)
+        r0, r1 = round(b.y_min_m / 0.25), round(b.y_max_m / 0.25)
+        covered[r0:r1, c0:c1] += 1
+    assert np.array_equal(covered, world.astype(int))             # disjoint and exact
+    assert len(boxes) < world.sum()
+
+
+def test_bad_map_text_is_a_config_error():
+    with pytest.raises(ConfigError):
+        parse_map("type octile\nheight 2\nwidth 2\nmap\n..\n.x\n")
+
+
+def test_segment_box_distance_matches_dense_sampling():
+    rng = np.random.default_rng(0)
+    a, b = rng.uniform(-2, 2, (60, 2)), rng.uniform(-2, 2, (60, 2))
+    lo = rng.uniform(-1, 0.5, (5, 2))
+    boxes = np.hstack([lo, lo + rng.uniform(0.1, 1, (5, 2))])
+    d = segment_box_distances(a, b, boxes)
+    t = np.linspace(0, 1, 4001)[:, None, None]
+    p = a[None] * (1 - t) + b[None] * t
+    gap = np.maximum(np.maximum(boxes[None, None, :, :2] - p[:, :, None], p[:, :, None] - boxes[None, None, :, 2:]), 0)
+    assert np.allclose(np.hypot(gap[..., 0], gap[..., 1]).min(axis=0), d, atol=2e-3)
+
+
+def test_map_scenarios_load_with_boxes_and_a_grid_at_map_resolution():
+    assert len(MAP_SCENARIOS) == 10
+    scenario = load_scenario("immas-env1-scattered")
+    problem = scenario.to_problem()
+    assert problem.grid.shape == (50, 50) and problem.grid.cell_m == pytest.approx(0.4)
+    assert 0 < len(scenario.boxes) < problem.grid.occupied.sum()
+
+
+def test_a_map_that_does_not_span_the_arena_is_rejected():
+    text = load_scenario("iaco-simple").source_text.replace("cell_m = 0.4", "cell_m = 0.3")
+    with pytest.raises(ConfigError) as err:
+        parse_scenario(text, str(load_scenario("iaco-simple").source_path))
+    assert err.value.field == "map.cell_m"
+
+
+# -- every planner on every bundled map ----------------------------------------
+
+@pytest.mark.parametrize("scenario_name", MAP_SCENARIOS)
+@pytest.mark.parametrize("planner_name", GRID_PLANNERS)
+def test_collision_free_on_every_bundled_map(planner_name, scenario_name):
+    if planner_name == "theta_star" and scenario_name not in ("iaco-simple", "immas-env2-rings"):
+        pytest.skip("theta_star is slow with exact box checks; two maps suffice here")
+    if planner_name == "iaco" and scenario_name == "iaco-baffle":
+        pytest.skip("iaco needs its full 50 x 100 budget on the baffle map (run by bench grid)")
+    scenario = load_scenario(scenario_name)
+    problem = scenario.to_problem()
+    params = dict(FAST.get(planner_name, {}))
+    if planner_name == scenario.planner_name:
+        params = {**scenario.planner_params, **params}
+    path = make_planner(planner_name, params).plan(problem, np.random.default_rng(0))
+    assert problem.is_collision_free(path.waypoints)
+    assert np.allclose(path.waypoints[0], problem.start.xy) and np.allclose(path.waypoints[-1], problem.goal.xy)
+    assert path.stats.extra["raw_cells"]
+
+
+@pytest.mark.parametrize("planner_name", GRID_PLANNERS + ("maco",))
+def test_same_seed_same_path(planner_name):
+    scenario = load_scenario("restaurant-table-2-maco" if planner_name == "maco" else "iaco-complex")
+    problem = scenario.to_problem()
+    params = FAST.get(planner_name, {})
+    one = make_planner(planner_name, params).plan(problem, np.random.default_rng(7))
+    two = make_planner(planner_name, params).plan(problem, np.random.default_rng(7))
+    assert one.same_as(two)
+
+
+def test_shortcut_off_keeps_the_raw_cells():
+    problem = load_scenario("iaco-simple").to_problem()
+    raw = make_planner("astar", {"shortcut": False}).plan(problem, np.random.default_rng(0))
+    assert len(raw.waypoints) == len(raw.stats.extra["raw_cells"])
+    short = make_planner("astar").plan(problem, np.random.default_rng(0))
+    assert short.stats.length_m <= raw.stats.length_m + 1e-9
+
+
+# -- searches ------------------------------------------------------------------
+
+def test_no_corner_cutting_and_octile_costs():
+    occ = draw(["...",
+                ".#.",
+                "..."])
+    # Corner to corner: every diagonal move passes the blocked centre, so 4 straight moves
+    # (with corner cutting it would be 2 + sqrt 2).
+    cells, cost, _ = astar_cells(occ, (0, 0), (2, 2))
+    assert cost == pytest.approx(4.0)
+    assert dijkstra_cells(occ, (0, 0), (2, 2))[1] == pytest.approx(4.0)
+    free = (~occ).tolist()
+    assert not grid_line_of_sight(free, (0, 0), (2, 2))
+    assert theta_star_cells(occ, (0, 0), (0, 2))[1] == pytest.approx(2.0)
+    squeeze = draw([".#",
+                    "#."])
+    with pytest.raises(NoPathFound):
+        astar_cells(squeeze, (1, 0), (0, 1))
+
+
+@pytest.mark.parametrize("planner_name", GRID_PLANNERS)
+def test_unreachable_goal_raises_no_path_found(planner_name):
+    occ = draw(["....#....",
+                "....#....",
+                "....#...."])
+    problem = map_problem(occ, 0.4, (1, 0), (1, 8))
+    with pytest.raises(NoPathFound):
+        make_planner(planner_name, FAST.get(planner_name, {})).plan(problem, np.random.default_rng(0))
+
+
+def test_dstar_lite_replans_after_cells_change():
+    rng = np.random.default_rng(5)
+    occ = rng.random((30, 30)) < 0.2
+    start, goal = (0, 0), (29, 29)
+    occ[start] = occ[goal] = False
+    planner = DStarLite(occ, start, goal)
+    cells = planner.plan()
+    assert planner.cost_cells == pytest.approx(astar_cells(occ, start, goal)[1])
+    # Block part of the current path, move the robot a few cells, and replan.
+    robot = cells[3]
+    blocked = {cells[k]: True for k in (8, 9, 10)}
+    for cell in blocked:
+        occ[cell] = True
+    planner.move_start(robot)
+    planner.update_cells(blocked)
+    replanned = planner.plan()
+    assert replanned[0] == robot and replanned[-1] == goal
+    assert not any(occ[c] for c in replanned)
+    assert planner.cost_cells == pytest.approx(astar_cells(occ, robot, goal)[1])
+    # Freeing them again restores the old cost-to-go.
+    for cell in blocked:
+        occ[cell] = False
+    planner.update_cells({cell: False for cell in blocked})
+    planner.plan()
+    assert planner.cost_cells == pytest.approx(astar_cells(occ, robot, goal)[1])
+
+
+# -- Moving AI -----------------------------------------------------------------
+
+SETS = benchmark_sets()
+
+
+@pytest.mark.skipif(not SETS, reason="Moving AI benchmark folder not found (set SWARMNAV_MOVINGAI_DIR)")
+@pytest.mark.parametrize("search", [astar_cells, dijkstra_cells], ids=["astar", "dijkstra"])
+def test_movingai_optimal_lengths_on_a_sample(search):
+    checked = 0
+    for map_path, scen_path in SETS:
+        occ = read_map(map_path)
+        scenarios = [s for s in read_scenarios(scen_path) if s.map_name.endswith(map_path.name)]
+        for s in scenarios[::7]:
+            _, cost, _ = search(occ, s.start_cell(), s.goal_cell())
+            assert abs(cost - s.optimal_length) < 1e-4, s
+            checked += 1
+    assert checked > 50
+
+
+# -- IMMAS ---------------------------------------------------------------------
+
+def test_gate_raise_closes_a_cell_between_two_diagonal_obstacles():
+    occ = draw(["#####",
+                "...#.",
+                ".....",
+                ".#...",
+                "....."])
+    # Cell (2, 2) in world rows (middle row) has NE (3, 3) and SW (1, 1) blocked.
+    analysis = analyse_environment(occ, start=(0, 0), goal=(4, 4) if not occ[4, 4] else (2, 4))
+    assert (2, 2) in analysis.gates
+    assert analysis.blocked[2, 2]
+
+
+def test_tight_tunnel_entrance_is_closed_and_the_wide_way_is_taken():
+    occ = draw([".........",
+                ".........",
+                "##.###...",
+                ".........",
+                "........."])
+    # The one-cell gap at world row 2, column 2 is flanked by obstacles left and right.
+    start, goal = (0, 0), (4, 0)
+    analysis = analyse_environment(occ, start, goal)
+    assert (2, 2) in analysis.tunnels and analysis.blocked[2, 2]
+    assert not analysis.closing_reverted
+    problem = map_problem(occ, 0.4, start, goal)
+    assert [2, 2] in make_planner("astar").plan(problem, np.random.default_rng(0)).stats.extra["raw_cells"]
+    wide = make_planner("immas").plan(problem, np.random.default_rng(0))
+    assert [2, 2] not in wide.stats.extra["raw_cells"]
+    assert wide.stats.extra["tunnels_closed"] >= 1
+    assert problem.is_collision_free(wide.waypoints)
+
+
+def test_closing_is_reverted_when_it_would_disconnect_start_and_goal():
+    occ = draw(["....",
+                "##.#",
+                "...."])
+    analysis = analyse_environment(occ, (0, 0), (2, 0))
+    assert analysis.closing_reverted and not analysis.gates and not analysis.tunnels
+
+
+def test_immas_reports_table_1_quantities():
+    scenario = load_scenario("immas-env1-scattered")
+    path = make_planner("immas", scenario.planner_params).plan(scenario.to_problem(), np.random.default_rng(0))
+    extra = path.stats.extra
+    for key in ("gates_raised", "tunnels_closed", "moves", "total_arc_cost"):
+        assert key in extra
+    assert path.stats.iterations == extra["moves"] or extra["moves"] < path.stats.iterations
+
+
+# -- IACO ----------------------------------------------------------------------
+
+def test_iaco_heuristic_eq6_hand_computed():
+    # From (0, 0) with the goal at (3, 4) (d_ig = 5), moving to (1, 1) (d_ij = sqrt 2, d_jg = sqrt 13),
+    # straight on from the previous move (omega = 0, factor 2).
+    eta = iaco_heuristic(5.0, math.sqrt(2.0), math.sqrt(13.0), 1.0)
+    assert eta == pytest.approx(5.0 / (math.sqrt(2.0) + math.sqrt(13.0)) * 2.0)
+    # A right-angle turn halves it; a U-turn gives zero.
+    assert iaco_heuristic(5.0, 1.0, 4.0, 0.0) == pytest.approx(1.0)
+    assert iaco_heuristic(5.0, 1.0, 4.0, -1.0) == pytest.approx(0.0)
+
+
+def test_iaco_adaptive_parameters_eqs_9_to_11_hand_computed():
+    # Nc / N = 0.5 and L_GL / (LF_best + L_GL) = 10 / (10 + 10) = 0.5, so x = 0.5.
+    alpha, beta, rho = adaptive_parameters(1.0, 5.0, 2.0, 0.7, 50, 100, 10.0, 10.0, 0.3)
+    assert alpha == pytest.approx(1.0 + 2.0 * math.sin(0.5 * math.pi))
+    assert beta == pytest.approx(5.0 * math.exp(-2.0 * 0.25))
+    assert rho == pytest.approx(0.7 * 0.5)
+    # Before any best length: ratio 0, rho keeps its initial value.
+    alpha, beta, rho = adaptive_parameters(1.0, 5.0, 2.0, 0.7, 1, 100, 10.0, None, 0.3)
+    assert alpha == pytest.approx(1.0 + 2.0 * math.sin(0.005 * math.pi))
+    assert rho == 0.3
+    # Eq. (7): a path 1 cell longer than the collar line gets Q * t_c ** -1.
+    assert pheromone_intensity(100.0, 1.5, 10.0, np.array([11.0]))[0] == pytest.approx(100.0 / 1.5)
+
+
+def test_feature_points_are_outside_convex_corners_only():
+    occ = np.zeros((6, 6), dtype=bool)
+    occ[2:4, 2:4] = True                   # a 2 x 2 block: 4 convex corners, no concave one
+    cells, labels, _ = feature_cells(occ)
+    assert sorted(map(tuple, cells.tolist())) == [(1, 1), (1, 4), (4, 1), (4, 4)]
+    assert set(labels.tolist()) == {1}
+
+
+def test_iaco_reports_table_3_quantities():
+    problem = load_scenario("iaco-simple").to_problem()
+    path = make_planner("iaco", FAST["iaco"]).plan(problem, np.random.default_rng(1))
+    extra = path.stats.extra
+    for key in ("optimal_length_m", "mean_length_m", "std_length_m", "convergence_iteration", "bends"):
+        assert key in extra
+    assert extra["optimal_length_m"] == pytest.approx(extra["raw_length_m"])
+
+
+# -- M-ACO ---------------------------------------------------------------------
+
+def test_maco_route_is_collision_free_and_baseline_links_are_checked():
+    scenario = load_scenario("restaurant-table-2-maco")
+    problem = scenario.to_problem()
+    path = make_planner("maco", scenario.planner_params).plan(problem, np.random.default_rng(0))
+    assert problem.is_collision_free(path.waypoints)
+    extra = path.stats.extra
+    assert extra["route"][0] == 0 and extra["route"][-1] == len(extra["nodes_m"]) - 1
+    for label in ("dijkstra", "astar"):
+        assert isinstance(extra[f"{label}_colliding_links"], list)
+    nodes = np.array(extra["nodes_m"])
+    for a, b in extra["dijkstra_colliding_links"]:
+        assert not problem.is_collision_free(nodes[[a, b]])
+
+
+def test_registry_has_the_grid_planners():
+    for name in GRID_PLANNERS + ("maco",):
+        assert name in PLANNERS
