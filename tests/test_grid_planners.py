@@ -305,3 +305,39 @@ def test_maco_route_is_collision_free_and_baseline_links_are_checked():
 def test_registry_has_the_grid_planners():
     for name in GRID_PLANNERS + ("maco",):
         assert name in PLANNERS
+
+
+# -- CLI -----------------------------------------------------------------------
+
+def _walled_scenario(tmp_path, planner: str) -> str:
+    rows = ["....#....", "....#....", "....#....", "....#...."]
+    (tmp_path / "walled.map").write_text(format_map(np.array([[ch == "#" for ch in r] for r in rows])))
+    toml = f'''name = "walled"
+arena = {{ width_m = 3.6, height_m = 1.6 }}
+robot = {{ radius_m = 0.15, clearance_m = 0.05 }}
+start = {{ x = 0.2, y = 0.2 }}
+goal = {{ x = 3.4, y = 1.4 }}
+planner = {{ name = "{planner}" }}
+
+[map]
+file = "walled.map"
+cell_m = 0.4
+'''
+    path = tmp_path / "walled.toml"
+    path.write_text(toml)
+    return str(path)
+
+
+@pytest.mark.parametrize("planner_name", ["astar", "immas"])
+def test_cli_exits_3_when_the_goal_is_unreachable(tmp_path, capsys, planner_name):
+    cli = pytest.importorskip("sim.cli")
+    assert cli.main(["plan", _walled_scenario(tmp_path, planner_name), "--json"]) == 3
+
+
+def test_cli_plans_a_map_scenario(capsys):
+    cli = pytest.importorskip("sim.cli")
+    import json
+
+    assert cli.main(["plan", "immas-env2-rings", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["planner"] == "immas" and out["collision_free"] is True
