@@ -1,0 +1,275 @@
+"""Run logs: MCAP contents, sim-time stamps, determinism, crash recovery, replay, plot.
+
+Real runs, real MCAP files, real EGL rendering (MUJOCO_GL=egl).
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import math  # noqa: E402
+import socket  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from mcap.reader import make_reader  # noqa: E402
+from mcap_protobuf.decoder import DecoderFactory  # noqa: E402
+
+from models.scenario import load_scenario  # noqa: E402
+from sim.cli import main  # noqa: E402
+from sim.log_reader import read_log, read_records  # noqa: E402
+from sim.mcap_log import TOPICS, McapRecorder  # noqa: E402
+from sim.runner import simulate  # noqa: E402
+
+REPO = Path(__file__).resolve().parent.parent
+SCENARIO = "gwo-scenario-2"  # moving obstacles and collisions: every channel has traffic
+PER_STEP = ("/tf", "/robot/pose", "/range/scan", "/wheels", "/controller")
+EXPECTED_SCHEMAS = {
+    "/tf": "foxglove.FrameTransform",
+    "/robot/pose": "foxglove.PoseInFrame",
+    "/planner/path": "foxglove.PosesInFrame",
+    "/obstacles": "foxglove.SceneUpdate",
+    "/range/scan": "foxglove.LaserScan",
+    "/wheels": "swarmnav.WheelSpeeds",
+    "/controller": "swarmnav.ControllerState",
+    "/events": "swarmnav.Event",
+}
+
+
+def record(path: Path, **run_options):
+    return simulate(load_scenario(SCENARIO), recorder=McapRecorder(path), **run_options)
+
+
+@pytest.fixture(scope="module")
+def full_run(tmp_path_factory):
+    path = tmp_path_factory.mktemp("logs") / "full.mcap"
+    episode = record(path)
+    return path, episode
+
+
+def messages_by_topic(path: Path) -> dict[str, list]:
+    with path.open("rb") as stream:
+        reader = make_reader(stream)
+        out: dict[str, list] = {}
+        for _, channel, message in reader.iter_messages(log_time_order=False):
+            out.setdefault(channel.topic, []).append(message)
+    return out
+
+
+def test_log_reads_back_with_expected_channels_counts_and_schemas(full_run):
+    path, episode = full_run
+    with path.open("rb") as stream:
+        reader = make_reader(stream)
+        summary = reader.get_summary()
+        schemas = {c.topic: summary.schemas[c.schema_id].name for c in summary.channels.values()}
+        metadata = {m.name: m.metadata for m in reader.iter_metadata()}
+        attachments = {a.name: a for a in reader.iter_attachments()}
+    assert schemas == EXPECTED_SCHEMAS
+    log = read_log(path)
+    steps = episode.result.steps + 1
+    for topic in PER_STEP:
+        assert log.counts[topic] == steps, topic
+    assert log.counts["/obstacles"] == steps + 1  # t = 0 at start, then every step (obstacles move)
+    assert log.counts["/planner/path"] == 1
+    kinds = [kind for _, kind, _ in log.events]
+    assert kinds[-1] == episode.result.outcome
+    assert kinds.count("collision_begin") == episode.result.collisions
+    assert all({"geom_a", "geom_b"} <= set(d) for _, k, d in log.events if k.startswith("collision"))
+    assert set(metadata) >= {"scenario", "planner", "run", "versions", "outcome"}
+    assert metadata["scenario"]["toml"] == load_scenario(SCENARIO).source_text
+    assert int(metadata["run"]["seed"]) == episode.seed
+    assert {"swarmnav", "mujoco", "python"} <= set(metadata["versions"])
+    assert not any(key.startswith("wall_") for key in metadata["outcome"])
+    assert attachments["scene.xml"].data.decode().startswith("<mujoco")
+    assert np.array_equal(log.position_m[:, :2], episode.result.poses[:, :2])
+
+
+def test_scan_and_obstacles_follow_foxglove_conventions(full_run):
+    path, _ = full_run
+    log = read_log(path)
+    # Misses are NaN (not MuJoCo's -1); hits lie beyond the rim of the body.
+    assert np.isnan(log.range_m).any()
+    finite = log.range_m[np.isfinite(log.range_m)]
+    assert finite.size and finite.min() > 0.15
+    assert len(log.scan_angles_rad) == 12
+    assert math.isclose(log.scan_angles_rad[-1] - log.scan_angles_rad[0], 2 * math.pi * 11 / 12)  # inclusive end
+    factory = DecoderFactory()
+    with path.open("rb") as stream:
+        for schema, channel, message in make_reader(stream).iter_messages(topics=["/obstacles"]):
+            update = factory.decoder_for(channel.message_encoding, schema)(message.data)
+            break
+    cylinders = [c for e in update.entities for c in e.cylinders]
+    assert cylinders and all(c.bottom_scale == 1.0 and c.top_scale == 1.0 for c in cylinders)
+    ids = [e.id for e in update.entities]
+    assert len(ids) == len(set(ids)) == len(load_scenario(SCENARIO).obstacles)
+
+
+def test_timestamps_are_simulation_time(full_run):
+    path, episode = full_run
+    topics = messages_by_topic(path)
+    for topic, messages in topics.items():
+        assert all(m.publish_time == m.log_time for m in messages), topic
+    tf_ns = np.array([m.log_time for m in topics["/tf"]])
+    dt_ns = round(episode.result.times_s[1] * 1e9)
+    assert tf_ns[0] == 0
+    assert np.array_equal(tf_ns, np.arange(len(tf_ns)) * dt_ns)
+    # The stamp inside each message is the same sim time.
+    factory = DecoderFactory()
+    with path.open("rb") as stream:
+        reader = make_reader(stream)
+        for schema, channel, message in reader.iter_messages(topics=["/tf", "/range/scan"]):
+            decoded = factory.decoder_for(channel.message_encoding, schema)(message.data)
+            assert decoded.timestamp.seconds * 10**9 + decoded.timestamp.nanos == message.log_time
+
+
+def test_same_seed_gives_identical_message_bytes(tmp_path):
+    first, second = tmp_path / "a.mcap", tmp_path / "b.mcap"
+    record(first, time_limit_s=25.0)
+    record(second, time_limit_s=25.0)
+    a, b = messages_by_topic(first), messages_by_topic(second)
+    assert set(a) == set(b) == set(TOPICS)
+    for topic in TOPICS:
+        assert [m.data for m in a[topic]] == [m.data for m in b[topic]], topic
+        assert [m.log_time for m in a[topic]] == [m.log_time for m in b[topic]], topic
+
+
+CRASHING_RUN = """
+import os, signal, sys
+from models.scenario import load_scenario
+from sim.mcap_log import McapRecorder
+from sim.runner import simulate
+
+class Crash(McapRecorder):
+    def step(self, frame):
+        super().step(frame)
+        if frame.time_s >= 3.5:
+            os.kill(os.getpid(), signal.SIGKILL)
+
+simulate(load_scenario(sys.argv[2]), recorder=Crash(sys.argv[1]))
+"""
+
+
+def test_sigkill_leaves_a_file_that_log_recover_completes(tmp_path, full_run, capsys):
+    killed, recovered = tmp_path / "killed.mcap", tmp_path / "recovered.mcap"
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    process = subprocess.run([sys.executable, "-c", CRASHING_RUN, str(killed), SCENARIO],
+                             cwd=REPO, env=env, capture_output=True, timeout=120)
+    assert process.returncode == -9, process.stderr.decode()[-2000:]
+    raw = read_records(killed)
+    assert not raw.complete and raw.messages
+    with killed.open("rb") as stream, pytest.raises(Exception):
+        make_reader(stream).get_summary().statistics.message_count  # the default reader cannot
+
+    assert main(["log", "recover", str(killed), str(recovered)]) == 0
+    assert "recovered" in capsys.readouterr().out
+    with recovered.open("rb") as stream:
+        reader = make_reader(stream)
+        statistics = reader.get_summary().statistics
+        got = [(m.channel_id, m.log_time, m.data) for _, _, m in reader.iter_messages(log_time_order=False)]
+    assert statistics.message_count == len(got) == len(raw.messages)
+    # Flushes happen every simulated second: everything up to t = 3 s survives,
+    # byte for byte the same as in the run that was not killed.
+    last_flush_ns = 3 * 10**9
+    assert max(t for _, t, _ in got) == last_flush_ns
+    reference = messages_by_topic(full_run[0])
+    recovered_topics = messages_by_topic(recovered)
+    for topic, messages in recovered_topics.items():
+        expected = [m.data for m in reference[topic] if m.log_time <= last_flush_ns]
+        assert [m.data for m in messages] == expected, topic
+    assert "recovery" in {m.name for m in make_reader(recovered.open("rb")).iter_metadata()}
+
+
+def test_replay_video_has_expected_frames_and_is_not_blank(tmp_path, full_run):
+    from sim.render import expected_frames, read_video_frames, video_info
+
+    path, _ = full_run
+    video = tmp_path / "top.mp4"
+    assert main(["replay", str(path), "--video", str(video), "--fps", "2",
+                 "--width", "160", "--height", "120"]) == 0
+    log = read_log(path)
+    frames, _ = video_info(video)
+    assert frames == expected_frames(log.duration_s, 2.0)
+    images = read_video_frames(video, every=50)
+    for image in images:
+        assert image.shape == (120, 160, 3)
+        assert image.std() > 10.0  # not a blank (uniform) frame
+    assert not np.array_equal(images[0], images[-1])  # the robot moved
+
+
+def test_chase_camera_renders(tmp_path, full_run):
+    from sim.render import read_video_frames
+
+    video = tmp_path / "chase.mp4"
+    assert main(["replay", str(full_run[0]), "--video", str(video), "--camera", "chase", "--fps", "0.5",
+                 "--width", "128", "--height", "96"]) == 0
+    assert all(image.std() > 10.0 for image in read_video_frames(video))
+
+
+def test_replay_verify_passes_bitwise_on_a_fresh_log(full_run, capsys):
+    assert main(["replay", str(full_run[0]), "--verify"]) == 0
+    out = capsys.readouterr().out
+    assert "bitwise equal" in out and "DIFFERENT" not in out
+
+
+def test_plot_writes_an_image(tmp_path, full_run):
+    out = tmp_path / "run.png"
+    assert main(["plot", str(full_run[0]), "-o", str(out)]) == 0
+    assert out.stat().st_size > 20_000
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_log_info_prints_channels_and_outcome(full_run, capsys):
+    assert main(["log", "info", str(full_run[0])]) == 0
+    out = capsys.readouterr().out
+    assert SCENARIO in out and "goal_reached" in out
+    for topic in TOPICS:
+        assert topic in out
+
+
+@pytest.mark.parametrize("kind", ["truncated", "not_mcap", "empty"])
+@pytest.mark.parametrize("command", [["log", "info"], ["replay"]])
+def test_bad_log_gives_one_line_error_and_exit_2(tmp_path, full_run, capsys, kind, command):
+    bad = tmp_path / f"{kind}.mcap"
+    if kind == "truncated":
+        bad.write_bytes(full_run[0].read_bytes()[:40_000])
+    elif kind == "not_mcap":
+        bad.write_text("name = 'not a log'\n")
+    else:
+        bad.write_bytes(b"")
+    argv = command + [str(bad)] + (["--video", str(tmp_path / "x.mp4")] if command == ["replay"] else [])
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1, err
+    assert str(bad) in err
+    assert not (tmp_path / "x.mp4").exists()
+
+
+def test_live_server_binds_loopback_only(tmp_path):
+    recorder = McapRecorder(tmp_path / "live.mcap", live=True, live_port=0)
+    simulate(load_scenario(SCENARIO), recorder=_KeepOpen(recorder), time_limit_s=0.5)
+    try:
+        port = recorder.live_port_bound
+        assert port
+        with socket.create_connection(("127.0.0.1", port), timeout=2.0):
+            pass
+    finally:
+        recorder.finish({})
+    assert read_log(tmp_path / "live.mcap").counts["/tf"] > 0
+
+
+class _KeepOpen:
+    """Delays ``finish`` so the test can talk to the live server first."""
+
+    def __init__(self, inner):
+        self.inner = inner
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
+
+    def finish(self, summary):
+        pass
