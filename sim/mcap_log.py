@@ -44,6 +44,8 @@ import importlib.metadata
 import json
 import math
 import platform
+import threading
+import time
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 from typing import Any
@@ -58,6 +60,7 @@ from foxglove.channels import (
     SceneUpdateChannel,
 )
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
+from foxglove.websocket import ServerListener
 from foxglove.messages import (
     Color,
     CubePrimitive,
@@ -228,6 +231,30 @@ def versions(extra: dict[str, str] | None = None) -> dict[str, str]:
     return found
 
 
+class _LateSubscribers(ServerListener):
+    """Server listener: remembers topics a Foxglove client subscribed to.
+
+    The path and the static obstacles are sent once, at t = 0; a client that
+    connects later would never see them.  The recorder re-sends them on the next
+    step after such a subscription (to every sink, so the MCAP file gets the
+    extra copy too, but only when someone actually watched).
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._lock = threading.Lock()
+        self._topics: set[str] = set()
+
+    def on_subscribe(self, client, channel) -> None:
+        with self._lock:
+            self._topics.add(channel.topic)
+
+    def take(self) -> set[str]:
+        with self._lock:
+            topics, self._topics = self._topics, set()
+        return topics
+
+
 class McapRecorder:
     """Writes one run to an MCAP file (and optionally serves it live).
 
@@ -236,7 +263,11 @@ class McapRecorder:
         flush_interval_s: close the current chunk at least this often in simulated
             time; 1 s loses at most one simulated second to a SIGKILL.
         live: also serve every channel over Foxglove's WebSocket protocol.
-        live_host, live_port: where the live server listens (loopback by default).
+        live_host, live_port: where the live server listens (loopback by default;
+            port 0 picks a free one, see :attr:`live_port_bound`).
+        live_speed: with ``live``, hold the run to this multiple of real time so a
+            viewer can follow it (``None`` or 0: as fast as it goes).  Only the
+            pacing uses the wall clock; nothing of it reaches the log.
         overwrite: replace an existing file instead of refusing.
     """
 
@@ -248,6 +279,7 @@ class McapRecorder:
         live: bool = False,
         live_host: str = "127.0.0.1",
         live_port: int = DEFAULT_LIVE_PORT,
+        live_speed: float | None = 1.0,
         overwrite: bool = False,
     ):
         if flush_interval_s <= 0:
@@ -257,8 +289,12 @@ class McapRecorder:
         self.live = live
         self.live_host = live_host
         self.live_port = live_port
+        self.live_speed = live_speed if live and live_speed else None
         self.overwrite = overwrite
         self.messages_written = 0
+        self._listener: _LateSubscribers | None = None
+        self._wall_start_s = 0.0
+        self._last_path: PosesInFrame | None = None
         self.flushes = 0
         self._writer = None
         self._server = None
@@ -285,12 +321,15 @@ class McapRecorder:
             self.file_path, allow_overwrite=self.overwrite, context=self._fox, writer_options=options
         )
         if self.live:
+            self._listener = _LateSubscribers()
             self._server = foxglove.start_server(
                 name=f"swarmnav {context.scenario_name}",
                 host=self.live_host,
                 port=self.live_port,
                 context=self._fox,
+                server_listener=self._listener,
             )
+            self._wall_start_s = time.perf_counter()
         self._tf = FrameTransformChannel("/tf", context=self._fox)
         self._pose = PoseInFrameChannel("/robot/pose", context=self._fox)
         self._path = PosesInFrameChannel("/planner/path", context=self._fox)
@@ -339,9 +378,9 @@ class McapRecorder:
             Pose(position=Vector3(x=float(x), y=float(y), z=0.01), orientation=_yaw_quaternion(float(h)))
             for (x, y), h in zip(points[:, :2], headings)
         ]
-        self._path.log(
-            PosesInFrame(timestamp=_stamp(t_ns), frame_id=WORLD_FRAME, poses=poses), log_time=t_ns
-        )
+        message = PosesInFrame(timestamp=_stamp(t_ns), frame_id=WORLD_FRAME, poses=poses)
+        self._path.log(message, log_time=t_ns)
+        self._last_path = message
         self._after_write(t_ns, 1)
 
     def step(self, frame: StepFrame) -> None:
@@ -407,10 +446,18 @@ class McapRecorder:
             log_time=t_ns,
         )
         written = 5
-        if self._moving_infos:
+        late = self._listener.take() if self._listener is not None else ()
+        if self._moving_infos or "/obstacles" in late:
             self._obstacles.log(self._scene_update(t_ns, frame.moving_obstacles_m), log_time=t_ns)
             written += 1
+        if "/planner/path" in late and self._last_path is not None:
+            self._path.log(self._last_path, log_time=t_ns)
+            written += 1
         self._after_write(t_ns, written)
+        if self.live_speed:
+            ahead_s = frame.time_s / self.live_speed - (time.perf_counter() - self._wall_start_s)
+            if ahead_s > 0:
+                time.sleep(ahead_s)
 
     def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
         """Log a discrete event and flush, so it survives a crash right after."""

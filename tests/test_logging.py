@@ -10,7 +10,6 @@ import os
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 import math  # noqa: E402
-import socket  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -249,27 +248,43 @@ def test_bad_log_gives_one_line_error_and_exit_2(tmp_path, full_run, capsys, kin
     assert not (tmp_path / "x.mp4").exists()
 
 
-def test_live_server_binds_loopback_only(tmp_path):
-    recorder = McapRecorder(tmp_path / "live.mcap", live=True, live_port=0)
-    simulate(load_scenario(SCENARIO), recorder=_KeepOpen(recorder), time_limit_s=0.5)
+def test_live_view_serves_the_same_channels_on_loopback(tmp_path):
+    """A Foxglove WebSocket client sees every channel, stamped with sim time,
+    and a late subscriber still gets the path and the static obstacles."""
+    import json
+    import struct
+    import threading
+    import time
+
+    from websockets.sync.client import connect  # a dependency of mujoco
+
+    recorder = McapRecorder(tmp_path / "live.mcap", live=True, live_port=0, live_speed=4.0)
+    runner = threading.Thread(target=simulate, args=(load_scenario("gwo-scenario-1"),),
+                              kwargs={"recorder": recorder, "time_limit_s": 3.0})
+    runner.start()
     try:
-        port = recorder.live_port_bound
-        assert port
-        with socket.create_connection(("127.0.0.1", port), timeout=2.0):
-            pass
+        deadline = time.monotonic() + 20
+        while recorder.live_port_bound is None and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert recorder._server is not None
+        with connect(f"ws://127.0.0.1:{recorder.live_port_bound}", subprotocols=["foxglove.sdk.v1"],
+                     open_timeout=5) as client:
+            channels: dict[str, int] = {}
+            while len(channels) < len(TOPICS):
+                message = json.loads(client.recv(timeout=5))
+                if message["op"] == "advertise":
+                    channels.update({c["topic"]: c["id"] for c in message["channels"]})
+            assert set(channels) == set(TOPICS)
+            wanted = {"/tf": 1, "/obstacles": 2, "/planner/path": 3}
+            client.send(json.dumps({"op": "subscribe", "subscriptions": [
+                {"id": sub, "channelId": channels[topic]} for topic, sub in wanted.items()]}))
+            seen: dict[int, int] = {}
+            while set(seen) != {1, 2, 3}:
+                data = client.recv(timeout=5)
+                if isinstance(data, bytes):
+                    _, subscription, stamp_ns = struct.unpack("<BIQ", data[:13])
+                    seen.setdefault(subscription, stamp_ns)
+            assert all(stamp < 3 * 10**9 for stamp in seen.values())  # sim time, not the epoch
     finally:
-        recorder.finish({})
-    assert read_log(tmp_path / "live.mcap").counts["/tf"] > 0
-
-
-class _KeepOpen:
-    """Delays ``finish`` so the test can talk to the live server first."""
-
-    def __init__(self, inner):
-        self.inner = inner
-
-    def __getattr__(self, name):
-        return getattr(self.inner, name)
-
-    def finish(self, summary):
-        pass
+        runner.join(timeout=30)
+    assert read_log(tmp_path / "live.mcap").counts["/tf"] == 151
