@@ -121,8 +121,10 @@ def read_records(path: str | Path) -> RawLog:
             if raw.bytes_read == 0 and not raw.messages and not raw.channels:
                 raise LogError(path, f"not a readable MCAP file ({_describe(error)})") from error
             raw.problem = _describe(error)
+            if raw.bytes_read == raw.file_bytes and type(error).__name__ == "EndOfFile":
+                raw.problem = None  # it ends cleanly after a record: just never closed
         if not raw.complete and raw.problem is None:
-            raw.problem = "no footer"
+            raw.problem = "no footer: the writer was not closed"
     return raw
 
 
@@ -401,7 +403,7 @@ def outcome_text(log: RunLog) -> str:
     for kind in ("goal_reached", "timeout"):
         if kind in kinds:
             return kind
-    return "unknown (the run did not finish)" if not log.complete else "unknown"
+    return "none: the run did not finish (no outcome recorded)"
 
 
 def describe(log: RunLog) -> list[str]:
@@ -416,6 +418,10 @@ def describe(log: RunLog) -> list[str]:
         f"outcome:    {outcome_text(log)}",
         f"file:       {log.raw.recovery_line()}",
     ]
+    recovery = log.metadata.get("recovery")
+    if recovery:
+        lines.append(f"recovered:  from {recovery.get('source')} ({recovery.get('problem') or 'complete'}); "
+                     f"{recovery.get('messages_recovered')} messages kept")
     collisions = sum(1 for _, kind, _ in log.events if kind == "collision_begin")
     lines.append(f"collisions: {collisions}")
     versions = log.metadata.get("versions", {})

@@ -44,6 +44,7 @@ import importlib.metadata
 import json
 import math
 import platform
+import sys
 import threading
 import time
 import xml.etree.ElementTree as ElementTree
@@ -330,6 +331,9 @@ class McapRecorder:
                 server_listener=self._listener,
             )
             self._wall_start_s = time.perf_counter()
+            # The one line a user needs to connect; the CLI cannot know the port earlier.
+            print(f"live view: ws://{self.live_host}:{self._server.port} "
+                  f"(Foxglove: Open connection > Foxglove WebSocket)", file=sys.stderr)
         self._tf = FrameTransformChannel("/tf", context=self._fox)
         self._pose = PoseInFrameChannel("/robot/pose", context=self._fox)
         self._path = PosesInFrameChannel("/planner/path", context=self._fox)
