@@ -9,7 +9,10 @@ by frame, and renders offscreen (see :mod:`sim.render`) through the same
 parameters, seed, and the attached MJCF, not today's model files) and compares
 every logged pose with the re-simulated one.  On the same machine and versions
 we expect bitwise equality; otherwise the largest deviation is reported and where
-it first appeared.
+it first appeared.  The range scans are compared too and reported, but are not
+part of the verdict: the attached MJCF is ``MjSpec.to_xml()`` text, which keeps 6
+significant digits, so sites (and with them the rangefinder readings) may move by
+micrometres unless the runner itself runs the model compiled from that text.
 """
 
 from __future__ import annotations
@@ -135,6 +138,8 @@ class VerifyReport:
     bitwise_equal: bool
     path_bitwise_equal: bool
     path_max_error_m: float
+    ranges_bitwise_equal: bool
+    max_range_error_m: float
     outcome_logged: str
     outcome_simulated: str
 
@@ -152,6 +157,9 @@ class VerifyReport:
             f"  max quaternion deviation: {self.max_quaternion_error:.3e}",
             f"  planned path: {'bitwise equal' if self.path_bitwise_equal else 'differs'} "
             f"(max {self.path_max_error_m:.3e} m)",
+            f"  range scans (not part of the verdict): "
+            f"{'bitwise equal' if self.ranges_bitwise_equal else 'differ'} "
+            f"(max {self.max_range_error_m:.3e} m)",
             f"  outcome: logged {self.outcome_logged}, re-simulated {self.outcome_simulated}",
         ]
         if self.first_difference_s is not None:
@@ -171,6 +179,7 @@ class TrajectoryCapture:
         self.times_s: list[float] = []
         self.positions_m: list[np.ndarray] = []
         self.quaternions_wxyz: list[np.ndarray] = []
+        self.ranges_m: list[np.ndarray] = []
 
     def start(self, context: RunContext) -> None:
         pass
@@ -182,6 +191,7 @@ class TrajectoryCapture:
         self.times_s.append(frame.time_s)
         self.positions_m.append(np.array(frame.position_m, dtype=float))
         self.quaternions_wxyz.append(np.array(frame.quaternion_wxyz, dtype=float))
+        self.ranges_m.append(np.array(frame.range_m, dtype=float))
 
     def event(self, time_s: float, kind: str, details: dict) -> None:
         pass
@@ -234,7 +244,17 @@ def verify_log(log: RunLog) -> VerifyReport:
     path_equal = logged_path.shape == replanned.shape and np.array_equal(logged_path, replanned)
     path_error = (float(np.max(np.linalg.norm(logged_path - replanned, axis=1)))
                   if logged_path.shape == replanned.shape and len(replanned) else math.inf)
-    worst = int(np.argmax(dp)) if n else None
+    # Ranges as the writer logged them (reading + rim offset, NaN for misses).
+    offset_m = float(log.run_value("sensor_offset_m", 0.0))
+    sim_r = np.array(capture.ranges_m, dtype=float).reshape(len(sim_t), -1)
+    sim_r = np.where(np.isfinite(sim_r) & (sim_r >= 0.0), sim_r + offset_m, np.nan)
+    m = min(len(sim_r), len(log.range_m))
+    ranges_equal = (sim_r.shape == log.range_m.shape
+                    and np.array_equal(sim_r, log.range_m, equal_nan=True))
+    range_diff = np.abs(sim_r[:m] - log.range_m[:m])
+    both_nan = np.isnan(sim_r[:m]) & np.isnan(log.range_m[:m])
+    range_diff = np.where(both_nan, 0.0, np.where(np.isnan(range_diff), np.inf, range_diff))
+    worst = int(np.argmax(dp)) if n and dp.max() > 0 else None
     from sim.log_reader import outcome_text
     return VerifyReport(
         logged_steps=len(log.time_s), simulated_steps=len(sim_t), compared_steps=n,
@@ -243,7 +263,8 @@ def verify_log(log: RunLog) -> VerifyReport:
         worst_time_s=float(log.time_s[worst]) if worst is not None else None,
         first_difference_s=float(log.time_s[differing[0]]) if len(differing) else None,
         bitwise_equal=len(differing) == 0 and len(sim_t) == len(log.time_s),
-        path_bitwise_equal=bool(path_equal), path_max_error_m=path_error if path_error != math.inf else math.inf,
+        path_bitwise_equal=bool(path_equal), path_max_error_m=path_error,
+        ranges_bitwise_equal=bool(ranges_equal), max_range_error_m=float(range_diff.max()) if m else 0.0,
         outcome_logged=outcome_text(log), outcome_simulated=result.outcome,
     )
 
