@@ -127,7 +127,7 @@ def bench_restaurant(runs: int) -> list[dict[str, Any]]:
     from models.scenario import load_scenario
     from planners import make_planner
 
-    scenario = load_scenario("restaurant-table-2-maco")
+    scenario = load_scenario("restaurant-table-2")
     problem = scenario.to_problem()
     astar = make_planner("astar").plan(problem, np.random.default_rng(0))
     planner = make_planner("maco", scenario.planner_params)

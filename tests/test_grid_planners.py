@@ -101,7 +101,7 @@ def test_collision_free_on_every_bundled_map(planner_name, scenario_name):
 
 @pytest.mark.parametrize("planner_name", GRID_PLANNERS + ("maco",))
 def test_same_seed_same_path(planner_name):
-    scenario = load_scenario("restaurant-table-2-maco" if planner_name == "maco" else "iaco-complex")
+    scenario = load_scenario("restaurant-table-2" if planner_name == "maco" else "iaco-complex")
     problem = scenario.to_problem()
     params = FAST.get(planner_name, {})
     one = make_planner(planner_name, params).plan(problem, np.random.default_rng(7))
@@ -289,7 +289,7 @@ def test_iaco_reports_table_3_quantities():
 # -- M-ACO ---------------------------------------------------------------------
 
 def test_maco_route_is_collision_free_and_baseline_links_are_checked():
-    scenario = load_scenario("restaurant-table-2-maco")
+    scenario = load_scenario("restaurant-table-2")
     problem = scenario.to_problem()
     path = make_planner("maco", scenario.planner_params).plan(problem, np.random.default_rng(0))
     assert problem.is_collision_free(path.waypoints)
