@@ -78,6 +78,7 @@ from foxglove.messages import (
     Vector3,
 )
 
+from planners.errors import ConfigError
 from sim.recording import ObstacleInfo, RunContext, StepFrame
 
 TOPICS = (
@@ -323,13 +324,20 @@ class McapRecorder:
         )
         if self.live:
             self._listener = _LateSubscribers()
-            self._server = foxglove.start_server(
-                name=f"swarmnav {context.scenario_name}",
-                host=self.live_host,
-                port=self.live_port,
-                context=self._fox,
-                server_listener=self._listener,
-            )
+            try:
+                self._server = foxglove.start_server(
+                    name=f"swarmnav {context.scenario_name}",
+                    host=self.live_host,
+                    port=self.live_port,
+                    context=self._fox,
+                    server_listener=self._listener,
+                )
+            except Exception as error:  # foxglove raises its own error types
+                self._writer.close()
+                self._writer = None
+                raise ConfigError(
+                    "--live", f"cannot serve on {self.live_host}:{self.live_port} ({error})"
+                ) from error
             self._wall_start_s = time.perf_counter()
             # The one line a user needs to connect; the CLI cannot know the port earlier.
             print(f"live view: ws://{self.live_host}:{self._server.port} "
