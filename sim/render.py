@@ -156,21 +156,24 @@ class SceneRenderer:
         camera: a camera name of the scene (``top`` or ``chase``).
     """
 
-    def __init__(self, model: mujoco.MjModel, width: int = 640, height: int = 480, camera: str = "top"):
+    def __init__(self, model: mujoco.MjModel, width: int = 640, height: int = 480, camera: str = "top",
+                 fast: bool = True):
         if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
             names = [model.camera(i).name for i in range(model.ncam)]
             raise ConfigError("--camera", f"no camera {camera!r} in the scene (has {names})")
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
-        model.vis.quality.offsamples = 0  # no multisampling
-        model.vis.quality.shadowsize = 0
+        if fast:
+            model.vis.quality.offsamples = 0  # no multisampling
+            model.vis.quality.shadowsize = 0
         self.camera = camera
         self.width, self.height = width, height
         self._renderer = mujoco.Renderer(model, height, width)
-        flags = self._renderer.scene.flags
-        flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
-        flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
-        flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
+        if fast:
+            flags = self._renderer.scene.flags
+            flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
+            flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+            flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
         self._option = mujoco.MjvOption()
         self._option.sitegroup[:] = 0  # no site spheres; beams are drawn instead
         self._option.geomgroup[:4] = 1  # the robot's chassis is a collision geom (group 3)
@@ -330,15 +333,23 @@ def read_video_frames(path: str | Path, every: int = 1) -> list[np.ndarray]:
 
 
 def benchmark_render(
-    mjcf_xml: str, *, width: int = 640, height: int = 480, frames: int = 120, camera: str = "top"
+    mjcf_xml: str, *, width: int = 640, height: int = 480, frames: int = 120, camera: str = "top",
+    fast: bool = True,
 ) -> dict[str, float]:
     """Rendered frames per second (pose + overlay + render, no encoding) for a scene.
 
-    The robot drives a circle so the chase camera moves too.
+    The robot drives a circle so the chase camera moves too.  ``fast=False`` keeps
+    MuJoCo's default quality (multisampling; shadows and reflections where the
+    scene's lights and materials ask for them) for comparison.
     """
     model = mujoco.MjModel.from_xml_string(mjcf_xml)
+    if not fast:
+        model.vis.quality.offsamples = 4
+        model.vis.quality.shadowsize = 4096
+        model.light_castshadow[:] = 1
+        model.mat_reflectance[:] = 0.2
     poser = ScenePoser(model)
-    renderer = SceneRenderer(model, width, height, camera)
+    renderer = SceneRenderer(model, width, height, camera, fast=fast)
     path = np.array([[1.0, 1.0], [3.0, 2.0], [5.0, 5.0], [8.0, 9.0]])
     try:
         renderer.render(poser.data)  # warm-up: context, textures

@@ -288,3 +288,14 @@ def test_live_view_serves_the_same_channels_on_loopback(tmp_path):
     finally:
         runner.join(timeout=30)
     assert read_log(tmp_path / "live.mcap").counts["/tf"] == 151
+
+
+def test_render_benchmark_runs(capsys):
+    assert main(["bench", "render", "--frames", "3", "--width", "64", "--height", "48", "--json"]) == 0
+    figures = __import__("json").loads(capsys.readouterr().out)
+    assert figures["frames"] == 3 and figures["frames_per_s"] > 0 and figures["mujoco_gl"] == "egl"
+
+
+def test_bad_video_size_is_a_config_error(full_run, tmp_path, capsys):
+    assert main(["replay", str(full_run[0]), "--video", str(tmp_path / "x.mp4"), "--width", "641"]) == 2
+    assert "--width" in capsys.readouterr().err
