@@ -70,9 +70,9 @@ class PointToPointController:
     max_speed_m_s: float = 0.2
     max_angular_rad_s: float = 1.2
     heading_gain: float = 2.5
-    switch_radius_m: float = 0.1
+    switch_radius_m: float = 0.05
     slowdown_radius_m: float = 0.3
-    turn_in_place_rad: float = math.radians(50.0)
+    turn_in_place_rad: float = math.radians(25.0)
     goal_tolerance_m: float = 0.1
 
     def __post_init__(self) -> None:
