@@ -47,7 +47,8 @@ def test_controller_switches_waypoints_and_stops_at_goal():
     c = PointToPointController(GEOMETRY, max_speed_m_s=0.2, goal_tolerance_m=0.1)
     c.reset(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]))
     assert c.command(Pose2D(0.0, 0.0, 0.0)).waypoint_index == 1
-    assert c.command(Pose2D(0.95, 0.0, 0.0)).waypoint_index == 2
+    assert c.command(Pose2D(0.9, 0.0, 0.0)).waypoint_index == 1
+    assert c.command(Pose2D(0.97, 0.0, 0.0)).waypoint_index == 2
     stop = c.command(Pose2D(1.0, 0.95, math.pi / 2))
     assert stop.linear_m_s == 0.0 and stop.wheels.left_rad_s == 0.0 and stop.wheels.right_rad_s == 0.0
 
