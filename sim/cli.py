@@ -12,7 +12,9 @@ import importlib
 import json
 import math
 import os
+import signal
 import sys
+import threading
 import time
 import tomllib
 from pathlib import Path as FilePath
@@ -231,8 +233,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _exit_on_sigterm(signum: int, frame: Any) -> None:
+    # SystemExit unwinds through the runner, which closes the log it was writing.
+    raise SystemExit(128 + signum)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``swarmnav`` console script."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _exit_on_sigterm)
     parser = build_parser()
     args = parser.parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func

@@ -47,7 +47,6 @@ import platform
 import sys
 import threading
 import time
-import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 from typing import Any
 
@@ -201,24 +200,9 @@ def beam_origin(context: RunContext) -> tuple[float, float]:
 
     The rangefinders sit on the rim of the body and point outward, so a beam's
     reading plus this distance is the range from base_link's origin that a
-    LaserScan needs.  Taken from the context when it says so, else from the
-    ``range_site_*`` sites of the attached MJCF (0 when there are none).
+    LaserScan needs.
     """
-    if hasattr(context, "sensor_offset_m"):
-        return float(context.sensor_offset_m), float(getattr(context, "sensor_height_m", 0.0))
-    try:
-        root = ElementTree.fromstring(context.mjcf_xml)
-    except ElementTree.ParseError:
-        return 0.0, 0.0
-    positions = [
-        [float(v) for v in site.get("pos", "0 0 0").split()]
-        for site in root.iter("site")
-        if (site.get("name") or "").startswith("range_site_")
-    ]
-    if not positions:
-        return 0.0, 0.0
-    xyz = np.array(positions, dtype=float).reshape(-1, 3)
-    return float(np.mean(np.hypot(xyz[:, 0], xyz[:, 1]))), float(np.mean(xyz[:, 2]))
+    return float(context.sensor_offset_m), float(context.sensor_height_m)
 
 
 def versions(extra: dict[str, str] | None = None) -> dict[str, str]:
@@ -520,6 +504,7 @@ class McapRecorder:
                 "sensor_angles_rad": dumps([float(a) for a in context.sensor_angles_rad]),
                 "sensor_range_m": repr(float(context.sensor_range_m)),
                 "sensor_offset_m": repr(beam_origin(context)[0]),
+                "sensor_height_m": repr(beam_origin(context)[1]),
                 "arena_size_m": dumps(list(context.arena_size_m)),
                 "obstacles": dumps(
                     [

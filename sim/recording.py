@@ -46,6 +46,8 @@ class RunContext:
     physics_dt_s: float
     sensor_angles_rad: np.ndarray  # (K,) beam directions in base_link, CCW from +x
     sensor_range_m: float
+    sensor_offset_m: float  # distance of the rangefinder sites from base_link's origin (the rim)
+    sensor_height_m: float  # height of the rangefinder sites above base_link's origin
     obstacles: tuple[ObstacleInfo, ...]
     versions: dict[str, str] = field(default_factory=dict)
     arena_size_m: tuple[float, float] = (10.0, 10.0)

@@ -49,6 +49,8 @@ def context_from_log(log: RunLog) -> RunContext:
         physics_dt_s=float(log.run_value("physics_dt_s", 0.002)),
         sensor_angles_rad=np.asarray(log.run_value("sensor_angles_rad", []), dtype=float),
         sensor_range_m=float(log.run_value("sensor_range_m", 0.0)),
+        sensor_offset_m=float(log.run_value("sensor_offset_m", 0.0)),
+        sensor_height_m=float(log.run_value("sensor_height_m", 0.0)),
         obstacles=tuple(
             ObstacleInfo(o["entity_id"], o["shape"], tuple(o["size_m"]), tuple(o["position_m"]), o["moving"])
             for o in log.obstacles

@@ -136,6 +136,7 @@ class Simulation:
             planner_name=planner_name, planner_params=dict(planner_params), seed=seed, mjcf_xml=self.scene.xml,
             control_dt_s=self.control_dt_s, physics_dt_s=float(model.opt.timestep),
             sensor_angles_rad=self.scene.range_angles_rad.copy(), sensor_range_m=self.scene.range_cutoff_m,
+            sensor_offset_m=self.scene.range_offset_m, sensor_height_m=self.scene.range_height_m,
             obstacles=tuple(infos), versions=versions(),
             arena_size_m=(self.scenario.arena_width_m, self.scenario.arena_height_m))
 

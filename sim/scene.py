@@ -52,6 +52,8 @@ class CompiledScene:
     range_sensor_adr: np.ndarray   # (K,) sensordata indices of the rangefinders
     range_angles_rad: np.ndarray   # (K,) beam directions in base_link, in [0, 2 pi), CCW from +x
     range_cutoff_m: float
+    range_offset_m: float          # distance of the rangefinder sites from the base origin
+    range_height_m: float          # their height above the base origin
     robot_geom_ids: np.ndarray
     chassis_geom_id: int
     obstacles: tuple[ObstacleGeom, ...]
@@ -136,8 +138,11 @@ def _set_rangefinders(spec: mujoco.MjSpec, count: int, body_radius_m: float, cut
 def compile_scene(scenario: Scenario) -> CompiledScene:
     """Compile the scene and look up every index the runner uses."""
     spec = build_spec(scenario)
-    model = spec.compile()
+    spec.compile()
     xml = spec.to_xml()
+    # Run exactly the model that the log attaches: to_xml rounds numbers, so the
+    # model is compiled from that text rather than from the spec.
+    model = mujoco.MjModel.from_xml_string(xml)
     return index_scene(model, xml)
 
 
@@ -158,11 +163,13 @@ def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
     range_ids = sorted((model.sensor(i).name, i) for i in range(model.nsensor)
                        if model.sensor_type[i] == mujoco.mjtSensor.mjSENS_RANGEFINDER)
     range_adr = np.array([model.sensor_adr[i] for _, i in range_ids], dtype=np.int64)
-    angles = []
+    angles, offsets, heights = [], [], []
     for _, i in range_ids:
         site = model.sensor_objid[i]
         p = model.site_pos[site]
         angles.append(math.atan2(p[1], p[0]) % (2.0 * math.pi))
+        offsets.append(math.hypot(p[0], p[1]))
+        heights.append(float(p[2]))
     cutoff = float(model.sensor_cutoff[range_ids[0][1]]) if range_ids else 0.0
 
     robot_bodies = {model.body(n).id for n in ROBOT_BODIES}
@@ -183,5 +190,7 @@ def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
         free_qvel_adr=int(free.dofadr[0]),
         wheel_qvel_adr=(int(left.dofadr[0]), int(right.dofadr[0])),
         range_sensor_adr=range_adr, range_angles_rad=np.array(angles), range_cutoff_m=cutoff,
+        range_offset_m=float(np.mean(offsets)) if offsets else 0.0,
+        range_height_m=float(np.mean(heights)) if heights else 0.0,
         robot_geom_ids=np.flatnonzero(is_robot), chassis_geom_id=gid("chassis"),
         obstacles=tuple(obstacles), is_robot_geom=is_robot, is_obstacle_geom=is_obstacle)

@@ -96,7 +96,8 @@ def test_scan_and_obstacles_follow_foxglove_conventions(full_run):
     finite = log.range_m[np.isfinite(log.range_m)]
     assert finite.size and finite.min() > 0.15
     assert len(log.scan_angles_rad) == 12
-    assert math.isclose(log.scan_angles_rad[-1] - log.scan_angles_rad[0], 2 * math.pi * 11 / 12)  # inclusive end
+    # Inclusive end; site positions are those of the logged MJCF, rounded to 6 digits.
+    assert math.isclose(log.scan_angles_rad[-1] - log.scan_angles_rad[0], 2 * math.pi * 11 / 12, abs_tol=1e-6)
     factory = DecoderFactory()
     with path.open("rb") as stream:
         for schema, channel, message in make_reader(stream).iter_messages(topics=["/obstacles"]):
