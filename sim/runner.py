@@ -282,9 +282,10 @@ class Simulation:
                 times_s=times[:step + 1].copy(), poses=poses[:step + 1].copy(),
                 wheel_command_rad_s=wheel_cmd[:step + 1].copy(),
                 collision_points_m=np.array(collision_points, dtype=float).reshape(-1, 2))
-        except BaseException:
+        except BaseException as exc:
             if recorder is not None:
-                recorder.finish({"outcome": "error", "sim_time_s": step * dt})
+                stopped = isinstance(exc, (KeyboardInterrupt, SystemExit))
+                recorder.finish({"outcome": "interrupted" if stopped else "error", "sim_time_s": step * dt})
             raise
         if recorder is not None:
             recorder.finish(result.summary())
