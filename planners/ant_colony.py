@@ -10,14 +10,13 @@ What the three papers have in common lives here, once:
   reached the goal or got stuck (no unvisited neighbour left).
 
 Each planner supplies only its desirability (how Eq. (1)/(3)/(6) of its paper
-weighs the neighbours) and its update rule, and runs through
+weighs the neighbours, as a per-cell and a per-turn table) and its update rule, and runs through
 :class:`planners.swarm.SwarmPlanner`, the one optimisation loop.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
@@ -27,6 +26,8 @@ from planners.problem import OccupancyGrid
 #: Index used for "no previous move" (an ant on its first step).
 NO_DIRECTION = 8
 STEP_LENGTHS = np.array(STEP_COSTS)
+#: :data:`STEP_LENGTHS` with a 0 for :data:`NO_DIRECTION`.
+STEP_LENGTHS_9 = np.append(STEP_LENGTHS, 0.0)
 DIRECTION_VECTORS = np.array(DIRECTIONS, dtype=float)  # (d_row, d_col)
 
 
@@ -68,14 +69,18 @@ class GridGraph:
     Attributes:
         grid: the occupancy grid (cells are flat indices ``row * cols + col``).
         table: (N, 8) neighbour indices in :data:`planners.grid_search.DIRECTIONS` order, -1 where illegal.
+        key_table: (9 N, 8) the same table repeated once per previous direction
+            (:data:`NO_DIRECTION` last), indexed by an ant's key ``direction * N + cell``.
     """
 
     grid: OccupancyGrid
     table: np.ndarray
+    key_table: np.ndarray
 
     @classmethod
     def of(cls, grid: OccupancyGrid) -> "GridGraph":
-        return cls(grid=grid, table=neighbour_table(grid.occupied))
+        table = neighbour_table(grid.occupied)
+        return cls(grid=grid, table=table, key_table=np.tile(table, (NO_DIRECTION + 1, 1)))
 
     @property
     def cols(self) -> int:
@@ -117,82 +122,122 @@ class ColonyWalk:
         return self.paths[ant, : self.steps[ant] + 1]
 
 
-Desirability = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
-
-
-def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, desirability: Desirability,
-                rng: np.random.Generator, max_steps: int, backtrack: bool = True,
-                max_length: float = np.inf) -> ColonyWalk:
+def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights: np.ndarray,
+                turn_weights: np.ndarray | None, rng: np.random.Generator, max_steps: int,
+                backtrack: bool = True, max_length: float = np.inf) -> ColonyWalk:
     """Let ``ants`` ants walk from ``start`` until each reaches ``goal``, gets stuck, or runs out of steps.
 
-    An ant never re-enters a cell it has visited (its tabu list).  All walking
-    ants move in the same NumPy step; finished and stuck ants are masked out.
+    An ant at cell i that last moved in direction p picks direction d with
+    probability proportional to ``turn_weights[p, d] * cell_weights[i, d]``
+    over the neighbours it has not visited (its tabu list): Eq. (1) of the ACO
+    papers once a planner has folded its ``tau^alpha * eta^beta`` into the two
+    tables (they are fixed within one iteration).  All walking ants move in the
+    same NumPy step; finished, pruned and failed ants leave the walking set.
+
+    Speed: the state of an ant is one integer ``key = p * N + i`` (previous
+    direction and cell), so a step reads its weights and candidates with one
+    gather each from per-iteration ``(9 N, 8)`` tables; tabu lists are flat
+    float masks multiplied into the weights; tours are stored as keys (cells and
+    directions are recovered after the walk).
 
     Args:
-        graph: the cell graph.
+        graph: the cell graph (N cells).
         start, goal: flat cell indices.
         ants: colony size.
-        desirability: ``f(position (A,), previous direction (A,), candidates (A, 8),
-            allowed (A, 8)) -> weights (A, 8)``, for the A ants still walking;
-            previous direction is :data:`NO_DIRECTION` on the first move.
-            Weights where ``allowed`` is False are ignored.
-        rng: the run's generator (one uniform per walking ant per step).
+        cell_weights: (N, 8) non-negative weight of each move of :data:`planners.grid_search.DIRECTIONS`
+            out of each cell; it must be 0 where ``graph.table`` is -1.
+        turn_weights: (9, 8) factor from the previous direction (row; :data:`NO_DIRECTION`
+            on the first move) to the next, or ``None`` for none.
+        rng: the run's generator (one uniform per walking ant per step, ants in index order).
         max_steps: NumPy steps after which an ant that has not arrived counts as failed.
         backtrack: an ant with no unvisited neighbour steps back one cell (the dead
             end stays on its tabu list) instead of failing; it fails only when
             back at the start with nowhere to go.
         max_length: an ant whose tour grows longer than this (in cells) stops and fails.
     """
-    table = graph.table
     n = graph.size
-    pos = np.full(ants, start, dtype=np.int64)
-    visited = np.zeros((ants, n), dtype=bool)
-    visited[:, start] = True
-    paths = np.full((ants, max_steps + 1), -1, dtype=np.int64)
-    paths[:, 0] = start
-    dirs = np.full((ants, max_steps + 1), NO_DIRECTION, dtype=np.int64)  # dirs[a, k]: move into paths[a, k]
+    add_reduce, min_reduce, max_reduce, or_reduce = np.add.reduce, np.minimum.reduce, np.maximum.reduce, np.logical_or.reduce
+    less_equal = np.less_equal
+    cw = np.asarray(cell_weights, dtype=float)
+    if turn_weights is None:
+        weights = np.tile(cw, (NO_DIRECTION + 1, 1))
+    else:
+        weights = (np.asarray(turn_weights, dtype=float)[:, None, :] * cw[None, :, :]).reshape(-1, 8)
+    candidates = graph.key_table                              # (9 N, 8) cells, -1 where illegal
+    width = max_steps + 1
+    keys = np.full(ants * width, -1, dtype=np.int64)           # tours as keys, ant-major
+    keys[::width] = NO_DIRECTION * n + start
     steps = np.zeros(ants, dtype=np.int64)
     length = np.zeros(ants)
     reached = np.zeros(ants, dtype=bool)
     reached[:] = start == goal
-    walking = np.arange(ants) if start != goal else np.arange(0)
+    unvisited = np.ones(ants * (n + 1))                        # per ant: N cells and a dummy slot
+    unvisited[np.arange(ants) * (n + 1) + start] = 0.0
+    # The walking set, in ant order, and its gathered per-ant state.
+    ids = np.arange(ants) if start != goal else np.arange(0)
+    key = np.full(ids.size, NO_DIRECTION * n + start, dtype=np.int64)
+    run = np.zeros(ids.size, dtype=np.int64)                   # steps of the walking ants
+    walked = np.zeros(ids.size)                                # their lengths
+    rows = np.arange(ids.size)
+    tabu_base = (ids * (n + 1))[:, None]
+    key_base = ids * width
     for _ in range(max_steps):
-        if walking.size == 0:
+        if ids.size == 0:
             break
-        here = pos[walking]
-        cand = table[here]                                    # (A, 8)
-        allowed = cand >= 0
-        safe = np.where(allowed, cand, 0)
-        allowed &= ~visited[walking[:, None], safe]
-        prev = dirs[walking, steps[walking]]
-        weights = np.where(allowed, desirability(here, prev, cand, allowed), 0.0)
-        choice, ok = roulette(weights, rng)
-        movers = walking[ok]
-        d = choice[ok]
-        nxt = cand[ok, d]
-        k = steps[movers] + 1
-        pos[movers] = nxt
-        visited[movers, nxt] = True
-        paths[movers, k] = nxt
-        dirs[movers, k] = d
-        steps[movers] = k
-        length[movers] += STEP_LENGTHS[d]
-        arrived = nxt == goal
-        reached[movers[arrived]] = True
-        still = movers[~arrived & (length[movers] <= max_length)]
-        stuck = walking[~ok]
-        if backtrack and stuck.size:
-            stuck = stuck[steps[stuck] > 0]
-            back = steps[stuck] - 1
-            length[stuck] -= STEP_LENGTHS[np.minimum(dirs[stuck, steps[stuck]], 7)]
-            paths[stuck, steps[stuck]] = -1
-            dirs[stuck, steps[stuck]] = NO_DIRECTION
-            steps[stuck] = back
-            pos[stuck] = paths[stuck, back]
-            still = np.sort(np.concatenate([still, stuck]))
-        walking = still
-    moved = np.arange(max_steps + 1)[None, :] <= steps[:, None]
-    moved[:, 0] = False
+        cand = candidates[key]                                 # (A, 8)
+        w = weights[key]
+        w *= unvisited[tabu_base + cand]                       # -1 reads the previous dummy slot: weight 0
+        cumulative = w.cumsum(axis=1)
+        total = cumulative[:, -1]
+        draw = rng.random(ids.size)
+        draw *= total
+        # Roulette (as :func:`roulette`): the first column whose running sum exceeds the draw.
+        choice = add_reduce(less_equal(cumulative, draw[:, None]), axis=1)
+        np.minimum(choice, 7, out=choice)                      # draw == total by rounding
+        if min_reduce(total) > 0.0:
+            # Every walking ant moves (the common case): no masks needed.
+            nxt = cand[rows, choice]
+            key = choice * n + nxt
+            unvisited[tabu_base[:, 0] + nxt] = 0.0
+            run += 1
+            keys[key_base + run] = key
+            walked += STEP_LENGTHS[choice]
+            arrived = nxt == goal
+            if not or_reduce(arrived) and max_reduce(walked) <= max_length:
+                continue
+            steps[ids] = run
+            length[ids] = walked
+            reached[ids[arrived]] = True
+            keep = ~arrived & (walked <= max_length)
+        else:
+            # Some ants are stuck: they step back one cell (masks, no index lists).
+            ok = total > 0.0
+            nxt = cand[rows, choice]
+            new_key = choice * n + nxt
+            walked += np.where(ok, STEP_LENGTHS_9[choice], -STEP_LENGTHS_9[key // n])
+            keys[key_base + run + ok] = np.where(ok, new_key, -1)
+            run += np.where(ok, 1, -1)
+            unvisited[tabu_base[:, 0] + np.where(ok, nxt, n)] = 0.0   # slot n: a per-ant dummy
+            key = np.where(ok, new_key, keys[key_base + run])
+            arrived = ok & (nxt == goal)
+            keep = ~arrived & (walked <= max_length) & (run >= 0 if backtrack else ok)
+            steps[ids] = np.maximum(run, 0)
+            length[ids] = walked
+            reached[ids[arrived]] = True
+            if keep.all():
+                continue
+        ids, key, run, walked = ids[keep], key[keep], run[keep], walked[keep]
+        rows = np.arange(ids.size)
+        tabu_base = (ids * (n + 1))[:, None]
+        key_base = ids * width
+    if ids.size:
+        steps[ids] = run
+        length[ids] = walked
+    keys = keys.reshape(ants, width)
+    keys[:, 0] = NO_DIRECTION * n + start                      # an ant that failed at the start cleared it
+    moved = np.arange(width)[None, :] <= steps[:, None]
+    paths = np.where(moved, keys % n, -1)
+    dirs = np.where(moved, keys // n, NO_DIRECTION)
     change = moved[:, 2:] & (dirs[:, 2:] != dirs[:, 1:-1])
     turns = change.sum(axis=1)
     return ColonyWalk(paths=paths, steps=steps, length_cells=length, turns=turns, reached=reached)

@@ -229,8 +229,13 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
         crossed_idx = np.array([r * cols + c for r, c in crossed
                                 if 0 <= r < rows and 0 <= c < cols and not grid.occupied[r, c]], dtype=np.int64)
         tau[crossed_idx] += self.collar_pheromone
+        legal = graph.table >= 0
+        safe_table = np.where(legal, graph.table, 0)
+        # Eq. (6)'s goal guidance d_ig / (d_ij + d_jg) of every move, fixed for the run.
+        guidance = iaco_heuristic(d_goal[:, None], STEP_LENGTHS[None, :], d_goal[safe_table], 0.0)
         data = {"problem": problem, "graph": graph, "start": graph.index(start), "goal": graph.index(goal),
-                "d_goal": d_goal, "cos": cosine_table(), "tau": tau, "collar_length": collar_cells,
+                "guidance": guidance, "legal": legal, "safe_table": safe_table, "cos": cosine_table(),
+                "tau": tau, "collar_length": collar_cells,
                 "collar_points": points, "last_lengths": np.zeros(0), "successes": 0,
                 "params": (self.alpha, self.beta, self.rho),
                 "max_steps": self.max_steps or rows * cols // 2}
@@ -242,23 +247,18 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
         alpha, beta, rho = adaptive_parameters(self.alpha, self.beta, self.delta, self.kappa, iteration + 1,
                                                self.iterations, data["collar_length"], best_cells, self.rho)
         data["params"] = (alpha, beta, rho)
-        tau, d_goal, cos = data["tau"], data["d_goal"], data["cos"]
-        # Eq. (6) split into a per-cell goal-guidance table and a per-turn bend table,
-        # raised to beta once per iteration (alpha and beta are fixed within one).
-        table = data["graph"].table
-        safe_table = np.where(table >= 0, table, 0)
-        guidance = iaco_heuristic(d_goal[:, None], STEP_LENGTHS[None, :], d_goal[safe_table], 0.0)
-        guidance_beta = np.power(guidance, beta)                       # (N, 8)
+        tau, cos = data["tau"], data["cos"]
+        # Eq. (6) split into its goal-guidance factor (per cell and move) and its bend
+        # factor (per turn), each raised to beta once per iteration (alpha and beta are
+        # fixed within one); Eq. (1)'s numerator is then their product with tau_j^alpha.
+        cell_weights = np.power(data["guidance"], beta)
+        cell_weights *= np.power(tau, alpha)[data["safe_table"]]
+        cell_weights *= data["legal"]
         bend_beta = np.power(cos + 1.0, beta)                          # (9, 8)
-        tau_alpha = np.power(tau, alpha)
-
-        def desirability(here, prev_dir, cand, allowed):
-            return tau_alpha[np.where(allowed, cand, 0)] * guidance_beta[here] * bend_beta[prev_dir]
-
         rows, cols = data["problem"].grid.shape
         limit = (self.prune_ratio * best_cells if best_cells is not None
                  else max(4.0 * data["collar_length"], float(rows + cols)))
-        walk = walk_colony(data["graph"], data["start"], data["goal"], self.ants, desirability, rng,
+        walk = walk_colony(data["graph"], data["start"], data["goal"], self.ants, cell_weights, bend_beta, rng,
                            data["max_steps"], max_length=limit)
         state.evaluations += self.ants
         arrived = np.flatnonzero(walk.reached)
