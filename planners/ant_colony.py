@@ -26,6 +26,8 @@ from planners.problem import OccupancyGrid
 #: Index used for "no previous move" (an ant on its first step).
 NO_DIRECTION = 8
 STEP_LENGTHS = np.array(STEP_COSTS)
+#: Steps of a colony walk whose roulette uniforms are drawn in one call.
+UNIFORM_BLOCK = 32
 #: :data:`STEP_LENGTHS` with a 0 for :data:`NO_DIRECTION`.
 STEP_LENGTHS_9 = np.append(STEP_LENGTHS, 0.0)
 DIRECTION_VECTORS = np.array(DIRECTIONS, dtype=float)  # (d_row, d_col)
@@ -148,7 +150,7 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
             out of each cell; it must be 0 where ``graph.table`` is -1.
         turn_weights: (9, 8) factor from the previous direction (row; :data:`NO_DIRECTION`
             on the first move) to the next, or ``None`` for none.
-        rng: the run's generator (one uniform per walking ant per step, ants in index order).
+        rng: the run's generator (uniforms drawn in blocks of :data:`UNIFORM_BLOCK` steps x ``ants``).
         max_steps: NumPy steps after which an ant that has not arrived counts as failed.
         backtrack: an ant with no unvisited neighbour steps back one cell (the dead
             end stays on its tabu list) instead of failing; it fails only when
@@ -165,14 +167,14 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
         weights = (np.asarray(turn_weights, dtype=float)[:, None, :] * cw[None, :, :]).reshape(-1, 8)
     candidates = graph.key_table                              # (9 N, 8) cells, -1 where illegal
     width = max_steps + 1
-    keys = np.full(ants * width, -1, dtype=np.int64)           # tours as keys, ant-major
+    keys = np.empty(ants * width, dtype=np.int64)              # tours as keys, ant-major (valid up to steps)
     keys[::width] = NO_DIRECTION * n + start
     steps = np.zeros(ants, dtype=np.int64)
     length = np.zeros(ants)
     reached = np.zeros(ants, dtype=bool)
     reached[:] = start == goal
-    unvisited = np.ones(ants * (n + 1))                        # per ant: N cells and a dummy slot
-    unvisited[np.arange(ants) * (n + 1) + start] = 0.0
+    unvisited = np.ones(ants * (n + 1), dtype=bool)            # per ant: N cells and a dummy slot
+    unvisited[np.arange(ants) * (n + 1) + start] = False
     # The walking set, in ant order, and its gathered per-ant state.
     ids = np.arange(ants) if start != goal else np.arange(0)
     key = np.full(ids.size, NO_DIRECTION * n + start, dtype=np.int64)
@@ -181,16 +183,18 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
     rows = np.arange(ids.size)
     tabu_base = (ids * (n + 1))[:, None]
     key_base = ids * width
-    for _ in range(max_steps):
+    uniforms = np.empty((0, ants))
+    for step in range(max_steps):
         if ids.size == 0:
             break
+        if step % UNIFORM_BLOCK == 0:
+            uniforms = rng.random((UNIFORM_BLOCK, ants))       # one draw per ant and step, fetched in blocks
         cand = candidates[key]                                 # (A, 8)
         w = weights[key]
         w *= unvisited[tabu_base + cand]                       # -1 reads the previous dummy slot: weight 0
         cumulative = w.cumsum(axis=1)
         total = cumulative[:, -1]
-        draw = rng.random(ids.size)
-        draw *= total
+        draw = uniforms[step % UNIFORM_BLOCK, :ids.size] * total
         # Roulette (as :func:`roulette`): the first column whose running sum exceeds the draw.
         choice = add_reduce(less_equal(cumulative, draw[:, None]), axis=1)
         np.minimum(choice, 7, out=choice)                      # draw == total by rounding
@@ -198,7 +202,7 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
             # Every walking ant moves (the common case): no masks needed.
             nxt = cand[rows, choice]
             key = choice * n + nxt
-            unvisited[tabu_base[:, 0] + nxt] = 0.0
+            unvisited[tabu_base[:, 0] + nxt] = False
             run += 1
             keys[key_base + run] = key
             walked += STEP_LENGTHS[choice]
@@ -215,9 +219,9 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
             nxt = cand[rows, choice]
             new_key = choice * n + nxt
             walked += np.where(ok, STEP_LENGTHS_9[choice], -STEP_LENGTHS_9[key // n])
-            keys[key_base + run + ok] = np.where(ok, new_key, -1)
-            run += np.where(ok, 1, -1)
-            unvisited[tabu_base[:, 0] + np.where(ok, nxt, n)] = 0.0   # slot n: a per-ant dummy
+            keys[key_base + run + ok] = new_key                 # a stuck ant overwrites the top it leaves
+            run += np.where(ok, 1, -1 if backtrack else 0)
+            unvisited[tabu_base[:, 0] + np.where(ok, nxt, n)] = False  # slot n: a per-ant dummy
             key = np.where(ok, new_key, keys[key_base + run])
             arrived = ok & (nxt == goal)
             keep = ~arrived & (walked <= max_length) & (run >= 0 if backtrack else ok)
@@ -233,9 +237,10 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
     if ids.size:
         steps[ids] = run
         length[ids] = walked
-    keys = keys.reshape(ants, width)
-    keys[:, 0] = NO_DIRECTION * n + start                      # an ant that failed at the start cleared it
-    moved = np.arange(width)[None, :] <= steps[:, None]
+    used = int(steps.max()) + 1 if ants else 1
+    keys = keys.reshape(ants, width)[:, :used]
+    keys[:, 0] = NO_DIRECTION * n + start                      # an ant stuck at the start overwrote it
+    moved = np.arange(used)[None, :] <= steps[:, None]
     paths = np.where(moved, keys % n, -1)
     dirs = np.where(moved, keys // n, NO_DIRECTION)
     change = moved[:, 2:] & (dirs[:, 2:] != dirs[:, 1:-1])
