@@ -27,14 +27,20 @@ Readings of the paper where its text is ambiguous (our choices):
   paper's sentence "the closer to 180 degrees, the greater eta" describes the
   interior angle, which this equals 180 degrees minus.  The first move counts as straight.
 * Eq. (7) is garbled in the text; we read it as ``Q_m = Q * t_c ** ((L_GL - L_m) ** 3)``
-  with lengths in cells, and clip the exponent to +-``exponent_limit`` so that it
-  cannot overflow.  Cells keep at least ``tau_floor`` pheromone so that none underflows.
+  with lengths in cells.  Tours longer than the collar line get ``t_c`` to a negative
+  power, uncapped as the paper writes it (a tour a few cells longer deposits next to
+  nothing: that is the "difference of pheromone on different paths" §3.3 wants).
+  Tours shorter than the collar line would get ``t_c`` to a large positive power; we
+  cap the exponent above at ``exponent_limit`` (ours: 3) so that it cannot overflow
+  and the first such tour does not swamp all others.  Cells keep at least
+  ``tau_floor`` pheromone (a numerical floor, 1e-12) so that none underflows.
 * Before any ant has reached the goal, Eqs. (9)-(10) use ``L_GL / (LF_best + L_GL) = 0``
   and rho keeps its initial value (Table 2: 0.3).
 * An ant never re-enters a cell (tabu list); in a dead end it steps back one
   cell (the dead end stays tabu).  It fails after ``max_steps`` NumPy steps or
-  once its tour exceeds ``prune_ratio`` x the best length (our additions: the
-  paper does not say how its ants leave dead ends; pruning only saves time).
+  once its tour can neither beat the best so far nor deposit more than
+  ``tau_floor`` under Eq. (7) (:func:`prune_length`); our additions: the paper does
+  not say how its ants leave dead ends, and pruning only saves time.
 """
 
 from __future__ import annotations
@@ -149,9 +155,23 @@ def adaptive_parameters(alpha0: float, beta0: float, delta: float, kappa: float,
 
 def pheromone_intensity(q: float, t_c: float, collar_length: float, lengths: np.ndarray,
                         exponent_limit: float = 30.0) -> np.ndarray:
-    """Eq. (7): ``Q_m = Q * t_c ** ((L_GL - L_m) ** 3)``, the exponent clipped to +-``exponent_limit``."""
-    exponent = np.clip((collar_length - np.asarray(lengths, dtype=float)) ** 3, -exponent_limit, exponent_limit)
+    """Eq. (7): ``Q_m = Q * t_c ** ((L_GL - L_m) ** 3)``, the exponent capped above at ``exponent_limit``.
+
+    Below there is no cap: a tour much longer than the collar line gets ``t_c`` to a
+    large negative power, which underflows harmlessly to 0 (it deposits nothing).
+    """
+    exponent = np.minimum((collar_length - np.asarray(lengths, dtype=float)) ** 3, exponent_limit)
     return q * np.power(t_c, exponent)
+
+
+def prune_length(q: float, t_c: float, collar_length: float, negligible: float) -> float:
+    """Tour length beyond which Eq. (7) gives ``Q_m < negligible``: ``L_GL + (log(Q / negligible) / log t_c) ** (1/3)``.
+
+    Infinite when ``t_c <= 1`` (Eq. (7) then never shrinks a deposit).
+    """
+    if t_c <= 1.0:
+        return math.inf
+    return collar_length + (math.log(q / negligible) / math.log(t_c)) ** (1.0 / 3.0)
 
 
 @dataclass
@@ -178,12 +198,21 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
             and hurts where it does not (trough: the greedy §3.1.2 line goes round the other
             side; curves: the colony never finds the shorter corridor at any setting).
         tau_floor: smallest pheromone a cell keeps.
-        exponent_limit: clip of Eq. (7)'s exponent (ours: 3, tuned on the bundled maps;
-            at 30 the first path shorter than the collar line takes over and the colony stagnates).
-        max_steps: NumPy steps after which an ant fails; 0 means half the number of cells.
-        prune_ratio: an ant whose tour grows past this multiple of the best length so
-            far stops (its Eq. (7) deposit would be negligible); before any best,
-            the limit is 4 x the collar length (at least rows + cols).
+        exponent_limit: upper cap of Eq. (7)'s exponent (ours: 3, tuned on the bundled maps;
+            at 30 the first path shorter than the collar line takes over and the colony
+            stagnates).  There is no cap below: a cap of -3 would give every tour longer
+            than the collar line the same Q_m and make Eq. (7) a constant on maps whose
+            collar line is shorter than any grid path (baffle).
+        max_steps: NumPy steps after which an ant fails; 0 means ``step_ratio`` x the
+            iteration's length limit (see ``prune_ratio``), at least rows + cols and at
+            most half the number of cells.
+        step_ratio: see ``max_steps`` (ours: 1.25; backtracking ants otherwise walk
+            for long without a chance to arrive, and an iteration lasts as long as its
+            slowest ant; 1.25 about halves the time on the baffle map at the same lengths).
+        prune_ratio: an ant stops once its tour is longer than this multiple of the best
+            length so far and than :func:`prune_length` (1: it could not become the best,
+            and its Eq. (7) deposit would lie below ``tau_floor``); before any best, the
+            limit is 4 x the collar length (at least rows + cols).
         cell_m: grid resolution; ``None`` keeps the problem's.
         shortcut: line-of-sight shortcut of the best tour (the raw cells stay in stats).
     """
@@ -203,7 +232,8 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
     tau_floor: float = 1e-12
     exponent_limit: float = 3.0
     max_steps: int = 0
-    prune_ratio: float = 1.25
+    step_ratio: float = 1.25
+    prune_ratio: float = 1.0
     cell_m: float | None = None
     shortcut: bool = True
     max_evaluations: int | None = None
@@ -245,8 +275,7 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
                 "guidance": guidance, "legal": legal, "safe_table": safe_table, "cos": cosine_table(),
                 "tau": tau, "collar_length": collar_cells,
                 "collar_points": points, "last_lengths": np.zeros(0), "successes": 0,
-                "params": (self.alpha, self.beta, self.rho),
-                "max_steps": self.max_steps or rows * cols // 2}
+                "params": (self.alpha, self.beta, self.rho)}
         return SwarmState(best_solution=None, best_cost=math.inf, data=data)
 
     def step(self, state: SwarmState, problem: Problem, rng: np.random.Generator, iteration: int) -> None:
@@ -264,10 +293,13 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
         cell_weights *= data["legal"]
         bend_beta = np.power(cos + 1.0, beta)                          # (9, 8)
         rows, cols = data["problem"].grid.shape
-        limit = (self.prune_ratio * best_cells if best_cells is not None
-                 else max(4.0 * data["collar_length"], float(rows + cols)))
+        limit = (max(self.prune_ratio * best_cells,
+                     prune_length(self.q, self.t_c, data["collar_length"], self.tau_floor))
+                 if best_cells is not None else max(4.0 * data["collar_length"], float(rows + cols)))
+        # An ant that backtracks keeps walking without growing its tour: cap its NumPy steps too.
+        max_steps = self.max_steps or min(rows * cols // 2, int(max(rows + cols, self.step_ratio * limit)))
         walk = walk_colony(data["graph"], data["start"], data["goal"], self.ants, cell_weights, bend_beta, rng,
-                           data["max_steps"], max_length=limit)
+                           max_steps, max_length=limit)
         state.evaluations += self.ants
         arrived = np.flatnonzero(walk.reached)
         lengths = walk.length_cells[arrived]
