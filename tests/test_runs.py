@@ -62,3 +62,19 @@ def test_an_empty_arena_reports_no_clearance_rather_than_infinity():
     summary = result.summary()
     assert result.reached and summary["min_clearance_m"] is None
     json.loads(json.dumps(summary, allow_nan=False))
+
+
+@pytest.mark.parametrize("scenario_name, planner_name, params", [
+    ("gwo-scenario-1", "gwo", {"population": 30, "iterations": 60}),
+    ("gwo-scenario-1", "adl_abc", {"population": 30, "iterations": 60}),
+    ("gwo-scenario-1", "optimal", {}),
+    ("immas-env1-scattered", "immas", {}),
+])
+def test_swarm_and_exact_paths_are_driven_without_collisions(scenario_name, planner_name, params):
+    scenario = load_scenario(scenario_name)
+    episode = simulate(scenario, planner_name, params, seed=0, time_limit_s=scenario.time_limit_s)
+    r = episode.result
+    assert scenario.to_problem().is_collision_free(episode.path.waypoints)
+    assert r.reached, r.summary()
+    if not any(ob.moving for ob in scenario.obstacles):
+        assert r.collisions == 0 and r.min_clearance_m > 0.0, r.summary()
