@@ -253,6 +253,10 @@ def main(argv: list[str] | None = None) -> int:
     except UserError as exc:
         print(f"swarmnav: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except OSError as exc:  # an output or input path the file system refuses
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        print(f"swarmnav: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except PlanningError as exc:
         print(f"swarmnav: no path: {type(exc).__name__}: {exc}", file=sys.stderr)
         return EXIT_NO_PATH

@@ -195,11 +195,11 @@ class Simulation:
         qvel = data.qvel
         geom_xpos = data.geom_xpos
 
-        if recorder is not None:
-            recorder.start(context)
-            recorder.path(0.0, path.waypoints)
         wall0 = time.perf_counter()
         try:
+            if recorder is not None:
+                recorder.start(context)
+                recorder.path(0.0, path.waypoints)
             while True:
                 t = step * dt
                 if has_moving:

@@ -135,3 +135,11 @@ def test_scenarios_lists_the_bundled_files(capsys):
     code, out, _ = run_cli(capsys, "scenarios", "--json")
     names = {row["name"] for row in json.loads(out)}
     assert code == 0 and {"gwo-scenario-1", "restaurant-table-2", "dense-field-30"} <= names
+
+
+def test_an_output_path_the_file_system_refuses_is_one_line_and_exit_2(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    code, out, err = run_cli(capsys, "run", write(tmp_path, BASE), "--out", str(blocker / "run.mcap"))
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and str(blocker) in err
