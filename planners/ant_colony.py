@@ -158,7 +158,8 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
         max_length: an ant whose tour grows longer than this (in cells) stops and fails.
     """
     n = graph.size
-    add_reduce, min_reduce, max_reduce, or_reduce = np.add.reduce, np.minimum.reduce, np.maximum.reduce, np.logical_or.reduce
+    add_reduce, min_reduce, max_reduce = np.add.reduce, np.minimum.reduce, np.maximum.reduce
+    or_reduce, and_reduce = np.logical_or.reduce, np.logical_and.reduce
     less_equal = np.less_equal
     cw = np.asarray(cell_weights, dtype=float)
     if turn_weights is None:
@@ -166,6 +167,7 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
     else:
         weights = (np.asarray(turn_weights, dtype=float)[:, None, :] * cw[None, :, :]).reshape(-1, 8)
     candidates = graph.key_table                              # (9 N, 8) cells, -1 where illegal
+    key_back_lengths = -np.repeat(STEP_LENGTHS_9, n)           # (9 N,) length undone by stepping back
     width = max_steps + 1
     keys = np.empty(ants * width, dtype=np.int64)              # tours as keys, ant-major (valid up to steps)
     keys[::width] = NO_DIRECTION * n + start
@@ -218,18 +220,18 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
             ok = total > 0.0
             nxt = cand[rows, choice]
             new_key = choice * n + nxt
-            walked += np.where(ok, STEP_LENGTHS_9[choice], -STEP_LENGTHS_9[key // n])
+            walked += np.where(ok, STEP_LENGTHS_9[choice], key_back_lengths[key])
             keys[key_base + run + ok] = new_key                 # a stuck ant overwrites the top it leaves
             run += np.where(ok, 1, -1 if backtrack else 0)
             unvisited[tabu_base[:, 0] + np.where(ok, nxt, n)] = False  # slot n: a per-ant dummy
             key = np.where(ok, new_key, keys[key_base + run])
             arrived = ok & (nxt == goal)
             keep = ~arrived & (walked <= max_length) & (run >= 0 if backtrack else ok)
+            if and_reduce(keep):
+                continue
             steps[ids] = np.maximum(run, 0)
             length[ids] = walked
             reached[ids[arrived]] = True
-            if keep.all():
-                continue
         ids, key, run, walked = ids[keep], key[keep], run[keep], walked[keep]
         rows = np.arange(ids.size)
         tabu_base = (ids * (n + 1))[:, None]
