@@ -12,7 +12,10 @@ from planners import PLANNERS, make_planner
 from planners.errors import ConfigError, NoPathFound
 from planners.geometry import segment_box_distances
 from planners.grid_search import DStarLite, astar_cells, dijkstra_cells, grid_line_of_sight, theta_star_cells
-from planners.improved_ant_colony import adaptive_parameters, feature_cells, iaco_heuristic, pheromone_intensity
+from planners.ant_colony import GridGraph, walk_colony
+from planners.improved_ant_colony import (adaptive_parameters, feature_cells, iaco_heuristic, pheromone_intensity,
+                                          prune_length)
+from planners.problem import OccupancyGrid
 from planners.max_min_ant_system import analyse_environment
 from planners.movingai import (benchmark_sets, format_map, map_problem, map_to_grid, merge_boxes, parse_map,
                                read_map, read_scenarios)
@@ -267,6 +270,36 @@ def test_iaco_adaptive_parameters_eqs_9_to_11_hand_computed():
     assert rho == 0.3
     # Eq. (7): a path 1 cell longer than the collar line gets Q * t_c ** -1.
     assert pheromone_intensity(100.0, 1.5, 10.0, np.array([11.0]))[0] == pytest.approx(100.0 / 1.5)
+
+
+def test_iaco_eq7_is_capped_above_only_and_prunes_where_deposits_vanish():
+    q_m = pheromone_intensity(100.0, 1.5, 10.0, np.array([5.0, 13.0, 30.0]), exponent_limit=3.0)
+    assert q_m[0] == pytest.approx(100.0 * 1.5 ** 3)              # 5 ** 3 capped at 3
+    assert q_m[1] == pytest.approx(100.0 * 1.5 ** -27)             # 3 cells longer: not capped below
+    assert q_m[2] == 0.0                                           # underflows: deposits nothing
+    limit = prune_length(100.0, 1.5, 10.0, 1e-12)
+    assert pheromone_intensity(100.0, 1.5, 10.0, np.array([limit]), 3.0)[0] == pytest.approx(1e-12)
+    assert prune_length(100.0, 1.0, 10.0, 1e-12) == math.inf
+
+
+def test_colony_walk_tours_are_legal_moves_and_dead_ends_are_backed_out_of():
+    occ = draw(["......",
+                ".####.",
+                ".#..#.",
+                ".#.##.",
+                "......"])
+    graph = GridGraph.of(OccupancyGrid(occupied=occ, cell_m=1.0, origin_m=(0.0, 0.0)))
+    start, goal = graph.index((2, 2)), graph.index((4, 5))        # start in a pocket open at the bottom
+    weights = np.where(graph.table >= 0, 1.0, 0.0)
+    walk = walk_colony(graph, start, goal, 40, weights, None, np.random.default_rng(0), 400)
+    assert walk.reached.all()
+    for a in range(40):
+        tour = walk.tour(a)
+        assert tour[0] == start and tour[-1] == goal and len(set(tour.tolist())) == len(tour)
+        for u, v in zip(tour[:-1], tour[1:]):
+            assert v in graph.table[u]
+        moves = np.diff(graph.cells(tour), axis=0)
+        assert walk.length_cells[a] == pytest.approx(np.sum(np.hypot(*moves.T)))
 
 
 def test_feature_points_are_outside_convex_corners_only():
