@@ -606,10 +606,11 @@ def segments_clear(problem: Problem, a: np.ndarray, bs: np.ndarray, tolerance_m:
 def exact_shortcut(problem: Problem, waypoints: np.ndarray, window: int = 32) -> np.ndarray:
     """Greedy line-of-sight shortcut: from each kept vertex jump to the farthest visible one.
 
-    Visibility is :func:`segments_clear`, evaluated for the next ``window``
-    vertices in one NumPy call per kept vertex (a longer straight run just keeps
-    an extra, nearly collinear vertex).  Consecutive vertices are assumed
-    visible (grid moves between free cells are), so this never fails.
+    Visibility is :func:`segments_clear`, evaluated ``window`` vertices at a
+    time in one NumPy call; while the last vertex of a window is still visible
+    the next window is tried too, so a long straight run collapses to one
+    segment.  Consecutive vertices are assumed visible (grid moves between free
+    cells are), so this never fails.
     """
     pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
     if len(pts) <= 2:
@@ -618,8 +619,16 @@ def exact_shortcut(problem: Problem, waypoints: np.ndarray, window: int = 32) ->
     i = 0
     last = len(pts) - 1
     while i < last:
-        visible = np.flatnonzero(segments_clear(problem, pts[i], pts[i + 1:i + 1 + window]))
-        j = i + 1 + int(visible[-1]) if visible.size else i + 1
+        j = i + 1
+        lo = i + 1
+        while lo <= last:
+            hi = min(lo + window, last + 1)
+            visible = np.flatnonzero(segments_clear(problem, pts[i], pts[lo:hi]))
+            if visible.size:
+                j = lo + int(visible[-1])
+            if not visible.size or j != hi - 1:
+                break
+            lo = hi
         kept.append(j)
         i = j
     return pts[kept]
