@@ -117,6 +117,8 @@ def make_planner(name: str, params: dict[str, Any] | None = None, source: str | 
             raise ConfigError(exc.field, exc.problem, source) from None
     try:
         return cls(**kwargs)
+    except ConfigError as exc:
+        raise ConfigError(exc.field, exc.problem, source) from None
     except (ValueError, TypeError) as exc:
         raise ConfigError(f"planner.params", str(exc), source) from None
 

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from planners.errors import ConfigError, NoPathFound
+from planners.errors import ConfigError, NoPathFound, check_parameters
 from planners.path_cost import PathObjective
 from planners.problem import Problem
 from planners.swarm import SwarmPlanner, SwarmState
@@ -103,9 +103,7 @@ class ContinuousPlanner(SwarmPlanner):
             ("waypoint_spacing_m", self.waypoint_spacing_m > 0, "must be positive"),
             ("repair_rounds", self.repair_rounds >= 0, "must not be negative"),
         )
-        for name, ok, problem in checks:
-            if not ok:
-                raise ConfigError(f"planner.params.{name}", f"{problem}, got {getattr(self, name)!r}")
+        check_parameters(self, checks)
 
     # ----------------------------------------------------------------- set-up
     def objective(self, problem: Problem) -> PathObjective:

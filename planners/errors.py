@@ -43,3 +43,16 @@ class NoPathFound(PlanningError):
 
 class BudgetExceeded(PlanningError):
     """The planner ran out of its time or evaluation budget."""
+
+
+def check_parameters(planner: object, checks: tuple[tuple[str, bool, str], ...]) -> None:
+    """Raise a :class:`ConfigError` naming the first planner parameter that fails its check.
+
+    Args:
+        planner: the planner instance (its attribute gives the offending value).
+        checks: ``(parameter name, passes, what it must be)`` triples, e.g.
+            ``("ants", self.ants >= 1, "must be at least 1")``.
+    """
+    for name, ok, requirement in checks:
+        if not ok:
+            raise ConfigError(f"planner.params.{name}", f"{requirement}, got {getattr(planner, name)!r}")

@@ -26,7 +26,7 @@ from typing import Any, Callable, ClassVar, Iterable
 
 import numpy as np
 
-from planners.errors import GoalBlocked, NoPathFound, StartBlocked
+from planners.errors import GoalBlocked, NoPathFound, StartBlocked, check_parameters
 from planners.geometry import segment_box_distances, segment_disc_distances
 from planners.problem import OccupancyGrid, Path, Problem, check_endpoints
 
@@ -653,6 +653,9 @@ class GridPlanner:
     name: ClassVar[str] = ""
     cell_m: float | None = None
     shortcut: bool = True
+
+    def __post_init__(self) -> None:
+        check_parameters(self, (("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),))
 
     def search(self, problem: Problem, grid: OccupancyGrid, start: Cell, goal: Cell
                ) -> tuple[list[Cell], float, int, dict[str, Any]]:

@@ -54,7 +54,7 @@ import numpy as np
 from scipy import ndimage
 
 from planners.ant_colony import STEP_LENGTHS, GridGraph, cosine_table, deposit, evaporate, walk_colony
-from planners.errors import NoPathFound
+from planners.errors import NoPathFound, check_parameters
 from planners.grid_search import (Cell, cells_to_waypoints, count_bends, exact_shortcut, grid_endpoints,
                                   grid_line_of_sight, line_cells)
 from planners.problem import Problem
@@ -241,14 +241,15 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
     max_evaluations: int | None = None
 
     def __post_init__(self) -> None:
-        if self.ants < 1 or self.iterations < 1:
-            raise ValueError("ants and iterations must be at least 1")
-        if not (0.0 < self.kappa < 1.0):
-            raise ValueError(f"kappa must lie in (0, 1), got {self.kappa}")
-        if not (0.0 <= self.rho < 1.0):
-            raise ValueError(f"rho must lie in [0, 1), got {self.rho}")
-        if self.t_c <= 0 or self.q <= 0:
-            raise ValueError("t_c and q must be positive")
+        check_parameters(self, (
+            ("ants", self.ants >= 1, "must be at least 1"),
+            ("iterations", self.iterations >= 1, "must be at least 1"),
+            ("kappa", 0.0 < self.kappa < 1.0, "must lie in (0, 1)"),
+            ("rho", 0.0 <= self.rho < 1.0, "must lie in [0, 1)"),
+            ("t_c", self.t_c > 0, "must be positive"),
+            ("q", self.q > 0, "must be positive"),
+            ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
+        ))
 
     def _problem(self, problem: Problem) -> Problem:
         if self.cell_m is not None and self.cell_m != problem.cell_m and problem.grid_override is None:

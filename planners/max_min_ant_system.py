@@ -53,7 +53,7 @@ import numpy as np
 from scipy import ndimage
 
 from planners.ant_colony import roulette
-from planners.errors import NoPathFound
+from planners.errors import NoPathFound, check_parameters
 from planners.grid_search import (DIRECTIONS, Cell, cells_to_waypoints, count_bends, exact_shortcut,
                                   grid_endpoints)
 from planners.problem import Problem
@@ -232,12 +232,12 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
     max_evaluations: int | None = None
 
     def __post_init__(self) -> None:
-        if self.selection not in ("best", "roulette"):
-            raise ValueError(f"selection must be 'best' or 'roulette', got {self.selection!r}")
-        if not (0.0 < self.rho <= 1.0):
-            raise ValueError(f"rho must lie in (0, 1], got {self.rho}")
-        if self.iterations < 0:
-            raise ValueError("iterations must not be negative")
+        check_parameters(self, (
+            ("selection", self.selection in ("best", "roulette"), "must be 'best' or 'roulette'"),
+            ("rho", 0.0 < self.rho <= 1.0, "must lie in (0, 1]"),
+            ("iterations", self.iterations >= 0, "must not be negative"),
+            ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
+        ))
 
     def plan(self, problem: Problem, rng: np.random.Generator):
         if self.cell_m is not None and self.cell_m != problem.cell_m and problem.grid_override is None:

@@ -38,7 +38,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from planners.ant_colony import deposit, evaporate, roulette
-from planners.errors import NoPathFound
+from planners.errors import NoPathFound, check_parameters
 from planners.geometry import segment_box_distances, segment_disc_distances
 from planners.grid_search import exact_shortcut
 from planners.problem import Problem
@@ -170,12 +170,14 @@ class WaiterAntColonyPlanner(SwarmPlanner):
     max_evaluations: int | None = None
 
     def __post_init__(self) -> None:
-        if self.nodes < 1 or self.ants < 1 or self.iterations < 1:
-            raise ValueError("nodes, ants and iterations must be at least 1")
-        if not (0.0 <= self.p0 <= 1.0) or not (0.0 <= self.rho < 1.0):
-            raise ValueError("p0 must lie in [0, 1] and rho in [0, 1)")
-        if self.corridor_m <= 0:
-            raise ValueError("corridor_m must be positive")
+        check_parameters(self, (
+            ("nodes", self.nodes >= 1, "must be at least 1"),
+            ("ants", self.ants >= 1, "must be at least 1"),
+            ("iterations", self.iterations >= 1, "must be at least 1"),
+            ("p0", 0.0 <= self.p0 <= 1.0, "must lie in [0, 1]"),
+            ("rho", 0.0 <= self.rho < 1.0, "must lie in [0, 1)"),
+            ("corridor_m", self.corridor_m > 0, "must be positive"),
+        ))
 
     def init_state(self, problem: Problem, rng: np.random.Generator) -> SwarmState:
         pts = random_nodes(problem, self.nodes, self.corridor_m, rng)

@@ -143,3 +143,16 @@ def test_an_output_path_the_file_system_refuses_is_one_line_and_exit_2(tmp_path,
     code, out, err = run_cli(capsys, "run", write(tmp_path, BASE), "--out", str(blocker / "run.mcap"))
     assert code == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and str(blocker) in err
+
+
+@pytest.mark.parametrize("planner, setting, field", [
+    ("gwo", "population=-5", "planner.params.population"),
+    ("astar", "cell_m=-1", "planner.params.cell_m"),
+    ("iaco", "ants=0", "planner.params.ants"),
+    ("maco", "p0=2", "planner.params.p0"),
+    ("abc", "colour=3", "planner.params.colour"),
+])
+def test_bad_planner_parameters_from_set_exit_2(capsys, planner, setting, field):
+    code, out, err = run_cli(capsys, "plan", "gwo-scenario-1", "--planner", planner, "--set", setting)
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and field in err and "Traceback" not in err
