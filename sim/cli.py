@@ -220,9 +220,6 @@ def build_parser() -> argparse.ArgumentParser:
     groups["log"] = log.add_subparsers(dest="log_command", required=True, metavar="LOGCMD")
 
     for words, module_name, help_text in MODULE_COMMANDS:
-        module_file = FilePath(__file__).resolve().parent.parent / (module_name.replace(".", "/") + ".py")
-        if not module_file.exists():
-            continue
         module = importlib.import_module(module_name)
         parent = groups[words[0]] if len(words) > 1 else sub
         p = parent.add_parser(words[-1], help=help_text)
