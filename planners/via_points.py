@@ -87,12 +87,10 @@ def not_a_knot_basis(knot_count: int, parameters: np.ndarray) -> np.ndarray:
         a[i, i - 1:i + 2] = (1.0, 4.0, 1.0)
         r[i, i - 1:i + 2] = np.array([1.0, -2.0, 1.0]) * 6.0 / h ** 2
     second = np.linalg.solve(a, r)  # (n, n): second derivatives per unit knot value
+    # The cubic is the piecewise-linear interpolant plus the curvature terms.
+    basis = polyline_basis(n, t)
     piece = np.clip(np.floor(t / h).astype(int), 0, n - 2)
     u = t / h - piece
-    basis = np.zeros((t.size, n))
-    rows = np.arange(t.size)
-    basis[rows, piece] += 1.0 - u
-    basis[rows, piece + 1] += u
     w_left = h ** 2 / 6.0 * ((1.0 - u) ** 3 - (1.0 - u))
     w_right = h ** 2 / 6.0 * (u ** 3 - u)
     basis += w_left[:, None] * second[piece] + w_right[:, None] * second[piece + 1]
