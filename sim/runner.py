@@ -5,14 +5,13 @@ Only ``sim/`` touches MuJoCo.  Each control step:
 
 1. move the mocap obstacles to their positions at time t;
 2. read the pose (free joint) and the rangefinders (``inf`` = nothing in range);
-3. check collisions: a MuJoCo contact between a robot geom and an obstacle geom;
-4. track the clearance to the nearest obstacle with ``mj_geomDistance``;
-5. stop on goal, timeout or (optionally) first collision;
-6. ask the controller for wheel speeds, write ``data.ctrl``, ``mj_step`` k times.
+3. track the clearance to the nearest obstacle with ``mj_geomDistance``;
+4. stop on goal, timeout or (optionally) first collision;
+5. ask the controller for wheel speeds, write ``data.ctrl``, and ``mj_step`` k
+   times, checking after every physics step for a collision: a MuJoCo contact
+   between a robot geom and an obstacle geom.
 
-Collisions and clearance are sampled at the control rate (every k physics
-steps), so a contact shorter than one control period (20 ms by default) can go
-unseen.
+The clearance is sampled at the control rate; collisions at the physics rate.
 """
 
 from __future__ import annotations
@@ -87,6 +86,60 @@ def versions() -> dict[str, str]:
     except metadata.PackageNotFoundError:
         swarmnav_version = "unknown"
     return {"swarmnav": swarmnav_version, "mujoco": mujoco.__version__, "python": platform.python_version()}
+
+
+class ContactMonitor:
+    """Counts collisions: MuJoCo contacts between a robot geom and an obstacle geom.
+
+    One event is a robot-obstacle contact after none for at least
+    ``release_s``: soft contacts flicker from one physics step to the next
+    while the robot is pushed along an obstacle, and that is one collision, not
+    hundreds.  ``update`` reads ``data.contact`` (the contacts of the last
+    ``mj_step``, found on the state before it integrated).
+    """
+
+    def __init__(self, model: mujoco.MjModel, is_robot: np.ndarray, is_obstacle: np.ndarray,
+                 recorder: Recorder | None, release_s: float):
+        self.model = model
+        self.is_robot = is_robot
+        self.is_obstacle = is_obstacle
+        self.recorder = recorder
+        self.release_s = release_s
+        self.collisions = 0
+        self.first_collision_s: float | None = None
+        self.in_contact = False
+        self.last_contact_s = -math.inf
+        self.pair = ("", "")
+        self.points: list[tuple[float, float]] = []
+
+    def _hits(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
+        """The contact geom pairs and which of them are robot-obstacle contacts."""
+        pairs = data.contact.geom[:data.ncon]
+        hit = (self.is_robot[pairs[:, 0]] & self.is_obstacle[pairs[:, 1]]) | \
+              (self.is_robot[pairs[:, 1]] & self.is_obstacle[pairs[:, 0]])
+        return pairs, hit
+
+    def robot_obstacle_contacts(self, data: mujoco.MjData) -> int:
+        return int(self._hits(data)[1].sum())
+
+    def update(self, data: mujoco.MjData, time_s: float, x_m: float, y_m: float) -> None:
+        pairs, hit = self._hits(data)
+        if hit.any():
+            if not self.in_contact:
+                g1, g2 = pairs[int(np.argmax(hit))]
+                self.in_contact = True
+                self.collisions += 1
+                self.points.append((x_m, y_m))
+                if self.first_collision_s is None:
+                    self.first_collision_s = time_s
+                self.pair = (self.model.geom(int(g1)).name, self.model.geom(int(g2)).name)
+                if self.recorder is not None:
+                    self.recorder.event(time_s, "collision_begin", {"geom_a": self.pair[0], "geom_b": self.pair[1]})
+            self.last_contact_s = time_s
+        elif self.in_contact and time_s - self.last_contact_s >= self.release_s:
+            self.in_contact = False
+            if self.recorder is not None:
+                self.recorder.event(time_s, "collision_end", {"geom_a": self.pair[0], "geom_b": self.pair[1]})
 
 
 class Simulation:
@@ -169,8 +222,6 @@ class Simulation:
         wl_adr, wr_adr = scene.wheel_qvel_adr
         range_adr = scene.range_sensor_adr
         cutoff = scene.range_cutoff_m
-        is_robot = scene.is_robot_geom
-        is_obstacle = scene.is_obstacle_geom
         chassis = scene.chassis_geom_id
         # Analytic 2-D prefilter to pick the nearest obstacle for mj_geomDistance.
         obstacle_ids = np.array([ob.geom_id for ob in scene.obstacles], dtype=np.int64)
@@ -181,11 +232,11 @@ class Simulation:
 
         poses = np.zeros((n_max + 1, 3))
         wheel_cmd = np.zeros((n_max + 1, 2))
-        collision_points = []
-        collisions = 0
-        first_collision_s = None
-        in_contact = False
-        contact_pair = ("", "")
+        monitor = ContactMonitor(model, scene.is_robot_geom, scene.is_obstacle_geom, recorder, release_s=dt)
+        # Contacts that are not collisions (wheels and casters on the floor), counted at the
+        # start: a substep with no more contacts than these and no ongoing collision is skipped.
+        resting_contacts = data.ncon - monitor.robot_obstacle_contacts(data)
+        physics_dt = float(model.opt.timestep)
         min_clearance = math.inf
         length = 0.0
         outcome = "timeout"
@@ -200,6 +251,8 @@ class Simulation:
             if recorder is not None:
                 recorder.start(context)
                 recorder.path(0.0, path.waypoints)
+            if data.ncon > resting_contacts:
+                monitor.update(data, 0.0, float(qpos[qadr]), float(qpos[qadr + 1]))
             while True:
                 t = step * dt
                 if has_moving:
@@ -211,29 +264,6 @@ class Simulation:
                     length += math.hypot(x - px, y - py)
                 poses[step] = (x, y, heading)
                 pose = Pose2D(x, y, heading)
-
-                # Physics-grounded collision check: robot-obstacle contacts in data.contact.
-                ncon = data.ncon
-                touching = False
-                if ncon:
-                    pairs = data.contact.geom[:ncon]
-                    hit = (is_robot[pairs[:, 0]] & is_obstacle[pairs[:, 1]]) | \
-                          (is_robot[pairs[:, 1]] & is_obstacle[pairs[:, 0]])
-                    if hit.any():
-                        touching = True
-                        g1, g2 = pairs[int(np.argmax(hit))]
-                        if not in_contact:
-                            collisions += 1
-                            collision_points.append((x, y))
-                            if first_collision_s is None:
-                                first_collision_s = t
-                            contact_pair = (model.geom(int(g1)).name, model.geom(int(g2)).name)
-                            if recorder is not None:
-                                recorder.event(t, "collision_begin", {"geom_a": contact_pair[0],
-                                                                      "geom_b": contact_pair[1]})
-                if in_contact and not touching and recorder is not None:
-                    recorder.event(t, "collision_end", {"geom_a": contact_pair[0], "geom_b": contact_pair[1]})
-                in_contact = touching
 
                 # Clearance to the nearest obstacle: analytic pick, then mj_geomDistance on it.
                 if len(obstacle_ids):
@@ -248,7 +278,7 @@ class Simulation:
 
                 if goal.reached(pose):
                     outcome = "goal_reached"
-                elif stop_on_collision and collisions:
+                elif stop_on_collision and monitor.collisions:
                     outcome = "collision"
                 elif step >= n_max:
                     outcome = "timeout"
@@ -272,16 +302,20 @@ class Simulation:
                     recorder.step(self._frame(data, t, x, y, heading, left, right, command.linear_m_s,
                                               command.angular_rad_s, command.waypoint_index,
                                               obstacle_track[step]))
-                mujoco.mj_step(model, data, k)
+                # Physics-grounded collision check at every physics step.
+                for substep in range(k):
+                    mujoco.mj_step(model, data)
+                    if data.ncon > resting_contacts or monitor.in_contact:
+                        monitor.update(data, (step * k + substep) * physics_dt, float(qpos[qadr]), float(qpos[qadr + 1]))
                 step += 1
             wall = time.perf_counter() - wall0
             result = RunResult(
-                reached=outcome == "goal_reached", outcome=outcome, collisions=collisions,
-                first_collision_s=first_collision_s, sim_time_s=step * dt, wall_time_s=wall,
+                reached=outcome == "goal_reached", outcome=outcome, collisions=monitor.collisions,
+                first_collision_s=monitor.first_collision_s, sim_time_s=step * dt, wall_time_s=wall,
                 path_length_m=length, min_clearance_m=float(min_clearance), steps=step,
                 times_s=times[:step + 1].copy(), poses=poses[:step + 1].copy(),
                 wheel_command_rad_s=wheel_cmd[:step + 1].copy(),
-                collision_points_m=np.array(collision_points, dtype=float).reshape(-1, 2))
+                collision_points_m=np.array(monitor.points, dtype=float).reshape(-1, 2))
         except BaseException as exc:
             if recorder is not None:
                 stopped = isinstance(exc, (KeyboardInterrupt, SystemExit))

@@ -78,3 +78,17 @@ def test_swarm_and_exact_paths_are_driven_without_collisions(scenario_name, plan
     assert r.reached, r.summary()
     if not any(ob.moving for ob in scenario.obstacles):
         assert r.collisions == 0 and r.min_clearance_m > 0.0, r.summary()
+
+
+def test_collisions_are_detected_at_the_physics_rate_where_the_bodies_touch():
+    scenario = load_scenario("gwo-scenario-1")  # the straight line hits the 0.2 m disc at (1, 1)
+    r = simulate(scenario, "straight", {}, seed=0, time_limit_s=10.0).result
+    assert r.collisions >= 1
+    physics_steps = r.first_collision_s / 0.002
+    assert abs(physics_steps - round(physics_steps)) < 1e-6
+    # Between two control steps (every 10 physics steps), not on one.
+    assert round(physics_steps) % 10 != 0
+    # The base is then one robot radius plus the disc radius from the disc centre
+    # (the chassis sits 1 cm ahead of the base origin).
+    gap = float(np.hypot(*(r.collision_points_m[0] - (1.0, 1.0))))
+    assert 0.34 <= gap <= 0.37
