@@ -251,6 +251,9 @@ def main(argv: list[str] | None = None) -> int:
     except UserError as exc:
         print(f"swarmnav: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except BrokenPipeError:  # stdout closed early (e.g. piped into head): not an error of ours
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
     except OSError as exc:  # an output or input path the file system refuses
         where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
         print(f"swarmnav: error: {where}{exc.strerror or exc}", file=sys.stderr)
