@@ -52,11 +52,24 @@ def _load(args: argparse.Namespace):
     return load_scenario(args.scenario)
 
 
-def _planner_choice(args: argparse.Namespace, scenario) -> tuple[str, dict[str, Any]]:
+def _plan(args: argparse.Namespace, scenario):
+    """Plan with the chosen planner: the scenario's parameters (for its own planner), then ``--set``.
+
+    A bad parameter given with ``--set`` is reported against ``--set``, not the file.
+    """
+    from sim.runner import plan_scenario
     name = args.planner or scenario.planner_name
     params = dict(scenario.planner_params) if name == scenario.planner_name else {}
-    params.update(parse_settings(args.set))
-    return name, params
+    settings = parse_settings(args.set)
+    params.update(settings)
+    try:
+        return plan_scenario(scenario, name, params, args.seed)
+    except ConfigError as exc:
+        if exc.field in {f"planner.params.{key}" for key in settings} or (
+                args.planner and exc.field == "planner.name"):
+            raise ConfigError(exc.field, exc.problem, "--set" if exc.field != "planner.name" else "--planner") \
+                from None
+        raise
 
 
 def plan_summary(scenario, name: str, seed: int, path) -> dict[str, Any]:
@@ -85,10 +98,8 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    from sim.runner import plan_scenario
     scenario = _load(args)
-    name, params = _planner_choice(args, scenario)
-    path, name, params, seed = plan_scenario(scenario, name, params, args.seed)
+    path, name, params, seed = _plan(args, scenario)
     out = plan_summary(scenario, name, seed, path)
     if args.json:
         print(json.dumps(out))
@@ -108,10 +119,9 @@ def _default_log_path(scenario_name: str, planner: str, seed: int) -> FilePath:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from sim.recording import RecorderGroup
-    from sim.runner import Simulation, plan_scenario
+    from sim.runner import Simulation
     scenario = _load(args)
-    name, params = _planner_choice(args, scenario)
-    path, name, params, seed = plan_scenario(scenario, name, params, args.seed)
+    path, name, params, seed = _plan(args, scenario)
     simulation = Simulation(scenario)
     recorders = []
     log_path = None

@@ -156,3 +156,4 @@ def test_bad_planner_parameters_from_set_exit_2(capsys, planner, setting, field)
     code, out, err = run_cli(capsys, "plan", "gwo-scenario-1", "--planner", planner, "--set", setting)
     assert code == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and field in err and "Traceback" not in err
+    assert err.startswith("swarmnav: error: --set: ")
