@@ -27,7 +27,7 @@ from typing import Any, Callable, ClassVar, Iterable
 import numpy as np
 
 from planners.errors import GoalBlocked, NoPathFound, StartBlocked, check_parameters
-from planners.geometry import segment_box_distances, segment_disc_distances
+from planners.geometry import segment_box_distance, segment_box_distances, segment_disc_distances
 from planners.problem import OccupancyGrid, Path, Problem, check_endpoints
 
 SQRT2 = math.sqrt(2.0)
@@ -296,7 +296,8 @@ def theta_star_cells(occupied: np.ndarray, start: Cell, goal: Cell,
         occupied: (rows, cols) bool.
         start, goal: (row, col) free cells.
         line_of_sight: visibility test between two cells; by default
-            :func:`grid_line_of_sight` on ``occupied``.
+            :func:`grid_line_of_sight` on ``occupied``.  Each pair is asked
+            at most once (answers are kept for the search).
 
     Returns:
         (corner cells from start to goal, Euclidean length in cells, expansions).
@@ -314,6 +315,7 @@ def theta_star_cells(occupied: np.ndarray, start: Cell, goal: Cell,
     g = [INF] * n
     parent = [-1] * n
     closed = bytearray(n)
+    seen: dict[int, bool] = {}      # line of sight by (parent, cell): Theta* asks most pairs several times
     g[s] = 0.0
     parent[s] = s
     gr, gc = goal
@@ -340,7 +342,14 @@ def theta_star_cells(occupied: np.ndarray, start: Cell, goal: Cell,
             if closed[v]:
                 continue
             vr, vc = divmod(v, cols)
-            if pu != u and los((pr, pc), (vr, vc)):
+            if pu != u:
+                key = pu * n + v
+                visible = seen.get(key)
+                if visible is None:
+                    visible = seen[key] = los((pr, pc), (vr, vc))
+            else:
+                visible = False
+            if visible:
                 cand, par = g[pu] + math.hypot(vr - pr, vc - pc), pu
             else:
                 cand, par = g[u] + w, u
@@ -603,6 +612,74 @@ def segments_clear(problem: Problem, a: np.ndarray, bs: np.ndarray, tolerance_m:
     return ok
 
 
+def boxes_by_cell(grid: OccupancyGrid, boxes: np.ndarray, reach_m: float) -> list[tuple[int, ...]]:
+    """For each cell (row-major index), the boxes that come within ``reach_m`` of it.
+
+    A box is listed when its footprint grown by ``reach_m`` (a square, so a
+    superset of the round Minkowski sum) overlaps the closed cell.  So any
+    point of a cell that lies within ``reach_m`` of a box has that box in the
+    cell's list.
+
+    Args:
+        grid: the grid whose cells are indexed.
+        boxes: (B, 4) rows of (x_min, y_min, x_max, y_max) in metres.
+        reach_m: how far from a box a cell may be and still list it.
+    """
+    rows, cols = grid.occupied.shape
+    boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
+    x_edges = grid.origin_m[0] + np.arange(cols + 1) * grid.cell_m
+    y_edges = grid.origin_m[1] + np.arange(rows + 1) * grid.cell_m
+    col_near = (x_edges[None, :-1] <= boxes[:, 2:3] + reach_m) & (x_edges[None, 1:] >= boxes[:, 0:1] - reach_m)
+    row_near = (y_edges[None, :-1] <= boxes[:, 3:4] + reach_m) & (y_edges[None, 1:] >= boxes[:, 1:2] - reach_m)
+    near = row_near[:, :, None] & col_near[:, None, :]               # (B, rows, cols)
+    box_ids, cell_ids = np.nonzero(near.reshape(len(boxes), -1))
+    lists: list[list[int]] = [[] for _ in range(rows * cols)]
+    for k, i in zip(box_ids.tolist(), cell_ids.tolist()):
+        lists[i].append(k)
+    return [tuple(ids) for ids in lists]
+
+
+def box_line_of_sight(problem: Problem, grid: OccupancyGrid, tolerance_m: float = 1e-9
+                      ) -> Callable[[Cell, Cell], bool]:
+    """Exact visibility between cell centres: free cells only, and the inflation kept from every box.
+
+    The segment must pass only through free cells (:func:`grid_line_of_sight`)
+    and keep at least ``problem.inflation_m`` (less ``tolerance_m``) from every
+    box of ``problem.box_array_m``.
+
+    Speed without giving up exactness: every cell lists the boxes within the
+    inflation of it (:func:`boxes_by_cell`, once per call of this function), and
+    the cells a segment enters (:func:`line_cells`) cover all its points, so
+    only the boxes those cells list can be within the inflation of the
+    segment; those few are tested with the scalar
+    :func:`~planners.geometry.segment_box_distance`.
+
+    Returns:
+        ``los(p, q)`` for (row, col) cells of ``grid``.
+    """
+    free = (~grid.occupied).tolist()
+    rows, cols = grid.occupied.shape
+    inflation_m = problem.inflation_m
+    # The small extra reach only lists more boxes; it guards the cull against rounding.
+    near = boxes_by_cell(grid, problem.box_array_m, inflation_m + 1e-6)
+    boxes = problem.box_array_m.tolist()
+    xs = grid.centres_m(np.column_stack([np.zeros(cols), np.arange(cols)]))[:, 0].tolist()   # by column
+    ys = grid.centres_m(np.column_stack([np.arange(rows), np.zeros(rows)]))[:, 1].tolist()   # by row
+
+    def los(p: Cell, q: Cell) -> bool:
+        if not grid_line_of_sight(free, p, q):
+            return False
+        ids: set[int] = set()
+        for r, c in line_cells(p, q):
+            ids.update(near[r * cols + c])
+        if not ids:
+            return True
+        ax, ay, bx, by = xs[p[1]], ys[p[0]], xs[q[1]], ys[q[0]]
+        return all(segment_box_distance(ax, ay, bx, by, *boxes[k]) - inflation_m >= -tolerance_m for k in ids)
+
+    return los
+
+
 def exact_shortcut(problem: Problem, waypoints: np.ndarray, window: int = 32) -> np.ndarray:
     """Greedy line-of-sight shortcut: from each kept vertex jump to the farthest visible one.
 
@@ -711,22 +788,14 @@ class ThetaStarPlanner(GridPlanner):
     """Theta*, any-angle: the grid yardstick for the length of a path that need not follow moves.
 
     Line of sight is checked cell by cell on the inflated grid and, where the
-    problem has box obstacles (maps), also exactly against the inflated boxes.
+    problem has box obstacles (maps), also exactly against the inflated boxes
+    (:func:`box_line_of_sight`).
     """
 
     name: ClassVar[str] = "theta_star"
 
     def search(self, problem, grid, start, goal):
-        free = (~grid.occupied).tolist()
-        if problem.boxes:
-            def los(p: Cell, q: Cell) -> bool:
-                if not grid_line_of_sight(free, p, q):
-                    return False
-                a, b = grid.centres_m(np.array([p, q]))
-                d = segment_box_distances(a[None], b[None], problem.box_array_m)
-                return bool(np.all(d - problem.inflation_m >= -1e-9))
-        else:
-            los = None
+        los = box_line_of_sight(problem, grid) if problem.boxes else None
         cells, cost, expansions = theta_star_cells(grid.occupied, start, goal, los)
         return cells, cost, expansions, {}
 

@@ -10,12 +10,13 @@ import pytest
 from models.scenario import list_scenarios, load_scenario, parse_scenario
 from planners import PLANNERS, make_planner
 from planners.errors import ConfigError, NoPathFound
-from planners.geometry import segment_box_distances
-from planners.grid_search import DStarLite, astar_cells, dijkstra_cells, grid_line_of_sight, theta_star_cells
+from planners.geometry import segment_box_distance, segment_box_distances
+from planners.grid_search import (DStarLite, astar_cells, box_line_of_sight, dijkstra_cells, grid_line_of_sight,
+                                  theta_star_cells)
 from planners.ant_colony import GridGraph, walk_colony
 from planners.improved_ant_colony import (adaptive_parameters, feature_cells, iaco_heuristic, pheromone_intensity,
                                           prune_length)
-from planners.problem import OccupancyGrid
+from planners.problem import Box, OccupancyGrid, Pose2D, Problem, Rect
 from planners.max_min_ant_system import analyse_environment
 from planners.movingai import (benchmark_sets, format_map, map_problem, map_to_grid, merge_boxes, parse_map,
                                read_map, read_scenarios)
@@ -67,6 +68,55 @@ def test_segment_box_distance_matches_dense_sampling():
     assert np.allclose(np.hypot(gap[..., 0], gap[..., 1]).min(axis=0), d, atol=2e-3)
 
 
+@pytest.mark.parametrize("snap", [False, True])
+def test_scalar_and_vectorised_segment_box_distances_agree(snap):
+    rng = np.random.default_rng(11)
+    a, b = rng.uniform(-2, 2, (300, 2)), rng.uniform(-2, 2, (300, 2))
+    lo = rng.uniform(-1, 0.5, (6, 2))
+    boxes = np.hstack([lo, lo + rng.uniform(0.1, 1, (6, 2))])
+    if snap:       # on a 0.5 lattice: axis-parallel, zero-length, touching and grazing segments
+        a, b, boxes = np.round(a * 2) / 2, np.round(b * 2) / 2, np.round(boxes * 2) / 2
+    scalar = [[segment_box_distance(*a[i], *b[i], *box) for box in boxes] for i in range(len(a))]
+    assert np.allclose(scalar, segment_box_distances(a, b, boxes), rtol=0, atol=1e-12)
+
+
+def off_lattice_boxes_problem() -> Problem:
+    """Boxes off the cell edges, inflation wider than a cell, and an all-free grid: the box test decides alone."""
+    rng = np.random.default_rng(2)
+    lo = rng.uniform(0.5, 5.0, (8, 2))
+    hi = lo + rng.uniform(0.05, 1.0, (8, 2))
+    boxes = tuple(Box(x0, y0, x1, y1) for (x0, y0), (x1, y1) in zip(lo.tolist(), hi.tolist()))
+    grid = OccupancyGrid(np.zeros((120, 120), dtype=bool), 0.05, (0.0, 0.0))
+    return Problem(Pose2D(0.1, 0.1), Pose2D(5.9, 5.9), Rect(0.0, 0.0, 6.0, 6.0), (), robot_radius_m=0.37,
+                   clearance_m=0.0, boxes=boxes, cell_m=0.05, grid_override=grid)
+
+
+@pytest.mark.parametrize("scenario_name", ["iaco-complex", "immas-env2-rings", "off-lattice"])
+def test_box_line_of_sight_equals_the_test_against_every_box(scenario_name):
+    if scenario_name == "off-lattice":
+        problem = off_lattice_boxes_problem()
+    else:
+        problem = load_scenario(scenario_name).to_problem()
+    grid = problem.grid
+    los = box_line_of_sight(problem, grid)
+    free = (~grid.occupied).tolist()
+    free_cells = np.argwhere(~grid.occupied)
+    rng = np.random.default_rng(5)
+    pairs = free_cells[rng.integers(len(free_cells), size=(300, 2))]
+    # Short segments too: most of Theta*'s questions are local, near obstacles.
+    near = np.clip(pairs[:, 0] + rng.integers(-4, 5, (300, 2)), 0, np.array(grid.shape) - 1)
+    pairs = np.concatenate([pairs, np.stack([pairs[:, 0], near], axis=1)])
+    answers = []
+    for p, q in pairs:
+        p, q = tuple(p.tolist()), tuple(q.tolist())
+        centres = grid.centres_m(np.array([p, q]))
+        d = segment_box_distances(centres[:1], centres[1:], problem.box_array_m)
+        expected = grid_line_of_sight(free, p, q) and bool(np.all(d - problem.inflation_m >= -1e-9))
+        assert los(p, q) == expected, (p, q)
+        answers.append(expected)
+    assert 0 < sum(answers) < len(answers)
+
+
 def test_map_scenarios_load_with_boxes_and_a_grid_at_map_resolution():
     assert len(MAP_SCENARIOS) == 10
     scenario = load_scenario("immas-env1-scattered")
@@ -87,8 +137,6 @@ def test_a_map_that_does_not_span_the_arena_is_rejected():
 @pytest.mark.parametrize("scenario_name", MAP_SCENARIOS)
 @pytest.mark.parametrize("planner_name", GRID_PLANNERS)
 def test_collision_free_on_every_bundled_map(planner_name, scenario_name):
-    if planner_name == "theta_star" and scenario_name not in ("iaco-simple", "immas-env2-rings"):
-        pytest.skip("theta_star is slow with exact box checks; two maps suffice here")
     if planner_name == "iaco" and scenario_name == "iaco-baffle":
         pytest.skip("iaco needs its full 50 x 100 budget on the baffle map (run by bench grid)")
     scenario = load_scenario(scenario_name)
