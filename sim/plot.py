@@ -13,16 +13,9 @@ import argparse
 import sys
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.collections import PatchCollection  # noqa: E402
-from matplotlib.patches import Circle, Rectangle  # noqa: E402
-
-from sim.log_reader import RunLog, outcome_text, read_log  # noqa: E402
+from sim.log_reader import RunLog, outcome_text, read_log
 
 MAX_SWEEP_DISCS = 40
 MAX_SCANS = 400
@@ -52,6 +45,9 @@ def collision_points_m(log: RunLog) -> np.ndarray:
 
 
 def _draw_obstacles(ax, log: RunLog) -> None:
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Circle, Rectangle
+
     static, swept = [], []
     for ob in log.obstacles:
         x, y = ob["position_m"][0], ob["position_m"][1]
@@ -75,6 +71,13 @@ def _draw_obstacles(ax, log: RunLog) -> None:
 
 
 def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
+    # Imported here so that the CLI starts without loading matplotlib.
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
+
     """Draw the two panels of a run into ``out`` (PNG, SVG, PDF by extension)."""
     fig, (ax, ax_wheels) = plt.subplots(
         2, 1, figsize=(8, 10.5), gridspec_kw={"height_ratios": [3, 1.1]}, layout="constrained"
