@@ -56,8 +56,6 @@ def planner_params(cls: type) -> dict[str, Any]:
 
 def _coerce(value: Any, annotation: Any, field: str) -> Any:
     """Check a user-given parameter against a dataclass field's annotation."""
-    if isinstance(annotation, str):
-        annotation = eval(annotation, vars(typing) | {"np": __import__("numpy")})  # noqa: S307
     origin = typing.get_origin(annotation)
     if origin in (typing.Union, types.UnionType):
         args = typing.get_args(annotation)
