@@ -12,9 +12,8 @@ import types
 import typing
 from typing import Any
 
-from planners.astar import AStarPlanner
 from planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
-from planners.grid_search import DijkstraPlanner, DStarLitePlanner, ThetaStarPlanner
+from planners.grid_search import AStarPlanner, DijkstraPlanner, DStarLitePlanner, ThetaStarPlanner
 from planners.improved_ant_colony import ImprovedAntColonyPlanner
 from planners.max_min_ant_system import MaxMinAntSystemPlanner
 from planners.waiter_ant_colony import WaiterAntColonyPlanner
