@@ -406,18 +406,14 @@ def _parse_map(top: _Table, source: str, width_m: float, height_m: float
 def _check_endpoints(scenario: Scenario, source: str) -> None:
     """Start and goal must lie in the arena and outside every obstacle grown by the robot radius."""
     bounds = scenario.planning_bounds(scenario.robot_radius_m)
+    problem = scenario.to_problem(clearance_m=0.0)
     for key, pose in (("start", scenario.start), ("goal", scenario.goal)):
         if not bounds.contains(pose.x_m, pose.y_m):
             raise ConfigError(key, f"({pose.x_m:g}, {pose.y_m:g}) is outside the arena "
                               f"[{bounds.x_min_m:g}, {bounds.x_max_m:g}] x [{bounds.y_min_m:g}, "
                               f"{bounds.y_max_m:g}] (walls keep the robot's centre a radius away)", source)
-        for i, disc in enumerate(scenario.discs_at(0.0)):
-            gap = math.hypot(pose.x_m - disc.x_m, pose.y_m - disc.y_m) - disc.radius_m - scenario.robot_radius_m
-            if gap < 0:
-                raise ConfigError(key, f"({pose.x_m:g}, {pose.y_m:g}) is inside obstacles[{i}] grown by "
-                                  f"the robot radius (by {-gap:.3f} m)", source)
-        for i, box in enumerate(scenario.boxes):
-            dx = max(box.x_min_m - pose.x_m, pose.x_m - box.x_max_m, 0.0)
-            dy = max(box.y_min_m - pose.y_m, pose.y_m - box.y_max_m, 0.0)
-            if math.hypot(dx, dy) < scenario.robot_radius_m:
-                raise ConfigError(key, f"({pose.x_m:g}, {pose.y_m:g}) is inside a map obstacle", source)
+        kind, index, gap = problem.nearest_obstacle(pose.x_m, pose.y_m)
+        if gap < 0:
+            what = f"obstacles[{index}]" if kind == "disc" else "a map obstacle"
+            raise ConfigError(key, f"({pose.x_m:g}, {pose.y_m:g}) is inside {what} grown by "
+                              f"the robot radius (by {-gap:.3f} m)", source)

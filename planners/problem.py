@@ -180,12 +180,27 @@ class Problem:
             return self.grid_override
         return rasterise(self.bounds, self.obstacles, self.boxes, self.inflation_m, self.cell_m)
 
+    def nearest_obstacle(self, x_m: float, y_m: float) -> tuple[str, int, float]:
+        """The obstacle nearest a point: ("disc" or "box", its index, signed gap to its inflated footprint).
+
+        ("", -1, inf) with no obstacle.  A point inside a box scores ``-inflation_m``.
+        """
+        best = ("", -1, float("inf"))
+        if self.obstacles:
+            d = np.hypot(self.disc_centres_m[:, 0] - x_m, self.disc_centres_m[:, 1] - y_m) - self.inflated_radii_m
+            i = int(np.argmin(d))
+            best = ("disc", i, float(d[i]))
+        if self.boxes:
+            p = np.array([[x_m, y_m]])
+            d = segment_box_distances(p, p, self.box_array_m)[0] - self.inflation_m
+            i = int(np.argmin(d))
+            if d[i] < best[2]:
+                best = ("box", i, float(d[i]))
+        return best
+
     def point_clearance_m(self, x_m: float, y_m: float) -> float:
-        """Signed gap from a point to the nearest inflated disc (inf with none)."""
-        if not self.obstacles:
-            return float("inf")
-        d = np.hypot(self.disc_centres_m[:, 0] - x_m, self.disc_centres_m[:, 1] - y_m)
-        return float(np.min(d - self.inflated_radii_m))
+        """Signed gap from a point to the nearest inflated disc or box (inf with none)."""
+        return self.nearest_obstacle(x_m, y_m)[2]
 
     @cached_property
     def box_array_m(self) -> np.ndarray:
@@ -272,12 +287,7 @@ def check_endpoints(problem: Problem) -> None:
     for pose, error, label in ((problem.start, StartBlocked, "start"), (problem.goal, GoalBlocked, "goal")):
         if not problem.bounds.contains(pose.x_m, pose.y_m):
             raise error(f"{label} ({pose.x_m:g}, {pose.y_m:g}) is outside the bounds")
-        gap = problem.point_clearance_m(pose.x_m, pose.y_m)
-        if gap < 0:
-            raise error(f"{label} ({pose.x_m:g}, {pose.y_m:g}) is inside an inflated obstacle "
+        kind, _, gap = problem.nearest_obstacle(pose.x_m, pose.y_m)
+        if gap < -1e-9:  # touching is allowed (map cell centres touch inflated boxes)
+            raise error(f"{label} ({pose.x_m:g}, {pose.y_m:g}) is inside an inflated {kind} obstacle "
                         f"(by {-gap:.3f} m)")
-        for box in problem.boxes:
-            dx = max(box.x_min_m - pose.x_m, pose.x_m - box.x_max_m, 0.0)
-            dy = max(box.y_min_m - pose.y_m, pose.y_m - box.y_max_m, 0.0)
-            if math.hypot(dx, dy) < problem.inflation_m - 1e-9:  # touching is allowed (map cells)
-                raise error(f"{label} ({pose.x_m:g}, {pose.y_m:g}) is inside an inflated box obstacle")
