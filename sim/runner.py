@@ -4,7 +4,8 @@ collision check -> recorder, at the control rate.
 Only ``sim/`` touches MuJoCo.  Each control step:
 
 1. move the mocap obstacles to their positions at time t;
-2. read the pose (free joint) and the rangefinders (``inf`` = nothing in range);
+2. read the pose (free joint); with a recorder, also the rangefinders (MuJoCo
+   computes them every step; ``inf`` = nothing in range) and the wheel speeds;
 3. track the clearance to the nearest obstacle with ``mj_geomDistance``;
 4. stop on goal, timeout or (optionally) first collision;
 5. ask the controller for wheel speeds, write ``data.ctrl``, and ``mj_step`` k
@@ -219,15 +220,11 @@ class Simulation:
         has_moving = len(mocap_index) > 0
 
         qadr = scene.free_qpos_adr
-        wl_adr, wr_adr = scene.wheel_qvel_adr
-        range_adr = scene.range_sensor_adr
-        cutoff = scene.range_cutoff_m
         chassis = scene.chassis_geom_id
         # Analytic 2-D prefilter to pick the nearest obstacle for mj_geomDistance.
         obstacle_ids = np.array([ob.geom_id for ob in scene.obstacles], dtype=np.int64)
         obstacle_is_box = model.geom_type[obstacle_ids] == mujoco.mjtGeom.mjGEOM_BOX if len(obstacle_ids) else np.zeros(0, bool)
         obstacle_half = model.geom_size[obstacle_ids, :2] if len(obstacle_ids) else np.zeros((0, 2))
-        robot_radius = float(model.geom_size[chassis][0])
         fromto = np.zeros(6)
 
         poses = np.zeros((n_max + 1, 3))
@@ -243,7 +240,6 @@ class Simulation:
         step = 0
         ctrl = data.ctrl
         qpos = data.qpos
-        qvel = data.qvel
         geom_xpos = data.geom_xpos
 
         wall0 = time.perf_counter()
