@@ -42,7 +42,7 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
     every measurement covers the same simulated time.
     """
     scenario = load_scenario(scenario_name)
-    path, *_ = plan_scenario(scenario)
+    path, planner_name, planner_params, seed = plan_scenario(scenario)
     simulation = Simulation(scenario)
     bare, closed, ratios, realtime, logging, logging_ratios = [], [], [], [], [], []
     physics_steps = int(round(duration_s / simulation.model.opt.timestep))
@@ -63,7 +63,7 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
             ratios.append(c / b)
             if recorder_cls is not None:
                 recorder = recorder_cls(FilePath(tmp) / f"bench_{r}.mcap", overwrite=True)
-                context = simulation.context("astar", {}, scenario.seed)
+                context = simulation.context(planner_name, planner_params, seed)
                 lg, _ = _closed_loop_steps_per_s(simulation, path, duration_s, recorder, context)
                 logging.append(lg)
                 logging_ratios.append(lg / b)
