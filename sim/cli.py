@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
-import math
 import os
 import signal
 import sys
@@ -19,8 +18,6 @@ import time
 import tomllib
 from pathlib import Path as FilePath
 from typing import Any, Callable
-
-import numpy as np
 
 from planners.errors import ConfigError, PlanningError
 
@@ -112,11 +109,6 @@ def cmd_plan(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _default_log_path(scenario_name: str, planner: str, seed: int) -> FilePath:
-    stamp = time.strftime("%Y%m%d-%H%M%S")
-    return FilePath("logs") / f"{scenario_name}_{planner}_seed{seed}_{stamp}.mcap"
-
-
 def cmd_run(args: argparse.Namespace) -> int:
     from sim.recording import RecorderGroup
     from sim.runner import Simulation
@@ -126,8 +118,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     recorders = []
     log_path = None
     if not args.no_log:
-        from sim.mcap_log import McapRecorder
-        log_path = FilePath(args.out) if args.out else _default_log_path(scenario.name, name, seed)
+        from sim.mcap_log import McapRecorder, default_log_path
+        log_path = FilePath(args.out) if args.out else default_log_path(
+            scenario.name, name, seed, time.strftime("%Y%m%d-%H%M%S"))
         if log_path.exists() and not args.overwrite:
             raise UserError(f"{log_path}: --out: file exists (use --overwrite)")
         recorders.append(McapRecorder(log_path, live=args.live, overwrite=True))
