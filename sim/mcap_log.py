@@ -43,7 +43,6 @@ from __future__ import annotations
 import importlib.metadata
 import json
 import math
-import platform
 import sys
 import threading
 import time
@@ -205,16 +204,13 @@ def beam_origin(context: RunContext) -> tuple[float, float]:
     return float(context.sensor_offset_m), float(context.sensor_height_m)
 
 
-def versions(extra: dict[str, str] | None = None) -> dict[str, str]:
-    """Versions worth recording: swarmnav, MuJoCo, Python, the log writer."""
-    found = {"python": platform.python_version()}
-    for key, dist in (("swarmnav", "swarmnav"), ("mujoco", "mujoco"), ("foxglove_sdk", "foxglove-sdk")):
-        try:
-            found[key] = importlib.metadata.version(dist)
-        except importlib.metadata.PackageNotFoundError:
-            found[key] = "unknown"
-    found.update(extra or {})
-    return found
+def versions(run_versions: dict[str, str]) -> dict[str, str]:
+    """The run's versions (swarmnav, MuJoCo, Python) plus the log writer's."""
+    try:
+        writer = importlib.metadata.version("foxglove-sdk")
+    except importlib.metadata.PackageNotFoundError:
+        writer = "unknown"
+    return {"foxglove_sdk": writer, **run_versions}
 
 
 class _LateSubscribers(ServerListener):
