@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from controllers.kinematics import DriveGeometry, WheelSpeeds, wheel_speeds
-from planners.problem import Pose2D
+from swarmnav.controllers.kinematics import DriveGeometry, WheelSpeeds, wheel_speeds
+from swarmnav.models.world import Pose2D
 
 
 def wrap_angle_rad(angle_rad: float) -> float:

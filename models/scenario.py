@@ -1,6 +1,6 @@
 """Scenarios are data: TOML files under ``models/scenarios/``, validated on load.
 
-Every problem in a file raises :class:`planners.errors.ConfigError` naming the
+Every problem in a file raises :class:`models.errors.ConfigError` naming the
 file, the field (a dotted path such as ``obstacles[3].motion.kind``) and what is
 wrong.  The schema is documented in the README; units are in the field names.
 """
@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
-from models.obstacle_motion import LinearMotion, RandomWalkMotion, Stationary, WaypointMotion
-from planners.errors import ConfigError
-from planners.problem import Box, Disc, OccupancyGrid, Pose2D, Problem, Rect
+from swarmnav.models.obstacle_motion import LinearMotion, RandomWalkMotion, Stationary, WaypointMotion
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem
 
 SCENARIO_DIR = FilePath(__file__).resolve().parent / "scenarios"
 MOTION_KINDS = ("linear", "random_walk", "waypoints")
@@ -97,15 +97,6 @@ class Scenario:
             out.append(Disc(float(x), float(y), ob.radius_m))
         return tuple(out)
 
-    def to_problem(self, cell_m: float | None = None, at_time_s: float = 0.0,
-                   clearance_m: float | None = None) -> Problem:
-        """The planning problem with obstacles frozen at ``at_time_s``."""
-        clearance_m = self.clearance_m if clearance_m is None else clearance_m
-        return Problem(start=self.start, goal=self.goal,
-                       bounds=self.planning_bounds(self.robot_radius_m + clearance_m),
-                       obstacles=self.discs_at(at_time_s), robot_radius_m=self.robot_radius_m,
-                       clearance_m=clearance_m,
-                       boxes=self.boxes, cell_m=cell_m or self.cell_m, grid_override=self.map_grid)
 
 
 class _Table:
@@ -262,10 +253,6 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     if not isinstance(params, dict):
         planner.fail("params", "expected a table")
     planner.close()
-    from planners import PLANNERS
-    if planner_name not in PLANNERS:
-        raise ConfigError("planner.name", f"unknown planner {planner_name!r} "
-                          f"(known: {', '.join(sorted(PLANNERS))})", source)
 
     sim_t = top.table("sim", {})
     sim = SimSettings(timestep_s=sim_t.number("timestep_s", 0.002, positive=True),
@@ -340,7 +327,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
             # Discs beside a map: rasterise both at the map's resolution (conservative margin).
             map_grid = None
         else:
-            from planners.movingai import inflated_map_grid
+            from swarmnav.models.grid_map import inflated_map_grid
             map_grid = inflated_map_grid(map_grid.occupied, map_cell_m, robot_radius_m + clearance_m, boxes)
 
     scenario = Scenario(
@@ -370,7 +357,7 @@ def _parse_map(top: _Table, source: str, width_m: float, height_m: float
     """
     if not top.has("map"):
         return (), None, None
-    from planners.movingai import map_to_grid, merge_boxes, read_map
+    from swarmnav.models.grid_map import map_to_grid, merge_boxes, read_map
 
     t = top.table("map")
     name = t.string("file")
@@ -406,14 +393,13 @@ def _parse_map(top: _Table, source: str, width_m: float, height_m: float
 def _check_endpoints(scenario: Scenario, source: str) -> None:
     """Start and goal must lie in the arena and outside every obstacle grown by the robot radius."""
     bounds = scenario.planning_bounds(scenario.robot_radius_m)
-    problem = scenario.to_problem(clearance_m=0.0)
+    discs = scenario.discs_at(0.0)
+    centres = np.array([[d.x_m, d.y_m] for d in discs], dtype=float).reshape(-1, 2)
+    radii = np.array([d.radius_m for d in discs], dtype=float)
+    boxes = np.array([[b.x_min_m, b.y_min_m, b.x_max_m, b.y_max_m] for b in scenario.boxes],
+                     dtype=float).reshape(-1, 4)
     for key, pose in (("start", scenario.start), ("goal", scenario.goal)):
-        if not bounds.contains(pose.x_m, pose.y_m):
-            raise ConfigError(key, f"({pose.x_m:g}, {pose.y_m:g}) is outside the arena "
-                              f"[{bounds.x_min_m:g}, {bounds.x_max_m:g}] x [{bounds.y_min_m:g}, "
-                              f"{bounds.y_max_m:g}] (walls keep the robot's centre a radius away)", source)
-        kind, index, gap = problem.nearest_obstacle(pose.x_m, pose.y_m)
-        if gap < 0:
-            what = f"obstacles[{index}]" if kind == "disc" else "a map obstacle"
-            raise ConfigError(key, f"({pose.x_m:g}, {pose.y_m:g}) is inside {what} grown by "
-                              f"the robot radius (by {-gap:.3f} m)", source)
+        why = endpoint_problem(pose, bounds, centres, radii, boxes, scenario.robot_radius_m)
+        if why is not None:
+            raise ConfigError(key, f"{why} (walls keep the robot's centre a radius away)"
+                              if "outside" in why and scenario.walls else why, source)

@@ -12,18 +12,19 @@ import types
 import typing
 from typing import Any
 
-from planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
-from planners.grid_search import AStarPlanner, DijkstraPlanner, DStarLitePlanner, ThetaStarPlanner
-from planners.improved_ant_colony import ImprovedAntColonyPlanner
-from planners.max_min_ant_system import MaxMinAntSystemPlanner
-from planners.waiter_ant_colony import WaiterAntColonyPlanner
-from planners.grey_wolf import GreyWolfPlanner
-from planners.optimal import OptimalPlanner
-from planners.particle_swarm import ParticleSwarmPlanner
-from planners.errors import (BudgetExceeded, ConfigError, GoalBlocked, NoPathFound,
-                             PlanningError, StartBlocked)
-from planners.problem import Box, Disc, Path, Planner, PlanStats, Pose2D, Problem, Rect
-from planners.straight import StraightPlanner
+from swarmnav.planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
+from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, DStarLitePlanner, ThetaStarPlanner
+from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
+from swarmnav.planners.max_min_ant_system import MaxMinAntSystemPlanner
+from swarmnav.planners.waiter_ant_colony import WaiterAntColonyPlanner
+from swarmnav.planners.grey_wolf import GreyWolfPlanner
+from swarmnav.planners.optimal import OptimalPlanner
+from swarmnav.planners.particle_swarm import ParticleSwarmPlanner
+from swarmnav.planners.errors import BudgetExceeded, GoalBlocked, NoPathFound, PlanningError, StartBlocked
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.world import Box, Disc, Pose2D, Rect
+from swarmnav.planners.problem import Path, Planner, PlanStats, Problem
+from swarmnav.planners.straight import StraightPlanner
 
 PLANNERS: dict[str, type] = {}
 

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.grid_search import DIRECTIONS, STEP_COSTS, neighbour_table
-from planners.problem import OccupancyGrid
+from swarmnav.planners.grid_search import DIRECTIONS, STEP_COSTS, neighbour_table
+from swarmnav.models.world import OccupancyGrid
 
 #: Index used for "no previous move" (an ant on its first step).
 NO_DIRECTION = 8

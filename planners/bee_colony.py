@@ -39,10 +39,10 @@ from typing import ClassVar
 
 import numpy as np
 
-from planners.continuous import ContinuousPlanner
-from planners.errors import ConfigError
-from planners.problem import Problem
-from planners.swarm import SwarmState
+from swarmnav.planners.continuous import ContinuousPlanner
+from swarmnav.models.errors import ConfigError
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.swarm import SwarmState
 
 
 def adaptive_limit(iteration: int, mcn: int, dimensions: int, limit: float) -> float:

@@ -39,11 +39,12 @@ from typing import Any
 
 import numpy as np
 
-from planners.errors import ConfigError, NoPathFound, check_parameters
-from planners.path_cost import PathObjective
-from planners.problem import Problem
-from planners.swarm import SwarmPlanner, SwarmState
-from planners.via_points import ENCODINGS, ViaPointCurve
+from swarmnav.models.errors import ConfigError
+from swarmnav.planners.errors import NoPathFound, check_parameters
+from swarmnav.planners.path_cost import PathObjective
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.swarm import SwarmPlanner, SwarmState
+from swarmnav.planners.via_points import ENCODINGS, ViaPointCurve
 
 
 @dataclass

@@ -7,22 +7,7 @@ is a :class:`ConfigError` instead and maps to exit code 2.
 
 from __future__ import annotations
 
-
-class ConfigError(ValueError):
-    """Invalid user input: a scenario field, a planner parameter, a CLI option.
-
-    Attributes:
-        source: the file (or other origin) the value came from, if known.
-        field: dotted path of the offending field, e.g. ``obstacles[2].radius_m``.
-        problem: what is wrong with it, in a few words.
-    """
-
-    def __init__(self, field: str, problem: str, source: str | None = None):
-        self.source = source
-        self.field = field
-        self.problem = problem
-        where = f"{source}: " if source else ""
-        super().__init__(f"{where}{field}: {problem}")
+from swarmnav.models.errors import ConfigError
 
 
 class PlanningError(RuntimeError):

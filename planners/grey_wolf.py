@@ -27,9 +27,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from planners.continuous import ContinuousPlanner
-from planners.problem import Problem
-from planners.swarm import SwarmState
+from swarmnav.planners.continuous import ContinuousPlanner
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.swarm import SwarmState
 
 
 @dataclass

@@ -26,9 +26,10 @@ from typing import Any, Callable, ClassVar, Iterable
 
 import numpy as np
 
-from planners.errors import GoalBlocked, NoPathFound, StartBlocked, check_parameters
-from planners.geometry import segment_box_distance, segment_box_distances, segment_disc_distances
-from planners.problem import OccupancyGrid, Path, Problem, check_endpoints
+from swarmnav.planners.errors import GoalBlocked, NoPathFound, StartBlocked, check_parameters
+from swarmnav.models.geometry import segment_box_distance, segment_box_distances, segment_disc_distances
+from swarmnav.models.world import OccupancyGrid
+from swarmnav.planners.problem import Path, Problem, check_endpoints
 
 SQRT2 = math.sqrt(2.0)
 INF = float("inf")

@@ -53,12 +53,12 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
-from planners.ant_colony import STEP_LENGTHS, GridGraph, cosine_table, deposit, evaporate, walk_colony
-from planners.errors import NoPathFound, check_parameters
-from planners.grid_search import (Cell, cells_to_waypoints, count_bends, exact_shortcut, grid_endpoints,
+from swarmnav.planners.ant_colony import STEP_LENGTHS, GridGraph, cosine_table, deposit, evaporate, walk_colony
+from swarmnav.planners.errors import NoPathFound, check_parameters
+from swarmnav.planners.grid_search import (Cell, cells_to_waypoints, count_bends, exact_shortcut, grid_endpoints,
                                   grid_line_of_sight, line_cells)
-from planners.problem import Problem
-from planners.swarm import SwarmPlanner, SwarmState
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 
 
 def feature_cells(occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -52,12 +52,12 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
-from planners.ant_colony import roulette
-from planners.errors import NoPathFound, check_parameters
-from planners.grid_search import (DIRECTIONS, Cell, cells_to_waypoints, count_bends, exact_shortcut,
+from swarmnav.planners.ant_colony import roulette
+from swarmnav.planners.errors import NoPathFound, check_parameters
+from swarmnav.planners.grid_search import (DIRECTIONS, Cell, cells_to_waypoints, count_bends, exact_shortcut,
                                   grid_endpoints)
-from planners.problem import Problem
-from planners.swarm import SwarmPlanner, SwarmState
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 
 INF = math.inf
 ORTHOGONAL = ((-1, 0), (1, 0), (0, -1), (0, 1))

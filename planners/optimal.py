@@ -39,9 +39,11 @@ from typing import ClassVar
 
 import numpy as np
 
-from planners.errors import ConfigError, NoPathFound
-from planners.geometry import segment_disc_distances
-from planners.problem import Path, Problem, Rect, check_endpoints
+from swarmnav.models.errors import ConfigError
+from swarmnav.planners.errors import NoPathFound
+from swarmnav.models.geometry import segment_disc_distances
+from swarmnav.planners.problem import Path, Problem, check_endpoints
+from swarmnav.models.world import Rect
 
 TOLERANCE_M = 1e-9
 

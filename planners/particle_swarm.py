@@ -21,10 +21,10 @@ from typing import ClassVar
 
 import numpy as np
 
-from planners.continuous import ContinuousPlanner
-from planners.errors import ConfigError
-from planners.problem import Problem
-from planners.swarm import SwarmState
+from swarmnav.planners.continuous import ContinuousPlanner
+from swarmnav.models.errors import ConfigError
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.swarm import SwarmState
 
 TOPOLOGIES = ("global", "ring")
 

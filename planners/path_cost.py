@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.problem import Rect
-from planners.via_points import ViaPointCurve
+from swarmnav.models.world import Rect
+from swarmnav.planners.via_points import ViaPointCurve
 
 
 def sampled_length_m(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:

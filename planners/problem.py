@@ -1,7 +1,8 @@
 """The planning seam: what a planner is given and what it returns.
 
-Nothing here knows MuJoCo or scenario files.  ``models.scenario`` builds a
-:class:`Problem` from a scenario; ``sim`` executes a :class:`Path`.
+Nothing here knows MuJoCo or files.  :func:`scenario_problem` builds a
+:class:`Problem` from a validated scenario, :func:`map_problem` from a grid map;
+``sim`` executes a :class:`Path`.
 """
 
 from __future__ import annotations
@@ -13,120 +14,11 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from planners.geometry import polyline_clearance_m, polyline_length_m, segment_box_distances
-
-
-@dataclass(frozen=True)
-class Pose2D:
-    """A planar pose: position in metres, heading in radians (CCW from +x)."""
-
-    x_m: float
-    y_m: float
-    heading_rad: float = 0.0
-
-    @property
-    def xy(self) -> np.ndarray:
-        return np.array([self.x_m, self.y_m], dtype=float)
-
-
-@dataclass(frozen=True)
-class Disc:
-    """A circular obstacle footprint (not inflated)."""
-
-    x_m: float
-    y_m: float
-    radius_m: float
-
-
-@dataclass(frozen=True)
-class Box:
-    """An axis-aligned rectangular obstacle footprint (not inflated)."""
-
-    x_min_m: float
-    y_min_m: float
-    x_max_m: float
-    y_max_m: float
-
-
-@dataclass(frozen=True)
-class Rect:
-    """Axis-aligned bounds of the workspace, in metres."""
-
-    x_min_m: float
-    y_min_m: float
-    x_max_m: float
-    y_max_m: float
-
-    @property
-    def width_m(self) -> float:
-        return self.x_max_m - self.x_min_m
-
-    @property
-    def height_m(self) -> float:
-        return self.y_max_m - self.y_min_m
-
-    def contains(self, x_m: float, y_m: float, margin_m: float = 0.0) -> bool:
-        return (self.x_min_m + margin_m <= x_m <= self.x_max_m - margin_m
-                and self.y_min_m + margin_m <= y_m <= self.y_max_m - margin_m)
-
-
-@dataclass(frozen=True, eq=False)
-class OccupancyGrid:
-    """A boolean occupancy grid over a :class:`Rect`.
-
-    ``occupied[row, col]`` covers x in ``[x_min + col*cell_m, x_min + (col+1)*cell_m)``
-    and y in ``[y_min + row*cell_m, ...)``: rows grow with y, columns with x.
-    """
-
-    occupied: np.ndarray  # (rows, cols) bool
-    cell_m: float
-    origin_m: tuple[float, float]  # world (x, y) of the corner of cell (0, 0)
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        return self.occupied.shape  # type: ignore[return-value]
-
-    def cell_of(self, x_m: float, y_m: float) -> tuple[int, int]:
-        """(row, col) of the cell containing a world point, clamped to the grid."""
-        rows, cols = self.occupied.shape
-        col = int(math.floor((x_m - self.origin_m[0]) / self.cell_m))
-        row = int(math.floor((y_m - self.origin_m[1]) / self.cell_m))
-        return min(max(row, 0), rows - 1), min(max(col, 0), cols - 1)
-
-    def centres_m(self, cells: np.ndarray) -> np.ndarray:
-        """World (x, y) centres of an (N, 2) array of (row, col) cells."""
-        cells = np.asarray(cells, dtype=float).reshape(-1, 2)
-        x = self.origin_m[0] + (cells[:, 1] + 0.5) * self.cell_m
-        y = self.origin_m[1] + (cells[:, 0] + 0.5) * self.cell_m
-        return np.column_stack([x, y])
-
-
-def rasterise(bounds: Rect, discs: tuple[Disc, ...], boxes: tuple[Box, ...],
-              inflation_m: float, cell_m: float) -> OccupancyGrid:
-    """Occupancy grid whose blocked cells have centres within ``inflation_m`` of an obstacle.
-
-    A further margin of ``cell_m / sqrt(2)`` is added so that the straight move
-    between the centres of two free 8-neighbours never enters an inflated
-    obstacle (with endpoints at least R + h/sqrt(2) from a centre, the midpoint
-    of a move of length h*sqrt(2) stays at least R away).
-    """
-    if cell_m <= 0:
-        raise ValueError("cell_m must be positive")
-    cols = max(1, int(math.ceil(bounds.width_m / cell_m - 1e-9)))
-    rows = max(1, int(math.ceil(bounds.height_m / cell_m - 1e-9)))
-    xs = bounds.x_min_m + (np.arange(cols) + 0.5) * cell_m
-    ys = bounds.y_min_m + (np.arange(rows) + 0.5) * cell_m
-    gx, gy = np.meshgrid(xs, ys)  # (rows, cols)
-    reach = inflation_m + cell_m / math.sqrt(2.0)
-    occupied = np.zeros((rows, cols), dtype=bool)
-    for disc in discs:
-        occupied |= (gx - disc.x_m) ** 2 + (gy - disc.y_m) ** 2 < (disc.radius_m + reach) ** 2
-    for box in boxes:
-        dx = np.maximum(np.maximum(box.x_min_m - gx, gx - box.x_max_m), 0.0)
-        dy = np.maximum(np.maximum(box.y_min_m - gy, gy - box.y_max_m), 0.0)
-        occupied |= dx * dx + dy * dy < reach * reach
-    return OccupancyGrid(occupied=occupied, cell_m=float(cell_m),
-                         origin_m=(bounds.x_min_m, bounds.y_min_m))
+from swarmnav.models.geometry import polyline_clearance_m, polyline_length_m, segment_box_distances
+from swarmnav.models.grid_map import inflated_map_grid, merge_boxes
+from swarmnav.models.scenario import Scenario
+from swarmnav.planners.errors import GoalBlocked, StartBlocked
+from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem, nearest_obstacle, rasterise
 
 
 @dataclass(frozen=True, eq=False)
@@ -181,22 +73,8 @@ class Problem:
         return rasterise(self.bounds, self.obstacles, self.boxes, self.inflation_m, self.cell_m)
 
     def nearest_obstacle(self, x_m: float, y_m: float) -> tuple[str, int, float]:
-        """The obstacle nearest a point: ("disc" or "box", its index, signed gap to its inflated footprint).
-
-        ("", -1, inf) with no obstacle.  A point inside a box scores ``-inflation_m``.
-        """
-        best = ("", -1, float("inf"))
-        if self.obstacles:
-            d = np.hypot(self.disc_centres_m[:, 0] - x_m, self.disc_centres_m[:, 1] - y_m) - self.inflated_radii_m
-            i = int(np.argmin(d))
-            best = ("disc", i, float(d[i]))
-        if self.boxes:
-            p = np.array([[x_m, y_m]])
-            d = segment_box_distances(p, p, self.box_array_m)[0] - self.inflation_m
-            i = int(np.argmin(d))
-            if d[i] < best[2]:
-                best = ("box", i, float(d[i]))
-        return best
+        """The obstacle nearest a point: ("disc" or "box", its index, signed gap to its inflated footprint)."""
+        return nearest_obstacle(x_m, y_m, self.disc_centres_m, self.disc_radii_m, self.box_array_m, self.inflation_m)
 
     def point_clearance_m(self, x_m: float, y_m: float) -> float:
         """Signed gap from a point to the nearest inflated disc or box (inf with none)."""
@@ -281,13 +159,46 @@ class Planner(Protocol):
 
 
 def check_endpoints(problem: Problem) -> None:
-    """Raise StartBlocked / GoalBlocked when an endpoint is outside the bounds or in an obstacle."""
-    from planners.errors import GoalBlocked, StartBlocked
+    """Raise StartBlocked / GoalBlocked when an endpoint is outside the bounds or in an obstacle.
 
+    Touching is allowed (map cell centres touch inflated boxes).
+    """
     for pose, error, label in ((problem.start, StartBlocked, "start"), (problem.goal, GoalBlocked, "goal")):
-        if not problem.bounds.contains(pose.x_m, pose.y_m):
-            raise error(f"{label} ({pose.x_m:g}, {pose.y_m:g}) is outside the bounds")
-        kind, _, gap = problem.nearest_obstacle(pose.x_m, pose.y_m)
-        if gap < -1e-9:  # touching is allowed (map cell centres touch inflated boxes)
-            raise error(f"{label} ({pose.x_m:g}, {pose.y_m:g}) is inside an inflated {kind} obstacle "
-                        f"(by {-gap:.3f} m)")
+        why = endpoint_problem(pose, problem.bounds, problem.disc_centres_m, problem.disc_radii_m,
+                               problem.box_array_m, problem.inflation_m, tolerance_m=1e-9)
+        if why is not None:
+            raise error(f"{label} {why}")
+
+
+def scenario_problem(scenario: Scenario, cell_m: float | None = None, at_time_s: float = 0.0,
+                     clearance_m: float | None = None) -> Problem:
+    """A scenario's planning problem, with its obstacles frozen at ``at_time_s``."""
+    clearance_m = scenario.clearance_m if clearance_m is None else clearance_m
+    return Problem(start=scenario.start, goal=scenario.goal,
+                   bounds=scenario.planning_bounds(scenario.robot_radius_m + clearance_m),
+                   obstacles=scenario.discs_at(at_time_s), robot_radius_m=scenario.robot_radius_m,
+                   clearance_m=clearance_m, boxes=scenario.boxes, cell_m=cell_m or scenario.cell_m,
+                   grid_override=scenario.map_grid)
+
+
+def map_problem(occupied: np.ndarray, cell_m: float, start_cell: tuple[int, int], goal_cell: tuple[int, int],
+                robot_radius_m: float | None = None, clearance_m: float = 0.0):
+    """A :class:`~planners.problem.Problem` on a world-grid map between two (row, col) cells' centres.
+
+    The robot radius defaults to half a cell minus the clearance (the papers'
+    one-cell robot); obstacles are the merged boxes, the grid is
+    :func:`inflated_map_grid`.
+    """
+    from swarmnav.models.world import Pose2D, Rect
+    from swarmnav.planners.problem import Problem
+
+    occ = np.asarray(occupied, dtype=bool)
+    rows, cols = occ.shape
+    if robot_radius_m is None:
+        robot_radius_m = cell_m / 2.0 - clearance_m
+    boxes = merge_boxes(occ, cell_m)
+    grid = inflated_map_grid(occ, cell_m, robot_radius_m + clearance_m, boxes)
+    centre = lambda cell: Pose2D((cell[1] + 0.5) * cell_m, (cell[0] + 0.5) * cell_m)  # noqa: E731
+    return Problem(start=centre(start_cell), goal=centre(goal_cell), bounds=Rect(0.0, 0.0, cols * cell_m, rows * cell_m),
+                   obstacles=(), robot_radius_m=robot_radius_m, clearance_m=clearance_m, boxes=boxes,
+                   cell_m=cell_m, grid_override=grid)

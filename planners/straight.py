@@ -8,7 +8,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from planners.problem import Path, Problem, check_endpoints
+from swarmnav.planners.problem import Path, Problem, check_endpoints
 
 
 @dataclass

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from planners.problem import Path, Problem, check_endpoints
+from swarmnav.planners.problem import Path, Problem, check_endpoints
 
 
 @dataclass

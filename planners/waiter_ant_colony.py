@@ -37,12 +37,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from planners.ant_colony import deposit, evaporate, roulette
-from planners.errors import NoPathFound, check_parameters
-from planners.geometry import segment_box_distances, segment_disc_distances
-from planners.grid_search import exact_shortcut
-from planners.problem import Problem
-from planners.swarm import SwarmPlanner, SwarmState
+from swarmnav.planners.ant_colony import deposit, evaporate, roulette
+from swarmnav.planners.errors import NoPathFound, check_parameters
+from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
+from swarmnav.planners.grid_search import exact_shortcut
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 
 
 def random_nodes(problem: Problem, count: int, corridor_m: float, rng: np.random.Generator,

@@ -8,7 +8,6 @@ planner found no path.
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import os
 import signal
@@ -19,7 +18,14 @@ import tomllib
 from pathlib import Path as FilePath
 from typing import Any, Callable
 
-from planners.errors import ConfigError, PlanningError
+from swarmnav.models.errors import ConfigError
+from swarmnav.planners.errors import PlanningError
+from swarmnav.planners.problem import scenario_problem
+from swarmnav.sim import log_commands, plot, replay
+from swarmnav.sim.benchmarks import grid as bench_grid
+from swarmnav.sim.benchmarks import planners as bench_planners
+from swarmnav.sim.benchmarks import render as bench_render
+from swarmnav.sim.benchmarks import sim as bench_sim
 
 EXIT_OK, EXIT_BAD_INPUT, EXIT_NO_PATH = 0, 2, 3
 
@@ -45,7 +51,7 @@ def parse_settings(pairs: list[str] | None) -> dict[str, Any]:
 
 
 def _load(args: argparse.Namespace):
-    from models.scenario import load_scenario
+    from swarmnav.models.scenario import load_scenario
     return load_scenario(args.scenario)
 
 
@@ -54,7 +60,7 @@ def _plan(args: argparse.Namespace, scenario):
 
     A bad parameter given with ``--set`` is reported against ``--set``, not the file.
     """
-    from sim.runner import plan_scenario
+    from swarmnav.sim.runner import plan_scenario
     name = args.planner or scenario.planner_name
     params = dict(scenario.planner_params) if name == scenario.planner_name else {}
     settings = parse_settings(args.set)
@@ -70,7 +76,7 @@ def _plan(args: argparse.Namespace, scenario):
 
 
 def plan_summary(scenario, name: str, seed: int, path) -> dict[str, Any]:
-    problem = scenario.to_problem()
+    problem = scenario_problem(scenario)
     return {"scenario": scenario.name, "planner": name, "seed": seed,
             "waypoints": [[float(x), float(y)] for x, y in path.waypoints],
             "length_m": path.stats.length_m, "plan_time_s": path.stats.plan_time_s,
@@ -79,7 +85,7 @@ def plan_summary(scenario, name: str, seed: int, path) -> dict[str, Any]:
 
 
 def cmd_scenarios(args: argparse.Namespace) -> int:
-    from models.scenario import list_scenarios, load_scenario
+    from swarmnav.models.scenario import list_scenarios, load_scenario
     rows = []
     for name in list_scenarios():
         s = load_scenario(name)
@@ -110,15 +116,15 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from sim.recording import RecorderGroup
-    from sim.runner import Simulation
+    from swarmnav.sim.recording import RecorderGroup
+    from swarmnav.sim.runner import Simulation
     scenario = _load(args)
     path, name, params, seed = _plan(args, scenario)
     simulation = Simulation(scenario)
     recorders = []
     log_path = None
     if not args.no_log:
-        from sim.mcap_log import McapRecorder, default_log_path
+        from swarmnav.sim.mcap_log import McapRecorder, default_log_path
         log_path = FilePath(args.out) if args.out else default_log_path(
             scenario.name, name, seed, time.strftime("%Y%m%d-%H%M%S"))
         if log_path.exists() and not args.overwrite:
@@ -127,7 +133,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     elif args.live:
         raise UserError("--live: needs the log (drop --no-log)")
     if args.video:
-        from sim.render import VideoRecorder
+        from swarmnav.sim.render import VideoRecorder
         recorders.append(VideoRecorder(args.video, camera=args.camera, width=args.width,
                                        height=args.height, fps=args.fps))
     recorder = RecorderGroup(recorders) if recorders else None
@@ -153,26 +159,17 @@ def cmd_run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def cmd_bench_sim(args: argparse.Namespace) -> int:
-    from sim.benchmark import benchmark_sim
-    figures = benchmark_sim(args.scenario, duration_s=args.duration, repeats=args.repeats)
-    if args.json:
-        print(json.dumps(figures))
-    else:
-        for key, value in figures.items():
-            print(f"{key:<28} {value:.4g}" if isinstance(value, float) else f"{key:<28} {value}")
-    return EXIT_OK
-
-
-# Subcommands implemented in their own modules (each has add_arguments(parser) and run(args) -> int).
-MODULE_COMMANDS: list[tuple[tuple[str, ...], str, str]] = [
-    (("bench", "planners"), "planners.bench_continuous", "continuous planners against the exact optimum and mealpy"),
-    (("bench", "grid"), "planners.bench_grid", "grid planners, Moving AI optima and the pathfinding peer"),
-    (("bench", "render"), "sim.render_benchmark", "offscreen rendering frames per second"),
-    (("log", "info"), "sim.log_commands", "what a log holds"),
-    (("log", "recover"), "sim.log_commands", "rewrite a truncated log as a complete one"),
-    (("replay",), "sim.replay", "re-render or re-simulate a log"),
-    (("plot",), "sim.plot", "plot a log to PNG"),
+# Subcommands implemented in their own modules: (words, module, help); each module has
+# add_arguments(parser) and run(args) -> int (or add_<word>_arguments / run_<word>).
+MODULE_COMMANDS: list[tuple[tuple[str, ...], Any, str]] = [
+    (("bench", "sim"), bench_sim, "closed loop vs bare mj_step on the dense 30-cylinder scene"),
+    (("bench", "planners"), bench_planners, "continuous planners against the exact optimum and mealpy"),
+    (("bench", "grid"), bench_grid, "grid planners, Moving AI optima and the pathfinding peer"),
+    (("bench", "render"), bench_render, "offscreen rendering frames per second"),
+    (("log", "info"), log_commands, "what a log holds"),
+    (("log", "recover"), log_commands, "rewrite a truncated log as a complete one"),
+    (("replay",), replay, "re-render or re-simulate a log"),
+    (("plot",), plot, "plot a log to PNG"),
 ]
 
 
@@ -214,17 +211,10 @@ def build_parser() -> argparse.ArgumentParser:
     groups: dict[str, argparse._SubParsersAction] = {}
     bench = sub.add_parser("bench", help="benchmarks that print figures")
     groups["bench"] = bench.add_subparsers(dest="bench_command", required=True, metavar="BENCH")
-    p = groups["bench"].add_parser("sim", help="closed loop vs bare mj_step on the dense 30-cylinder scene")
-    p.add_argument("--scenario", default="dense-field-30")
-    p.add_argument("--duration", type=float, default=20.0, help="simulated seconds per measurement")
-    p.add_argument("--repeats", type=int, default=3)
-    p.add_argument("--json", action="store_true")
-    p.set_defaults(func=cmd_bench_sim)
     log = sub.add_parser("log", help="inspect and repair MCAP logs")
     groups["log"] = log.add_subparsers(dest="log_command", required=True, metavar="LOGCMD")
 
-    for words, module_name, help_text in MODULE_COMMANDS:
-        module = importlib.import_module(module_name)
+    for words, module, help_text in MODULE_COMMANDS:
         parent = groups[words[0]] if len(words) > 1 else sub
         p = parent.add_parser(words[-1], help=help_text)
         adder = getattr(module, f"add_{words[-1]}_arguments", None) or module.add_arguments

@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from sim.log_reader import describe, read_log, recover_log
+from swarmnav.sim.log_reader import describe, read_log, recover_log
 
 
 def add_info_arguments(parser: argparse.ArgumentParser) -> None:

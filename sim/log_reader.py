@@ -26,8 +26,8 @@ from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
 from mcap_protobuf.decoder import DecoderFactory
 
-from planners.errors import ConfigError
-from sim.mcap_log import MJCF_ATTACHMENT, TOPICS
+from swarmnav.models.errors import ConfigError
+from swarmnav.sim.mcap_log import MJCF_ATTACHMENT, TOPICS
 
 
 class LogError(ConfigError):

@@ -76,8 +76,8 @@ from foxglove.messages import (
     Vector3,
 )
 
-from planners.errors import ConfigError
-from sim.recording import ObstacleInfo, RunContext, StepFrame
+from swarmnav.models.errors import ConfigError
+from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
 
 TOPICS = (
     "/tf",

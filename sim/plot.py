@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.log_reader import RunLog, outcome_text, read_log
+from swarmnav.sim.log_reader import RunLog, outcome_text, read_log
 
 MAX_SWEEP_DISCS = 40
 MAX_SCANS = 400

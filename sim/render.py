@@ -32,8 +32,8 @@ import imageio_ffmpeg  # noqa: E402
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-from planners.errors import ConfigError  # noqa: E402
-from sim.recording import RunContext, StepFrame  # noqa: E402
+from swarmnav.models.errors import ConfigError
+from swarmnav.sim.recording import RunContext, StepFrame  # noqa: E402
 
 CAMERAS = ("top", "chase")
 PATH_RGBA = np.array([0.1, 0.75, 0.2, 1.0], dtype=np.float32)

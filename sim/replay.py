@@ -26,9 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from planners.errors import ConfigError
-from sim.log_reader import LogError, RunLog, read_log
-from sim.recording import ObstacleInfo, RunContext, StepFrame
+from swarmnav.models.errors import ConfigError
+from swarmnav.sim.log_reader import LogError, RunLog, read_log
+from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
 
 DEFAULT_FPS = 30.0
 
@@ -109,7 +109,7 @@ def frames_from_log(log: RunLog) -> list[StepFrame]:
 def render_log(log: RunLog, video_path: str | Path, *, camera: str = "top", width: int = 640,
                height: int = 480, fps: float = DEFAULT_FPS, trail: bool = True) -> dict[str, float]:
     """Render a log to MP4; returns frame count, video and render seconds."""
-    from sim.render import VideoRecorder  # EGL only when a video is asked for
+    from swarmnav.sim.render import VideoRecorder  # EGL only when a video is asked for
 
     recorder = VideoRecorder(video_path, camera=camera, width=width, height=height, fps=fps, trail=trail)
     recorder.start(context_from_log(log))
@@ -212,9 +212,9 @@ def verify_log(log: RunLog) -> VerifyReport:
     """Re-simulate a logged run from the log alone and compare poses step by step."""
     import mujoco
 
-    from models.scenario import parse_scenario
-    from sim.runner import Simulation, plan_scenario
-    from sim.scene import index_scene
+    from swarmnav.models.scenario import parse_scenario
+    from swarmnav.sim.runner import Simulation, plan_scenario
+    from swarmnav.sim.scene import index_scene
 
     context = context_from_log(log)
     scenario = parse_scenario(context.scenario_toml, f"{log.raw.path}[scenario]")
@@ -257,7 +257,7 @@ def verify_log(log: RunLog) -> VerifyReport:
     both_nan = np.isnan(sim_r[:m]) & np.isnan(log.range_m[:m])
     range_diff = np.where(both_nan, 0.0, np.where(np.isnan(range_diff), np.inf, range_diff))
     worst = int(np.argmax(dp)) if n and dp.max() > 0 else None
-    from sim.log_reader import outcome_text
+    from swarmnav.sim.log_reader import outcome_text
     return VerifyReport(
         logged_steps=len(log.time_s), simulated_steps=len(sim_t), compared_steps=n,
         max_position_error_m=float(dp.max()) if n else 0.0,
@@ -289,7 +289,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.video and not args.verify:
         raise ConfigError("replay", "nothing to do: give --video OUT.mp4 and/or --verify")
     if args.video:
-        from sim.render import check_video_size
+        from swarmnav.sim.render import check_video_size
         check_video_size(args.width, args.height, args.fps)
     log = read_log(args.log)
     results: dict = {"log": str(args.log)}

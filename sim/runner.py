@@ -27,12 +27,14 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from controllers import GoalChecker, PointToPointController
-from models.scenario import Scenario
-from planners import make_planner
-from planners.problem import Path, Pose2D
-from sim.recording import ObstacleInfo, Recorder, RunContext, StepFrame
-from sim.scene import CompiledScene, compile_scene
+from swarmnav.controllers import GoalChecker, PointToPointController
+from swarmnav.models.scenario import Scenario
+from swarmnav.planners import make_planner
+from swarmnav.planners.problem import Path
+from swarmnav.models.world import Pose2D
+from swarmnav.sim.recording import ObstacleInfo, Recorder, RunContext, StepFrame
+from swarmnav.sim.scene import CompiledScene, compile_scene
+from swarmnav.planners.problem import scenario_problem
 
 CLEARANCE_HORIZON_M = 2.0  # mj_geomDistance search radius: clearances are reported up to this value
 
@@ -355,7 +357,7 @@ def plan_scenario(scenario: Scenario, planner_name: str | None = None,
                   else (planner_params or {}))
     seed = scenario.seed if seed is None else seed
     planner = make_planner(name, params, scenario.source_path)
-    path = planner.plan(scenario.to_problem(), np.random.default_rng(seed))
+    path = planner.plan(scenario_problem(scenario), np.random.default_rng(seed))
     return path, name, params, seed
 
 

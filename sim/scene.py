@@ -16,8 +16,8 @@ from pathlib import Path as FilePath
 import mujoco
 import numpy as np
 
-from controllers.kinematics import DriveGeometry
-from models.scenario import Scenario
+from swarmnav.controllers.kinematics import DriveGeometry
+from swarmnav.models.scenario import Scenario
 
 MODEL_DIR = FilePath(__file__).resolve().parent.parent / "models" / "diff_drive"
 SCENE_XML = MODEL_DIR / "scene.xml"

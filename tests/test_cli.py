@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from sim.cli import main
+from swarmnav.sim.cli import main
 
 BASE = """
 name = "probe"

@@ -9,14 +9,17 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline
 
-from models.scenario import list_scenarios, load_scenario
-from planners import PLANNERS, make_planner
-from planners.bee_colony import adaptive_limit
-from planners.errors import ConfigError, GoalBlocked, NoPathFound, PlanningError, StartBlocked
-from planners.optimal import OptimalPlanner
-from planners.path_cost import obstacle_penalty, sampled_length_m, smoothness_rad
-from planners.problem import Disc, Pose2D, Problem, Rect
-from planners.via_points import not_a_knot_basis, polyline_basis
+from swarmnav.models.scenario import list_scenarios, load_scenario
+from swarmnav.planners import PLANNERS, make_planner
+from swarmnav.planners.bee_colony import adaptive_limit
+from swarmnav.models.errors import ConfigError
+from swarmnav.planners.errors import GoalBlocked, NoPathFound, PlanningError, StartBlocked
+from swarmnav.planners.optimal import OptimalPlanner
+from swarmnav.planners.path_cost import obstacle_penalty, sampled_length_m, smoothness_rad
+from swarmnav.models.world import Disc, Pose2D, Rect
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.via_points import not_a_knot_basis, polyline_basis
+from swarmnav.planners.problem import scenario_problem
 
 CONTINUOUS = ("abc", "adl_abc", "gwo", "pso")
 # Real algorithms, smaller budgets than the defaults to keep the suite fast.
@@ -35,7 +38,7 @@ def _disc_scenarios() -> list[str]:
 
 @pytest.fixture(scope="module")
 def problems() -> dict[str, Problem]:
-    return {name: load_scenario(name).to_problem() for name in _disc_scenarios()}
+    return {name: scenario_problem(load_scenario(name)) for name in _disc_scenarios()}
 
 
 @pytest.fixture(scope="module")
@@ -134,7 +137,7 @@ def test_optimum_matches_closed_form_on_one_disc():
 
 
 def test_optimum_on_seed_004_scenario_1_and_never_beaten():
-    problem = load_scenario("gwo-scenario-1").to_problem(clearance_m=0.0)
+    problem = scenario_problem(load_scenario("gwo-scenario-1"), clearance_m=0.0)
     optimum = OptimalPlanner().plan(problem, np.random.default_rng(0)).stats.extra["optimum_length_m"]
     assert optimum == pytest.approx(14.1905, abs=5e-5)
     for planner in CONTINUOUS:
@@ -196,7 +199,7 @@ def test_bad_parameters_are_config_errors():
 
 
 def test_bench_json_keys():
-    from planners import bench_continuous
+    from swarmnav.sim.benchmarks import planners as bench_continuous
 
     parser = argparse.ArgumentParser()
     bench_continuous.add_arguments(parser)

@@ -5,8 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from controllers import DriveGeometry, PointToPointController, body_twist, wheel_speeds
-from planners.problem import Path, Pose2D
+from swarmnav.controllers import DriveGeometry, PointToPointController, body_twist, wheel_speeds
+from swarmnav.planners.problem import Path
+from swarmnav.models.world import Pose2D
 
 GEOMETRY = DriveGeometry(wheel_radius_m=0.04, track_m=0.22, max_wheel_speed_rad_s=10.0)
 
@@ -55,8 +56,8 @@ def test_controller_switches_waypoints_and_stops_at_goal():
 
 @pytest.mark.parametrize("target", [(3.0, 1.0), (1.0, 3.0)])
 def test_controller_drives_the_robot_in_physics_to_a_waypoint_2_m_away(target):
-    from models.scenario import parse_scenario
-    from sim.runner import Simulation
+    from swarmnav.models.scenario import parse_scenario
+    from swarmnav.sim.runner import Simulation
 
     scenario = parse_scenario(f"""
 name = "two-metres"

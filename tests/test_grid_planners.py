@@ -7,19 +7,22 @@ import math
 import numpy as np
 import pytest
 
-from models.scenario import list_scenarios, load_scenario, parse_scenario
-from planners import PLANNERS, make_planner
-from planners.errors import ConfigError, NoPathFound
-from planners.geometry import segment_box_distance, segment_box_distances
-from planners.grid_search import (DStarLite, astar_cells, box_line_of_sight, dijkstra_cells, grid_line_of_sight,
+from swarmnav.models.scenario import list_scenarios, load_scenario, parse_scenario
+from swarmnav.planners import PLANNERS, make_planner
+from swarmnav.models.errors import ConfigError
+from swarmnav.planners.errors import NoPathFound
+from swarmnav.models.geometry import segment_box_distance, segment_box_distances
+from swarmnav.planners.grid_search import (DStarLite, astar_cells, box_line_of_sight, dijkstra_cells, grid_line_of_sight,
                                   theta_star_cells)
-from planners.ant_colony import GridGraph, walk_colony
-from planners.improved_ant_colony import (adaptive_parameters, feature_cells, iaco_heuristic, pheromone_intensity,
+from swarmnav.planners.ant_colony import GridGraph, walk_colony
+from swarmnav.planners.improved_ant_colony import (adaptive_parameters, feature_cells, iaco_heuristic, pheromone_intensity,
                                           prune_length)
-from planners.problem import Box, OccupancyGrid, Pose2D, Problem, Rect
-from planners.max_min_ant_system import analyse_environment
-from planners.movingai import (benchmark_sets, format_map, map_problem, map_to_grid, merge_boxes, parse_map,
-                               read_map, read_scenarios)
+from swarmnav.models.world import Box, OccupancyGrid, Pose2D, Rect
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.max_min_ant_system import analyse_environment
+from swarmnav.planners.problem import map_problem
+from swarmnav.models.grid_map import benchmark_sets, format_map, map_to_grid, merge_boxes, parse_map, read_map, read_scenarios
+from swarmnav.planners.problem import scenario_problem
 
 GRID_PLANNERS = ("astar", "dijkstra", "theta_star", "dstar_lite", "immas", "iaco")
 MAP_SCENARIOS = [n for n in list_scenarios() if n.startswith(("immas-", "iaco-"))]
@@ -96,7 +99,7 @@ def test_box_line_of_sight_equals_the_test_against_every_box(scenario_name):
     if scenario_name == "off-lattice":
         problem = off_lattice_boxes_problem()
     else:
-        problem = load_scenario(scenario_name).to_problem()
+        problem = scenario_problem(load_scenario(scenario_name))
     grid = problem.grid
     los = box_line_of_sight(problem, grid)
     free = (~grid.occupied).tolist()
@@ -120,7 +123,7 @@ def test_box_line_of_sight_equals_the_test_against_every_box(scenario_name):
 def test_map_scenarios_load_with_boxes_and_a_grid_at_map_resolution():
     assert len(MAP_SCENARIOS) == 10
     scenario = load_scenario("immas-env1-scattered")
-    problem = scenario.to_problem()
+    problem = scenario_problem(scenario)
     assert problem.grid.shape == (50, 50) and problem.grid.cell_m == pytest.approx(0.4)
     assert 0 < len(scenario.boxes) < problem.grid.occupied.sum()
 
@@ -140,7 +143,7 @@ def test_collision_free_on_every_bundled_map(planner_name, scenario_name):
     if planner_name == "iaco" and scenario_name == "iaco-baffle":
         pytest.skip("iaco needs its full 50 x 100 budget on the baffle map (run by bench grid)")
     scenario = load_scenario(scenario_name)
-    problem = scenario.to_problem()
+    problem = scenario_problem(scenario)
     params = dict(FAST.get(planner_name, {}))
     if planner_name == scenario.planner_name:
         params = {**scenario.planner_params, **params}
@@ -153,7 +156,7 @@ def test_collision_free_on_every_bundled_map(planner_name, scenario_name):
 @pytest.mark.parametrize("planner_name", GRID_PLANNERS + ("maco",))
 def test_same_seed_same_path(planner_name):
     scenario = load_scenario("restaurant-table-2" if planner_name == "maco" else "iaco-complex")
-    problem = scenario.to_problem()
+    problem = scenario_problem(scenario)
     params = FAST.get(planner_name, {})
     one = make_planner(planner_name, params).plan(problem, np.random.default_rng(7))
     two = make_planner(planner_name, params).plan(problem, np.random.default_rng(7))
@@ -161,7 +164,7 @@ def test_same_seed_same_path(planner_name):
 
 
 def test_shortcut_off_keeps_the_raw_cells():
-    problem = load_scenario("iaco-simple").to_problem()
+    problem = scenario_problem(load_scenario("iaco-simple"))
     raw = make_planner("astar", {"shortcut": False}).plan(problem, np.random.default_rng(0))
     assert len(raw.waypoints) == len(raw.stats.extra["raw_cells"])
     short = make_planner("astar").plan(problem, np.random.default_rng(0))
@@ -287,7 +290,7 @@ def test_closing_is_reverted_when_it_would_disconnect_start_and_goal():
 
 def test_immas_reports_table_1_quantities():
     scenario = load_scenario("immas-env1-scattered")
-    path = make_planner("immas", scenario.planner_params).plan(scenario.to_problem(), np.random.default_rng(0))
+    path = make_planner("immas", scenario.planner_params).plan(scenario_problem(scenario), np.random.default_rng(0))
     extra = path.stats.extra
     for key in ("gates_raised", "tunnels_closed", "moves", "total_arc_cost"):
         assert key in extra
@@ -359,7 +362,7 @@ def test_feature_points_are_outside_convex_corners_only():
 
 
 def test_iaco_reports_table_3_quantities():
-    problem = load_scenario("iaco-simple").to_problem()
+    problem = scenario_problem(load_scenario("iaco-simple"))
     path = make_planner("iaco", FAST["iaco"]).plan(problem, np.random.default_rng(1))
     extra = path.stats.extra
     for key in ("optimal_length_m", "mean_length_m", "std_length_m", "convergence_iteration", "bends"):
@@ -371,7 +374,7 @@ def test_iaco_reports_table_3_quantities():
 
 def test_maco_route_is_collision_free_and_baseline_links_are_checked():
     scenario = load_scenario("restaurant-table-2")
-    problem = scenario.to_problem()
+    problem = scenario_problem(scenario)
     path = make_planner("maco", scenario.planner_params).plan(problem, np.random.default_rng(0))
     assert problem.is_collision_free(path.waypoints)
     extra = path.stats.extra

@@ -19,11 +19,11 @@ import pytest  # noqa: E402
 from mcap.reader import make_reader  # noqa: E402
 from mcap_protobuf.decoder import DecoderFactory  # noqa: E402
 
-from models.scenario import load_scenario  # noqa: E402
-from sim.cli import main  # noqa: E402
-from sim.log_reader import read_log, read_records  # noqa: E402
-from sim.mcap_log import TOPICS, McapRecorder  # noqa: E402
-from sim.runner import simulate  # noqa: E402
+from swarmnav.models.scenario import load_scenario  # noqa: E402
+from swarmnav.sim.cli import main  # noqa: E402
+from swarmnav.sim.log_reader import read_log, read_records  # noqa: E402
+from swarmnav.sim.mcap_log import TOPICS, McapRecorder  # noqa: E402
+from swarmnav.sim.runner import simulate  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 SCENARIO = "gwo-scenario-2"  # moving obstacles and collisions: every channel has traffic
@@ -140,9 +140,9 @@ def test_same_seed_gives_identical_message_bytes(tmp_path):
 
 CRASHING_RUN = """
 import os, signal, sys
-from models.scenario import load_scenario
-from sim.mcap_log import McapRecorder
-from sim.runner import simulate
+from swarmnav.models.scenario import load_scenario
+from swarmnav.sim.mcap_log import McapRecorder
+from swarmnav.sim.runner import simulate
 
 class Crash(McapRecorder):
     def step(self, frame):
@@ -185,7 +185,7 @@ def test_sigkill_leaves_a_file_that_log_recover_completes(tmp_path, full_run, ca
 
 
 def test_replay_video_has_expected_frames_and_is_not_blank(tmp_path, full_run):
-    from sim.render import expected_frames, read_video_frames, video_info
+    from swarmnav.sim.render import expected_frames, read_video_frames, video_info
 
     path, _ = full_run
     video = tmp_path / "top.mp4"
@@ -202,7 +202,7 @@ def test_replay_video_has_expected_frames_and_is_not_blank(tmp_path, full_run):
 
 
 def test_chase_camera_renders(tmp_path, full_run):
-    from sim.render import read_video_frames
+    from swarmnav.sim.render import read_video_frames
 
     video = tmp_path / "chase.mp4"
     assert main(["replay", str(full_run[0]), "--video", str(video), "--camera", "chase", "--fps", "0.5",

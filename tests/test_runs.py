@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 
-from models.scenario import load_scenario
-from planners import PLANNERS, make_planner
-from sim.runner import simulate
+from swarmnav.models.scenario import load_scenario
+from swarmnav.planners import PLANNERS, make_planner
+from swarmnav.sim.runner import simulate
+from swarmnav.planners.problem import scenario_problem
 
 
 @pytest.mark.parametrize("name", ["gwo-scenario-1", "restaurant-table-2", "restaurant-table-5"])
@@ -42,7 +43,7 @@ def test_a_straight_line_through_an_obstacle_collides_in_physics():
 
 @pytest.mark.parametrize("name", sorted(PLANNERS))
 def test_every_planner_gives_the_same_path_for_the_same_seed(name):
-    problem = load_scenario("gwo-scenario-1").to_problem()
+    problem = scenario_problem(load_scenario("gwo-scenario-1"))
     planner = make_planner(name, {})
     a = planner.plan(problem, np.random.default_rng(11))
     b = planner.plan(problem, np.random.default_rng(11))
@@ -52,9 +53,9 @@ def test_every_planner_gives_the_same_path_for_the_same_seed(name):
 def test_an_empty_arena_reports_no_clearance_rather_than_infinity():
     import json
 
-    from models.scenario import parse_scenario
-    from sim.runner import Simulation
-    from planners.problem import Path
+    from swarmnav.models.scenario import parse_scenario
+    from swarmnav.sim.runner import Simulation
+    from swarmnav.planners.problem import Path
 
     scenario = parse_scenario('name = "empty"\narena = { width_m = 3.0, height_m = 3.0 }\n'
                               'start = { x = 1.0, y = 1.0 }\ngoal = { x = 2.0, y = 1.0 }\n')
@@ -74,7 +75,7 @@ def test_swarm_and_exact_paths_are_driven_without_collisions(scenario_name, plan
     scenario = load_scenario(scenario_name)
     episode = simulate(scenario, planner_name, params, seed=0, time_limit_s=scenario.time_limit_s)
     r = episode.result
-    assert scenario.to_problem().is_collision_free(episode.path.waypoints)
+    assert scenario_problem(scenario).is_collision_free(episode.path.waypoints)
     assert r.reached, r.summary()
     if not any(ob.moving for ob in scenario.obstacles):
         assert r.collisions == 0 and r.min_clearance_m > 0.0, r.summary()

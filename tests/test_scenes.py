@@ -4,9 +4,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from models.scenario import list_scenarios, load_scenario
-from sim.runner import Simulation, ranges_from_sensors
-from sim.scene import compile_scene
+from swarmnav.models.scenario import list_scenarios, load_scenario
+from swarmnav.sim.runner import Simulation, ranges_from_sensors
+from swarmnav.sim.scene import compile_scene
 
 SCENARIOS = list_scenarios()
 
@@ -68,7 +68,7 @@ def test_rangefinder_convention_inf_for_nothing_in_range():
 
 
 def test_rangefinders_see_an_obstacle_in_front(tmp_path):
-    from models.scenario import parse_scenario
+    from swarmnav.models.scenario import parse_scenario
     text = """
 name = "probe"
 arena = { width_m = 4.0, height_m = 4.0 }

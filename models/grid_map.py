@@ -4,7 +4,7 @@ The format (N. Sturtevant, "Benchmarks for Grid-Based Pathfinding", IEEE TCIAIG
 4(2), 2012): a header ``type octile`` / ``height H`` / ``width W`` / ``map``,
 then H rows of W characters, ``.`` ``G`` ``S`` passable and ``@`` ``O`` ``T``
 ``W`` not.  The first row of the file is the *top* of the map, while an
-:class:`~planners.problem.OccupancyGrid` has rows growing with y, so
+:class:`~models.world.OccupancyGrid` has rows growing with y, so
 :func:`map_to_grid` flips the rows.  Scenario lines are tab-separated: bucket,
 map, width, height, start x, start y, goal x, goal y, optimal length, with
 (x, y) = (column, row from the top).
@@ -18,8 +18,8 @@ from pathlib import Path as FilePath
 
 import numpy as np
 
-from planners.errors import ConfigError
-from planners.problem import Box, OccupancyGrid
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.world import Box, OccupancyGrid, Rect, rasterise
 
 PASSABLE = frozenset(".GS")
 BLOCKED = frozenset("@OTW")
@@ -198,14 +198,14 @@ def inflated_map_grid(occupied: np.ndarray, cell_m: float, inflation_m: float,
     centre is then at least ``cell_m / 2`` from every occupied cell, and every
     legal move between free centres (no corner cutting) keeps that distance,
     so a robot of diameter up to one cell passes the map's one-cell gaps, as in
-    the papers.  Wider robots get :func:`planners.problem.rasterise` of the
+    the papers.  Wider robots get :func:`models.world.rasterise` of the
     merged boxes, which blocks every cell whose centre is within
     ``inflation_m + cell_m / sqrt(2)`` of an occupied cell.
 
     Args:
         occupied: (rows, cols) world grid (rows grow with y).
     """
-    from planners.problem import Rect, rasterise
+    from swarmnav.models.world import Rect, rasterise
 
     occ = np.asarray(occupied, dtype=bool)
     if inflation_m <= cell_m / 2.0 + 1e-12:
@@ -215,25 +215,3 @@ def inflated_map_grid(occupied: np.ndarray, cell_m: float, inflation_m: float,
         boxes = merge_boxes(occ, cell_m, origin_m)
     bounds = Rect(origin_m[0], origin_m[1], origin_m[0] + cols * cell_m, origin_m[1] + rows * cell_m)
     return rasterise(bounds, (), tuple(boxes), inflation_m, cell_m)
-
-
-def map_problem(occupied: np.ndarray, cell_m: float, start_cell: tuple[int, int], goal_cell: tuple[int, int],
-                robot_radius_m: float | None = None, clearance_m: float = 0.0):
-    """A :class:`~planners.problem.Problem` on a world-grid map between two (row, col) cells' centres.
-
-    The robot radius defaults to half a cell minus the clearance (the papers'
-    one-cell robot); obstacles are the merged boxes, the grid is
-    :func:`inflated_map_grid`.
-    """
-    from planners.problem import Pose2D, Problem, Rect
-
-    occ = np.asarray(occupied, dtype=bool)
-    rows, cols = occ.shape
-    if robot_radius_m is None:
-        robot_radius_m = cell_m / 2.0 - clearance_m
-    boxes = merge_boxes(occ, cell_m)
-    grid = inflated_map_grid(occ, cell_m, robot_radius_m + clearance_m, boxes)
-    centre = lambda cell: Pose2D((cell[1] + 0.5) * cell_m, (cell[0] + 0.5) * cell_m)  # noqa: E731
-    return Problem(start=centre(start_cell), goal=centre(goal_cell), bounds=Rect(0.0, 0.0, cols * cell_m, rows * cell_m),
-                   obstacles=(), robot_radius_m=robot_radius_m, clearance_m=clearance_m, boxes=boxes,
-                   cell_m=cell_m, grid_override=grid)

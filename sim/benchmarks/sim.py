@@ -6,6 +6,8 @@ robust to a noisy machine.  Planning is done once, before timing.
 
 from __future__ import annotations
 
+import argparse
+import json
 import statistics
 import tempfile
 import time
@@ -13,8 +15,8 @@ from pathlib import Path as FilePath
 
 import mujoco
 
-from models.scenario import load_scenario
-from sim.runner import Simulation, plan_scenario
+from swarmnav.models.scenario import load_scenario
+from swarmnav.sim.runner import Simulation, plan_scenario
 
 
 def _bare_steps_per_s(simulation: Simulation, steps: int) -> float:
@@ -49,7 +51,7 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
     recorder_cls = None
     if with_logging:
         try:
-            from sim.mcap_log import McapRecorder
+            from swarmnav.sim.mcap_log import McapRecorder
             recorder_cls = McapRecorder
         except ImportError:
             recorder_cls = None
@@ -84,3 +86,20 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
         figures["logging_steps_per_s"] = statistics.median(logging)
         figures["logging_ratio"] = statistics.median(logging_ratios)
     return figures
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenario", default="dense-field-30")
+    parser.add_argument("--duration", type=float, default=20.0, help="simulated seconds per measurement")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--json", action="store_true")
+
+
+def run(args: argparse.Namespace) -> int:
+    figures = benchmark_sim(args.scenario, duration_s=args.duration, repeats=args.repeats)
+    if args.json:
+        print(json.dumps(figures))
+    else:
+        for key, value in figures.items():
+            print(f"{key:<28} {value:.4g}" if isinstance(value, float) else f"{key:<28} {value}")
+    return 0

@@ -28,6 +28,7 @@ import tomllib
 from typing import Any
 
 import numpy as np
+from swarmnav.planners.problem import scenario_problem
 from scipy import ndimage
 
 TARGETS = {"astar_plan_s": 0.005, "immas_plan_s": 0.050, "iaco_plan_s": 1.0, "iaco_median_ratio": 1.05}
@@ -46,7 +47,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _map_scenarios(names: list[str] | None):
-    from models.scenario import list_scenarios, load_scenario
+    from swarmnav.models.scenario import list_scenarios, load_scenario
 
     out = []
     for name in names or list_scenarios():
@@ -60,9 +61,9 @@ def _problems(scenario, all_pairs: bool):
     """(label, Problem) for the scenario's own start/goal, or for each of its [map].pairs."""
     from dataclasses import replace
 
-    from planners.problem import Pose2D
+    from swarmnav.models.world import Pose2D
 
-    problem = scenario.to_problem()
+    problem = scenario_problem(scenario)
     if not all_pairs:
         return [(scenario.name, problem)]
     pairs = tomllib.loads(scenario.source_text).get("map", {}).get("pairs", [])
@@ -83,7 +84,7 @@ def _mean_clearance_m(problem, cells) -> float:
 
 
 def bench_maps(args: argparse.Namespace) -> list[dict[str, Any]]:
-    from planners import make_planner
+    from swarmnav.planners import make_planner
 
     rows = []
     for scenario in _map_scenarios(args.maps):
@@ -124,11 +125,11 @@ def bench_maps(args: argparse.Namespace) -> list[dict[str, Any]]:
 
 def bench_restaurant(runs: int) -> list[dict[str, Any]]:
     """M-ACO on its home scenario, with the paper's node baselines' collisions."""
-    from models.scenario import load_scenario
-    from planners import make_planner
+    from swarmnav.models.scenario import load_scenario
+    from swarmnav.planners import make_planner
 
     scenario = load_scenario("restaurant-table-2")
-    problem = scenario.to_problem()
+    problem = scenario_problem(scenario)
     astar = make_planner("astar").plan(problem, np.random.default_rng(0))
     planner = make_planner("maco", scenario.planner_params)
     lengths, times, crashes = [], [], 0
@@ -144,11 +145,12 @@ def bench_restaurant(runs: int) -> list[dict[str, Any]]:
 
 
 def bench_movingai(sample: int) -> dict[str, Any]:
-    from planners.errors import PlanningError
-    from planners.grid_search import astar_cells, dijkstra_cells
-    from planners.improved_ant_colony import ImprovedAntColonyPlanner
-    from planners.max_min_ant_system import MaxMinAntSystemPlanner
-    from planners.movingai import benchmark_sets, benchmarks_dir, map_problem, read_map, read_scenarios
+    from swarmnav.planners.errors import PlanningError
+    from swarmnav.planners.grid_search import astar_cells, dijkstra_cells
+    from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
+    from swarmnav.planners.max_min_ant_system import MaxMinAntSystemPlanner
+    from swarmnav.models.grid_map import benchmark_sets, benchmarks_dir, read_map, read_scenarios
+    from swarmnav.planners.problem import map_problem
 
     sets = benchmark_sets()
     if not sets:
@@ -201,13 +203,13 @@ def bench_peers(names: list[str] | None, repeats: int = 20) -> list[dict[str, An
         from pathfinding.finder.a_star import AStarFinder
     except ImportError:
         return {"skipped": "the pathfinding package is not importable (pip install swarmnav[bench])"}
-    from planners.grid_search import ADJACENCY, astar_cells
+    from swarmnav.planners.grid_search import ADJACENCY, astar_cells
 
     ours_s = theirs_s = ours_cold_s = 0.0
     plans = 0
     disagreements = 0
     for scenario in _map_scenarios(names):
-        problem = scenario.to_problem()
+        problem = scenario_problem(scenario)
         occ = problem.grid.occupied
         start = problem.grid.cell_of(problem.start.x_m, problem.start.y_m)
         goal = problem.grid.cell_of(problem.goal.x_m, problem.goal.y_m)

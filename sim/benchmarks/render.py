@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from sim.render import benchmark_render
+from swarmnav.sim.render import benchmark_render
 
 TARGET_FRAMES_PER_S = 30.0
 
@@ -26,8 +26,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from models.scenario import load_scenario
-    from sim.scene import compile_scene
+    from swarmnav.models.scenario import load_scenario
+    from swarmnav.sim.scene import compile_scene
 
     scene = compile_scene(load_scenario(args.scenario))
     figures = {"scenario": args.scenario,

@@ -39,11 +39,12 @@ from typing import Any
 
 import numpy as np
 
-from planners import make_planner
-from planners.errors import PlanningError
-from planners.optimal import OptimalPlanner
-from planners.path_cost import PathObjective
-from planners.problem import Problem
+from swarmnav.planners import make_planner
+from swarmnav.planners.errors import PlanningError
+from swarmnav.planners.optimal import OptimalPlanner
+from swarmnav.planners.path_cost import PathObjective
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.problem import scenario_problem
 
 DEFAULT_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3",
                      "adl-abc-path-1", "adl-abc-path-2", "adl-abc-path-3")
@@ -77,8 +78,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def load_problem(name: str, clearance_m: float) -> Problem:
     """A bundled scenario's problem with obstacles at t = 0."""
-    from models.scenario import load_scenario
-    return load_scenario(name).to_problem(clearance_m=clearance_m)
+    from swarmnav.models.scenario import load_scenario
+    return scenario_problem(load_scenario(name), clearance_m=clearance_m)
 
 
 def optimum_length_m(problem: Problem) -> float | None:
