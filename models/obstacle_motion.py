@@ -11,14 +11,15 @@ Three kinds, each a frozen dataclass with ``positions_at(times_s) -> (T, 2)``:
   compass steps of ``step_m``; "free" means inside the arena and not overlapping a
   static obstacle.  We interpolate linearly within a period rather than teleport,
   so the physics sees a continuous motion (the paper's grid jumps have no
-  physical meaning).  The walk is drawn once from its own seeded generator.
+  physical meaning).  The walk is drawn from the run's world seed, one stream per obstacle.
 * :class:`WaypointMotion`: patrol through points at constant speed, closing the loop.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -56,42 +57,61 @@ class LinearMotion:
         return start[None, :] + tc[:, None] * velocity[None, :]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class RandomWalkMotion:
-    """A random walk over free neighbouring positions, one step per ``period_s``."""
+    """A random walk over free neighbouring positions, one step per ``period_s``.
 
-    nodes_m: np.ndarray  # (K+1, 2) position at the start of each period
+    The walk is drawn on first use from its own stream of the run's world seed:
+    ``SeedSequence(world_seed, spawn_key=(stream,))``, with ``stream`` the
+    obstacle's index in the scenario, so adding an obstacle does not shift the
+    others' draws and the planner's seed never changes the world.
+    """
+
+    start_m: tuple[float, float]
+    radius_m: float
+    step_m: float
     period_s: float
+    duration_s: float
+    lower_m: tuple[float, float]
+    upper_m: tuple[float, float]
+    static_centres_m: np.ndarray = field(repr=False)
+    static_radii_m: np.ndarray = field(repr=False)
+    stream: int = 0
+    world_seed: int = 0
 
-    @classmethod
-    def draw(cls, start_m: tuple[float, float], radius_m: float, step_m: float, period_s: float,
-             duration_s: float, lower_m: tuple[float, float], upper_m: tuple[float, float],
-             static_centres_m: np.ndarray, static_radii_m: np.ndarray, seed: int) -> "RandomWalkMotion":
-        rng = np.random.default_rng(seed)
+    def reseeded(self, world_seed: int) -> "RandomWalkMotion":
+        """The same walk description drawn from another world seed."""
+        return replace(self, world_seed=int(world_seed))
+
+    @cached_property
+    def nodes_m(self) -> np.ndarray:
+        """(K+1, 2) position at the start of each period."""
+        rng = np.random.default_rng(np.random.SeedSequence(self.world_seed, spawn_key=(self.stream,)))
         angles = np.arange(8) * (math.pi / 4.0)
-        steps = step_m * np.column_stack([np.cos(angles), np.sin(angles)])
+        steps = self.step_m * np.column_stack([np.cos(angles), np.sin(angles)])
         steps[np.abs(steps) < 1e-12] = 0.0
-        count = int(math.ceil(duration_s / period_s)) + 1
+        count = int(math.ceil(self.duration_s / self.period_s)) + 1
         nodes = np.empty((count + 1, 2))
-        nodes[0] = start_m
-        lo, hi = np.asarray(lower_m), np.asarray(upper_m)
+        nodes[0] = self.start_m
+        lo, hi = np.asarray(self.lower_m), np.asarray(self.upper_m)
         for k in range(count):
             candidates = nodes[k] + steps
             inside = np.all((candidates >= lo) & (candidates <= hi), axis=1)
-            if len(static_radii_m):
-                gap = np.linalg.norm(candidates[:, None, :] - static_centres_m[None, :, :], axis=2) \
-                    - static_radii_m[None, :] - radius_m
+            if len(self.static_radii_m):
+                gap = np.linalg.norm(candidates[:, None, :] - self.static_centres_m[None, :, :], axis=2) \
+                    - self.static_radii_m[None, :] - self.radius_m
                 inside &= np.all(gap > 0.0, axis=1)
             choices = np.flatnonzero(inside)
             nodes[k + 1] = candidates[rng.choice(choices)] if len(choices) else nodes[k]
-        return cls(nodes_m=nodes, period_s=period_s)
+        return nodes
 
     def positions_at(self, times_s: np.ndarray) -> np.ndarray:
         t = np.asarray(times_s, dtype=float).reshape(-1)
-        u = np.clip(t / self.period_s, 0.0, len(self.nodes_m) - 1.0)
-        k = np.minimum(np.floor(u).astype(int), len(self.nodes_m) - 2)
+        nodes = self.nodes_m
+        u = np.clip(t / self.period_s, 0.0, len(nodes) - 1.0)
+        k = np.minimum(np.floor(u).astype(int), len(nodes) - 2)
         frac = (u - k)[:, None]
-        return self.nodes_m[k] * (1.0 - frac) + self.nodes_m[k + 1] * frac
+        return nodes[k] * (1.0 - frac) + nodes[k + 1] * frac
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path as FilePath
 from typing import Any
 
@@ -69,12 +69,15 @@ class Scenario:
     sensor_range_m: float
     planner_name: str
     planner_params: dict[str, Any]
+    navigator_name: str
+    navigator_params: dict[str, Any]
     obstacles: tuple[Obstacle, ...]
     sim: SimSettings
     cell_m: float
     source_text: str
     source_path: str
     boxes: tuple[Box, ...] = ()
+    world_seed: int = 0  # random obstacle motions are drawn from it; the file's ``seed`` by default
     map_grid: OccupancyGrid | None = field(default=None, repr=False)
 
     @property
@@ -88,6 +91,12 @@ class Scenario:
             return self.bounds
         return Rect(inflation_m, inflation_m, self.arena_width_m - inflation_m,
                     self.arena_height_m - inflation_m)
+
+    def with_world_seed(self, world_seed: int) -> "Scenario":
+        """This scenario with every random obstacle motion drawn from ``world_seed``."""
+        obstacles = tuple(replace(ob, motion=ob.motion.reseeded(world_seed))
+                          if isinstance(ob.motion, RandomWalkMotion) else ob for ob in self.obstacles)
+        return replace(self, obstacles=obstacles, world_seed=int(world_seed))
 
     def discs_at(self, time_s: float = 0.0) -> tuple[Disc, ...]:
         """Every obstacle's footprint at a given time."""
@@ -254,6 +263,13 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         planner.fail("params", "expected a table")
     planner.close()
 
+    navigator = top.table("navigator", {})
+    navigator_name = navigator.string("name", "follow")
+    navigator_params = navigator.raw("params", {})
+    if not isinstance(navigator_params, dict):
+        navigator.fail("params", "expected a table")
+    navigator.close()
+
     sim_t = top.table("sim", {})
     sim = SimSettings(timestep_s=sim_t.number("timestep_s", 0.002, positive=True),
                       control_hz=sim_t.number("control_hz", 50.0, positive=True),
@@ -303,10 +319,9 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
                                       math.radians(m.number("heading_deg")),
                                       m.string("at_edge", choices=("reflect", "stop")), lower, upper)
             elif kind == "random_walk":
-                motion = RandomWalkMotion.draw(
+                motion = RandomWalkMotion(
                     (x, y), radius, m.number("step_m", positive=True), m.number("period_s", positive=True),
-                    time_limit_s, lower, upper, static_centres_arr, static_radii_arr,
-                    seed=seed * 1000 + i)
+                    time_limit_s, lower, upper, static_centres_arr, static_radii_arr, stream=i, world_seed=seed)
             else:
                 points = m.raw("points")
                 if (not isinstance(points, list) or not points
@@ -336,8 +351,10 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         robot_radius_m=robot_radius_m, max_speed_m_s=max_speed_m_s, clearance_m=clearance_m,
         start=start, goal=goal, goal_tolerance_m=tolerance_m,
         sensor_count=sensor_count, sensor_range_m=sensor_range_m,
-        planner_name=planner_name, planner_params=dict(params), obstacles=tuple(obstacles),
-        sim=sim, cell_m=cell_m, source_text=text, source_path=source, boxes=boxes, map_grid=map_grid)
+        planner_name=planner_name, planner_params=dict(params),
+        navigator_name=navigator_name, navigator_params=dict(navigator_params), obstacles=tuple(obstacles),
+        sim=sim, cell_m=cell_m, source_text=text, source_path=source, boxes=boxes, world_seed=seed,
+        map_grid=map_grid)
     _check_endpoints(scenario, source)
     return scenario
 
