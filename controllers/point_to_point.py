@@ -2,8 +2,9 @@
 (Habib et al. 2021, sections 2.6-2.7): the robot drives from its current pose to
 each waypoint in turn along a straight line, turning toward it first.
 
-The controller seam (after nav2's ``computeVelocityCommands``):
-``reset(waypoints)`` then ``command(pose) -> ControlCommand`` every control step.
+It implements the :class:`~controllers.controller.Controller` seam: ``reset(path)``
+then ``command(pose, twist) -> ControlCommand`` every control step.  Stopping
+at the goal is the goal checker's job (:mod:`controllers.goal`), not this one's.
 No MuJoCo here: plain numbers in, wheel speeds out.
 """
 
@@ -14,35 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from swarmnav.controllers.controller import ControlCommand, Twist
 from swarmnav.controllers.kinematics import DriveGeometry, WheelSpeeds, wheel_speeds
-from swarmnav.models.world import Pose2D
-
-
-def wrap_angle_rad(angle_rad: float) -> float:
-    """Wrap an angle to [-pi, pi)."""
-    return (angle_rad + math.pi) % (2.0 * math.pi) - math.pi
-
-
-@dataclass(frozen=True)
-class ControlCommand:
-    """One control step's output."""
-
-    wheels: WheelSpeeds
-    linear_m_s: float
-    angular_rad_s: float
-    waypoint_index: int
-
-
-@dataclass(frozen=True)
-class GoalChecker:
-    """Goal reached when the base is within ``tolerance_m`` of the goal position."""
-
-    x_m: float
-    y_m: float
-    tolerance_m: float
-
-    def reached(self, pose: Pose2D) -> bool:
-        return math.hypot(pose.x_m - self.x_m, pose.y_m - self.y_m) <= self.tolerance_m
+from swarmnav.models.world import Pose2D, wrap_angle_rad
+from swarmnav.planners.problem import Path
 
 
 @dataclass
@@ -52,8 +28,7 @@ class PointToPointController:
     Each step: heading error e to the active waypoint gives omega = k * e within
     +-``max_angular_rad_s``; v = ``max_speed_m_s`` * cos(e) when |e| < ``turn_in_place_rad``
     (else 0, turning on the spot), further reduced within ``slowdown_radius_m`` of the
-    final waypoint; the next waypoint becomes active within ``switch_radius_m``; inside
-    ``goal_tolerance_m`` of the last waypoint the robot stops.
+    final waypoint; the next waypoint becomes active within ``switch_radius_m``.
 
     Args:
         geometry: wheel radius, track and wheel speed limit, read from the model.
@@ -63,7 +38,6 @@ class PointToPointController:
         switch_radius_m: distance at which an intermediate waypoint counts as passed.
         slowdown_radius_m: distance to the final waypoint below which v shrinks linearly.
         turn_in_place_rad: heading error above which the robot turns without advancing.
-        goal_tolerance_m: stop radius around the last waypoint.
     """
 
     geometry: DriveGeometry
@@ -73,15 +47,14 @@ class PointToPointController:
     switch_radius_m: float = 0.05
     slowdown_radius_m: float = 0.3
     turn_in_place_rad: float = math.radians(25.0)
-    goal_tolerance_m: float = 0.1
 
     def __post_init__(self) -> None:
         self._waypoints: list[tuple[float, float]] = []
         self._index = 0
 
-    def reset(self, waypoints: np.ndarray) -> None:
+    def reset(self, path: Path) -> None:
         """Start following a new path (also after a replan); the first waypoint is the start."""
-        pts = [(float(x), float(y)) for x, y in np.asarray(waypoints, dtype=float).reshape(-1, 2)]
+        pts = [(float(x), float(y)) for x, y in np.asarray(path.waypoints, dtype=float).reshape(-1, 2)]
         if not pts:
             raise ValueError("a path needs at least one waypoint")
         self._waypoints = pts
@@ -91,8 +64,8 @@ class PointToPointController:
     def waypoint_index(self) -> int:
         return self._index
 
-    def command(self, pose: Pose2D) -> ControlCommand:
-        """Wheel speeds that drive ``pose`` toward the active waypoint."""
+    def command(self, pose: Pose2D, twist: Twist | None = None) -> ControlCommand:
+        """Wheel speeds that drive ``pose`` toward the active waypoint (the twist is not needed)."""
         last = len(self._waypoints) - 1
         tx, ty = self._waypoints[self._index]
         dist = math.hypot(tx - pose.x_m, ty - pose.y_m)
@@ -100,7 +73,7 @@ class PointToPointController:
             self._index += 1
             tx, ty = self._waypoints[self._index]
             dist = math.hypot(tx - pose.x_m, ty - pose.y_m)
-        if self._index == last and dist <= self.goal_tolerance_m:
+        if dist == 0.0:  # on the last waypoint exactly: no heading to steer by
             return ControlCommand(WheelSpeeds(0.0, 0.0), 0.0, 0.0, self._index)
         error = wrap_angle_rad(math.atan2(ty - pose.y_m, tx - pose.x_m) - pose.heading_rad)
         omega = max(-self.max_angular_rad_s, min(self.max_angular_rad_s, self.heading_gain * error))

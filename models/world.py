@@ -14,6 +14,11 @@ import numpy as np
 
 from swarmnav.models.geometry import segment_box_distances
 
+def wrap_angle_rad(angle_rad):
+    """Wrap an angle (a float or an array) to [-pi, pi)."""
+    return (angle_rad + math.pi) % (2.0 * math.pi) - math.pi
+
+
 @dataclass(frozen=True)
 class Pose2D:
     """A planar pose: position in metres, heading in radians (CCW from +x)."""

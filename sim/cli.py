@@ -20,7 +20,6 @@ from typing import Any, Callable
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
-from swarmnav.planners.problem import scenario_problem
 from swarmnav.sim import log_commands, plot, replay
 from swarmnav.sim.benchmarks import grid as bench_grid
 from swarmnav.sim.benchmarks import planners as bench_planners
@@ -34,14 +33,14 @@ class UserError(Exception):
     """A bad command-line value or file that is not a scenario (exit 2)."""
 
 
-def parse_settings(pairs: list[str] | None) -> dict[str, Any]:
-    """``--set key=value`` pairs; values are read as TOML (numbers, booleans, arrays) or else strings."""
+def parse_settings(pairs: list[str] | None, option: str = "--set") -> dict[str, Any]:
+    """``KEY=VALUE`` pairs of an option; values are read as TOML (numbers, booleans, arrays) or else strings."""
     params: dict[str, Any] = {}
     for pair in pairs or []:
         key, sep, text = pair.partition("=")
         key = key.strip()
         if not sep or not key:
-            raise ConfigError("--set", f"expected key=value, got {pair!r}")
+            raise ConfigError(option, f"expected key=value, got {pair!r}")
         try:
             value = tomllib.loads(f"v = {text}")["v"]
         except tomllib.TOMLDecodeError:
@@ -55,33 +54,25 @@ def _load(args: argparse.Namespace):
     return load_scenario(args.scenario)
 
 
-def _plan(args: argparse.Namespace, scenario):
-    """Plan with the chosen planner: the scenario's parameters (for its own planner), then ``--set``.
-
-    A bad parameter given with ``--set`` is reported against ``--set``, not the file.
-    """
-    from swarmnav.sim.runner import plan_scenario
-    name = args.planner or scenario.planner_name
-    params = dict(scenario.planner_params) if name == scenario.planner_name else {}
-    settings = parse_settings(args.set)
-    params.update(settings)
-    try:
-        return plan_scenario(scenario, name, params, args.seed)
-    except ConfigError as exc:
-        if exc.field in {f"planner.params.{key}" for key in settings} or (
-                args.planner and exc.field == "planner.name"):
-            raise ConfigError(exc.field, exc.problem, "--set" if exc.field != "planner.name" else "--planner") \
-                from None
-        raise
+def _episode_spec(args: argparse.Namespace):
+    """The episode the command line asks for: the scenario, then ``--planner``/``--set``, ``--navigator``/
+    ``--navigator-set`` and the two seeds on top."""
+    from swarmnav.sim.episode import EpisodeSpec
+    return EpisodeSpec(_load(args), planner=args.planner, planner_params=parse_settings(args.set, "--set"),
+                       navigator=args.navigator,
+                       navigator_params=parse_settings(args.navigator_set, "--navigator-set"),
+                       seed=args.seed, world_seed=args.world_seed)
 
 
-def plan_summary(scenario, name: str, seed: int, path) -> dict[str, Any]:
-    problem = scenario_problem(scenario)
-    return {"scenario": scenario.name, "planner": name, "seed": seed,
-            "waypoints": [[float(x), float(y)] for x, y in path.waypoints],
-            "length_m": path.stats.length_m, "plan_time_s": path.stats.plan_time_s,
-            "iterations": path.stats.iterations, "evaluations": path.stats.evaluations,
-            "collision_free": bool(problem.is_collision_free(path.waypoints))}
+def _blame_options(args: argparse.Namespace, exc: ConfigError) -> ConfigError:
+    """A bad value given on the command line is reported against the option, not the scenario file."""
+    options = {"planner.name": "--planner" if args.planner else None,
+               "navigator.name": "--navigator" if args.navigator else None}
+    options.update({f"planner.params.{key}": "--set" for key in parse_settings(args.set, "--set")})
+    options.update({f"navigator.params.{key}": "--navigator-set"
+                    for key in parse_settings(args.navigator_set, "--navigator-set")})
+    option = options.get(exc.field)
+    return ConfigError(exc.field, exc.problem, option) if option else exc
 
 
 def cmd_scenarios(args: argparse.Namespace) -> int:
@@ -101,13 +92,17 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    scenario = _load(args)
-    path, name, params, seed = _plan(args, scenario)
-    out = plan_summary(scenario, name, seed, path)
+    from swarmnav.sim.episode import plan_episode
+    try:
+        episode = plan_episode(_episode_spec(args))
+    except ConfigError as exc:
+        raise _blame_options(args, exc) from None
+    out = episode.plan_summary()
+    path = episode.path
     if args.json:
         print(json.dumps(out))
     else:
-        print(f"{scenario.name}: {name} (seed {seed}) {len(path.waypoints)} waypoints, "
+        print(f"{out['scenario']}: {out['planner']} (seed {out['seed']}) {len(path.waypoints)} waypoints, "
               f"{out['length_m']:.4f} m in {out['plan_time_s'] * 1000:.1f} ms, "
               f"{'collision-free' if out['collision_free'] else 'NOT collision-free'}")
         for x, y in path.waypoints:
@@ -116,17 +111,18 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from swarmnav.sim.recording import RecorderGroup
-    from swarmnav.sim.runner import Simulation
-    scenario = _load(args)
-    path, name, params, seed = _plan(args, scenario)
-    simulation = Simulation(scenario)
+    from swarmnav.sim.episode import plan_episode, run_episode
+    spec = _episode_spec(args)
+    try:
+        planned = plan_episode(spec)  # bad input or no path fails before any file is made
+    except ConfigError as exc:
+        raise _blame_options(args, exc) from None
     recorders = []
     log_path = None
     if not args.no_log:
         from swarmnav.sim.mcap_log import McapRecorder, default_log_path
         log_path = FilePath(args.out) if args.out else default_log_path(
-            scenario.name, name, seed, time.strftime("%Y%m%d-%H%M%S"))
+            planned.spec.scenario.name, planned.spec.planner, planned.spec.seed, time.strftime("%Y%m%d-%H%M%S"))
         if log_path.exists() and not args.overwrite:
             raise UserError(f"{log_path}: --out: file exists (use --overwrite)")
         recorders.append(McapRecorder(log_path, live=args.live, overwrite=True))
@@ -136,18 +132,16 @@ def cmd_run(args: argparse.Namespace) -> int:
         from swarmnav.sim.render import VideoRecorder
         recorders.append(VideoRecorder(args.video, camera=args.camera, width=args.width,
                                        height=args.height, fps=args.fps))
-    recorder = RecorderGroup(recorders) if recorders else None
-    context = simulation.context(name, params, seed) if recorder else None
-    result = simulation.run(path, recorder=recorder, context=context,
-                            stop_on_collision=True if args.stop_on_collision else None)
-    out = {"scenario": scenario.name, "planner": name, "seed": seed, **result.summary(),
-           "plan": plan_summary(scenario, name, seed, path),
-           "log": str(log_path) if log_path else None, "video": args.video}
+    episode = run_episode(spec, recorders, stop_on_collision=True if args.stop_on_collision else None,
+                          planned=planned)
+    result, path = episode.result, episode.path
+    out = {**episode.summary(), "log": str(log_path) if log_path else None, "video": args.video}
     if args.json:
         print(json.dumps(out))
     else:
         status = "reached the goal" if result.reached else f"did not reach the goal ({result.outcome})"
-        print(f"{scenario.name}: {name} (seed {seed}) {status} in {result.sim_time_s:.2f} s sim "
+        print(f"{out['scenario']}: {out['planner']} + {out['navigator']} (seed {out['seed']}, world seed "
+              f"{out['world_seed']}) {status} in {result.sim_time_s:.2f} s sim "
               f"({result.wall_time_s:.2f} s wall); driven {result.path_length_m:.3f} m "
               f"(planned {path.stats.length_m:.3f} m); collisions {result.collisions}"
               + (f", first at {result.first_collision_s:.2f} s" if result.first_collision_s is not None else "")
@@ -176,8 +170,11 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Any, str]] = [
 def _add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", help="bundled scenario name or path to a .toml file")
     p.add_argument("--planner", help="planner name (default: the scenario's)")
-    p.add_argument("--seed", type=int, help="random seed (default: the scenario's)")
+    p.add_argument("--seed", type=int, help="the planner's and navigator's random seed (default: the scenario's)")
+    p.add_argument("--world-seed", type=int, help="seed of the random obstacle motions (default: the scenario's seed)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="planner parameter (repeatable)")
+    p.add_argument("--navigator", help="navigator name (default: the scenario's, else follow)")
+    p.add_argument("--navigator-set", action="append", metavar="KEY=VALUE", help="navigator parameter (repeatable)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 

@@ -25,8 +25,8 @@ Time: ``log_time`` = ``publish_time`` = every message's own timestamp = simulati
 time in ns from 0.  No wall-clock time is written, so two runs with the same seed
 give identical message bytes on every channel.
 
-Metadata records: ``scenario`` (name, TOML text), ``planner`` (name, JSON params),
-``run`` (seed, time steps, sensor layout, obstacles), ``versions`` and, from
+Metadata records: ``scenario`` (name, TOML text), ``planner`` and ``navigator`` (name, JSON params),
+``run`` (seed, world seed, time steps, sensor layout, obstacles), ``versions`` and, from
 ``finish``, ``outcome`` (the runner's summary, JSON-encoded values).  Attachment:
 ``scene.xml``, the compiled MJCF.  Everything needed to re-simulate is in the file.
 
@@ -492,9 +492,13 @@ class McapRecorder:
             "planner", {"name": context.planner_name, "params": dumps(context.planner_params)}
         )
         writer.write_metadata(
+            "navigator", {"name": context.navigator_name, "params": dumps(context.navigator_params)}
+        )
+        writer.write_metadata(
             "run",
             {
                 "seed": str(int(context.seed)),
+                "world_seed": str(int(context.world_seed)),
                 "control_dt_s": repr(float(context.control_dt_s)),
                 "physics_dt_s": repr(float(context.physics_dt_s)),
                 "sensor_angles_rad": dumps([float(a) for a in context.sensor_angles_rad]),

@@ -51,6 +51,9 @@ class RunContext:
     obstacles: tuple[ObstacleInfo, ...]
     versions: dict[str, str] = field(default_factory=dict)
     arena_size_m: tuple[float, float] = (10.0, 10.0)
+    navigator_name: str = "follow"
+    navigator_params: dict[str, Any] = field(default_factory=dict)
+    world_seed: int = 0
 
 
 @dataclass

@@ -38,6 +38,7 @@ def context_from_log(log: RunLog) -> RunContext:
     if not log.mjcf_xml:
         raise LogError(log.raw.path, "the log has no MJCF attachment (scene.xml)")
     planner = log.metadata.get("planner", {})
+    navigator = log.metadata.get("navigator", {})
     return RunContext(
         scenario_name=log.scenario_name,
         scenario_toml=log.metadata.get("scenario", {}).get("toml", ""),
@@ -57,6 +58,10 @@ def context_from_log(log: RunLog) -> RunContext:
         ),
         versions=dict(log.metadata.get("versions", {})),
         arena_size_m=tuple(log.run_value("arena_size_m", [10.0, 10.0])),
+        navigator_name=navigator.get("name", "follow"),
+        navigator_params=json.loads(navigator.get("params", "{}")),
+        world_seed=int(log.metadata.get("run", {}).get("seed" if "world_seed" not in log.metadata.get("run", {})
+                                                       else "world_seed", 0)),
     )
 
 
@@ -213,14 +218,14 @@ def verify_log(log: RunLog) -> VerifyReport:
     import mujoco
 
     from swarmnav.models.scenario import parse_scenario
-    from swarmnav.sim.runner import Simulation, plan_scenario
+    from swarmnav.sim.episode import EpisodeSpec, run_episode
     from swarmnav.sim.scene import index_scene
 
     context = context_from_log(log)
     scenario = parse_scenario(context.scenario_toml, f"{log.raw.path}[scenario]")
-    path, name, params, seed = plan_scenario(scenario, context.planner_name, context.planner_params, context.seed)
+    spec = EpisodeSpec(scenario, context.planner_name, context.planner_params, context.navigator_name,
+                       context.navigator_params, context.seed, context.world_seed)
     model = mujoco.MjModel.from_xml_string(context.mjcf_xml)
-    simulation = Simulation(scenario, index_scene(model, context.mjcf_xml))
     # Reproduce how the logged run stopped: a timeout at T means the limit was T.
     kinds = [kind for _, kind, _ in log.events]
     options = {}
@@ -229,7 +234,8 @@ def verify_log(log: RunLog) -> VerifyReport:
     if "stopped_on_collision" in kinds:
         options["stop_on_collision"] = True
     capture = TrajectoryCapture()
-    result = simulation.run(path, recorder=capture, context=simulation.context(name, params, seed), **options)
+    episode = run_episode(spec, [capture], scene=index_scene(model, context.mjcf_xml), **options)
+    path, result = episode.path, episode.result
     sim_t, sim_p, sim_q = capture.arrays()
 
     n = min(len(sim_t), len(log.time_s))

@@ -126,7 +126,7 @@ def test_unknown_bundled_name_and_planner_on_the_command_line_exit_2(capsys):
 
 def test_console_script_exits_2_without_traceback(tmp_path):
     bad = write(tmp_path, BASE.replace("radius_m = 0.5", "radius_m = 0"))
-    proc = subprocess.run([sys.executable, "-m", "sim.cli", "plan", bad], capture_output=True, text=True)
+    proc = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "plan", bad], capture_output=True, text=True)
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr and "obstacles[0].radius_m" in proc.stderr
 

@@ -5,7 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from swarmnav.controllers import DriveGeometry, PointToPointController, body_twist, wheel_speeds
+from swarmnav.controllers.goal import GoalChecker
+from swarmnav.controllers.kinematics import DriveGeometry, body_twist, wheel_speeds
+from swarmnav.controllers.point_to_point import PointToPointController
 from swarmnav.planners.problem import Path
 from swarmnav.models.world import Pose2D
 
@@ -38,26 +40,33 @@ def test_saturation_scales_both_wheels_and_keeps_curvature():
 
 def test_controller_turns_in_place_toward_a_waypoint_behind():
     c = PointToPointController(GEOMETRY, max_speed_m_s=0.2)
-    c.reset(np.array([[0.0, 0.0], [-1.0, 0.0]]))
+    c.reset(Path.from_waypoints(np.array([[0.0, 0.0], [-1.0, 0.0]]), 0.0))
     cmd = c.command(Pose2D(0.0, 0.0, 0.0))
     assert cmd.linear_m_s == 0.0 and abs(cmd.angular_rad_s) == pytest.approx(c.max_angular_rad_s)
     assert cmd.wheels.left_rad_s == pytest.approx(-cmd.wheels.right_rad_s)
 
 
-def test_controller_switches_waypoints_and_stops_at_goal():
-    c = PointToPointController(GEOMETRY, max_speed_m_s=0.2, goal_tolerance_m=0.1)
-    c.reset(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]))
+def test_controller_switches_waypoints_and_slows_down_before_the_last():
+    c = PointToPointController(GEOMETRY, max_speed_m_s=0.2)
+    c.reset(Path.from_waypoints(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]), 0.0))
     assert c.command(Pose2D(0.0, 0.0, 0.0)).waypoint_index == 1
     assert c.command(Pose2D(0.9, 0.0, 0.0)).waypoint_index == 1
     assert c.command(Pose2D(0.97, 0.0, 0.0)).waypoint_index == 2
-    stop = c.command(Pose2D(1.0, 0.95, math.pi / 2))
-    assert stop.linear_m_s == 0.0 and stop.wheels.left_rad_s == 0.0 and stop.wheels.right_rad_s == 0.0
+    far = c.command(Pose2D(1.0, 0.5, math.pi / 2))
+    near = c.command(Pose2D(1.0, 0.95, math.pi / 2))
+    assert far.linear_m_s == pytest.approx(0.2) and 0.0 < near.linear_m_s < far.linear_m_s
+
+
+def test_the_goal_checker_alone_decides_arrival():
+    goal = GoalChecker(1.0, 1.0, 0.1)
+    assert goal.reached(Pose2D(1.0, 0.95)) and goal.reached(Pose2D(1.07, 1.07))
+    assert not goal.reached(Pose2D(1.0, 0.85)) and not goal.reached(Pose2D(1.08, 1.08))
 
 
 @pytest.mark.parametrize("target", [(3.0, 1.0), (1.0, 3.0)])
 def test_controller_drives_the_robot_in_physics_to_a_waypoint_2_m_away(target):
     from swarmnav.models.scenario import parse_scenario
-    from swarmnav.sim.runner import Simulation
+    from swarmnav.sim.episode import EpisodeSpec, run_episode
 
     scenario = parse_scenario(f"""
 name = "two-metres"
@@ -66,8 +75,7 @@ arena = {{ width_m = 4.0, height_m = 4.0 }}
 start = {{ x = 1.0, y = 1.0, heading_deg = 0.0 }}
 goal = {{ x = {target[0]}, y = {target[1]}, tolerance_m = 0.05 }}
 """)
-    path = Path.from_waypoints(np.array([[1.0, 1.0], target]), 0.0)
-    result = Simulation(scenario).run(path)
+    result = run_episode(EpisodeSpec(scenario, "straight")).result
     assert result.reached, result.summary()
     final = result.poses[-1, :2]
     assert math.dist(final, target) <= 0.05

@@ -23,7 +23,7 @@ from swarmnav.models.scenario import load_scenario  # noqa: E402
 from swarmnav.sim.cli import main  # noqa: E402
 from swarmnav.sim.log_reader import read_log, read_records  # noqa: E402
 from swarmnav.sim.mcap_log import TOPICS, McapRecorder  # noqa: E402
-from swarmnav.sim.runner import simulate  # noqa: E402
+from swarmnav.sim.episode import EpisodeSpec, run_episode  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 SCENARIO = "gwo-scenario-2"  # moving obstacles and collisions: every channel has traffic
@@ -41,7 +41,7 @@ EXPECTED_SCHEMAS = {
 
 
 def record(path: Path, **run_options):
-    return simulate(load_scenario(SCENARIO), recorder=McapRecorder(path), **run_options)
+    return run_episode(EpisodeSpec(load_scenario(SCENARIO)), [McapRecorder(path)], **run_options)
 
 
 @pytest.fixture(scope="module")
@@ -81,7 +81,7 @@ def test_log_reads_back_with_expected_channels_counts_and_schemas(full_run):
     assert all({"geom_a", "geom_b"} <= set(d) for _, k, d in log.events if k.startswith("collision"))
     assert set(metadata) >= {"scenario", "planner", "run", "versions", "outcome"}
     assert metadata["scenario"]["toml"] == load_scenario(SCENARIO).source_text
-    assert int(metadata["run"]["seed"]) == episode.seed
+    assert int(metadata["run"]["seed"]) == episode.spec.seed
     assert {"swarmnav", "mujoco", "python"} <= set(metadata["versions"])
     assert not any(key.startswith("wall_") for key in metadata["outcome"])
     assert attachments["scene.xml"].data.decode().startswith("<mujoco")
@@ -142,7 +142,7 @@ CRASHING_RUN = """
 import os, signal, sys
 from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.mcap_log import McapRecorder
-from swarmnav.sim.runner import simulate
+from swarmnav.sim.episode import EpisodeSpec, run_episode
 
 class Crash(McapRecorder):
     def step(self, frame):
@@ -150,7 +150,7 @@ class Crash(McapRecorder):
         if frame.time_s >= 3.5:
             os.kill(os.getpid(), signal.SIGKILL)
 
-simulate(load_scenario(sys.argv[2]), recorder=Crash(sys.argv[1]))
+run_episode(EpisodeSpec(load_scenario(sys.argv[2])), [Crash(sys.argv[1])])
 """
 
 
@@ -260,8 +260,8 @@ def test_live_view_serves_the_same_channels_on_loopback(tmp_path):
     from websockets.sync.client import connect  # a dependency of mujoco
 
     recorder = McapRecorder(tmp_path / "live.mcap", live=True, live_port=0, live_speed=4.0)
-    runner = threading.Thread(target=simulate, args=(load_scenario("gwo-scenario-1"),),
-                              kwargs={"recorder": recorder, "time_limit_s": 3.0})
+    runner = threading.Thread(target=run_episode, args=(EpisodeSpec(load_scenario("gwo-scenario-1")), [recorder]),
+                              kwargs={"time_limit_s": 3.0})
     runner.start()
     try:
         deadline = time.monotonic() + 20

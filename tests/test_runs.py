@@ -5,8 +5,12 @@ import pytest
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.planners import PLANNERS, make_planner
-from swarmnav.sim.runner import simulate
+from swarmnav.sim.episode import EpisodeSpec, run_episode
 from swarmnav.planners.problem import scenario_problem
+
+
+def simulate(scenario, planner, params, seed, **options):
+    return run_episode(EpisodeSpec(scenario, planner, params, seed=seed), **options)
 
 
 @pytest.mark.parametrize("name", ["gwo-scenario-1", "restaurant-table-2", "restaurant-table-5"])
@@ -54,12 +58,9 @@ def test_an_empty_arena_reports_no_clearance_rather_than_infinity():
     import json
 
     from swarmnav.models.scenario import parse_scenario
-    from swarmnav.sim.runner import Simulation
-    from swarmnav.planners.problem import Path
-
     scenario = parse_scenario('name = "empty"\narena = { width_m = 3.0, height_m = 3.0 }\n'
                               'start = { x = 1.0, y = 1.0 }\ngoal = { x = 2.0, y = 1.0 }\n')
-    result = Simulation(scenario).run(Path.from_waypoints(np.array([[1.0, 1.0], [2.0, 1.0]]), 0.0))
+    result = simulate(scenario, "straight", {}, 0).result
     summary = result.summary()
     assert result.reached and summary["min_clearance_m"] is None
     json.loads(json.dumps(summary, allow_nan=False))

@@ -16,7 +16,8 @@ from pathlib import Path as FilePath
 import mujoco
 
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.runner import Simulation, plan_scenario
+from swarmnav.sim.episode import Episode, EpisodeSpec, plan_episode, run_episode
+from swarmnav.sim.runner import Simulation
 
 
 def _bare_steps_per_s(simulation: Simulation, steps: int) -> float:
@@ -27,9 +28,10 @@ def _bare_steps_per_s(simulation: Simulation, steps: int) -> float:
     return steps / (time.perf_counter() - t0)
 
 
-def _closed_loop_steps_per_s(simulation: Simulation, path, duration_s: float, recorder=None,
-                             context=None) -> tuple[float, float]:
-    result = simulation.run(path, recorder=recorder, context=context, time_limit_s=duration_s)
+def _closed_loop_steps_per_s(simulation: Simulation, planned: Episode, duration_s: float,
+                             recorders=()) -> tuple[float, float]:
+    result = run_episode(planned.spec, recorders, simulation=simulation, planned=planned,
+                         time_limit_s=duration_s).result
     steps = result.steps * simulation.steps_per_control
     return steps / result.wall_time_s, result.sim_time_s / result.wall_time_s
 
@@ -44,8 +46,8 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
     every measurement covers the same simulated time.
     """
     scenario = load_scenario(scenario_name)
-    path, planner_name, planner_params, seed = plan_scenario(scenario)
-    simulation = Simulation(scenario)
+    planned = plan_episode(EpisodeSpec(scenario))
+    simulation = Simulation(planned.spec.scenario)
     bare, closed, ratios, realtime, logging, logging_ratios = [], [], [], [], [], []
     physics_steps = int(round(duration_s / simulation.model.opt.timestep))
     recorder_cls = None
@@ -58,15 +60,14 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
     with tempfile.TemporaryDirectory() as tmp:
         for r in range(repeats):
             b = _bare_steps_per_s(simulation, physics_steps)
-            c, rt = _closed_loop_steps_per_s(simulation, path, duration_s)
+            c, rt = _closed_loop_steps_per_s(simulation, planned, duration_s)
             bare.append(b)
             closed.append(c)
             realtime.append(rt)
             ratios.append(c / b)
             if recorder_cls is not None:
                 recorder = recorder_cls(FilePath(tmp) / f"bench_{r}.mcap", overwrite=True)
-                context = simulation.context(planner_name, planner_params, seed)
-                lg, _ = _closed_loop_steps_per_s(simulation, path, duration_s, recorder, context)
+                lg, _ = _closed_loop_steps_per_s(simulation, planned, duration_s, [recorder])
                 logging.append(lg)
                 logging_ratios.append(lg / b)
     figures: dict[str, float | int | str] = {

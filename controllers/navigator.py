@@ -1,0 +1,91 @@
+"""The navigator seam: between the sensors and the controller, one call per control step.
+
+A navigator is reset once with a :class:`NavigationSetup` (the path planned at
+t = 0, the known map, the planner and its generator, the controller and the
+goal checker), then receives an :class:`Observation` every control step and
+returns a :class:`NavigationStep`: the wheel command, optionally a new path
+(which the runner logs and draws), and events (replans, stops) to log.  No
+MuJoCo type crosses this seam: the simulation converts its sensors into plain
+arrays first.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar, Protocol
+
+import numpy as np
+
+from swarmnav.controllers.controller import ControlCommand, Controller, Twist
+from swarmnav.controllers.goal import GoalChecker
+from swarmnav.models.world import Pose2D
+from swarmnav.planners.problem import Path, Planner, Problem
+
+
+@dataclass(frozen=True, eq=False)
+class Observation:
+    """What the robot senses at one control step.
+
+    Attributes:
+        time_s: simulation time.
+        pose: the base pose (x, y, heading) in the world.
+        twist: the measured forward speed and turn rate.
+        ranges_m: (K,) rangefinder distances from each sensor site on the rim;
+            ``inf`` where nothing is in range.
+        range_angles_rad: (K,) beam directions in the base frame, CCW from +x.
+        range_offset_m: distance of the sensor sites from the base's centre.
+    """
+
+    time_s: float
+    pose: Pose2D
+    twist: Twist
+    ranges_m: np.ndarray
+    range_angles_rad: np.ndarray
+    range_offset_m: float
+
+
+@dataclass(frozen=True, eq=False)
+class NavigationSetup:
+    """What a navigator is given before the first step.
+
+    Attributes:
+        path: the path planned at t = 0 on ``problem``.
+        problem: the planning problem the first path was planned on.
+        planner: the scenario's planner, for navigators that replan.
+        rng: the generator of the run's ``seed`` (planner and navigator randomness).
+        controller: turns a path into wheel speeds.
+        goal: the goal checker.
+        control_dt_s: the control period.
+        max_speed_m_s: the robot's speed limit.
+    """
+
+    path: Path
+    problem: Problem
+    planner: Planner
+    rng: np.random.Generator
+    controller: Controller
+    goal: GoalChecker
+    control_dt_s: float
+    max_speed_m_s: float
+
+
+@dataclass(frozen=True, eq=False)
+class NavigationStep:
+    """A navigator's answer for one control step.
+
+    Attributes:
+        command: the wheel command to apply now.
+        new_path: a path that replaces the one being followed (logged and drawn), or None.
+        events: ``(kind, details)`` pairs to log, e.g. ``("replan", {"reason": ...})``.
+    """
+
+    command: ControlCommand
+    new_path: Path | None = None
+    events: tuple[tuple[str, dict[str, Any]], ...] = ()
+
+
+class Navigator(Protocol):
+    name: ClassVar[str]
+
+    def reset(self, setup: NavigationSetup) -> None: ...
+    def step(self, observation: Observation) -> NavigationStep: ...

@@ -1,0 +1,36 @@
+"""Navigators behind one seam (:mod:`controllers.navigator`), in an explicit registry.
+
+No module in this package imports MuJoCo.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from swarmnav.controllers.navigators.follow import FollowNavigator
+from swarmnav.models.parameters import build_component
+
+NAVIGATORS: dict[str, type] = {}
+
+
+def register(cls: type) -> type:
+    """Add a navigator class to :data:`NAVIGATORS`; a name already taken is an error."""
+    name = getattr(cls, "name", None)
+    if not isinstance(name, str) or not name:
+        raise TypeError(f"{cls.__name__} has no navigator name")
+    if name in NAVIGATORS:
+        raise ValueError(f"navigator name {name!r} is registered twice")
+    NAVIGATORS[name] = cls
+    return cls
+
+
+for _cls in (FollowNavigator,):
+    register(_cls)
+
+
+def make_navigator(name: str, params: dict[str, Any] | None = None, source: str | None = None) -> Any:
+    """Build a registered navigator from its name and a parameter table (ConfigError naming the field)."""
+    return build_component(NAVIGATORS, "navigator", name, params, source)
+
+
+__all__ = ["NAVIGATORS", "register", "make_navigator"]

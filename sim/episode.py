@@ -1,0 +1,143 @@
+"""The one run composition: an episode spec in, a plan and a simulated run out.
+
+Everything that plans and simulates a scenario (the CLI's ``plan`` and ``run``,
+``replay --verify``, the benchmarks, studies, the tests) goes through
+:func:`plan_episode` and :func:`run_episode`; nothing else assembles a run.
+
+Parameters resolve in one place (:meth:`EpisodeSpec.resolved`): a scenario's own
+planner (navigator) parameters apply when the spec names the same planner
+(navigator) as the scenario or none; the spec's parameters override them.
+
+Two seeds say what they seed: ``seed`` the planner's and the navigator's
+randomness, ``world_seed`` every random obstacle motion.  The planner draws from
+``default_rng(seed)``; the navigator from its own stream,
+``SeedSequence(seed, spawn_key=(1,))``, so a navigator's draws never shift the plan.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import numpy as np
+
+from swarmnav.controllers.navigator import NavigationSetup
+from swarmnav.controllers.navigators import make_navigator
+from swarmnav.controllers.point_to_point import PointToPointController
+from swarmnav.models.scenario import Scenario
+from swarmnav.planners import make_planner
+from swarmnav.planners.problem import Path, Problem, scenario_problem
+from swarmnav.sim.recording import Recorder, RecorderGroup
+from swarmnav.sim.runner import RunResult, Simulation
+from swarmnav.sim.scene import CompiledScene
+
+NAVIGATOR_STREAM = 1  # spawn key of the navigator's generator under the run's seed
+
+
+@dataclass(frozen=True, eq=False)
+class EpisodeSpec:
+    """What to run: a scenario, a planner and a navigator with their parameters, and two seeds.
+
+    ``None`` means "the scenario's": its planner, navigator, ``seed`` (for both seeds).
+    Parameters given here override the scenario's own for the same planner or navigator.
+    """
+
+    scenario: Scenario
+    planner: str | None = None
+    planner_params: dict[str, Any] | None = None
+    navigator: str | None = None
+    navigator_params: dict[str, Any] | None = None
+    seed: int | None = None
+    world_seed: int | None = None
+
+    def resolved(self) -> "EpisodeSpec":
+        """Every field filled in; the scenario carries the world seed."""
+        scenario = self.scenario
+        planner = self.planner or scenario.planner_name
+        navigator = self.navigator or scenario.navigator_name
+        planner_params = {**(scenario.planner_params if planner == scenario.planner_name else {}),
+                          **(self.planner_params or {})}
+        navigator_params = {**(scenario.navigator_params if navigator == scenario.navigator_name else {}),
+                            **(self.navigator_params or {})}
+        seed = scenario.seed if self.seed is None else int(self.seed)
+        world_seed = scenario.seed if self.world_seed is None else int(self.world_seed)
+        if world_seed != scenario.world_seed:
+            scenario = scenario.with_world_seed(world_seed)
+        return EpisodeSpec(scenario, planner, planner_params, navigator, navigator_params, seed, world_seed)
+
+
+@dataclass(eq=False)
+class Episode:
+    """A planned (and, unless plan-only, simulated) episode."""
+
+    spec: EpisodeSpec  # resolved
+    problem: Problem
+    path: Path
+    result: RunResult | None = None
+
+    def plan_summary(self) -> dict[str, Any]:
+        """The object ``swarmnav plan --json`` prints."""
+        spec, stats = self.spec, self.path.stats
+        return {"scenario": spec.scenario.name, "planner": spec.planner, "seed": spec.seed,
+                "waypoints": [[float(x), float(y)] for x, y in self.path.waypoints],
+                "length_m": stats.length_m, "plan_time_s": stats.plan_time_s,
+                "iterations": stats.iterations, "evaluations": stats.evaluations,
+                "collision_free": bool(self.problem.is_collision_free(self.path.waypoints))}
+
+    def summary(self) -> dict[str, Any]:
+        """The object ``swarmnav run --json`` prints (without the log and video paths)."""
+        spec = self.spec
+        out = {"scenario": spec.scenario.name, "planner": spec.planner, "navigator": spec.navigator,
+               "seed": spec.seed, "world_seed": spec.world_seed}
+        if self.result is not None:
+            out.update(self.result.summary())
+        out["plan"] = self.plan_summary()
+        return out
+
+
+def plan_episode(spec: EpisodeSpec) -> Episode:
+    """Resolve the spec and plan on the scenario's obstacles at t = 0.
+
+    Raises:
+        ConfigError: unknown planner or navigator, or a bad parameter (naming the field).
+        PlanningError: the planner found no path.
+    """
+    spec = spec.resolved()
+    source = spec.scenario.source_path
+    planner = make_planner(spec.planner, spec.planner_params, source)
+    make_navigator(spec.navigator, spec.navigator_params, source)  # a bad navigator fails before planning
+    problem = scenario_problem(spec.scenario)
+    path = planner.plan(problem, np.random.default_rng(spec.seed))
+    return Episode(spec, problem, path)
+
+
+def run_episode(spec: EpisodeSpec, recorders: Sequence[Recorder] = (), *, scene: CompiledScene | None = None,
+                time_limit_s: float | None = None, stop_on_collision: bool | None = None,
+                simulation: Simulation | None = None, planned: Episode | None = None) -> Episode:
+    """Plan, build the simulation and run the closed loop with the given recorders.
+
+    Args:
+        scene: a compiled scene to run instead of compiling the scenario (replay
+            runs the MJCF its log carries).
+        simulation: a ready :class:`Simulation` of the same scenario (benchmarks reuse one).
+        planned: the result of :func:`plan_episode` on this spec, when it was planned already.
+        time_limit_s, stop_on_collision: override the scenario's.
+    """
+    episode = planned if planned is not None else plan_episode(spec)
+    spec = episode.spec
+    simulation = simulation or Simulation(spec.scenario, scene)
+    navigator = make_navigator(spec.navigator, spec.navigator_params, spec.scenario.source_path)
+    planner = make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)
+    scenario = spec.scenario
+    setup = NavigationSetup(
+        path=episode.path, problem=episode.problem, planner=planner,
+        rng=np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(NAVIGATOR_STREAM,))),
+        controller=PointToPointController(simulation.scene.drive, max_speed_m_s=scenario.max_speed_m_s),
+        goal=simulation.goal_checker(), control_dt_s=simulation.control_dt_s,
+        max_speed_m_s=scenario.max_speed_m_s)
+    recorder = RecorderGroup(list(recorders)) if recorders else None
+    context = simulation.context(spec.planner, spec.planner_params, spec.seed, spec.navigator,
+                                 spec.navigator_params) if recorder is not None else None
+    episode.result = simulation.run(navigator, setup, recorder=recorder, context=context,
+                                    time_limit_s=time_limit_s, stop_on_collision=stop_on_collision)
+    return episode
