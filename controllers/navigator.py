@@ -22,6 +22,28 @@ from swarmnav.models.world import Pose2D
 from swarmnav.planners.problem import Path, Planner, Problem
 
 
+@dataclass(frozen=True)
+class DetectedObstacle:
+    """A moving obstacle as the robot's sensing reports it (never the true future).
+
+    With the ``detector`` sensing model these are exact within the range; with
+    ``rangefinder`` they are a tracker's estimates from the rays' hits.
+
+    Attributes:
+        x_m, y_m: centre in the world.
+        radius_m: footprint radius (an estimate or a lower bound for the rangefinder tracker).
+        vx_m_s, vy_m_s: velocity in the world.
+        track_id: a stable id while the obstacle stays sensed.
+    """
+
+    x_m: float
+    y_m: float
+    radius_m: float
+    vx_m_s: float = 0.0
+    vy_m_s: float = 0.0
+    track_id: int = -1
+
+
 @dataclass(frozen=True, eq=False)
 class Observation:
     """What the robot senses at one control step.
@@ -34,6 +56,8 @@ class Observation:
             ``inf`` where nothing is in range.
         range_angles_rad: (K,) beam directions in the base frame, CCW from +x.
         range_offset_m: distance of the sensor sites from the base's centre.
+        detections: moving obstacles reported by the ``detector`` sensing model
+            (empty with the rangefinder model, whose hits a tracker turns into estimates).
     """
 
     time_s: float
@@ -42,6 +66,7 @@ class Observation:
     ranges_m: np.ndarray
     range_angles_rad: np.ndarray
     range_offset_m: float
+    detections: tuple[DetectedObstacle, ...] = ()
 
 
 @dataclass(frozen=True, eq=False)
