@@ -1,0 +1,121 @@
+"""The one run composition: seeds that say what they seed, navigators by name, one namespace."""
+
+import json
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from swarmnav.models.scenario import parse_scenario
+from swarmnav.sim.cli import main
+from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
+
+ROOT = Path(__file__).resolve().parent.parent
+
+RANDOM_WALKS = """
+name = "walkers"
+seed = 4
+time_limit_s = 6.0
+arena = { width_m = 4.0, height_m = 4.0 }
+start = { x = 0.5, y = 0.5 }
+goal = { x = 3.5, y = 3.5 }
+
+[[obstacles]]
+x = 2.0
+y = 1.0
+radius_m = 0.2
+motion = { kind = "random_walk", step_m = 0.2, period_s = 0.5 }
+
+[[obstacles]]
+x = 1.0
+y = 2.5
+radius_m = 0.2
+motion = { kind = "random_walk", step_m = 0.2, period_s = 0.5 }
+"""
+
+
+def tracks(world_seed, text=RANDOM_WALKS):
+    spec = EpisodeSpec(parse_scenario(text), "straight", world_seed=world_seed).resolved()
+    times = np.arange(0.0, 6.0, 0.02)
+    return np.stack([ob.trajectory().positions_at(times) for ob in spec.scenario.obstacles])
+
+
+def test_world_seed_changes_the_world_and_only_the_world():
+    assert np.array_equal(tracks(1), tracks(1))
+    assert not np.array_equal(tracks(1), tracks(2))
+    # The planner's seed never moves an obstacle: the default world seed is the file's seed.
+    a = EpisodeSpec(parse_scenario(RANDOM_WALKS), "straight", seed=0).resolved()
+    b = EpisodeSpec(parse_scenario(RANDOM_WALKS), "straight", seed=9).resolved()
+    assert a.world_seed == b.world_seed == 4
+    assert np.array_equal(tracks(None), tracks(4))
+
+
+def test_adding_an_obstacle_does_not_shift_the_others_draws():
+    extra = RANDOM_WALKS + ('\n[[obstacles]]\nx = 3.0\ny = 2.0\nradius_m = 0.2\n'
+                            'motion = { kind = "random_walk", step_m = 0.2, period_s = 0.5 }\n')
+    assert np.array_equal(tracks(7, extra)[:2], tracks(7))
+
+
+def test_run_gives_other_obstacle_tracks_for_another_world_seed(tmp_path, capsys):
+    path = tmp_path / "walkers.toml"
+    path.write_text(RANDOM_WALKS)
+    outputs = []
+    for world_seed in (1, 1, 2):
+        out = tmp_path / f"w{len(outputs)}.mcap"
+        assert main(["run", str(path), "--planner", "straight", "--world-seed", str(world_seed),
+                     "--out", str(out), "--json"]) == 0
+        summary = json.loads(capsys.readouterr().out)
+        assert summary["world_seed"] == world_seed and summary["navigator"] == "follow"
+        outputs.append(out.read_bytes())
+    assert outputs[0] == outputs[1]
+    assert outputs[0] != outputs[2]
+
+
+def test_a_scenario_names_its_navigator_and_the_command_line_overrides_it(tmp_path, capsys):
+    path = tmp_path / "nav.toml"
+    path.write_text(RANDOM_WALKS + '\n[navigator]\nname = "follow"\nparams = {}\n')
+    assert main(["plan", str(path), "--planner", "straight", "--json"]) == 0
+    capsys.readouterr()
+    code = main(["run", str(path), "--planner", "straight", "--navigator", "teleport", "--no-log"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "--navigator" in err and "navigator.name" in err
+    code = main(["run", str(path), "--planner", "straight", "--navigator-set", "gain=3", "--no-log"])
+    err = capsys.readouterr().err
+    assert code == 2 and "navigator.params.gain" in err and "--navigator-set" in err
+    path.write_text(RANDOM_WALKS + '\n[navigator]\nname = "teleport"\n')
+    assert main(["plan", str(path), "--planner", "straight"]) == 2
+    assert "navigator.name" in capsys.readouterr().err
+
+
+def test_scenario_parameters_apply_only_to_the_scenario_s_own_planner():
+    scenario = parse_scenario(RANDOM_WALKS + '\n[planner]\nname = "astar"\nparams = { cell_m = 0.1 }\n')
+    assert EpisodeSpec(scenario).resolved().planner_params == {"cell_m": 0.1}
+    assert EpisodeSpec(scenario, "astar", {"cell_m": 0.2}).resolved().planner_params == {"cell_m": 0.2}
+    assert EpisodeSpec(scenario, "theta_star").resolved().planner_params == {}
+
+
+def test_the_navigator_draws_from_its_own_stream():
+    scenario = parse_scenario(RANDOM_WALKS)
+    first = run_episode(EpisodeSpec(scenario, "straight", seed=3), time_limit_s=1.0)
+    second = run_episode(EpisodeSpec(scenario, "straight", seed=3), time_limit_s=1.0)
+    assert np.array_equal(first.result.poses, second.result.poses)
+    assert plan_episode(EpisodeSpec(scenario, "straight", seed=3)).path.same_as(first.path)
+
+
+def test_the_wheel_installs_one_namespace_and_nothing_named_models(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(tmp_path),
+                           str(ROOT)], capture_output=True, text=True)
+    if proc.returncode != 0:
+        pytest.fail(f"pip wheel failed: {proc.stderr[-2000:]}")
+    wheel = next(tmp_path.glob("swarmnav-*.whl"))
+    names = zipfile.ZipFile(wheel).namelist()
+    tops = {name.split("/")[0] for name in names}
+    assert {top for top in tops if not top.endswith(".dist-info")} == {"swarmnav"}
+    for package in ("models", "planners", "controllers", "sim"):
+        assert f"swarmnav/{package}/__init__.py" in names
+    assert "swarmnav/models/scenarios/gwo-scenario-1.toml" in names
+    assert "swarmnav/sim/benchmarks/sim.py" in names
+    assert "swarmnav/controllers/navigators/follow.py" in names
