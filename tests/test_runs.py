@@ -94,3 +94,21 @@ def test_collisions_are_detected_at_the_physics_rate_where_the_bodies_touch():
     # (the chassis sits 1 cm ahead of the base origin).
     gap = float(np.hypot(*(r.collision_points_m[0] - (1.0, 1.0))))
     assert 0.34 <= gap <= 0.37
+
+
+def test_stepping_k_physics_steps_at_once_away_from_obstacles_changes_nothing(monkeypatch):
+    from swarmnav.sim import runner
+
+    scenario = load_scenario("gwo-scenario-2")  # the straight line meets a moving obstacle
+    fast = simulate(scenario, "straight", {}, 0, time_limit_s=40.0).result
+    original = runner.StepLoop.__init__
+
+    def always_check_every_physics_step(self, *args, **kwargs):
+        original(self, *args, **kwargs)
+        self.contact_free_gap_m = float("inf")
+
+    monkeypatch.setattr(runner.StepLoop, "__init__", always_check_every_physics_step)
+    slow = simulate(scenario, "straight", {}, 0, time_limit_s=40.0).result
+    assert fast.collisions == slow.collisions >= 1
+    assert fast.first_collision_s == slow.first_collision_s
+    assert np.array_equal(fast.poses, slow.poses)
