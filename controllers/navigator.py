@@ -11,6 +11,7 @@ arrays first.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, Protocol
 
@@ -58,6 +59,7 @@ class Observation:
         range_offset_m: distance of the sensor sites from the base's centre.
         detections: moving obstacles reported by the ``detector`` sensing model
             (empty with the rangefinder model, whose hits a tracker turns into estimates).
+        range_cutoff_m: the rangefinders' reach (``inf``: unknown).
     """
 
     time_s: float
@@ -67,6 +69,7 @@ class Observation:
     range_angles_rad: np.ndarray
     range_offset_m: float
     detections: tuple[DetectedObstacle, ...] = ()
+    range_cutoff_m: float = math.inf
 
 
 @dataclass(frozen=True, eq=False)

@@ -21,6 +21,7 @@ from typing import Any, Callable
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
 from swarmnav.sim import log_commands, plot, replay
+from swarmnav.sim.benchmarks import env as bench_env
 from swarmnav.sim.benchmarks import grid as bench_grid
 from swarmnav.sim.benchmarks import planners as bench_planners
 from swarmnav.sim.benchmarks import render as bench_render
@@ -160,6 +161,7 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Any, str]] = [
     (("bench", "planners"), bench_planners, "continuous planners against the exact optimum and mealpy"),
     (("bench", "grid"), bench_grid, "grid planners, Moving AI optima and the pathfinding peer"),
     (("bench", "render"), bench_render, "offscreen rendering frames per second"),
+    (("bench", "env"), bench_env, "the Gymnasium environment vs the closed-loop runner and bare mj_step"),
     (("log", "info"), log_commands, "what a log holds"),
     (("log", "recover"), log_commands, "rewrite a truncated log as a complete one"),
     (("replay",), replay, "re-render or re-simulate a log"),

@@ -85,9 +85,12 @@ class Simulation:
         return np.stack([self.scenario.obstacles[ob.scenario_index].trajectory().positions_at(times_s)
                          for ob in self._moving], axis=1)
 
-    def reset(self) -> mujoco.MjData:
-        """New MjData with the robot at the start pose and obstacles at t = 0."""
-        data = mujoco.MjData(self.model)
+    def reset(self, data: mujoco.MjData | None = None) -> mujoco.MjData:
+        """New MjData (or ``data`` reset in place) with the robot at the start pose and obstacles at t = 0."""
+        if data is None:
+            data = mujoco.MjData(self.model)
+        else:
+            mujoco.mj_resetData(self.model, data)
         start = self.scenario.start
         adr = self.scene.free_qpos_adr
         data.qpos[adr:adr + 3] = [start.x_m, start.y_m, 0.0]
@@ -173,15 +176,18 @@ class Simulation:
 class StepLoop:
     """One episode's state on a :class:`Simulation`, advanced one control step at a time.
 
-    Arrays hold one row per control step; ``step`` counts control steps.
+    Arrays hold one row per control step; ``step`` counts control steps.  ``data``:
+    an ``MjData`` of the simulation's model to run in (the environment's physics
+    owns one); by default a new one.
     """
 
-    def __init__(self, simulation: Simulation, recorder: Recorder | None, time_limit_s: float):
+    def __init__(self, simulation: Simulation, recorder: Recorder | None, time_limit_s: float,
+                 data: mujoco.MjData | None = None):
         self.simulation = simulation
         self.scene = scene = simulation.scene
         self.model = simulation.model
         self.recorder = recorder
-        self.data = simulation.reset()
+        self.data = simulation.reset(data)
         self.k = simulation.steps_per_control
         self.dt_s = simulation.control_dt_s
         self.physics_dt_s = float(self.model.opt.timestep)
@@ -195,7 +201,6 @@ class StepLoop:
         # start: a substep with no more contacts than these and no ongoing collision is skipped.
         self.resting_contacts = self.data.ncon - self.monitor.robot_obstacle_contacts(self.data)
         self.clearance = ClearanceProbe(scene)
-        self.gap_m = 0.0  # clearance at the current step
         # Farther than this from every obstacle, no contact can begin within one control period:
         # twice the distance the base covers at full wheel speed, plus a centimetre.
         top_speed_m_s = scene.drive.max_wheel_speed_rad_s * scene.drive.wheel_radius_m
@@ -204,6 +209,7 @@ class StepLoop:
         self.poses = np.zeros((self.n_max + 1, 3))
         self.wheel_cmd = np.zeros((self.n_max + 1, 2))
         self.min_clearance_m = math.inf
+        self.clearance_m = math.inf  # at the last observation
         self.length_m = 0.0
         self.waypoint_index = 0  # of the last command, recorded with the final step
         self.step = 0
@@ -230,14 +236,15 @@ class StepLoop:
         if step:
             self.length_m += math.hypot(x - self.poses[step - 1, 0], y - self.poses[step - 1, 1])
         self.poses[step] = (x, y, heading)
-        self.gap_m = gap = self.clearance.measure(data, x, y)
+        self.clearance_m = gap = self.clearance.measure(data, x, y)
         if gap < self.min_clearance_m:
             self.min_clearance_m = gap
         v, omega = base_twist(data.qvel, scene.free_qvel_adr, heading)
         return Observation(time_s=self.time_s, pose=Pose2D(x, y, heading), twist=Twist(v, omega),
                            ranges_m=ranges_from_sensors(data.sensordata[scene.range_sensor_adr],
                                                         scene.range_cutoff_m),
-                           range_angles_rad=scene.range_angles_rad, range_offset_m=scene.range_offset_m)
+                           range_angles_rad=scene.range_angles_rad, range_offset_m=scene.range_offset_m,
+                           range_cutoff_m=scene.range_cutoff_m)
 
     def outcome(self, pose: Pose2D, goal: GoalChecker, stop_on_collision: bool) -> str:
         """"goal_reached", "collision" (when stopping on one), "timeout", or "" to go on."""
@@ -267,7 +274,7 @@ class StepLoop:
         control steps), no contact can begin, and the k steps run in one call.
         """
         model, data, monitor, qpos, qadr = self.model, self.data, self.monitor, self.data.qpos, self.qadr
-        if self.gap_m > self.contact_free_gap_m and not monitor.in_contact:
+        if self.clearance_m > self.contact_free_gap_m and not monitor.in_contact:
             mujoco.mj_step(model, data, self.k)
             self.step += 1
             return

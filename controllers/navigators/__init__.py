@@ -8,6 +8,7 @@ from __future__ import annotations
 from typing import Any
 
 from swarmnav.controllers.navigators.follow import FollowNavigator
+from swarmnav.controllers.navigators.policy import PolicyNavigator
 from swarmnav.models.parameters import build_component
 
 NAVIGATORS: dict[str, type] = {}
@@ -24,7 +25,7 @@ def register(cls: type) -> type:
     return cls
 
 
-for _cls in (FollowNavigator,):
+for _cls in (FollowNavigator, PolicyNavigator):
     register(_cls)
 
 

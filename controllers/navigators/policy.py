@@ -1,0 +1,79 @@
+"""``policy``: a Python callable ``obs -> action`` drives the robot (a learned or hand-written policy).
+
+``--navigator policy --navigator-set policy=mypkg.agent:act`` calls ``act`` with
+the observation dict the environment gives (:mod:`controllers.policy_interface`)
+every control step and turns its (2,) action into wheel speeds the same way, so
+a policy trained in ``swarmnav.sim.env`` runs here unchanged.
+
+Loading the callable: ``pkgutil.resolve_name`` (the standard library's
+``module:attribute`` resolver) imports the user's module.  This is the one place
+outside ``sim/`` that loads code by name, and it only ever loads the user's
+policy, never project code (the registry of navigators stays explicit);
+``tests/test_layering.py`` allows exactly this module and this call.
+"""
+
+from __future__ import annotations
+
+import pkgutil
+from dataclasses import dataclass
+from typing import Any, Callable, ClassVar
+
+import numpy as np
+
+from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command
+from swarmnav.models.errors import ConfigError
+
+FIELD = "navigator.params.policy"
+
+
+def load_policy(name: str) -> Callable[[dict[str, np.ndarray]], Any]:
+    """``"module:function"`` -> the callable (ConfigError naming ``navigator.params.policy``)."""
+    module, sep, attribute = name.partition(":")
+    if not sep or not module or not attribute:
+        raise ConfigError(FIELD, f"expected 'module:function', got {name!r}")
+    try:
+        policy = pkgutil.resolve_name(name)
+    except Exception as exc:  # any failure of the user's module is a bad value of this field
+        raise ConfigError(FIELD, f"cannot load {name!r}: {type(exc).__name__}: {exc}") from None
+    if not callable(policy):
+        raise ConfigError(FIELD, f"{name!r} is not callable")
+    return policy
+
+
+@dataclass
+class PolicyNavigator:
+    """Calls ``policy`` on the environment's observation dict; its action becomes the wheel command.
+
+    Args:
+        policy: ``module:function``, a callable ``obs -> action``.
+        action: ``"twist"`` (normalised v, omega) or ``"wheels"`` (rad/s), as in the environment.
+        path_waypoints: N > 0 adds the next N waypoints of the path planned at t = 0 as ``path``.
+    """
+
+    name: ClassVar[str] = "policy"
+    policy: str = ""
+    action: str = "twist"
+    path_waypoints: int = 0
+
+    def __post_init__(self) -> None:
+        if self.action not in ACTION_MODES:
+            raise ConfigError("navigator.params.action", f"expected one of {list(ACTION_MODES)}, got {self.action!r}")
+        if self.path_waypoints < 0:
+            raise ConfigError("navigator.params.path_waypoints", f"must be >= 0, got {self.path_waypoints}")
+        self._policy = load_policy(self.policy)
+
+    def reset(self, setup: NavigationSetup) -> None:
+        geometry = getattr(setup.controller, "geometry", None)
+        if geometry is None:
+            raise TypeError("the policy navigator needs a controller with a drive geometry")
+        self._geometry = geometry
+        self._max_speed_m_s = setup.max_speed_m_s
+        goal = setup.goal
+        self._observer = PolicyObserver((goal.x_m, goal.y_m), setup.path.waypoints, self.path_waypoints)
+
+    def step(self, observation: Observation) -> NavigationStep:
+        action = np.asarray(self._policy(self._observer(observation)), dtype=float)
+        if action.shape != (2,) or not np.all(np.isfinite(action)):
+            raise ConfigError(FIELD, f"{self.policy!r} returned {action!r}; expected 2 finite numbers")
+        return NavigationStep(action_command(action, self.action, self._geometry, self._max_speed_m_s))

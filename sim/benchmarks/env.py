@@ -1,0 +1,98 @@
+"""``swarmnav bench env``: the Gymnasium environment against the closed-loop runner and bare ``mj_step``.
+
+All three run in this process, interleaved, on ``dense-field-30``: the
+environment with uniformly random normalised (v, omega) actions (episodes
+reset as they end), the runner's ``follow`` loop (planned once, before
+timing), and ``mj_step`` with constant wheel commands on the same compiled
+model.  Rates are control steps per second (bare: physics steps per second
+divided by the physics steps per control step), so the ratios compare like
+with like.  Target: environment >= 0.7 x runner.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+
+import mujoco
+import numpy as np
+
+from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
+from swarmnav.sim.runner import Simulation
+
+
+def _env_steps_per_s(env, steps: int, rng: np.random.Generator) -> float:
+    env.reset(seed=0)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        _, _, terminated, truncated, _ = env.step(rng.uniform(-1.0, 1.0, 2))
+        if terminated or truncated:
+            env.reset()
+    return steps / (time.perf_counter() - t0)
+
+
+def _runner_steps_per_s(simulation: Simulation, planned, duration_s: float) -> float:
+    result = run_episode(planned.spec, simulation=simulation, planned=planned, time_limit_s=duration_s).result
+    return result.steps / result.wall_time_s
+
+
+def _bare_control_steps_per_s(simulation: Simulation, control_steps: int) -> float:
+    data = simulation.reset()
+    data.ctrl[:] = [3.0, 3.2]
+    steps = control_steps * simulation.steps_per_control
+    t0 = time.perf_counter()
+    mujoco.mj_step(simulation.model, data, steps)
+    return control_steps / (time.perf_counter() - t0)
+
+
+def benchmark_env(scenario_name: str = "dense-field-30", duration_s: float = 20.0,
+                  repeats: int = 3) -> dict[str, float | int | str]:
+    """Median control steps per second of the three, and the environment's ratios to the other two."""
+    from swarmnav.sim.env import NavigateEnv  # dm_control and Gymnasium load only for this benchmark
+    env = NavigateEnv(scenario_name)
+    planned = plan_episode(EpisodeSpec(env.task.scenario))
+    simulation = Simulation(planned.spec.scenario)
+    control_steps = int(round(duration_s / simulation.control_dt_s))
+    rng = np.random.default_rng(0)
+    envs, runners, bares, ratios = [], [], [], []
+    for _ in range(repeats):
+        e = _env_steps_per_s(env, control_steps, rng)
+        r = _runner_steps_per_s(simulation, planned, duration_s)
+        b = _bare_control_steps_per_s(simulation, control_steps)
+        envs.append(e)
+        runners.append(r)
+        bares.append(b)
+        ratios.append(e / r)
+    env.close()
+    return {
+        "scenario": scenario_name,
+        "control_hz": round(1.0 / simulation.control_dt_s, 6),
+        "physics_steps_per_control": simulation.steps_per_control,
+        "control_steps_per_run": control_steps,
+        "repeats": repeats,
+        "env_steps_per_s": statistics.median(envs),
+        "runner_steps_per_s": statistics.median(runners),
+        "bare_control_steps_per_s": statistics.median(bares),
+        "env_vs_runner": statistics.median(ratios),
+        "env_vs_bare": statistics.median(envs) / statistics.median(bares),
+        "target_env_vs_runner": 0.7,
+    }
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenario", default="dense-field-30")
+    parser.add_argument("--duration", type=float, default=20.0, help="simulated seconds per measurement")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--json", action="store_true")
+
+
+def run(args: argparse.Namespace) -> int:
+    figures = benchmark_env(args.scenario, duration_s=args.duration, repeats=args.repeats)
+    if args.json:
+        print(json.dumps(figures))
+    else:
+        for key, value in figures.items():
+            print(f"{key:<28} {value:.4g}" if isinstance(value, float) else f"{key:<28} {value}")
+    return 0

@@ -1,0 +1,117 @@
+"""A Gymnasium adapter over the dm_control task: ``swarmnav/Navigate-v0``.
+
+Importing :mod:`swarmnav.sim.env` registers the id, so in a fresh interpreter::
+
+    env = gymnasium.make("swarmnav.sim.env:swarmnav/Navigate-v0", scenario="gwo-scenario-2")
+
+(Gymnasium 1.x imports the module before the colon; it does not load plugin
+entry points.)  ``reset(seed=..., options={"scenario": ..., "world_seed": ...})``:
+``seed`` seeds the path planner (and ``np_random``), ``world_seed`` the
+obstacles' random walks, ``scenario`` switches to another scenario (a new
+model).  ``step`` returns ``(obs, reward, terminated, truncated, info)`` with
+``terminated`` on the goal (or a collision when the scenario stops on one),
+``truncated`` at the time limit, and ``info`` from :meth:`NavigationTask.info`
+(``cost``, ``collisions``, ``clearance_m``, ``time_s``, ``outcome``, and
+``metrics`` at the end).  ``render()`` (``render_mode="rgb_array"``) draws the
+scene with the offscreen renderer of ``swarmnav run --video``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium
+import numpy as np
+from dm_env import specs
+from gymnasium import spaces
+
+from swarmnav.sim.env.task import EnvOptions, NavigationTask, make_environment
+
+ENV_ID = "swarmnav/Navigate-v0"
+
+
+def _box(spec: specs.Array) -> spaces.Box:
+    if isinstance(spec, specs.BoundedArray):
+        low, high = np.broadcast_to(spec.minimum, spec.shape), np.broadcast_to(spec.maximum, spec.shape)
+    else:
+        low, high = np.full(spec.shape, -np.inf), np.full(spec.shape, np.inf)
+    return spaces.Box(low=low.astype(spec.dtype), high=high.astype(spec.dtype), shape=spec.shape, dtype=spec.dtype)
+
+
+class NavigateEnv(gymnasium.Env):
+    """One scenario's navigation task as a Gymnasium environment (see the module docstring).
+
+    Args:
+        scenario: a bundled scenario name, a path, or a Scenario.
+        render_mode: None or ``"rgb_array"``.
+        width, height, camera: the rendered frames.
+        **options: :class:`EnvOptions` fields (action, path_planner, reward, record_to, ...).
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 50}
+
+    def __init__(self, scenario: Any = "gwo-scenario-2", render_mode: str | None = None, width: int = 640,
+                 height: int = 480, camera: str = "top", **options: Any):
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode: expected None or 'rgb_array', got {render_mode!r}")
+        self.render_mode = render_mode
+        self._size = (width, height, camera)
+        self._options = EnvOptions(**options)
+        self._renderer = None
+        self._build(scenario)
+
+    def _build(self, scenario: Any) -> None:
+        self.close()
+        self.dm_env = make_environment(scenario, self._options)
+        self.observation_space = spaces.Dict({key: _box(spec) for key, spec in self.dm_env.observation_spec().items()})
+        self.action_space = _box(self.dm_env.action_spec())
+        self.metadata = {**self.metadata, "render_fps": 1.0 / self.dm_env.control_timestep()}
+
+    @property
+    def task(self) -> NavigationTask:
+        return self.dm_env.task
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        options = dict(options or {})
+        unknown = set(options) - {"scenario", "world_seed"}
+        if unknown:
+            raise ValueError(f"reset options: unknown {sorted(unknown)} (known: scenario, world_seed)")
+        if "scenario" in options:
+            self._build(options["scenario"])
+        if options.get("world_seed") is not None:
+            self.task.set_world_seed(int(options["world_seed"]))
+        if seed is not None:
+            self.task.set_seed(seed)
+        timestep = self.dm_env.reset()
+        return timestep.observation, self.task.info()
+
+    def step(self, action):
+        timestep = self.dm_env.step(np.asarray(action, dtype=np.float64))
+        last = timestep.last()
+        terminated = bool(last and timestep.discount == 0.0)
+        truncated = bool(last and timestep.discount == 1.0)
+        return timestep.observation, float(timestep.reward), terminated, truncated, self.task.info()
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        from swarmnav.sim.render import SceneRenderer
+        loop = self.task.loop
+        if self._renderer is None:
+            width, height, camera = self._size
+            self._renderer = SceneRenderer(self.dm_env.physics.model.ptr, width, height, camera)
+        planned = self.task.planned_path()
+        return self._renderer.render(loop.data, path_m=None if planned is None else planned.path.waypoints,
+                                     trail_m=loop.poses[:loop.step + 1, :2])
+
+    def close(self) -> None:
+        if getattr(self, "dm_env", None) is not None:
+            self.task.close_recording("interrupted")
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+
+if ENV_ID not in gymnasium.registry:
+    gymnasium.register(id=ENV_ID, entry_point=NavigateEnv)

@@ -1,0 +1,269 @@
+"""A scenario as a dm_control task: the ``dm_env`` API over the runner's own steps.
+
+The physics is a :class:`dm_control.mujoco.Physics` built from the MJCF text
+that runs and logs use (``compile_scene(scenario).xml``); :func:`same_model`
+checks that it compiled to the same model, byte for byte.  The task drives a
+:class:`sim.runner.StepLoop` on that physics' ``MjData``:
+
+* ``initialize_episode``: a new ``StepLoop`` (start pose, obstacles at t = 0),
+  the initial contact check, the first observation;
+* ``before_step``: the action becomes a wheel command (:func:`action_command`)
+  and ``StepLoop.apply`` writes it;
+* ``physics.step``: ``StepLoop.advance`` (``mj_step`` k times with the
+  collision check after each, exactly as ``swarmnav run``);
+* ``after_step``: ``StepLoop.move_obstacles``, ``observe`` and ``outcome``.
+
+So the environment and ``swarmnav run`` share the code that moves obstacles,
+reads sensors and counts collisions.  ``discount`` is 0 when the goal is
+reached (termination) or, when the scenario stops on collision, at the first
+collision; it is 1 at the time limit (truncation), as dm_env defines them.
+The step's collision count (the Safety-Gymnasium ``cost``) and the run's
+metrics are in :meth:`NavigationTask.info`: dm_env's ``TimeStep`` has no slot
+for them.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path as FilePath
+from typing import Any
+
+import mujoco
+import numpy as np
+from dm_control import mujoco as dm_mujoco
+from dm_control.rl import control
+
+from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import Scenario, load_scenario
+from swarmnav.sim.episode import EpisodeSpec, plan_episode
+from swarmnav.sim.env.observations import action_spec, observation_specs
+from swarmnav.sim.env.reward import RewardWeights
+from swarmnav.sim.runner import RunResult, Simulation, StepLoop
+from swarmnav.sim.scene import compile_scene, index_scene
+
+NAVIGATOR_NAME = "env"  # what a recorded episode names as its navigator
+
+
+@dataclass(frozen=True)
+class EnvOptions:
+    """How the environment is set up.
+
+    Attributes:
+        action: ``"twist"`` (normalised v, omega in [-1, 1]^2) or ``"wheels"`` (rad/s).
+        path_planner: a planner name; its path (planned at reset on the obstacles at
+            t = 0) gives the ``path`` observation.  None: no ``path``.
+        path_waypoints: N, the waypoints in ``path``.
+        reward: the reward's weights.
+        time_limit_s, stop_on_collision: override the scenario's.
+        seed: the planner's seed (None: the scenario's).
+        world_seed: the obstacles' random walks (None: the scenario's).
+        record_to: an ``.mcap`` path to record each episode to with the recorder of
+            ``swarmnav run``; ``{episode}`` in it is replaced by the episode number.
+    """
+
+    action: str = "twist"
+    path_planner: str | None = None
+    path_waypoints: int = 5
+    reward: RewardWeights = field(default_factory=RewardWeights)
+    time_limit_s: float | None = None
+    stop_on_collision: bool | None = None
+    seed: int | None = None
+    world_seed: int | None = None
+    record_to: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.action not in ACTION_MODES:
+            raise ConfigError("env.action", f"expected one of {list(ACTION_MODES)}, got {self.action!r}")
+        if self.path_waypoints < 1:
+            raise ConfigError("env.path_waypoints", f"must be >= 1, got {self.path_waypoints}")
+        if self.time_limit_s is not None and not self.time_limit_s > 0:
+            raise ConfigError("env.time_limit_s", f"must be > 0, got {self.time_limit_s}")
+
+
+def model_bytes(model: mujoco.MjModel) -> bytes:
+    """The model in MuJoCo's binary format (MJB)."""
+    buffer = np.empty(mujoco.mj_sizeModel(model), dtype=np.uint8)
+    mujoco.mj_saveModel(model, None, buffer)
+    return buffer.tobytes()
+
+
+def same_model(a: mujoco.MjModel, b: mujoco.MjModel) -> bool:
+    return model_bytes(a) == model_bytes(b)
+
+
+class SwarmnavPhysics(dm_mujoco.Physics):
+    """dm_control physics whose control step is the runner's ``StepLoop.advance``."""
+
+    loop: StepLoop | None = None
+
+    def step(self, nstep: int = 1) -> None:
+        if self.loop is None or nstep != self.loop.k:
+            raise RuntimeError(f"step {nstep} physics steps: the environment steps {getattr(self.loop, 'k', '?')} "
+                               "at a time, through its task")
+        with self.check_invalid_state():
+            self.loop.advance()
+
+
+class NavigationTask(control.Task):
+    """Drive from the scenario's start to its goal; see the module docstring."""
+
+    def __init__(self, scenario: Scenario, physics: SwarmnavPhysics, xml: str, options: EnvOptions):
+        self.options = options
+        self.scene = index_scene(physics.model.ptr, xml)  # the indices, on the physics' own model
+        if options.world_seed is not None and options.world_seed != scenario.world_seed:
+            scenario = scenario.with_world_seed(int(options.world_seed))
+        self.simulation = Simulation(scenario, self.scene)
+        self.seed = scenario.seed if options.seed is None else int(options.seed)
+        self.episode = -1
+        self.loop: StepLoop | None = None
+        self.result: RunResult | None = None
+        self._recorder = None
+        self._planned: tuple[int, int, Any] | None = None  # (seed, world seed, episode) of the path
+
+    # --- set-up between episodes -------------------------------------------------------------
+    @property
+    def scenario(self) -> Scenario:
+        return self.simulation.scenario
+
+    def set_world_seed(self, world_seed: int) -> None:
+        """Obstacle random walks of this world seed from the next episode on (the model is unchanged)."""
+        if int(world_seed) != self.scenario.world_seed:
+            self.simulation = Simulation(self.scenario.with_world_seed(int(world_seed)), self.scene)
+
+    def set_seed(self, seed: int) -> None:
+        """The planner's seed (for the ``path`` observation) from the next episode on."""
+        self.seed = int(seed)
+
+    def planned_path(self):
+        """The path planner's episode for the current seeds, planned once and kept (None without a planner)."""
+        if self.options.path_planner is None:
+            return None
+        key = (self.seed, self.scenario.world_seed)
+        if self._planned is None or self._planned[:2] != key:
+            spec = EpisodeSpec(self.scenario, planner=self.options.path_planner, seed=self.seed,
+                               world_seed=self.scenario.world_seed)
+            self._planned = (*key, plan_episode(spec))
+        return self._planned[2]
+
+    # --- dm_control.rl.control.Task ---------------------------------------------------------------
+    def initialize_episode(self, physics: SwarmnavPhysics) -> None:
+        self.close_recording("interrupted")
+        self.episode += 1
+        scenario, options = self.scenario, self.options
+        planned = self.planned_path()
+        waypoints = planned.path.waypoints if planned is not None else None
+        goal = scenario.goal
+        self.goal = self.simulation.goal_checker()
+        self.observer = PolicyObserver((goal.x_m, goal.y_m), waypoints, options.path_waypoints)
+        self.stop_on_collision = (scenario.sim.stop_on_collision if options.stop_on_collision is None
+                                  else options.stop_on_collision)
+        recorder = self._open_recorder(planned)
+        time_limit_s = scenario.time_limit_s if options.time_limit_s is None else options.time_limit_s
+        self.loop = loop = StepLoop(self.simulation, recorder, time_limit_s, data=physics.data.ptr)
+        physics.loop = loop
+        if recorder is not None:
+            recorder.start(self.simulation.context(
+                options.path_planner or "none", {}, self.seed, NAVIGATOR_NAME,
+                {"action": options.action}))
+            if waypoints is not None:
+                recorder.path(0.0, waypoints)
+        self.result = None
+        self.return_, self.cost, self.reward_value = 0.0, 0.0, 0.0
+        self._wall0 = time.perf_counter()
+        loop.check_initial_contacts()
+        self._collisions = loop.monitor.collisions
+        self._sense()
+
+    def before_step(self, action: np.ndarray, physics: SwarmnavPhysics) -> None:
+        command = action_command(action, self.options.action, self.scene.drive, self.scenario.max_speed_m_s)
+        self.loop.apply(self.observation, command)
+
+    def after_step(self, physics: SwarmnavPhysics) -> None:
+        distance_before_m = self.distance_m
+        self._sense()
+        self.reward_value = self.options.reward.reward(distance_before_m, self.distance_m,
+                                                       self.outcome == "goal_reached", self.loop.dt_s)
+        self.return_ += self.reward_value
+        collisions = self.loop.monitor.collisions
+        self.cost = float(collisions - self._collisions)
+        self._collisions = collisions
+
+    def get_observation(self, physics: SwarmnavPhysics) -> dict[str, np.ndarray]:
+        return {key: value.copy() for key, value in self.obs.items()}
+
+    def get_reward(self, physics: SwarmnavPhysics) -> float:
+        return self.reward_value
+
+    def get_termination(self, physics: SwarmnavPhysics) -> float | None:
+        if self.outcome in ("goal_reached", "collision"):
+            return 0.0
+        if self.outcome == "timeout":
+            return 1.0
+        return None
+
+    def action_spec(self, physics: SwarmnavPhysics):
+        return action_spec(self.options.action, self.scene.drive)
+
+    def observation_spec(self, physics: SwarmnavPhysics):
+        return observation_specs(len(self.scene.range_sensor_adr),
+                                 self.options.path_waypoints if self.options.path_planner else 0)
+
+    # --- the step's side information -------------------------------------------------------------
+    def info(self) -> dict[str, Any]:
+        """The step's ``cost``, the collisions so far, the clearance now and, at the end, the run's metrics."""
+        loop = self.loop
+        out: dict[str, Any] = {"cost": self.cost, "collisions": loop.monitor.collisions,
+                               "clearance_m": loop.clearance_m, "time_s": self.observation.time_s,
+                               "outcome": self.outcome}
+        if self.result is not None:
+            out["metrics"] = self.result.summary()
+        return out
+
+    def close_recording(self, outcome: str) -> None:
+        """Finish a recording still open (an episode reset or closed before its end)."""
+        if self._recorder is not None:
+            recorder, self._recorder = self._recorder, None
+            recorder.finish({"outcome": outcome, "sim_time_s": self.loop.time_s if self.loop else 0.0})
+
+    def _sense(self) -> None:
+        """The runner's steps between two commands: obstacles, sensors, outcome; stop at the end."""
+        loop = self.loop
+        loop.move_obstacles()
+        self.observation = observation = loop.observe()
+        self.outcome = loop.outcome(observation.pose, self.goal, self.stop_on_collision)
+        self.obs = self.observer(observation)
+        self.distance_m = float(self.obs["goal"][0])
+        if self.outcome:
+            loop.stop(observation, self.outcome)
+            self.result = loop.result(self.outcome, time.perf_counter() - self._wall0)
+            if self._recorder is not None:
+                recorder, self._recorder = self._recorder, None
+                recorder.finish(self.result.summary())
+
+    def _open_recorder(self, planned):
+        if self.options.record_to is None:
+            return None
+        from swarmnav.sim.mcap_log import McapRecorder
+        path = FilePath(self.options.record_to.replace("{episode}", str(self.episode)))
+        self._recorder = McapRecorder(path, overwrite=True)
+        return self._recorder
+
+
+def make_environment(scenario: Scenario | str, options: EnvOptions | None = None, **kwargs: Any
+                     ) -> control.Environment:
+    """The dm_env environment of a scenario (a name, a path or a :class:`Scenario`).
+
+    ``kwargs`` are :class:`EnvOptions` fields when ``options`` is not given.
+    """
+    if isinstance(scenario, (str, FilePath)):
+        scenario = load_scenario(str(scenario))
+    options = options or EnvOptions(**kwargs)
+    scene = compile_scene(scenario)
+    physics = SwarmnavPhysics.from_xml_string(scene.xml)
+    if not same_model(physics.model.ptr, scene.model):
+        raise RuntimeError("dm_control compiled the scene's MJCF to a different model")
+    task = NavigationTask(scenario, physics, scene.xml, options)
+    return control.Environment(physics, task, n_sub_steps=task.simulation.steps_per_control)
+

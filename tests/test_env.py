@@ -1,0 +1,177 @@
+"""The dm_control task: the same model, the same steps as ``swarmnav run``, dm_env's contract."""
+
+import math
+
+import numpy as np
+import pytest
+from absl.testing import absltest
+from dm_env import test_utils
+
+from swarmnav.models.scenario import load_scenario, parse_scenario
+from swarmnav.sim.env import RewardWeights, make_environment
+from swarmnav.sim.env.task import same_model
+from swarmnav.sim.episode import EpisodeSpec, run_episode
+from swarmnav.sim.scene import compile_scene
+
+
+@pytest.fixture(scope="module")
+def follow_run():
+    """A ``follow`` run on a scenario with moving obstacles, which it bumps into."""
+    episode = run_episode(EpisodeSpec(load_scenario("gwo-scenario-2")))
+    assert episode.result.collisions > 0 and episode.result.reached
+    return episode.result
+
+
+def replay_commands(env, wheel_commands):
+    """Drive the environment with a run's wheel commands until its episode ends."""
+    timesteps = [env.reset()]
+    for command in wheel_commands:
+        timesteps.append(env.step(command))
+        if timesteps[-1].last():
+            break
+    return timesteps
+
+
+def random_walk_scenario():
+    text = load_scenario("gwo-scenario-2").source_text
+    text = text.replace('kind = "linear", speed_m_s = 0.05, heading_deg = 150.0, at_edge = "reflect"',
+                        'kind = "random_walk", step_m = 0.3, period_s = 1.0')
+    assert "random_walk" in text
+    return parse_scenario(text, "random-walk.toml")
+
+
+def test_the_physics_carries_the_model_runs_and_logs_use():
+    scenario = load_scenario("gwo-scenario-2")
+    env = make_environment(scenario)
+    assert same_model(env.physics.model.ptr, compile_scene(scenario).model)
+    assert not same_model(env.physics.model.ptr, compile_scene(load_scenario("gwo-scenario-1")).model)
+    assert env.control_timestep() == pytest.approx(1.0 / scenario.sim.control_hz)
+
+
+def test_env_and_run_agree_bit_for_bit_on_the_same_wheel_commands(follow_run):
+    env = make_environment("gwo-scenario-2", action="wheels")
+    timesteps = replay_commands(env, follow_run.wheel_command_rad_s)
+    loop = env.task.loop
+    assert loop.step == follow_run.steps
+    assert np.array_equal(loop.poses[:loop.step + 1], follow_run.poses)
+    assert sum(ts.reward is not None for ts in timesteps) == follow_run.steps
+    metrics = env.task.info()["metrics"]
+    assert metrics["collisions"] == follow_run.collisions
+    assert metrics["min_clearance_m"] == follow_run.min_clearance_m
+    assert metrics["path_length_m"] == follow_run.path_length_m
+
+
+def test_costs_sum_to_the_runs_collisions_and_stay_out_of_the_reward(follow_run):
+    weights = RewardWeights(progress_per_m=0.0, goal_bonus=0.0, time_penalty_per_s=0.0)
+    env = make_environment("gwo-scenario-2", action="wheels", reward=weights)
+    env.reset()
+    costs, rewards = [], []
+    for command in follow_run.wheel_command_rad_s:
+        timestep = env.step(command)
+        costs.append(env.task.info()["cost"])
+        rewards.append(timestep.reward)
+        if timestep.last():
+            break
+    assert sum(costs) == follow_run.collisions
+    assert set(rewards) == {0.0}
+
+
+def test_goal_is_a_termination_with_discount_zero_and_its_reward_uses_the_goal_reached(follow_run):
+    env = make_environment("gwo-scenario-2", action="wheels")
+    timesteps = replay_commands(env, follow_run.wheel_command_rad_s)
+    last = timesteps[-1]
+    assert last.last() and last.discount == 0.0 and env.task.info()["outcome"] == "goal_reached"
+    goal = load_scenario("gwo-scenario-2").goal
+    before, after = follow_run.poses[-2], follow_run.poses[-1]
+    d_before = math.hypot(goal.x_m - before[0], goal.y_m - before[1])
+    d_after = math.hypot(goal.x_m - after[0], goal.y_m - after[1])
+    weights = RewardWeights()
+    expected = weights.progress_per_m * (d_before - d_after) + weights.goal_bonus \
+        - weights.time_penalty_per_s * env.control_timestep()
+    assert last.reward == pytest.approx(expected, rel=1e-12)
+    assert last.reward > weights.goal_bonus / 2  # the bonus is in the final step's reward
+    assert last.observation["goal"][0] == pytest.approx(d_after)  # the observation of the goal reached
+    assert all(ts.discount == 1.0 for ts in timesteps[1:-1])
+
+
+def test_time_limit_is_a_truncation_with_discount_one_like_the_runs_timeout():
+    scenario = load_scenario("gwo-scenario-2")
+    run = run_episode(EpisodeSpec(scenario), time_limit_s=3.0).result
+    assert run.outcome == "timeout"
+    env = make_environment(scenario, action="wheels", time_limit_s=3.0)
+    timesteps = replay_commands(env, run.wheel_command_rad_s)
+    assert timesteps[-1].last() and timesteps[-1].discount == 1.0
+    assert len(timesteps) - 1 == run.steps
+    assert np.array_equal(env.task.loop.poses[:run.steps + 1], run.poses)
+
+
+def test_stop_on_collision_is_a_termination_at_the_runs_collision(follow_run):
+    scenario = load_scenario("gwo-scenario-2")
+    run = run_episode(EpisodeSpec(scenario), stop_on_collision=True).result
+    assert run.outcome == "collision" and run.steps < follow_run.steps
+    env = make_environment(scenario, action="wheels", stop_on_collision=True)
+    timesteps = replay_commands(env, run.wheel_command_rad_s)
+    assert len(timesteps) - 1 == run.steps
+    assert timesteps[-1].discount == 0.0 and env.task.info()["outcome"] == "collision"
+    assert env.task.info()["cost"] == 1.0
+
+
+def _rollout(env, seed, steps=150):
+    rng = np.random.default_rng(seed)
+    out = [env.reset()]
+    for _ in range(steps):
+        out.append(env.step(rng.uniform(-1.0, 1.0, 2)))
+    return out, env.task.loop.poses[:steps + 1].copy()
+
+
+def test_same_seeds_and_actions_give_the_same_observations_rewards_and_costs():
+    scenario = random_walk_scenario()
+    a = make_environment(scenario, world_seed=7, path_planner="astar", seed=3)
+    b = make_environment(scenario, world_seed=7, path_planner="astar", seed=3)
+    (run_a, poses_a), (run_b, poses_b) = _rollout(a, 1), _rollout(b, 1)
+    for ta, tb in zip(run_a, run_b):
+        assert ta.reward == tb.reward and ta.discount == tb.discount
+        for key in ta.observation:
+            assert np.array_equal(ta.observation[key], tb.observation[key])
+    assert np.array_equal(poses_a, poses_b)
+    # A second episode of the same environment repeats the first.
+    run_again, poses_again = _rollout(a, 1)
+    assert np.array_equal(poses_again, poses_a)
+    assert [t.reward for t in run_again] == [t.reward for t in run_a]
+    # Another world seed moves the random-walk obstacle elsewhere.
+    a.task.set_world_seed(8)
+    a.reset()
+    moved = a.task.loop.obstacle_track_m
+    b.reset()
+    assert not np.array_equal(moved, b.task.loop.obstacle_track_m)
+
+
+def test_observations_follow_the_documented_conventions():
+    env = make_environment("gwo-scenario-2", path_planner="astar", path_waypoints=3)
+    obs = env.reset().observation
+    scenario = load_scenario("gwo-scenario-2")
+    start, goal = scenario.start, scenario.goal
+    assert obs["goal"][0] == pytest.approx(math.hypot(goal.x_m - start.x_m, goal.y_m - start.y_m))
+    bearing = math.atan2(goal.y_m - start.y_m, goal.x_m - start.x_m) - start.heading_rad
+    assert obs["goal"][1] == pytest.approx(bearing, abs=1e-6)
+    assert np.all(obs["ranges"] == 1.0)  # nothing within reach at the start
+    waypoints = env.task.planned_path().path.waypoints
+    rel = waypoints[1] - (start.x_m, start.y_m)
+    c, s = math.cos(start.heading_rad), math.sin(start.heading_rad)
+    assert obs["path"].shape == (3, 2)
+    assert obs["path"][0] == pytest.approx([c * rel[0] + s * rel[1], -s * rel[0] + c * rel[1]], abs=1e-6)
+    spec = env.observation_spec()
+    for key, value in obs.items():
+        spec[key].validate(value)
+
+
+class DmEnvContract(test_utils.EnvironmentTestMixin, absltest.TestCase):
+    """dm_env's own checks of reset/step/spec conformance."""
+
+    def make_object_under_test(self):
+        return make_environment("restaurant-table-5", time_limit_s=0.5)
+
+
+class DmEnvContractWithPath(test_utils.EnvironmentTestMixin, absltest.TestCase):
+    def make_object_under_test(self):
+        return make_environment("gwo-scenario-2", time_limit_s=0.5, action="wheels", path_planner="astar")

@@ -1,0 +1,96 @@
+"""The Gymnasium adapter: Gymnasium's checker, registration, reset options, render, MCAP recording."""
+
+import json
+import subprocess
+import sys
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+from swarmnav.models.scenario import load_scenario
+from swarmnav.sim.env import ENV_ID, NavigateEnv
+from swarmnav.sim.log_reader import read_log
+
+
+def test_gymnasiums_env_checker_passes():
+    check_env(NavigateEnv("restaurant-table-5", time_limit_s=0.5), skip_render_check=True)
+    check_env(NavigateEnv("gwo-scenario-2", time_limit_s=0.5, path_planner="astar", action="wheels"),
+              skip_render_check=True)
+
+
+def test_make_by_module_and_id_in_a_fresh_interpreter():
+    code = ("import gymnasium, json, numpy as np\n"
+            f"env = gymnasium.make('swarmnav.sim.env:{ENV_ID}', scenario='restaurant-table-5', time_limit_s=1.0)\n"
+            "obs, info = env.reset(seed=0)\n"
+            "done, n, ret = False, 0, 0.0\n"
+            "while not done:\n"
+            "    obs, r, term, trunc, info = env.step(env.action_space.sample())\n"
+            "    done, n, ret = term or trunc, n + 1, ret + r\n"
+            "print(json.dumps({'steps': n, 'trunc': trunc, 'outcome': info['outcome'], 'keys': sorted(obs)}))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    control_hz = load_scenario("restaurant-table-5").sim.control_hz
+    assert result == {"steps": round(1.0 * control_hz), "trunc": True, "outcome": "timeout",
+                      "keys": ["goal", "ranges", "velocity"]}
+
+
+def test_terminated_truncated_and_info_follow_the_outcome():
+    env = NavigateEnv("restaurant-table-5", time_limit_s=60.0)
+    obs, info = env.reset(seed=0)
+    terminated = truncated = False
+    costs = 0.0
+    while not (terminated or truncated):
+        distance, bearing = obs["goal"]
+        obs, reward, terminated, truncated, info = env.step(np.array([1.0 if abs(bearing) < 0.3 else 0.0,
+                                                                      np.clip(2.0 * bearing, -1.0, 1.0)]))
+        costs += info["cost"]
+    assert info["outcome"] == ("goal_reached" if terminated else "timeout")
+    assert info["metrics"]["outcome"] == info["outcome"]
+    assert info["metrics"]["collisions"] == costs == info["collisions"]
+    assert np.isfinite(info["clearance_m"])
+
+
+def test_reset_options_switch_scenario_and_world_seed():
+    env = NavigateEnv("gwo-scenario-2", time_limit_s=1.0)
+    env.reset(seed=1)
+    assert env.task.scenario.name == "gwo-scenario-2"
+    env.reset(seed=1, options={"scenario": "dense-field-30", "world_seed": 5})
+    assert env.task.scenario.name == "dense-field-30" and env.task.scenario.world_seed == 5
+    assert env.unwrapped.dm_env.physics.model.ngeom != NavigateEnv("gwo-scenario-2").dm_env.physics.model.ngeom
+    with pytest.raises(ValueError, match="unknown"):
+        env.reset(options={"sceanrio": "x"})
+
+
+def test_render_returns_frames_of_the_moving_robot():
+    env = NavigateEnv("gwo-scenario-2", render_mode="rgb_array", width=160, height=120, time_limit_s=5.0)
+    env.reset(seed=0)
+    first = env.render()
+    for _ in range(100):
+        env.step(np.array([1.0, 0.5]))
+    later = env.render()
+    assert first.shape == (120, 160, 3) and first.dtype == np.uint8
+    assert first.std() > 0 and not np.array_equal(first, later)
+    env.close()
+
+
+def test_an_episode_records_to_mcap_like_a_run(tmp_path):
+    env = NavigateEnv("restaurant-table-5", time_limit_s=1.0, record_to=str(tmp_path / "ep{episode}.mcap"))
+    env.reset(seed=0)
+    truncated = False
+    steps = 0
+    while not truncated:
+        _, _, _, truncated, info = env.step(np.array([0.5, 0.2]))
+        steps += 1
+    poses = env.task.loop.poses[:steps + 1].copy()
+    env.reset(seed=0)  # the second episode is closed before its end
+    for _ in range(5):
+        env.step(np.array([0.5, 0.2]))
+    env.close()
+    log = read_log(tmp_path / "ep0.mcap")
+    assert log.complete and log.outcome["outcome"] == "timeout"
+    assert len(log.time_s) == steps + 1
+    assert np.array_equal(log.position_m[:, :2], poses[:, :2])
+    assert read_log(tmp_path / "ep1.mcap").outcome["outcome"] == "interrupted"
