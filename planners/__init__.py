@@ -9,7 +9,8 @@ from __future__ import annotations
 from typing import Any
 
 from swarmnav.planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
-from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, DStarLitePlanner, ThetaStarPlanner
+from swarmnav.planners.dstar_lite import DStarLitePlanner
+from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, ThetaStarPlanner
 from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
 from swarmnav.planners.max_min_ant_system import MaxMinAntSystemPlanner
 from swarmnav.planners.waiter_ant_colony import WaiterAntColonyPlanner

@@ -40,6 +40,7 @@ from typing import ClassVar
 import numpy as np
 
 from swarmnav.planners.continuous import ContinuousPlanner
+from swarmnav.planners.path_cost import inverse_fitness
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmState
@@ -150,7 +151,7 @@ class BeeColonyPlanner(ContinuousPlanner):
         failures[~better] += 1
 
         # Onlooker bees: roulette over fitness (Eqs. (8)-(9)), then Eq. (7).
-        fitness = 1.0 / (1.0 + costs)                                             # Eq. (8), f >= 0
+        fitness = inverse_fitness(costs, 1.0)                                     # Eq. (8), f >= 0
         chosen = rng.choice(count, size=count, p=fitness / fitness.sum())         # Eq. (9)
         trial = self._neighbours(sources, chosen, rng, state)
         trial_costs = self.evaluate(state, trial)

@@ -46,7 +46,6 @@ Readings of the paper where its text is ambiguous (our choices):
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
@@ -55,8 +54,9 @@ from scipy import ndimage
 
 from swarmnav.planners.ant_colony import STEP_LENGTHS, GridGraph, cosine_table, deposit, evaporate, walk_colony
 from swarmnav.planners.errors import NoPathFound, check_parameters
-from swarmnav.planners.grid_search import (Cell, cells_to_waypoints, count_bends, exact_shortcut, grid_endpoints,
-                                  grid_line_of_sight, line_cells)
+from swarmnav.planners.grid_graph import (Cell, cells_to_waypoints, count_bends, grid_endpoints, grid_line_of_sight,
+                                          line_cells)
+from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 

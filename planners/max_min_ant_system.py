@@ -54,8 +54,8 @@ from scipy import ndimage
 
 from swarmnav.planners.ant_colony import roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
-from swarmnav.planners.grid_search import (DIRECTIONS, Cell, cells_to_waypoints, count_bends, exact_shortcut,
-                                  grid_endpoints)
+from swarmnav.planners.grid_graph import DIRECTIONS, Cell, cells_to_waypoints, count_bends, grid_endpoints
+from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 

@@ -222,7 +222,7 @@ def build_tangent_graph(problem: Problem) -> TangentGraph:
     return TangentGraph(points=pts, circle=circ, angle_rad=ang, edges=edges)
 
 
-def shortest_route(graph: TangentGraph) -> tuple[list[int], float]:
+def shortest_tangent_route(graph: TangentGraph) -> tuple[list[int], float]:
     """Dijkstra from node 0 (start) to node 1 (goal).
 
     Raises:
@@ -284,7 +284,7 @@ class OptimalPlanner:
                               "this problem has box obstacles")
         check_endpoints(problem)
         graph = build_tangent_graph(problem)
-        route, length_m = shortest_route(graph)
+        route, length_m = shortest_tangent_route(graph)
         waypoints = self._waypoints(problem, graph, route, self.arc_bulge_m)
         if not problem.is_collision_free(waypoints):
             # an arc grazes a neighbouring disc closer than the bulge: follow it tighter

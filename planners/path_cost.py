@@ -134,9 +134,8 @@ class PathObjective:
 
     def cost_from_samples(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
         """(P,) costs of curves already sampled, (P, S) each (for peers that sample their own way)."""
-        cost = self.length_weight * sampled_length_m(xs, ys)
-        if self.smoothness_weight:
-            cost = cost + self.smoothness_weight * smoothness_rad(xs, ys)
+        smoothness = smoothness_rad(xs, ys) if self.smoothness_weight else 0.0
+        cost = weighted_objective(sampled_length_m(xs, ys), smoothness, self.length_weight, self.smoothness_weight)
         penalty = obstacle_penalty(xs, ys, self.centres_m, self.penalty_radii_m)
         penalty = penalty + bounds_penalty(xs, ys, self.bounds)
         return cost + self.penalty_weight * penalty

@@ -39,8 +39,7 @@ import numpy as np
 
 from swarmnav.planners.ant_colony import deposit, evaporate, roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
-from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
-from swarmnav.planners.grid_search import exact_shortcut
+from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 
@@ -77,36 +76,21 @@ def random_nodes(problem: Problem, count: int, corridor_m: float, rng: np.random
 def points_free(problem: Problem, pts: np.ndarray) -> np.ndarray:
     """Which points lie in the bounds and outside every inflated disc and box."""
     pts = np.asarray(pts, dtype=float).reshape(-1, 2)
-    b = problem.bounds
-    ok = (pts[:, 0] >= b.x_min_m) & (pts[:, 0] <= b.x_max_m) & (pts[:, 1] >= b.y_min_m) & (pts[:, 1] <= b.y_max_m)
-    if problem.obstacles:
-        d = np.hypot(pts[:, None, 0] - problem.disc_centres_m[None, :, 0],
-                     pts[:, None, 1] - problem.disc_centres_m[None, :, 1])
-        ok &= np.all(d >= problem.inflated_radii_m[None, :], axis=1)
-    if problem.boxes:
-        d = segment_box_distances(pts, pts, problem.box_array_m)
-        ok &= np.all(d >= problem.inflation_m, axis=1)
-    return ok
+    return problem.in_bounds(pts) & (problem.segment_clearances_m(pts, pts, cull_beyond_m=0.0) >= 0.0)
 
 
 def link_clearance_m(problem: Problem, nodes: np.ndarray) -> np.ndarray:
     """(M, M) smallest gap between each straight link and the inflated obstacles (inf with none)."""
     m = len(nodes)
     i, j = np.triu_indices(m, k=1)
-    gap = np.full(len(i), np.inf)
-    if problem.obstacles:
-        d = segment_disc_distances(nodes[i], nodes[j], problem.disc_centres_m)
-        gap = np.minimum(gap, np.min(d - problem.inflated_radii_m[None, :], axis=1))
-    if problem.boxes:
-        d = segment_box_distances(nodes[i], nodes[j], problem.box_array_m)
-        gap = np.minimum(gap, np.min(d, axis=1) - problem.inflation_m)
+    gap = problem.segment_clearances_m(nodes[i], nodes[j])
     out = np.full((m, m), np.inf)
     out[i, j] = gap
     out[j, i] = gap
     return out
 
 
-def shortest_route(distance: np.ndarray, allowed: np.ndarray, source: int, target: int,
+def dense_graph_route(distance: np.ndarray, allowed: np.ndarray, source: int, target: int,
                    heuristic: np.ndarray | None = None) -> tuple[list[int], float]:
     """Dijkstra (or A* with an admissible ``heuristic`` to the target) on a dense node graph.
 
@@ -258,7 +242,7 @@ class WaiterAntColonyPlanner(SwarmPlanner):
         }
         for label, h in (("dijkstra", None), ("astar", heuristic)):
             try:
-                base_route, base_length = shortest_route(distance, unchecked, 0, goal, h)
+                base_route, base_length = dense_graph_route(distance, unchecked, 0, goal, h)
             except NoPathFound:
                 extra[f"{label}_route"] = None
                 continue

@@ -12,8 +12,10 @@ from swarmnav.planners import PLANNERS, make_planner
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.models.geometry import segment_box_distance, segment_box_distances
-from swarmnav.planners.grid_search import (DStarLite, astar_cells, box_line_of_sight, dijkstra_cells, grid_line_of_sight,
-                                  theta_star_cells)
+from swarmnav.planners.dstar_lite import DStarLite
+from swarmnav.planners.grid_graph import grid_line_of_sight
+from swarmnav.planners.grid_search import astar_cells, dijkstra_cells, theta_star_cells
+from swarmnav.planners.grid_shortcut import box_line_of_sight
 from swarmnav.planners.ant_colony import GridGraph, walk_colony
 from swarmnav.planners.improved_ant_colony import (adaptive_parameters, feature_cells, iaco_heuristic, pheromone_intensity,
                                           prune_length)
