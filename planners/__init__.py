@@ -32,6 +32,10 @@ def register(cls: type) -> type:
     name = getattr(cls, "name", None)
     if not isinstance(name, str) or not name:
         raise TypeError(f"{cls.__name__} has no planner name")
+    supports = getattr(cls, "supports", None)
+    if not isinstance(supports, frozenset) or not supports or not supports <= {"discs", "boxes"}:
+        raise TypeError(f"{cls.__name__} must declare the obstacles it supports, a non-empty subset "
+                        "of {'discs', 'boxes'}")
     if name in PLANNERS:
         raise ValueError(f"planner name {name!r} is registered twice "
                          f"({PLANNERS[name].__name__} and {cls.__name__})")

@@ -17,9 +17,11 @@ from __future__ import annotations
 
 import math
 from collections import OrderedDict
+from dataclasses import replace
 
 import numpy as np
 
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.errors import GoalBlocked, StartBlocked
 from swarmnav.planners.problem import Problem
@@ -32,6 +34,32 @@ DIRECTIONS = ((-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (-1, 1), (1, -1), (1, 
 STEP_COSTS = (1.0, 1.0, 1.0, 1.0, SQRT2, SQRT2, SQRT2, SQRT2)
 
 Cell = tuple[int, int]
+#: Most cells a grid planner's grid may have (a 100 x 100 m arena at 0.05 m is 4 M);
+#: the neighbour table alone takes 64 bytes a cell.
+MAX_GRID_CELLS = 5_000_000
+
+
+def grid_problem(problem: Problem, cell_m: float | None, max_cells: int = MAX_GRID_CELLS) -> Problem:
+    """``problem`` at a planner's own ``cell_m`` (None: the problem's), its grid size checked up front.
+
+    A problem with a fixed grid (a map) keeps it.
+
+    Raises:
+        ConfigError: the grid would have more than ``max_cells`` cells; names the
+            planner's ``cell_m`` when it set the resolution, else the scenario's ``sim.cell_m``.
+    """
+    field = "sim.cell_m"
+    if cell_m is not None and cell_m != problem.cell_m and problem.grid_override is None:
+        problem = replace(problem, cell_m=cell_m)
+        field = "planner.params.cell_m"
+    if problem.grid_override is None:
+        b = problem.bounds
+        cols = max(1, math.ceil(b.width_m / problem.cell_m - 1e-9))
+        rows = max(1, math.ceil(b.height_m / problem.cell_m - 1e-9))
+        if rows * cols > max_cells:
+            raise ConfigError(field, f"a {b.width_m:g} x {b.height_m:g} m workspace at {problem.cell_m:g} m a cell "
+                              f"needs {rows * cols:,} grid cells, more than the maximum {max_cells:,}")
+    return problem
 
 
 def octile_cells(dr: int, dc: int) -> float:

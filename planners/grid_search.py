@@ -15,7 +15,7 @@ from __future__ import annotations
 import heapq
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any, Callable, ClassVar
 
 import numpy as np
@@ -23,7 +23,8 @@ import numpy as np
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.grid_graph import (ADJACENCY, INF, SQRT2, Cell, cells_to_waypoints, check_cells,
-                                          count_bends, grid_endpoints, grid_line_of_sight, moves_by_mask)
+                                          count_bends, grid_endpoints, grid_line_of_sight, grid_problem,
+                                          moves_by_mask)
 from swarmnav.planners.grid_shortcut import box_line_of_sight, exact_shortcut
 from swarmnav.planners.problem import Path, Problem, check_endpoints
 
@@ -204,6 +205,7 @@ class GridPlanner:
     """
 
     name: ClassVar[str] = ""
+    supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     cell_m: float | None = None
     shortcut: bool = True
 
@@ -218,8 +220,7 @@ class GridPlanner:
     def plan(self, problem: Problem, rng: np.random.Generator) -> Path:
         t0 = time.perf_counter()
         check_endpoints(problem)
-        if self.cell_m is not None and self.cell_m != problem.cell_m and problem.grid_override is None:
-            problem = replace(problem, cell_m=self.cell_m)
+        problem = grid_problem(problem, self.cell_m)
         grid = problem.grid
         start, goal = grid_endpoints(problem, grid)
         cells, cost_cells, expansions, extra = self.search(problem, grid, start, goal)
@@ -237,7 +238,8 @@ class AStarPlanner(GridPlanner):
     """Grid A* (octile heuristic, no corner cutting), then exact line-of-sight shortcutting.
 
     Args:
-        cell_m: grid resolution; ``None`` keeps the problem's.
+        cell_m: grid resolution; ``None`` keeps the problem's.  The grid may have at most
+            :data:`planners.grid_graph.MAX_GRID_CELLS` (5,000,000) cells.
         shortcut: apply line-of-sight shortcutting (on by default for execution).
     """
 

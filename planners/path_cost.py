@@ -4,10 +4,10 @@ Every function takes sampled curves ``xs, ys`` of shape ``(P, S)`` (``P``
 candidates, ``S`` samples each, from :class:`planners.via_points.ViaPointCurve`)
 and returns one value per candidate, shape ``(P,)``.
 
-* Length: seed 001 Eq. (1) and seed 004 Eq. (2) (the same sum of chord lengths).
-* Obstacle penalty: seed 001 Eqs. (3)-(5).
-* Smoothness: seed 004 Eqs. (3)-(5).
-* Weighted objective and its fitness: seed 004 Eqs. (6)-(8); seed 001 Eq. (2).
+* Length: Kamil et al. (2020) Eq. (1) and Abdulla & Hadi (2025) Eq. (2) (the same sum of chord lengths).
+* Obstacle penalty: Kamil et al. (2020) Eqs. (3)-(5).
+* Smoothness: Abdulla & Hadi (2025) Eqs. (3)-(5).
+* Weighted objective and its fitness: Abdulla & Hadi (2025) Eqs. (6)-(8); Kamil et al. (2020) Eq. (2).
 
 :class:`PathObjective` combines them into the one cost the optimisers minimise.
 """
@@ -23,7 +23,7 @@ from swarmnav.planners.via_points import ViaPointCurve
 
 
 def sampled_length_m(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-    """Length of each sampled curve, seed 001 Eq. (1) / seed 004 Eq. (2).
+    """Length of each sampled curve, Kamil et al. (2020) Eq. (1) / Abdulla & Hadi (2025) Eq. (2).
 
     ``F = sum_i sqrt((x[i+1] - x[i])**2 + (y[i+1] - y[i])**2)`` over the samples.
     """
@@ -32,7 +32,7 @@ def sampled_length_m(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
 
 def obstacle_penalty(xs: np.ndarray, ys: np.ndarray, centres_m: np.ndarray,
                      radii_m: np.ndarray) -> np.ndarray:
-    """Seed 001's obstacle penalty, Eqs. (3)-(5).
+    """Kamil et al. 2020's obstacle penalty, Eqs. (3)-(5).
 
     For every obstacle ``j``: ``Dist`` is the distance of each sample to its
     centre (Eq. 5), ``v = max(1 - Dist / R, 0)`` (Eq. 4), and the penalty grows
@@ -72,7 +72,7 @@ def wrap_angle_rad(angle_rad: np.ndarray) -> np.ndarray:
 
 
 def smoothness_rad(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-    """Seed 004's smoothness, Eqs. (3)-(5).
+    """Abdulla & Hadi 2025's smoothness, Eqs. (3)-(5).
 
     ``F2 = sum_i |theta(p_i, p_{i+1}) - theta(p_i, p_N)|`` over samples
     ``i = 1 .. N-1``, where Eq. (4) is the heading of the next step and Eq. (5)
@@ -89,12 +89,12 @@ def smoothness_rad(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
 
 def weighted_objective(length_m: np.ndarray, smoothness: np.ndarray, length_weight: float,
                        smoothness_weight: float) -> np.ndarray:
-    """Seed 004 Eq. (6): ``F = w1 F1 + w2 F2`` (Eq. (7) only names ``w = w1 + w2``)."""
+    """Abdulla & Hadi (2025) Eq. (6): ``F = w1 F1 + w2 F2`` (Eq. (7) only names ``w = w1 + w2``)."""
     return length_weight * length_m + smoothness_weight * smoothness
 
 
 def inverse_fitness(objective: np.ndarray, epsilon: float = 0.001) -> np.ndarray:
-    """Seed 004 Eq. (8) ``1 / (F + e)``; with ``e = 0`` and ``F`` = length + penalty, seed 001 Eq. (2)."""
+    """Abdulla & Hadi (2025) Eq. (8) ``1 / (F + e)``; with ``e = 0`` and ``F`` = length + penalty, Kamil et al. (2020) Eq. (2)."""
     return 1.0 / (np.asarray(objective, dtype=float) + epsilon)
 
 
@@ -104,9 +104,9 @@ class PathObjective:
 
     ``cost = w1 * length + w2 * smoothness + penalty_weight * (obstacle_penalty + bounds_penalty)``
 
-    With ``w2 = 0`` this is seed 001's ``F + $p`` (Eqs. (1)-(5), the reciprocal
-    of its fitness Eq. (2)) with the penalty scaled; with ``w2 > 0`` it is seed
-    004's Eq. (6) plus that penalty (seed 004 states no obstacle term in its
+    With ``w2 = 0`` this is Kamil et al. 2020's ``F + $p`` (Eqs. (1)-(5), the reciprocal
+    of its fitness Eq. (2)) with the penalty scaled; with ``w2 > 0`` it is Abdulla & Hadi
+    2025's Eq. (6) plus that penalty (Abdulla & Hadi 2025 states no obstacle term in its
     objective).  Minimising the cost is the same as maximising either paper's
     fitness ``1 / (cost + e)``, Eq. (8).
 
@@ -116,7 +116,7 @@ class PathObjective:
         penalty_radii_m: (C,) radii ``R`` used by the penalty (inflated radius plus margin).
         bounds: the workspace.
         length_weight, smoothness_weight: ``w1`` and ``w2`` of Eq. (6).
-        penalty_weight: multiplier of the penalty (seed 001 uses 1).
+        penalty_weight: multiplier of the penalty (Kamil et al. 2020 uses 1).
     """
 
     curve: ViaPointCurve

@@ -16,6 +16,7 @@ import numpy as np
 
 from swarmnav.models.geometry import polyline_length_m, segment_box_distances, segment_disc_distances
 from swarmnav.models.grid_map import inflated_map_grid, merge_boxes
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario
 from swarmnav.planners.errors import GoalBlocked, StartBlocked
 from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem, nearest_obstacle, rasterise
@@ -75,6 +76,11 @@ class Problem:
     def nearest_obstacle(self, x_m: float, y_m: float) -> tuple[str, int, float]:
         """The obstacle nearest a point: ("disc" or "box", its index, signed gap to its inflated footprint)."""
         return nearest_obstacle(x_m, y_m, self.disc_centres_m, self.disc_radii_m, self.box_array_m, self.inflation_m)
+
+    @property
+    def obstacle_kinds(self) -> frozenset[str]:
+        """The kinds of obstacle this problem has: "discs", "boxes"."""
+        return frozenset(kind for kind, present in (("discs", self.obstacles), ("boxes", self.boxes)) if present)
 
     @cached_property
     def box_array_m(self) -> np.ndarray:
@@ -184,8 +190,19 @@ class Planner(Protocol):
     """
 
     name: ClassVar[str]
+    #: The obstacle kinds the planner handles ("discs", "boxes").
+    supports: ClassVar[frozenset[str]]
 
     def plan(self, problem: Problem, rng: np.random.Generator) -> Path: ...
+
+
+def check_supported(planner: Planner, problem: Problem) -> None:
+    """Raise a :class:`ConfigError` on ``planner.name`` when ``problem`` has an obstacle kind
+    the planner does not declare in ``supports``."""
+    missing = problem.obstacle_kinds - type(planner).supports
+    if missing:
+        raise ConfigError("planner.name", f"{planner.name} supports {' and '.join(sorted(type(planner).supports))} "
+                          f"only, this problem has {' and '.join(sorted(missing))}")
 
 
 def check_endpoints(problem: Problem) -> None:

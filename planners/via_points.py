@@ -1,7 +1,7 @@
 """Via-point path encodings shared by every continuous swarm planner.
 
 A candidate path is ``k`` free via-points between the fixed start and goal
-(seed 001, Sect. 3: "cubic polynomial connects the start point to the end point
+(Kamil et al. 2020, Sect. 3: "cubic polynomial connects the start point to the end point
 through three via points").  The curve through the ``k + 2`` knots is sampled at
 ``samples`` points; the cost functions in :mod:`planners.path_cost` read those
 samples.
@@ -14,7 +14,7 @@ instead of one spline fit per candidate.
 * ``"spline"``: a not-a-knot cubic spline over the uniform parameter
   ``t_j = j / (k + 1)`` (the same curve as ``scipy.interpolate.CubicSpline(t,
   knots, bc_type="not-a-knot")``; with 3 knots it is the parabola through them,
-  with 2 the segment).  Seed 001 does not say how its "cubic polynomial" is
+  with 2 the segment).  Kamil et al. (2020) does not say how its "cubic polynomial" is
   parameterised; a uniform parameter is the simplest choice that is linear in
   the knots.
 * ``"polyline"``: straight segments start -> via-points -> goal, sampled
@@ -128,7 +128,7 @@ class ViaPointCurve:
         encoding: ``"spline"`` or ``"polyline"``.
         via_point_count: ``k``, the number of free via-points.
         start_m, goal_m: (2,) fixed end points.
-        samples: number of curve samples the costs see (seed 001's ``np``).
+        samples: number of curve samples the costs see (Kamil et al. 2020's ``np``).
     """
 
     encoding: str
