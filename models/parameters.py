@@ -38,6 +38,8 @@ def _coerce(value: Any, annotation: Any, field: str) -> Any:
             return value
         raise ConfigError(field, f"expected true or false, got {value!r}")
     if annotation is int:
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ConfigError(field, f"expected an integer, got {value!r}")
         if isinstance(value, bool) or not isinstance(value, (int, float)) or float(value) != int(value):
             raise ConfigError(field, f"expected an integer, got {value!r}")
         return int(value)

@@ -9,7 +9,8 @@ from __future__ import annotations
 from typing import Any
 
 from swarmnav.planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
-from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, DStarLitePlanner, ThetaStarPlanner
+from swarmnav.planners.dstar_lite import DStarLitePlanner
+from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, ThetaStarPlanner
 from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
 from swarmnav.planners.max_min_ant_system import MaxMinAntSystemPlanner
 from swarmnav.planners.waiter_ant_colony import WaiterAntColonyPlanner
@@ -31,6 +32,10 @@ def register(cls: type) -> type:
     name = getattr(cls, "name", None)
     if not isinstance(name, str) or not name:
         raise TypeError(f"{cls.__name__} has no planner name")
+    supports = getattr(cls, "supports", None)
+    if not isinstance(supports, frozenset) or not supports or not supports <= {"discs", "boxes"}:
+        raise TypeError(f"{cls.__name__} must declare the obstacles it supports, a non-empty subset "
+                        "of {'discs', 'boxes'}")
     if name in PLANNERS:
         raise ValueError(f"planner name {name!r} is registered twice "
                          f"({PLANNERS[name].__name__} and {cls.__name__})")

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarmnav.planners.grid_search import DIRECTIONS, STEP_COSTS, neighbour_table
+from swarmnav.planners.grid_graph import DIRECTIONS, STEP_COSTS, neighbour_table
 from swarmnav.models.world import OccupancyGrid
 
 #: Index used for "no previous move" (an ant on its first step).
@@ -70,7 +70,7 @@ class GridGraph:
 
     Attributes:
         grid: the occupancy grid (cells are flat indices ``row * cols + col``).
-        table: (N, 8) neighbour indices in :data:`planners.grid_search.DIRECTIONS` order, -1 where illegal.
+        table: (N, 8) neighbour indices in :data:`planners.grid_graph.DIRECTIONS` order, -1 where illegal.
         key_table: (9 N, 8) the same table repeated once per previous direction
             (:data:`NO_DIRECTION` last), indexed by an ant's key ``direction * N + cell``.
     """
@@ -146,7 +146,7 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
         graph: the cell graph (N cells).
         start, goal: flat cell indices.
         ants: colony size.
-        cell_weights: (N, 8) non-negative weight of each move of :data:`planners.grid_search.DIRECTIONS`
+        cell_weights: (N, 8) non-negative weight of each move of :data:`planners.grid_graph.DIRECTIONS`
             out of each cell; it must be 0 where ``graph.table`` is -1.
         turn_weights: (9, 8) factor from the previous direction (row; :data:`NO_DIRECTION`
             on the first move) to the next, or ``None`` for none.

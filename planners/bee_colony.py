@@ -1,6 +1,6 @@
-"""Artificial Bee Colony over spline via-points: ``abc`` and ``adl_abc`` (seed 001).
+"""Artificial Bee Colony over spline via-points: ``abc`` and ``adl_abc`` (Kamil et al. 2020).
 
-Karaboga's ABC as seed 001 Algorithm 1 gives it (also seed 004 Sect. 4.1):
+Karaboga's ABC as Kamil et al. (2020) Algorithm 1 gives it (also Abdulla & Hadi (2025) Sect. 4.1):
 
 * ``population`` food sources ``SN``, placed by Eq. (6) ``x = x_min + rand (x_max - x_min)``;
 * employed bees: every source ``i`` tries ``v_ij = x_ij + phi (x_ij - x_kj)``
@@ -26,7 +26,7 @@ and its counter grows by the number of onlookers that failed to improve it
 other's improvements within the phase; the difference is a matter of order, not
 of the algorithm.
 
-``adl_abc`` (seed 001 Sect. 5) replaces the fixed limit by the adaptive limit of
+``adl_abc`` (Kamil et al. 2020 Sect. 5) replaces the fixed limit by the adaptive limit of
 Eqs. (10)-(12), see :func:`adaptive_limit`, with the failure counter per
 solution described in the paper's text.
 """
@@ -39,14 +39,14 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.planners.continuous import ContinuousPlanner
+from swarmnav.planners.continuous import ContinuousPlanner, ContinuousState
+from swarmnav.planners.path_cost import inverse_fitness
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.problem import Problem
-from swarmnav.planners.swarm import SwarmState
 
 
 def adaptive_limit(iteration: int, mcn: int, dimensions: int, limit: float) -> float:
-    """The ADL-ABC abandonment limit after ``iteration`` cycles, seed 001 Eqs. (10)-(12).
+    """The ADL-ABC abandonment limit after ``iteration`` cycles, Kamil et al. (2020) Eqs. (10)-(12).
 
     * Eq. (10): ``MAXLIM = MCN / D``;
     * Eq. (11): ``MINLIM = LIMIT / D``, with ``LIMIT`` the fixed limit of the
@@ -84,10 +84,10 @@ class BeeColonyPlanner(ContinuousPlanner):
     """``abc``: Karaboga's Artificial Bee Colony (see the module docstring).
 
     Attributes:
-        population: food sources ``SN`` (seed 001: 100).
-        limit: failures before a source is abandoned (seed 001: 5).
+        population: food sources ``SN`` (Kamil et al. 2020: 100).
+        limit: failures before a source is abandoned (Kamil et al. 2020: 5).
         adaptive_limit: use ADL-ABC's limit, Eqs. (10)-(12), instead of ``limit``.
-        mcn: ``MCN`` of Eqs. (10)-(12) (seed 001: 100); only with ``adaptive_limit``.
+        mcn: ``MCN`` of Eqs. (10)-(12) (Kamil et al. 2020: 100); only with ``adaptive_limit``.
     """
 
     name: ClassVar[str] = "abc"
@@ -110,15 +110,14 @@ class BeeColonyPlanner(ContinuousPlanner):
             return adaptive_limit(iteration + 1, self.mcn, dimensions, self.limit)
         return float(self.limit)
 
-    def init_swarm(self, state: SwarmState, rng: np.random.Generator) -> None:
+    def init_swarm(self, state: ContinuousState, rng: np.random.Generator) -> None:
         sources = self.random_solutions(state, self.population, rng)              # Eq. (6)
-        state.data["population"] = sources
-        state.data["costs"] = self.evaluate(state, sources)
+        state.population = sources
+        state.costs = self.evaluate(state, sources)
         state.data["failures"] = np.zeros(self.population, dtype=np.int64)
-        state.data["limit_history"] = []
 
     def _neighbours(self, sources: np.ndarray, chosen: np.ndarray, rng: np.random.Generator,
-                    state: SwarmState) -> np.ndarray:
+                    state: ContinuousState) -> np.ndarray:
         """Eq. (7) around ``sources[chosen]``: one coordinate moved relative to a random partner."""
         count, dims = chosen.size, sources.shape[1]
         # partner k != chosen: draw from the other SN - 1 sources
@@ -130,12 +129,12 @@ class BeeColonyPlanner(ContinuousPlanner):
         candidates = sources[chosen].copy()
         x = candidates[rows, coordinate]
         candidates[rows, coordinate] = x + phi * (x - sources[partner, coordinate])
-        return np.clip(candidates, state.data["lower"], state.data["upper"])
+        return np.clip(candidates, state.lower, state.upper)
 
-    def step(self, state: SwarmState, problem: Problem, rng: np.random.Generator,
+    def step(self, state: ContinuousState, problem: Problem, rng: np.random.Generator,
              iteration: int) -> None:
-        sources = state.data["population"]
-        costs = state.data["costs"]
+        sources = state.population
+        costs = state.costs
         failures = state.data["failures"]
         count = sources.shape[0]
 
@@ -150,7 +149,7 @@ class BeeColonyPlanner(ContinuousPlanner):
         failures[~better] += 1
 
         # Onlooker bees: roulette over fitness (Eqs. (8)-(9)), then Eq. (7).
-        fitness = 1.0 / (1.0 + costs)                                             # Eq. (8), f >= 0
+        fitness = inverse_fitness(costs, 1.0)                                     # Eq. (8), f >= 0
         chosen = rng.choice(count, size=count, p=fitness / fitness.sum())         # Eq. (9)
         trial = self._neighbours(sources, chosen, rng, state)
         trial_costs = self.evaluate(state, trial)
@@ -168,7 +167,6 @@ class BeeColonyPlanner(ContinuousPlanner):
 
         # Scout bees: abandon every source that reached the limit (Eq. (6)).
         limit = self.current_limit(iteration, sources.shape[1])
-        state.data["limit_history"].append(limit)
         abandoned = np.flatnonzero(failures >= limit)
         if abandoned.size:
             fresh = self.random_solutions(state, abandoned.size, rng)
@@ -179,7 +177,7 @@ class BeeColonyPlanner(ContinuousPlanner):
 
 @dataclass
 class AdaptiveLimitBeeColonyPlanner(BeeColonyPlanner):
-    """``adl_abc``: ABC with the adaptive limit of seed 001 Eqs. (10)-(12).
+    """``adl_abc``: ABC with the adaptive limit of Kamil et al. (2020) Eqs. (10)-(12).
 
     The same class as ``abc`` with ``adaptive_limit`` on by default.
     """

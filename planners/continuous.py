@@ -24,10 +24,13 @@ which is the returned path, *exactly* against the inflated discs and the bounds
 best candidate fails, the planner *repairs*: first by taking the cheapest
 candidate of the final population that passes the same check; failing that, by a
 short local search around the best candidate on a *finer* penalty (ten times the
-samples, ``repair_rounds`` batches of ``population`` Gaussian steps, shrinking;
-its evaluations are counted), stopping at the first candidate that passes.
-``stats.extra["repaired"]`` says which ("population" or "fine_penalty").  If
-nothing passes it raises :class:`planners.errors.NoPathFound`.
+samples, ``repair_rounds`` batches of ``population`` Gaussian steps, shrinking),
+stopping at the first candidate that passes.  The repair runs as the loop's
+repair stage (:mod:`planners.swarm`), so its evaluations count against the same
+``max_evaluations`` budget as the search's.  ``stats.extra["repaired"]`` says
+which ("population" or "fine_penalty").  If nothing passes it raises
+:class:`planners.errors.NoPathFound` (:class:`planners.errors.BudgetExceeded`
+when the budget ran out).
 """
 
 from __future__ import annotations
@@ -35,16 +38,48 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.path_cost import PathObjective
-from swarmnav.planners.problem import Problem
+from swarmnav.planners.problem import Problem, check_supported
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 from swarmnav.planners.via_points import ENCODINGS, ViaPointCurve
+
+
+#: Most curve points one evaluation batch may sample (population x samples): the
+#: cost's temporaries grow with it.
+MAX_POPULATION_SAMPLES = 1_000_000
+
+@dataclass
+class ContinuousState(SwarmState):
+    """:class:`planners.swarm.SwarmState` with what every continuous planner has.
+
+    Attributes:
+        objective: the cost of this run's problem.
+        lower, upper: (2k,) the search box.
+        chosen: the candidate that passed the exact check (None until one has).
+        repaired: how ``chosen`` was found: None (the best), "population" or "fine_penalty".
+        best_gap_m: the best clearance among the candidates checked.
+        fine: the repair's finer objective (ten times the samples), once the repair starts.
+        repair_solution, repair_cost: the repair's incumbent and its fine cost.
+        repair_step_m: the repair's current step size.
+    """
+
+    objective: PathObjective | None = None
+    lower: np.ndarray | None = None
+    upper: np.ndarray | None = None
+    scanned: bool = False
+    chosen: np.ndarray | None = None
+    repaired: str | None = None
+    best_gap_m: float = -math.inf
+    fine: PathObjective | None = None
+    repair_solution: np.ndarray | None = None
+    repair_cost: float = math.inf
+    repair_step_m: float = 0.0
 
 
 @dataclass
@@ -52,17 +87,18 @@ class ContinuousPlanner(SwarmPlanner):
     """Common parameters of the via-point swarm planners.
 
     Attributes:
-        population: candidates per iteration (food sources, wolves, particles).
-        iterations: iterations of the loop (seed 004 uses 100).
+        population: candidates per iteration (food sources, wolves, particles); population
+            x samples may be at most :data:`MAX_POPULATION_SAMPLES` (1,000,000).
+        iterations: iterations of the loop (Abdulla & Hadi 2025 uses 100).
         max_evaluations: optional cap on objective evaluations (0 or None: none).
-        via_points: free via-points ``k`` (seeds 001 and 004 use 3).
-        samples: curve samples the cost sees (seed 001's ``np``; 100).
+        via_points: free via-points ``k`` (Kamil et al. 2020 and Abdulla & Hadi (2025) use 3).
+        samples: curve samples the cost sees (Kamil et al. 2020's ``np``; 100).
         encoding: ``"spline"`` (not-a-knot cubic) or ``"polyline"``.
-        length_weight: ``w1`` of seed 004 Eq. (6).
-        smoothness_weight: ``w2`` of seed 004 Eq. (6); 0 gives seed 001's objective.
-            Seed 004 gives no values for w1, w2; the default 0 makes the
+        length_weight: ``w1`` of Abdulla & Hadi (2025) Eq. (6).
+        smoothness_weight: ``w2`` of Abdulla & Hadi (2025) Eq. (6); 0 gives Kamil et al. 2020's objective.
+            Abdulla & Hadi (2025) gives no values for w1, w2; the default 0 makes the
             objective the path length, which the benchmark compares.
-        penalty_weight: multiplier of seed 001's penalty, Eqs. (3)-(5).  The
+        penalty_weight: multiplier of Kamil et al. 2020's penalty, Eqs. (3)-(5).  The
             paper adds it with weight 1; that is too weak to keep a spline out of a
             disc (a cut of a few centimetres costs less penalty than the detour
             saves), so the default is 1000 (measured on dense-field-30 and gwo-scenario-1:
@@ -74,6 +110,8 @@ class ContinuousPlanner(SwarmPlanner):
         waypoint_spacing_m: spacing of the returned waypoints along the spline; the
             polyline through them is what the exact check verifies.
     """
+
+    supports: ClassVar[frozenset[str]] = frozenset({"discs"})
 
     population: int = 50
     iterations: int = 100
@@ -105,8 +143,15 @@ class ContinuousPlanner(SwarmPlanner):
             ("repair_rounds", self.repair_rounds >= 0, "must not be negative"),
         )
         check_parameters(self, checks)
+        points = self.population * self.samples
+        if points > MAX_POPULATION_SAMPLES:
+            raise ConfigError("planner.params.population",
+                              f"population x samples = {self.population:,} x {self.samples:,} needs {points:,} "
+                              f"curve points an evaluation, more than the maximum {MAX_POPULATION_SAMPLES:,}")
 
     # ----------------------------------------------------------------- set-up
+    state_type = ContinuousState
+
     def objective(self, problem: Problem) -> PathObjective:
         """The cost function of ``problem`` for this planner's encoding and weights."""
         curve = ViaPointCurve(self.encoding, self.via_points, problem.start.xy, problem.goal.xy,
@@ -125,97 +170,114 @@ class ContinuousPlanner(SwarmPlanner):
         upper = np.concatenate([np.full(k, b.x_max_m), np.full(k, b.y_max_m)])
         return lower, upper
 
-    def random_solutions(self, state: SwarmState, count: int, rng: np.random.Generator) -> np.ndarray:
-        """``count`` uniform random decision vectors in the search box (seed 001 Eq. (6))."""
-        lower, upper = state.data["lower"], state.data["upper"]
-        return lower + rng.random((count, lower.size)) * (upper - lower)
+    def random_solutions(self, state: ContinuousState, count: int, rng: np.random.Generator) -> np.ndarray:
+        """``count`` uniform random decision vectors in the search box (Kamil et al. 2020 Eq. (6))."""
+        return state.lower + rng.random((count, state.lower.size)) * (state.upper - state.lower)
 
-    def evaluate(self, state: SwarmState, population: np.ndarray) -> np.ndarray:
-        """Costs of a population; counts the evaluations and offers them to the best."""
-        costs = state.data["objective"](population)
-        state.evaluations += int(population.shape[0])
-        state.offer(population, costs)
+    def evaluate(self, state: ContinuousState, population: np.ndarray,
+                 objective: PathObjective | None = None, offer: bool = True) -> np.ndarray:
+        """Costs of a population; counts the evaluations and offers them to the best.
+
+        Only as many candidates as the budget has left are evaluated (the first
+        ones); the others cost ``inf`` and count for nothing.
+
+        Args:
+            objective: the cost to use (default: the run's).
+            offer: offer the costs to ``state``'s best (off for the repair's finer cost).
+        """
+        objective = objective or state.objective
+        count = population.shape[0]
+        left = state.evaluations_left
+        if left >= count:
+            costs = objective(population)
+        else:
+            left = int(left)
+            costs = np.full(count, math.inf)
+            if left:
+                costs[:left] = objective(population[:left])
+            count = left
+        state.evaluations += count
+        if offer:
+            state.offer(population, costs)
         return costs
 
     # ------------------------------------------------------- the loop's hooks
-    def init_state(self, problem: Problem, rng: np.random.Generator) -> SwarmState:
-        if problem.boxes:
-            raise ConfigError("planner.name", f"{self.name} supports disc obstacles only, "
-                              "this problem has box obstacles (a grid map)")
-        lower, upper = self.search_bounds(problem)
-        state = SwarmState(best_solution=None, best_cost=math.inf,
-                           data={"objective": self.objective(problem), "lower": lower, "upper": upper,
-                                 "rng": rng})
+    def init_state(self, state: ContinuousState, problem: Problem, rng: np.random.Generator) -> None:
+        check_supported(self, problem)
+        state.objective = self.objective(problem)
+        state.lower, state.upper = self.search_bounds(problem)
         self.init_swarm(state, rng)
-        return state
 
-    def init_swarm(self, state: SwarmState, rng: np.random.Generator) -> None:
-        """Create and evaluate the first population; store it as ``state.data["population"]``
-        and its costs as ``state.data["costs"]``."""
+    def init_swarm(self, state: ContinuousState, rng: np.random.Generator) -> None:
+        """Create and evaluate the first population (``state.population``, ``state.costs``)."""
         raise NotImplementedError
 
-    def finish(self, state: SwarmState, problem: Problem) -> tuple[np.ndarray, dict[str, Any]]:
-        """Dense waypoints of the best candidate that passes the exact check.
+    def repair_limit(self) -> int:
+        return self.repair_rounds
+
+    def needs_repair(self, state: ContinuousState, problem: Problem) -> bool:
+        """Scan the best and then the final population (cheapest first) once for a
+        candidate that passes the exact check; repair while there is none."""
+        if not state.scanned:
+            state.scanned = True
+            candidates = [] if state.best_solution is None else [np.asarray(state.best_solution, dtype=float)]
+            if state.population is not None:
+                order = np.argsort(state.costs, kind="stable")
+                candidates.extend(np.asarray(state.population[i], dtype=float) for i in order
+                                  if math.isfinite(state.costs[i]))
+            for rank, solution in enumerate(candidates):
+                waypoints = self.dense_waypoints(state.objective, solution)
+                state.best_gap_m = max(state.best_gap_m, problem.path_clearance_m(waypoints))
+                if problem.is_collision_free(waypoints):
+                    state.chosen, state.repaired = solution, ("population" if rank > 0 else None)
+                    break
+        return state.chosen is None and state.best_solution is not None
+
+    def repair_step(self, state: ContinuousState, problem: Problem, rng: np.random.Generator,
+                    round_index: int) -> None:
+        """One batch of the local search from the best candidate on ten times the samples;
+        keeps the first candidate whose returned polyline passes the exact check."""
+        if state.fine is None:
+            curve = state.objective.curve
+            state.fine = dataclasses.replace(state.objective, curve=ViaPointCurve(
+                curve.encoding, curve.via_point_count, curve.start_m, curve.goal_m, 10 * curve.samples))
+            best = np.asarray(state.best_solution, dtype=float)
+            state.repair_solution = best
+            state.repair_cost = float(self.evaluate(state, best[None, :], state.fine, offer=False)[0])
+            state.repair_step_m = 4.0 * max(self.penalty_margin_m, 0.01)
+        best = state.repair_solution
+        trial = np.clip(best + rng.normal(0.0, state.repair_step_m, (self.population, best.size)),
+                        state.lower, state.upper)
+        costs = self.evaluate(state, trial, state.fine, offer=False)
+        i = int(np.argmin(costs))
+        if costs[i] < state.repair_cost:
+            state.repair_solution, state.repair_cost = trial[i], float(costs[i])
+            if problem.is_collision_free(self.dense_waypoints(state.objective, trial[i])):
+                state.chosen, state.repaired = trial[i], "fine_penalty"
+        state.repair_step_m *= 0.6
+
+    def finish(self, state: ContinuousState, problem: Problem,
+               rng: np.random.Generator) -> tuple[np.ndarray, dict[str, Any]]:
+        """Dense waypoints of the candidate that passed the exact check.
 
         Raises:
-            NoPathFound: neither the best nor any member of the final population
-                is collision-free.
+            NoPathFound: neither the best, nor any member of the final population,
+                nor the repair is collision-free.
         """
-        objective: PathObjective = state.data["objective"]
-        curve = objective.curve
-        candidates = [np.asarray(state.best_solution, dtype=float)]
-        population = state.data.get("population")
-        if population is not None:
-            order = np.argsort(state.data["costs"], kind="stable")
-            candidates.extend(np.asarray(population[i], dtype=float) for i in order)
-        best_gap = -math.inf
-        chosen, repaired = None, None
-        for rank, solution in enumerate(candidates):
-            waypoints = self.dense_waypoints(objective, solution)
-            best_gap = max(best_gap, problem.path_clearance_m(waypoints))
-            if problem.is_collision_free(waypoints):
-                chosen, repaired = solution, ("population" if rank > 0 else None)
-                break
-        if chosen is None:
-            chosen = self._repair_on_fine_penalty(state, problem)
-            repaired = "fine_penalty"
-        if chosen is None:
+        self.needs_repair(state, problem)          # the scan, when the loop ran no repair stage
+        if state.chosen is None:
             raise NoPathFound(f"{self.name}: no candidate of the final population is collision-free "
-                              f"(best clearance {best_gap:.4f} m), nor the fine-penalty repair; try "
+                              f"(best clearance {state.best_gap_m:.4f} m), nor the fine-penalty repair; try "
                               f"more iterations or a larger penalty_weight")
-        waypoints = self.dense_waypoints(objective, chosen)
+        objective = state.objective
+        waypoints = self.dense_waypoints(objective, state.chosen)
         return waypoints, {
-            "repaired": repaired,
-            "via_points_m": curve.via_points(chosen).round(6).tolist(),
-            "objective_cost": float(objective(chosen[None, :])[0]),
+            "repaired": state.repaired,
+            "via_points_m": objective.curve.via_points(state.chosen).round(6).tolist(),
+            "objective_cost": float(objective(state.chosen[None, :])[0]),
             "clearance_m": problem.path_clearance_m(waypoints),
             "encoding": self.encoding,
         }
-
-    def _repair_on_fine_penalty(self, state: SwarmState, problem: Problem) -> np.ndarray | None:
-        """Local search from the best candidate on ten times the samples; the first
-        candidate whose returned polyline passes the exact check, or None."""
-        objective: PathObjective = state.data["objective"]
-        curve = objective.curve
-        fine = dataclasses.replace(objective, curve=ViaPointCurve(
-            curve.encoding, curve.via_point_count, curve.start_m, curve.goal_m, 10 * curve.samples))
-        rng: np.random.Generator = state.data["rng"]
-        lower, upper = state.data["lower"], state.data["upper"]
-        best = np.asarray(state.best_solution, dtype=float)
-        best_cost = float(fine(best[None, :])[0])
-        state.evaluations += 1
-        step_m = 4.0 * max(self.penalty_margin_m, 0.01)
-        for _ in range(self.repair_rounds):
-            trial = np.clip(best + rng.normal(0.0, step_m, (self.population, best.size)), lower, upper)
-            costs = fine(trial)
-            state.evaluations += trial.shape[0]
-            i = int(np.argmin(costs))
-            if costs[i] < best_cost:
-                best, best_cost = trial[i], float(costs[i])
-                if problem.is_collision_free(self.dense_waypoints(objective, best)):
-                    return best
-            step_m *= 0.6
-        return None
 
     def dense_waypoints(self, objective: PathObjective, solution: np.ndarray) -> np.ndarray:
         """The returned polyline: the spline every ``waypoint_spacing_m``, projected onto the

@@ -1,6 +1,6 @@
-"""Grey Wolf Optimisation over spline via-points (seed 004, Eqs. (15)-(25)).
+"""Grey Wolf Optimisation over spline via-points (Abdulla & Hadi 2025, Eqs. (15)-(25)).
 
-After Mirjalili, Mirjalili and Lewis (2014), as seed 004 gives it: the three
+After Mirjalili, Mirjalili and Lewis (2014), as Abdulla & Hadi (2025) gives it: the three
 best wolves found so far, alpha, beta and delta, lead; every wolf moves to the
 mean of three positions, one drawn towards each leader:
 
@@ -27,9 +27,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.planners.continuous import ContinuousPlanner
+from swarmnav.planners.continuous import ContinuousPlanner, ContinuousState
 from swarmnav.planners.problem import Problem
-from swarmnav.planners.swarm import SwarmState
 
 
 @dataclass
@@ -37,9 +36,9 @@ class GreyWolfPlanner(ContinuousPlanner):
     """``gwo``: Grey Wolf Optimisation of the via-points (see the module docstring).
 
     Attributes:
-        population: wolves in the pack (50; seed 004's "population size of 0.5"
+        population: wolves in the pack (50; Abdulla & Hadi 2025's "population size of 0.5"
             is garbled in the extraction).
-        iterations: seed 004 uses 100.
+        iterations: Abdulla & Hadi (2025) uses 100.
     """
 
     name: ClassVar[str] = "gwo"
@@ -47,15 +46,15 @@ class GreyWolfPlanner(ContinuousPlanner):
     population: int = 50
     iterations: int = 100
 
-    def init_swarm(self, state: SwarmState, rng: np.random.Generator) -> None:
+    def init_swarm(self, state: ContinuousState, rng: np.random.Generator) -> None:
         wolves = self.random_solutions(state, self.population, rng)
         costs = self.evaluate(state, wolves)
-        state.data["population"] = wolves
-        state.data["costs"] = costs
+        state.population = wolves
+        state.costs = costs
         self._update_leaders(state, wolves, costs)
 
     @staticmethod
-    def _update_leaders(state: SwarmState, wolves: np.ndarray, costs: np.ndarray) -> None:
+    def _update_leaders(state: ContinuousState, wolves: np.ndarray, costs: np.ndarray) -> None:
         """Keep the three best positions seen so far as alpha, beta, delta."""
         if "leaders" in state.data:
             wolves = np.vstack([state.data["leaders"], wolves])
@@ -64,9 +63,9 @@ class GreyWolfPlanner(ContinuousPlanner):
         state.data["leaders"] = wolves[order].copy()
         state.data["leader_costs"] = costs[order].copy()
 
-    def step(self, state: SwarmState, problem: Problem, rng: np.random.Generator,
+    def step(self, state: ContinuousState, problem: Problem, rng: np.random.Generator,
              iteration: int) -> None:
-        wolves = state.data["population"]
+        wolves = state.population
         leaders = state.data["leaders"]                              # (3, D)
         a = 2.0 - 2.0 * iteration / max(self.iterations, 1)
         shape = (3,) + wolves.shape                                  # (3, P, D)
@@ -74,8 +73,8 @@ class GreyWolfPlanner(ContinuousPlanner):
         big_c = 2.0 * rng.random(shape)                              # Eq. (18)
         distance = np.abs(big_c * leaders[:, None, :] - wolves[None, :, :])   # Eqs. (19)-(21)
         moves = leaders[:, None, :] - big_a * distance               # Eqs. (22)-(24)
-        wolves = np.clip(moves.mean(axis=0), state.data["lower"], state.data["upper"])  # Eq. (25)
+        wolves = np.clip(moves.mean(axis=0), state.lower, state.upper)  # Eq. (25)
         costs = self.evaluate(state, wolves)
-        state.data["population"] = wolves
-        state.data["costs"] = costs
+        state.population = wolves
+        state.costs = costs
         self._update_leaders(state, wolves, costs)

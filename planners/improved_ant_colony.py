@@ -1,4 +1,4 @@
-"""IACO: the improved ant colony of Gong, Yang, Yuan & Wang (2022), seed 003.
+"""IACO: the improved ant colony of Gong, Yang, Yuan & Wang (2022).
 
 On the inflated occupancy grid, with the shared colony core
 (:mod:`planners.ant_colony`) and the one optimisation loop:
@@ -46,8 +46,7 @@ Readings of the paper where its text is ambiguous (our choices):
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
@@ -55,10 +54,16 @@ from scipy import ndimage
 
 from swarmnav.planners.ant_colony import STEP_LENGTHS, GridGraph, cosine_table, deposit, evaporate, walk_colony
 from swarmnav.planners.errors import NoPathFound, check_parameters
-from swarmnav.planners.grid_search import (Cell, cells_to_waypoints, count_bends, exact_shortcut, grid_endpoints,
-                                  grid_line_of_sight, line_cells)
+from swarmnav.planners.grid_graph import (Cell, cells_to_waypoints, count_bends, grid_endpoints, grid_line_of_sight,
+                                          grid_problem, line_cells)
+from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
+
+#: Most cells IACO's grid may have: the colony's tables take about 600 bytes a cell.
+MAX_COLONY_CELLS = 500_000
+#: Most ants: each keeps a visited mask of the whole grid.
+MAX_ANTS = 10_000
 
 
 def feature_cells(occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -176,10 +181,15 @@ def prune_length(q: float, t_c: float, collar_length: float, negligible: float) 
 
 @dataclass
 class ImprovedAntColonyPlanner(SwarmPlanner):
-    """IACO (seed 003).  Defaults are the paper's Table 2.
+    """IACO (Gong et al. 2022).  Defaults are the paper's Table 2.
+
+    The quantities of the paper's Table 3 are in ``stats.extra``: its "optimal
+    length" is the best tour's length, ``raw_length_m`` (the best any ant walked,
+    not a proven optimum); ``mean_length_m`` and ``std_length_m`` over the last
+    iteration's arrived tours, ``convergence_iteration`` and ``bends``.
 
     Args:
-        ants: colony size m (50).
+        ants: colony size m (50; at most :data:`MAX_ANTS`, 10,000).
         iterations: N (100).
         alpha, beta: initial alpha and beta of Eqs. (9)-(10) (1 and 5).
         rho: initial evaporation, until Eq. (11) has a best length (0.3).
@@ -215,11 +225,13 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
             length so far and than :func:`prune_length` (1: it could not become the best,
             and its Eq. (7) deposit would lie below ``tau_floor``); before any best, the
             limit is 4 x the collar length (at least rows + cols).
-        cell_m: grid resolution; ``None`` keeps the problem's.
+        cell_m: grid resolution; ``None`` keeps the problem's.  The grid may have at most
+            :data:`MAX_COLONY_CELLS` (500,000) cells.
         shortcut: line-of-sight shortcut of the best tour (the raw cells stay in stats).
     """
 
     name: ClassVar[str] = "iaco"
+    supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     ants: int = 50
     iterations: int = 100
     alpha: float = 1.0
@@ -242,7 +254,7 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
 
     def __post_init__(self) -> None:
         check_parameters(self, (
-            ("ants", self.ants >= 1, "must be at least 1"),
+            ("ants", 1 <= self.ants <= MAX_ANTS, f"must lie in [1, {MAX_ANTS:,}]"),
             ("iterations", self.iterations >= 1, "must be at least 1"),
             ("kappa", 0.0 < self.kappa < 1.0, "must lie in (0, 1)"),
             ("rho", 0.0 <= self.rho < 1.0, "must lie in [0, 1)"),
@@ -251,13 +263,10 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
             ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
         ))
 
-    def _problem(self, problem: Problem) -> Problem:
-        if self.cell_m is not None and self.cell_m != problem.cell_m and problem.grid_override is None:
-            return replace(problem, cell_m=self.cell_m)
-        return problem
+    def prepare(self, problem: Problem) -> Problem:
+        return grid_problem(problem, self.cell_m, MAX_COLONY_CELLS)
 
-    def init_state(self, problem: Problem, rng: np.random.Generator) -> SwarmState:
-        problem = self._problem(problem)
+    def init_state(self, state: SwarmState, problem: Problem, rng: np.random.Generator) -> None:
         grid = problem.grid
         start, goal = grid_endpoints(problem, grid)
         graph = GridGraph.of(grid)
@@ -274,12 +283,10 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
         safe_table = np.where(legal, graph.table, 0)
         # Eq. (6)'s goal guidance d_ig / (d_ij + d_jg) of every move, fixed for the run.
         guidance = iaco_heuristic(d_goal[:, None], STEP_LENGTHS[None, :], d_goal[safe_table], 0.0)
-        data = {"problem": problem, "graph": graph, "start": graph.index(start), "goal": graph.index(goal),
-                "guidance": guidance, "legal": legal, "safe_table": safe_table, "cos": cosine_table(),
-                "tau": tau, "collar_length": collar_cells,
-                "collar_points": points, "last_lengths": np.zeros(0), "successes": 0,
-                "params": (self.alpha, self.beta, self.rho)}
-        return SwarmState(best_solution=None, best_cost=math.inf, data=data)
+        state.data = {"graph": graph, "start": graph.index(start), "goal": graph.index(goal),
+                      "guidance": guidance, "legal": legal, "safe_table": safe_table, "cos": cosine_table(),
+                      "tau": tau, "collar_length": collar_cells, "collar_points": points,
+                      "last_lengths": np.zeros(0), "successes": 0, "params": (self.alpha, self.beta, self.rho)}
 
     def step(self, state: SwarmState, problem: Problem, rng: np.random.Generator, iteration: int) -> None:
         data = state.data
@@ -295,15 +302,16 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
         cell_weights *= np.power(tau, alpha)[data["safe_table"]]
         cell_weights *= data["legal"]
         bend_beta = np.power(cos + 1.0, beta)                          # (9, 8)
-        rows, cols = data["problem"].grid.shape
+        rows, cols = problem.grid.shape
         limit = (max(self.prune_ratio * best_cells,
                      prune_length(self.q, self.t_c, data["collar_length"], self.tau_floor))
                  if best_cells is not None else max(4.0 * data["collar_length"], float(rows + cols)))
         # An ant that backtracks keeps walking without growing its tour: cap its NumPy steps too.
         max_steps = self.max_steps or min(rows * cols // 2, int(max(rows + cols, self.step_ratio * limit)))
-        walk = walk_colony(data["graph"], data["start"], data["goal"], self.ants, cell_weights, bend_beta, rng,
+        ants = int(min(self.ants, state.evaluations_left))       # a tour is one evaluation
+        walk = walk_colony(data["graph"], data["start"], data["goal"], ants, cell_weights, bend_beta, rng,
                            max_steps, max_length=limit)
-        state.evaluations += self.ants
+        state.evaluations += ants
         arrived = np.flatnonzero(walk.reached)
         lengths = walk.length_cells[arrived]
         data["last_lengths"] = lengths
@@ -316,7 +324,7 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
             tours = [walk.tour(a)[1:] for a in arrived]
             deposit(tau, np.concatenate(tours), np.repeat(amounts, [len(t) for t in tours]))
             best = int(np.argmin(lengths))
-            cost_m = float(lengths[best]) * data["problem"].grid.cell_m
+            cost_m = float(lengths[best]) * problem.grid.cell_m
             if cost_m < state.best_cost:
                 state.best_cost = cost_m
                 state.best_solution = walk.tour(arrived[best]).copy()
@@ -324,11 +332,11 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
         free = tau > 0.0
         np.maximum(tau, self.tau_floor, out=tau, where=free)
 
-    def finish(self, state: SwarmState, problem: Problem) -> tuple[np.ndarray, dict[str, Any]]:
+    def finish(self, state: SwarmState, problem: Problem,
+               rng: np.random.Generator) -> tuple[np.ndarray, dict[str, Any]]:
         data = state.data
         if state.best_solution is None:
             raise NoPathFound(f"no ant of {state.evaluations} reached the goal")
-        problem = data["problem"]
         grid = problem.grid
         cells = [tuple(int(v) for v in rc) for rc in data["graph"].cells(state.best_solution)]
         raw = cells_to_waypoints(problem, grid, cells)
@@ -338,7 +346,6 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
         extra = {
             "raw_cells": [list(c) for c in cells],
             "raw_length_m": state.best_cost,
-            "optimal_length_m": state.best_cost,
             "mean_length_m": float(np.mean(lengths_m)) if lengths_m.size else math.nan,
             "std_length_m": float(np.std(lengths_m)) if lengths_m.size else math.nan,
             "bends": count_bends(cells),

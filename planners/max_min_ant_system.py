@@ -1,4 +1,4 @@
-"""IMMAS: the improved MAX-MIN ant system of Hasan, Abdullah & Saleh (2023), seed 000.
+"""IMMAS: the improved MAX-MIN ant system of Hasan, Abdullah & Saleh (2023).
 
 A wide-free-space planner in two stages, on the inflated occupancy grid:
 
@@ -46,7 +46,7 @@ from __future__ import annotations
 import heapq
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -54,8 +54,8 @@ from scipy import ndimage
 
 from swarmnav.planners.ant_colony import roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
-from swarmnav.planners.grid_search import (DIRECTIONS, Cell, cells_to_waypoints, count_bends, exact_shortcut,
-                                  grid_endpoints)
+from swarmnav.planners.grid_graph import DIRECTIONS, Cell, cells_to_waypoints, count_bends, grid_endpoints, grid_problem
+from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 
@@ -200,7 +200,7 @@ def tour_scores(tau: np.ndarray, clean: np.ndarray, eta: np.ndarray, alpha: floa
 
 @dataclass
 class MaxMinAntSystemPlanner(SwarmPlanner):
-    """IMMAS (seed 000): wide free space by cleaning weights and closing gates and tight tunnels.
+    """IMMAS (Hasan et al. 2023): wide free space by cleaning weights and closing gates and tight tunnels.
 
     Each iteration of the loop is one move of the robot (Algorithm 3), so the
     reported iterations are the paper's "No. of Iteration".
@@ -214,11 +214,13 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
         close_gates_and_tunnels: apply GateRaiseState and Algorithm 2.
         selection: "best" (Algorithm 3: the smallest Eq. (3) value) or "roulette".
         iterations: max_itr, the move budget; 0 means the number of cells.
-        cell_m: grid resolution; ``None`` keeps the problem's.
+        cell_m: grid resolution; ``None`` keeps the problem's.  The grid may have at most
+            :data:`planners.grid_graph.MAX_GRID_CELLS` (5,000,000) cells.
         shortcut: line-of-sight shortcut of the tour (the raw cells stay in stats).
     """
 
     name: ClassVar[str] = "immas"
+    supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     alpha: float = 3.0
     beta: float = 1.0
     rho: float = 0.98
@@ -239,15 +241,15 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
             ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
         ))
 
-    def plan(self, problem: Problem, rng: np.random.Generator):
-        if self.cell_m is not None and self.cell_m != problem.cell_m and problem.grid_override is None:
-            problem = replace(problem, cell_m=self.cell_m)
-        if self.iterations == 0:
-            rows, cols = problem.grid.shape
-            return replace(self, iterations=rows * cols).plan(problem, rng)
-        return super().plan(problem, rng)
+    def prepare(self, problem: Problem) -> Problem:
+        return grid_problem(problem, self.cell_m)
 
-    def init_state(self, problem: Problem, rng: np.random.Generator) -> SwarmState:
+    def iteration_limit(self, problem: Problem) -> int:
+        """max_itr: ``iterations``, or the number of cells when it is 0."""
+        rows, cols = problem.grid.shape
+        return self.iterations or rows * cols
+
+    def init_state(self, state: SwarmState, problem: Problem, rng: np.random.Generator) -> None:
         t0 = time.perf_counter()
         grid = problem.grid
         start, goal = grid_endpoints(problem, grid)
@@ -258,15 +260,13 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
         eta = np.hypot(rr - goal[0], cc - goal[1])
         visited = np.zeros((rows, cols), dtype=bool)
         visited[start] = True
-        data = {"problem": problem, "analysis": analysis, "eta": eta, "visited": visited, "start": start,
-                "goal": goal, "cells": [start], "arc_cost": 0.0, "analysis_time_s": time.perf_counter() - t0,
-                "fallbacks": 0}
-        return SwarmState(best_solution=None, best_cost=math.inf, data=data, done=start == goal)
+        state.data = {"analysis": analysis, "eta": eta, "visited": visited, "start": start, "goal": goal,
+                      "cells": [start], "arc_cost": 0.0, "analysis_time_s": time.perf_counter() - t0,
+                      "fallbacks": 0}
+        state.done = start == goal
 
     def step(self, state: SwarmState, problem: Problem, rng: np.random.Generator, iteration: int) -> None:
         data = state.data
-        if state.done:
-            return
         a: EnvironmentAnalysis = data["analysis"]
         rows, cols = a.blocked.shape
         r, c = data["cells"][-1]
@@ -308,15 +308,15 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
             state.best_solution = cells
             state.best_cost = float(np.sum(np.hypot(*np.diff(arr, axis=0).T))) * problem.grid.cell_m
 
-    def finish(self, state: SwarmState, problem: Problem) -> tuple[np.ndarray, dict[str, Any]]:
+    def finish(self, state: SwarmState, problem: Problem,
+               rng: np.random.Generator) -> tuple[np.ndarray, dict[str, Any]]:
         data = state.data
-        problem = data["problem"]
         grid = problem.grid
         if state.best_solution is None:
             if data["start"] == data["goal"]:
                 state.best_solution, state.best_cost = [data["start"]], 0.0
             else:
-                raise NoPathFound(f"the tour did not reach the goal within {self.iterations} moves")
+                raise NoPathFound(f"the tour did not reach the goal within {self.iteration_limit(problem)} moves")
         cells = state.best_solution
         raw = cells_to_waypoints(problem, grid, cells)
         waypoints = exact_shortcut(problem, raw) if self.shortcut else raw

@@ -42,7 +42,7 @@ import numpy as np
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.models.geometry import segment_disc_distances
-from swarmnav.planners.problem import Path, Problem, check_endpoints
+from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
 from swarmnav.models.world import Rect
 
 TOLERANCE_M = 1e-9
@@ -222,7 +222,7 @@ def build_tangent_graph(problem: Problem) -> TangentGraph:
     return TangentGraph(points=pts, circle=circ, angle_rad=ang, edges=edges)
 
 
-def shortest_route(graph: TangentGraph) -> tuple[list[int], float]:
+def shortest_tangent_route(graph: TangentGraph) -> tuple[list[int], float]:
     """Dijkstra from node 0 (start) to node 1 (goal).
 
     Raises:
@@ -263,6 +263,7 @@ class OptimalPlanner:
     """
 
     name: ClassVar[str] = "optimal"
+    supports: ClassVar[frozenset[str]] = frozenset({"discs"})
 
     arc_bulge_m: float = 1e-4
 
@@ -279,12 +280,10 @@ class OptimalPlanner:
             ConfigError: the problem has box obstacles.
         """
         t0 = time.perf_counter()
-        if problem.boxes:
-            raise ConfigError("planner.name", "optimal supports disc obstacles only, "
-                              "this problem has box obstacles")
+        check_supported(self, problem)
         check_endpoints(problem)
         graph = build_tangent_graph(problem)
-        route, length_m = shortest_route(graph)
+        route, length_m = shortest_tangent_route(graph)
         waypoints = self._waypoints(problem, graph, route, self.arc_bulge_m)
         if not problem.is_collision_free(waypoints):
             # an arc grazes a neighbouring disc closer than the bulge: follow it tighter

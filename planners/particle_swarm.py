@@ -21,10 +21,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.planners.continuous import ContinuousPlanner
+from swarmnav.planners.continuous import ContinuousPlanner, ContinuousState
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.problem import Problem
-from swarmnav.planners.swarm import SwarmState
 
 TOPOLOGIES = ("global", "ring")
 
@@ -58,16 +57,16 @@ class ParticleSwarmPlanner(ContinuousPlanner):
             raise ConfigError("planner.params.velocity_limit",
                               f"must be positive, got {self.velocity_limit!r}")
 
-    def init_swarm(self, state: SwarmState, rng: np.random.Generator) -> None:
+    def init_swarm(self, state: ContinuousState, rng: np.random.Generator) -> None:
         positions = self.random_solutions(state, self.population, rng)
         costs = self.evaluate(state, positions)
-        width = state.data["upper"] - state.data["lower"]
+        width = state.upper - state.lower
         state.data["velocity_max"] = self.velocity_limit * width
         state.data["velocities"] = (rng.random(positions.shape) * 2.0 - 1.0) * state.data["velocity_max"]
         state.data["positions"] = positions
         # "population"/"costs" are the personal bests: the candidates finish() falls back on.
-        state.data["population"] = positions.copy()
-        state.data["costs"] = costs.copy()
+        state.population = positions.copy()
+        state.costs = costs.copy()
 
     def _neighbourhood_best(self, best_positions: np.ndarray, best_costs: np.ndarray) -> np.ndarray:
         """(P, D) the best personal best each particle is pulled towards."""
@@ -78,12 +77,12 @@ class ParticleSwarmPlanner(ContinuousPlanner):
         winner = ring[np.arange(count), np.argmin(best_costs[ring], axis=1)]
         return best_positions[winner]
 
-    def step(self, state: SwarmState, problem: Problem, rng: np.random.Generator,
+    def step(self, state: ContinuousState, problem: Problem, rng: np.random.Generator,
              iteration: int) -> None:
         positions = state.data["positions"]
         velocities = state.data["velocities"]
-        best_positions = state.data["population"]
-        best_costs = state.data["costs"]
+        best_positions = state.population
+        best_costs = state.costs
         lead = self._neighbourhood_best(best_positions, best_costs)
         r1 = rng.random(positions.shape)
         r2 = rng.random(positions.shape)
@@ -93,7 +92,7 @@ class ParticleSwarmPlanner(ContinuousPlanner):
         v_max = state.data["velocity_max"]
         velocities = np.clip(velocities, -v_max, v_max)
         moved = positions + velocities
-        positions = np.clip(moved, state.data["lower"], state.data["upper"])
+        positions = np.clip(moved, state.lower, state.upper)
         velocities = np.where(moved == positions, velocities, 0.0)
         costs = self.evaluate(state, positions)
         better = costs < best_costs

@@ -14,8 +14,9 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from swarmnav.models.geometry import polyline_clearance_m, polyline_length_m, segment_box_distances
+from swarmnav.models.geometry import polyline_length_m, segment_box_distances, segment_disc_distances
 from swarmnav.models.grid_map import inflated_map_grid, merge_boxes
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario
 from swarmnav.planners.errors import GoalBlocked, StartBlocked
 from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem, nearest_obstacle, rasterise
@@ -76,9 +77,10 @@ class Problem:
         """The obstacle nearest a point: ("disc" or "box", its index, signed gap to its inflated footprint)."""
         return nearest_obstacle(x_m, y_m, self.disc_centres_m, self.disc_radii_m, self.box_array_m, self.inflation_m)
 
-    def point_clearance_m(self, x_m: float, y_m: float) -> float:
-        """Signed gap from a point to the nearest inflated disc or box (inf with none)."""
-        return self.nearest_obstacle(x_m, y_m)[2]
+    @property
+    def obstacle_kinds(self) -> frozenset[str]:
+        """The kinds of obstacle this problem has: "discs", "boxes"."""
+        return frozenset(kind for kind, present in (("discs", self.obstacles), ("boxes", self.boxes)) if present)
 
     @cached_property
     def box_array_m(self) -> np.ndarray:
@@ -86,28 +88,62 @@ class Problem:
         return np.array([[b.x_min_m, b.y_min_m, b.x_max_m, b.y_max_m] for b in self.boxes],
                         dtype=float).reshape(-1, 4)
 
-    def path_clearance_m(self, waypoints: np.ndarray) -> float:
-        """Exact smallest gap between a polyline and the inflated discs and boxes.
+    def segment_clearances_m(self, a: np.ndarray, b: np.ndarray, cull_beyond_m: float = math.inf) -> np.ndarray:
+        """Exact smallest gap between each segment ``a[k] -> b[k]`` and the inflated discs and boxes.
 
-        Discs by segment-disc distance, boxes by segment-box distance; a segment
-        crossing a box scores ``-inflation_m``.
+        The one implementation of "is this segment clear of the inflated
+        obstacles" (bounds are separate: :meth:`in_bounds`): segment-disc
+        distances less the inflated radii, segment-box distances less the
+        inflation (a segment crossing a box scores ``-inflation_m``).  A point is
+        the segment from it to itself.
+
+        Args:
+            a, b: (K, 2) segment ends in metres (or (2,) for one segment).
+            cull_beyond_m: boxes that do not reach the segments' joint bounding box
+                grown by the inflation plus this much are not measured; their gaps
+                (all larger than ``cull_beyond_m``) read ``inf``.  A yes/no test
+                ("is the gap >= 0?") passes 0; the default measures every box.
+
+        Returns:
+            (K,) signed gaps in metres, ``inf`` with no obstacle near.
         """
-        gap = polyline_clearance_m(waypoints, self.disc_centres_m, self.inflated_radii_m)
-        if self.boxes:
-            pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
-            if pts.shape[0] == 1:
-                pts = np.vstack([pts, pts])
-            dist = segment_box_distances(pts[:-1], pts[1:], self.box_array_m)
-            gap = min(gap, float(np.min(dist)) - self.inflation_m)
+        a = np.asarray(a, dtype=float).reshape(-1, 2)
+        b = np.asarray(b, dtype=float).reshape(-1, 2)
+        a, b = np.broadcast_arrays(a, b)
+        gap = np.full(a.shape[0], np.inf)
+        if self.obstacles and gap.size:
+            d = segment_disc_distances(a, b, self.disc_centres_m)
+            gap = np.min(d - self.inflated_radii_m[None, :], axis=1)
+        if self.boxes and gap.size:
+            boxes = self.box_array_m
+            reach_m = self.inflation_m + cull_beyond_m
+            lo = np.minimum(a.min(axis=0), b.min(axis=0)) - reach_m
+            hi = np.maximum(a.max(axis=0), b.max(axis=0)) + reach_m
+            near = (boxes[:, 0] <= hi[0]) & (boxes[:, 2] >= lo[0]) & (boxes[:, 1] <= hi[1]) & (boxes[:, 3] >= lo[1])
+            if near.any():
+                d = segment_box_distances(a, b, boxes[near])
+                gap = np.minimum(gap, d.min(axis=1) - self.inflation_m)
         return gap
 
-    def is_collision_free(self, waypoints: np.ndarray, tolerance_m: float = 1e-6) -> bool:
-        """Exact check: inside the bounds and clear of every inflated disc."""
+    def path_clearance_m(self, waypoints: np.ndarray) -> float:
+        """Exact smallest gap between a polyline and the inflated discs and boxes
+        (the minimum of :meth:`segment_clearances_m` over its segments)."""
         pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+        if pts.shape[0] == 1:
+            pts = np.vstack([pts, pts])
+        return float(np.min(self.segment_clearances_m(pts[:-1], pts[1:]), initial=np.inf))
+
+    def in_bounds(self, points: np.ndarray, tolerance_m: float = 0.0) -> np.ndarray:
+        """(K,) whether each point lies inside the bounds grown by ``tolerance_m``."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
         b = self.bounds
-        if np.any(pts[:, 0] < b.x_min_m - tolerance_m) or np.any(pts[:, 0] > b.x_max_m + tolerance_m):
-            return False
-        if np.any(pts[:, 1] < b.y_min_m - tolerance_m) or np.any(pts[:, 1] > b.y_max_m + tolerance_m):
+        return ((pts[:, 0] >= b.x_min_m - tolerance_m) & (pts[:, 0] <= b.x_max_m + tolerance_m)
+                & (pts[:, 1] >= b.y_min_m - tolerance_m) & (pts[:, 1] <= b.y_max_m + tolerance_m))
+
+    def is_collision_free(self, waypoints: np.ndarray, tolerance_m: float = 1e-6) -> bool:
+        """Exact check: inside the bounds and clear of every inflated disc and box."""
+        pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+        if not np.all(self.in_bounds(pts, tolerance_m)):
             return False
         return self.path_clearance_m(pts) >= -tolerance_m
 
@@ -154,8 +190,19 @@ class Planner(Protocol):
     """
 
     name: ClassVar[str]
+    #: The obstacle kinds the planner handles ("discs", "boxes").
+    supports: ClassVar[frozenset[str]]
 
     def plan(self, problem: Problem, rng: np.random.Generator) -> Path: ...
+
+
+def check_supported(planner: Planner, problem: Problem) -> None:
+    """Raise a :class:`ConfigError` on ``planner.name`` when ``problem`` has an obstacle kind
+    the planner does not declare in ``supports``."""
+    missing = problem.obstacle_kinds - type(planner).supports
+    if missing:
+        raise ConfigError("planner.name", f"{planner.name} supports {' and '.join(sorted(type(planner).supports))} "
+                          f"only, this problem has {' and '.join(sorted(missing))}")
 
 
 def check_endpoints(problem: Problem) -> None:

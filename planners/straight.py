@@ -17,6 +17,7 @@ class StraightPlanner:
     ``collision_free`` in the CLI tells whether that segment happens to be clear."""
 
     name: ClassVar[str] = "straight"
+    supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
 
     def plan(self, problem: Problem, rng: np.random.Generator) -> Path:
         t0 = time.perf_counter()

@@ -1,7 +1,7 @@
 """Via-point path encodings shared by every continuous swarm planner.
 
 A candidate path is ``k`` free via-points between the fixed start and goal
-(seed 001, Sect. 3: "cubic polynomial connects the start point to the end point
+(Kamil et al. 2020, Sect. 3: "cubic polynomial connects the start point to the end point
 through three via points").  The curve through the ``k + 2`` knots is sampled at
 ``samples`` points; the cost functions in :mod:`planners.path_cost` read those
 samples.
@@ -14,7 +14,7 @@ instead of one spline fit per candidate.
 * ``"spline"``: a not-a-knot cubic spline over the uniform parameter
   ``t_j = j / (k + 1)`` (the same curve as ``scipy.interpolate.CubicSpline(t,
   knots, bc_type="not-a-knot")``; with 3 knots it is the parabola through them,
-  with 2 the segment).  Seed 001 does not say how its "cubic polynomial" is
+  with 2 the segment).  Kamil et al. (2020) does not say how its "cubic polynomial" is
   parameterised; a uniform parameter is the simplest choice that is linear in
   the knots.
 * ``"polyline"``: straight segments start -> via-points -> goal, sampled
@@ -128,7 +128,7 @@ class ViaPointCurve:
         encoding: ``"spline"`` or ``"polyline"``.
         via_point_count: ``k``, the number of free via-points.
         start_m, goal_m: (2,) fixed end points.
-        samples: number of curve samples the costs see (seed 001's ``np``).
+        samples: number of curve samples the costs see (Kamil et al. 2020's ``np``).
     """
 
     encoding: str
@@ -138,6 +138,7 @@ class ViaPointCurve:
     samples: int = 100
     _via_basis: np.ndarray = field(init=False, repr=False)
     _end_offset: np.ndarray = field(init=False, repr=False)
+    _via_basis_columns: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.via_point_count < 1:
@@ -151,6 +152,7 @@ class ViaPointCurve:
         object.__setattr__(self, "start_m", start)
         object.__setattr__(self, "goal_m", goal)
         object.__setattr__(self, "_via_basis", np.ascontiguousarray(basis[:, 1:-1].T))  # (k, S)
+        object.__setattr__(self, "_via_basis_columns", np.ascontiguousarray(basis[:, 1:-1]))  # (S, k)
         # Contribution of the fixed end points: (2, S), x row then y row.
         object.__setattr__(self, "_end_offset",
                            np.outer(start, basis[:, 0]) + np.outer(goal, basis[:, -1]))
@@ -184,6 +186,15 @@ class ViaPointCurve:
         xs = pop[:, :k] @ self._via_basis + self._end_offset[0]
         ys = pop[:, k:] @ self._via_basis + self._end_offset[1]
         return xs, ys
+
+    def sample_columns(self, population: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`sample` stored sample-major: ``(xt, yt)``, each (samples, P), one column per
+        candidate (the layout the fast costs in :mod:`planners.path_cost` reduce along)."""
+        pop = np.asarray(population, dtype=float).reshape(-1, self.dimensions)
+        k = self.via_point_count
+        xt = self._via_basis_columns @ pop[:, :k].T + self._end_offset[0][:, None]
+        yt = self._via_basis_columns @ pop[:, k:].T + self._end_offset[1][:, None]
+        return xt, yt
 
     def dense_waypoints(self, solution: np.ndarray, samples: int) -> np.ndarray:
         """(N, 2) waypoints of one candidate for output and the exact check.

@@ -1,4 +1,4 @@
-"""M-ACO: the modified ant colony of Habib, Purwanto & Soeprijanto (2021), seed 002 (waiter robot).
+"""M-ACO: the modified ant colony of Habib, Purwanto & Soeprijanto (2021) (waiter robot).
 
 1. **Random nodes** (§2.2): ``nodes`` points drawn uniformly in a corridor
    around the straight start-goal line, kept only outside the inflated obstacles.
@@ -14,7 +14,9 @@ Every link an ant may take is checked against the inflated obstacles first
 (exactly, segment-disc and segment-box), so the M-ACO route never collides.
 The paper's baselines, Dijkstra and A* over the *same* nodes, run on the
 complete graph without that check (as the paper's "crash"), and the links of
-their routes that cut an inflated obstacle are reported.
+their routes that cut an inflated obstacle are reported.  They are not part of
+the optimisation: they are computed once when the nodes are drawn
+(:func:`node_baselines`, in ``init_state``) and reported by ``finish``.
 
 Readings of the paper where its text is ambiguous (our choices):
 
@@ -31,7 +33,6 @@ Readings of the paper where its text is ambiguous (our choices):
 from __future__ import annotations
 
 import heapq
-import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -39,10 +40,14 @@ import numpy as np
 
 from swarmnav.planners.ant_colony import deposit, evaporate, roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
-from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
-from swarmnav.planners.grid_search import exact_shortcut
+from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
+
+#: Most random nodes: the links are nodes^2 / 2 segments, each measured against every obstacle.
+MAX_NODES = 1_000
+#: Most ants per iteration.
+MAX_ANTS = 10_000
 
 
 def random_nodes(problem: Problem, count: int, corridor_m: float, rng: np.random.Generator,
@@ -77,36 +82,21 @@ def random_nodes(problem: Problem, count: int, corridor_m: float, rng: np.random
 def points_free(problem: Problem, pts: np.ndarray) -> np.ndarray:
     """Which points lie in the bounds and outside every inflated disc and box."""
     pts = np.asarray(pts, dtype=float).reshape(-1, 2)
-    b = problem.bounds
-    ok = (pts[:, 0] >= b.x_min_m) & (pts[:, 0] <= b.x_max_m) & (pts[:, 1] >= b.y_min_m) & (pts[:, 1] <= b.y_max_m)
-    if problem.obstacles:
-        d = np.hypot(pts[:, None, 0] - problem.disc_centres_m[None, :, 0],
-                     pts[:, None, 1] - problem.disc_centres_m[None, :, 1])
-        ok &= np.all(d >= problem.inflated_radii_m[None, :], axis=1)
-    if problem.boxes:
-        d = segment_box_distances(pts, pts, problem.box_array_m)
-        ok &= np.all(d >= problem.inflation_m, axis=1)
-    return ok
+    return problem.in_bounds(pts) & (problem.segment_clearances_m(pts, pts, cull_beyond_m=0.0) >= 0.0)
 
 
 def link_clearance_m(problem: Problem, nodes: np.ndarray) -> np.ndarray:
     """(M, M) smallest gap between each straight link and the inflated obstacles (inf with none)."""
     m = len(nodes)
     i, j = np.triu_indices(m, k=1)
-    gap = np.full(len(i), np.inf)
-    if problem.obstacles:
-        d = segment_disc_distances(nodes[i], nodes[j], problem.disc_centres_m)
-        gap = np.minimum(gap, np.min(d - problem.inflated_radii_m[None, :], axis=1))
-    if problem.boxes:
-        d = segment_box_distances(nodes[i], nodes[j], problem.box_array_m)
-        gap = np.minimum(gap, np.min(d, axis=1) - problem.inflation_m)
+    gap = problem.segment_clearances_m(nodes[i], nodes[j])
     out = np.full((m, m), np.inf)
     out[i, j] = gap
     out[j, i] = gap
     return out
 
 
-def shortest_route(distance: np.ndarray, allowed: np.ndarray, source: int, target: int,
+def dense_graph_route(distance: np.ndarray, allowed: np.ndarray, source: int, target: int,
                    heuristic: np.ndarray | None = None) -> tuple[list[int], float]:
     """Dijkstra (or A* with an admissible ``heuristic`` to the target) on a dense node graph.
 
@@ -143,12 +133,12 @@ def shortest_route(distance: np.ndarray, allowed: np.ndarray, source: int, targe
 
 @dataclass
 class WaiterAntColonyPlanner(SwarmPlanner):
-    """M-ACO (seed 002) over random nodes, with PTP linking.
+    """M-ACO (Habib et al. 2021) over random nodes, with PTP linking.
 
     Args:
-        nodes: random nodes R (the paper uses 10 and 15).
+        nodes: random nodes R (the paper uses 10 and 15; at most :data:`MAX_NODES`, 1,000).
         corridor_m: half-width of the corridor around the start-goal line.
-        ants: colony size.
+        ants: colony size (at most :data:`MAX_ANTS`, 10,000).
         iterations: colony iterations.
         alpha: pheromone gain of Eq. (3) (1).
         rho: evaporation rate of Eq. (4) (0.9, the paper's best).
@@ -158,6 +148,7 @@ class WaiterAntColonyPlanner(SwarmPlanner):
     """
 
     name: ClassVar[str] = "maco"
+    supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     nodes: int = 15
     corridor_m: float = 1.5
     ants: int = 20
@@ -171,15 +162,15 @@ class WaiterAntColonyPlanner(SwarmPlanner):
 
     def __post_init__(self) -> None:
         check_parameters(self, (
-            ("nodes", self.nodes >= 1, "must be at least 1"),
-            ("ants", self.ants >= 1, "must be at least 1"),
+            ("nodes", 1 <= self.nodes <= MAX_NODES, f"must lie in [1, {MAX_NODES:,}]"),
+            ("ants", 1 <= self.ants <= MAX_ANTS, f"must lie in [1, {MAX_ANTS:,}]"),
             ("iterations", self.iterations >= 1, "must be at least 1"),
             ("p0", 0.0 <= self.p0 <= 1.0, "must lie in [0, 1]"),
             ("rho", 0.0 <= self.rho < 1.0, "must lie in [0, 1)"),
             ("corridor_m", self.corridor_m > 0, "must be positive"),
         ))
 
-    def init_state(self, problem: Problem, rng: np.random.Generator) -> SwarmState:
+    def init_state(self, state: SwarmState, problem: Problem, rng: np.random.Generator) -> None:
         pts = random_nodes(problem, self.nodes, self.corridor_m, rng)
         nodes = np.vstack([problem.start.xy, pts, problem.goal.xy])          # 0 = start, M-1 = goal
         m = len(nodes)
@@ -189,15 +180,14 @@ class WaiterAntColonyPlanner(SwarmPlanner):
         np.fill_diagonal(safe, False)
         with np.errstate(divide="ignore"):
             tau = np.where(distance > 0, 1.0 / distance, 0.0)                             # Eq. (2)
-        data = {"nodes": nodes, "distance": distance, "clearance": clearance, "safe": safe, "tau": tau,
-                "goal": m - 1}
-        return SwarmState(best_solution=None, best_cost=math.inf, data=data)
+        state.data = {"nodes": nodes, "distance": distance, "clearance": clearance, "safe": safe, "tau": tau,
+                      "goal": m - 1, "baselines": node_baselines(distance, clearance, m - 1)}
 
     def step(self, state: SwarmState, problem: Problem, rng: np.random.Generator, iteration: int) -> None:
         data = state.data
         tau, safe, distance, goal = data["tau"], data["safe"], data["distance"], data["goal"]
         m = len(tau)
-        ants = self.ants
+        ants = int(min(self.ants, state.evaluations_left))      # a tour is one evaluation
         cur = np.zeros(ants, dtype=np.int64)
         visited = np.zeros((ants, m), dtype=bool)
         visited[:, 0] = True
@@ -238,32 +228,43 @@ class WaiterAntColonyPlanner(SwarmPlanner):
                 state.best_cost = float(length[best])
                 state.best_solution = tours[best][tours[best] >= 0].copy()
 
-    def finish(self, state: SwarmState, problem: Problem) -> tuple[np.ndarray, dict[str, Any]]:
+    def finish(self, state: SwarmState, problem: Problem,
+               rng: np.random.Generator) -> tuple[np.ndarray, dict[str, Any]]:
         data = state.data
         if state.best_solution is None:
             raise NoPathFound(f"no ant of {state.evaluations} reached the goal over collision-free links")
-        nodes, distance, clearance, goal = data["nodes"], data["distance"], data["clearance"], data["goal"]
+        nodes, clearance = data["nodes"], data["clearance"]
         route = [int(v) for v in state.best_solution]
         raw = nodes[route]
         waypoints = exact_shortcut(problem, raw) if self.shortcut else raw
-        # The paper's baselines: the same nodes, every link allowed except start-goal, no collision check.
-        unchecked = ~np.eye(len(nodes), dtype=bool)
-        unchecked[0, goal] = unchecked[goal, 0] = False
-        heuristic = distance[:, goal]
         extra: dict[str, Any] = {
             "nodes_m": nodes.tolist(),
             "route": route,
             "raw_length_m": state.best_cost,
             "route_min_clearance_m": float(min(clearance[a, b] for a, b in zip(route[:-1], route[1:]))),
         }
-        for label, h in (("dijkstra", None), ("astar", heuristic)):
-            try:
-                base_route, base_length = shortest_route(distance, unchecked, 0, goal, h)
-            except NoPathFound:
-                extra[f"{label}_route"] = None
-                continue
-            links = list(zip(base_route[:-1], base_route[1:]))
-            extra[f"{label}_route"] = base_route
-            extra[f"{label}_length_m"] = base_length
-            extra[f"{label}_colliding_links"] = [[a, b] for a, b in links if clearance[a, b] < -1e-9]
+        extra.update(data["baselines"])
         return waypoints, extra
+
+
+def node_baselines(distance: np.ndarray, clearance: np.ndarray, goal: int) -> dict[str, Any]:
+    """The paper's baselines on the same nodes: Dijkstra and A* over every link except
+    start-goal, without the collision check, and which of their links collide.
+
+    They depend only on the nodes drawn at initialisation, so they are computed
+    there (in ``init_state``), once, and ``finish`` only reports them.
+    """
+    unchecked = ~np.eye(len(distance), dtype=bool)
+    unchecked[0, goal] = unchecked[goal, 0] = False
+    out: dict[str, Any] = {}
+    for label, h in (("dijkstra", None), ("astar", distance[:, goal])):
+        try:
+            base_route, base_length = dense_graph_route(distance, unchecked, 0, goal, h)
+        except NoPathFound:
+            out[f"{label}_route"] = None
+            continue
+        links = list(zip(base_route[:-1], base_route[1:]))
+        out[f"{label}_route"] = base_route
+        out[f"{label}_length_m"] = base_length
+        out[f"{label}_colliding_links"] = [[a, b] for a, b in links if clearance[a, b] < -1e-9]
+    return out

@@ -12,8 +12,9 @@ from scipy.interpolate import CubicSpline
 from swarmnav.models.scenario import list_scenarios, load_scenario
 from swarmnav.planners import PLANNERS, make_planner
 from swarmnav.planners.bee_colony import adaptive_limit
+from swarmnav.planners.continuous import ContinuousPlanner
 from swarmnav.models.errors import ConfigError
-from swarmnav.planners.errors import GoalBlocked, NoPathFound, PlanningError, StartBlocked
+from swarmnav.planners.errors import GoalBlocked, NoPathFound, StartBlocked
 from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.path_cost import obstacle_penalty, sampled_length_m, smoothness_rad
 from swarmnav.models.world import Disc, Pose2D, Rect
@@ -21,7 +22,7 @@ from swarmnav.planners.problem import Problem
 from swarmnav.planners.via_points import not_a_knot_basis, polyline_basis
 from swarmnav.planners.problem import scenario_problem
 
-CONTINUOUS = ("abc", "adl_abc", "gwo", "pso")
+CONTINUOUS = sorted(name for name, cls in PLANNERS.items() if issubclass(cls, ContinuousPlanner))
 # Real algorithms, smaller budgets than the defaults to keep the suite fast.
 FAST = {"population": 30, "iterations": 60}
 
@@ -52,9 +53,8 @@ def optima(problems) -> dict[str, float | None]:
     return out
 
 
-def test_registered():
-    for name in CONTINUOUS + ("optimal",):
-        assert name in PLANNERS
+def test_the_continuous_planners_are_registered():
+    assert {"abc", "adl_abc", "gwo", "pso"} <= set(CONTINUOUS)
 
 
 # Thirty discs are hard for three via-points: at the test budget, over seeds 1-8,
@@ -123,7 +123,7 @@ def _one_disc_problem(start=(0.0, 0.0), goal=(10.0, 10.0)) -> Problem:
 
 
 def test_optimum_matches_closed_form_on_one_disc():
-    """Two tangents and the arc between their tangent points: seed 004 scenario 1's 14.1905 m."""
+    """Two tangents and the arc between their tangent points: Abdulla & Hadi (2025) scenario 1's 14.1905 m."""
     problem = _one_disc_problem()
     r = 0.35
     a, b = math.sqrt(2.0), 9.0 * math.sqrt(2.0)
@@ -159,7 +159,7 @@ def test_optimal_raises_typed_errors():
 
 
 def test_adaptive_limit_hand_computed():
-    """Seed 001 Eqs. (10)-(12) with MCN = 100, D = 6, limit = 5:
+    """Kamil et al. (2020) Eqs. (10)-(12) with MCN = 100, D = 6, limit = 5:
     MAXLIM = 100/6 = 16.667, MINLIM = 5/6 = 0.833, and at t = 40 the decrement is
     fix(15.833 / 100 * 40) = fix(6.333) = 6, so LIMIT = 10.667."""
     assert adaptive_limit(0, 100, 6, 5) == pytest.approx(100 / 6)
@@ -198,18 +198,30 @@ def test_bad_parameters_are_config_errors():
         make_planner("adl_abc", {"limit": 0})
 
 
-def test_bench_json_keys():
+def test_bench_planners_rows_agree_with_their_runs():
     from swarmnav.sim.benchmarks import planners as bench_continuous
 
     parser = argparse.ArgumentParser()
     bench_continuous.add_arguments(parser)
-    args = parser.parse_args(["--scenarios", "gwo-scenario-1", "--planners", "gwo", "--seeds", "2",
-                              "--population", "10", "--iterations", "5", "--peer-runs", "0"])
+    args = parser.parse_args(["--scenarios", "gwo-scenario-1", "adl-abc-path-1", "--planners", "gwo", "pso",
+                              "--seeds", "2", "--population", "10", "--iterations", "5", "--peer-runs", "0"])
     result = bench_continuous.benchmark(args)
-    row = result["rows"][0]
-    assert set(row) >= {"scenario", "planner", "runs", "feasible_runs", "best_length_m", "median_length_m",
-                        "std_length_m", "optimum_length_m", "ratio_to_optimum", "mean_plan_time_s",
-                        "evaluations", "paper_length_m"}
-    assert row["paper_length_m"] == 14.0541 and "impossible" in row["note"]
-    assert row["optimum_length_m"] == pytest.approx(14.1905, abs=5e-5)
     assert result["peers"] == []
+    rows = {(r["scenario"], r["planner"]): r for r in result["rows"]}
+    assert set(rows) == {(s, p) for s in ("gwo-scenario-1", "adl-abc-path-1") for p in ("gwo", "pso")}
+    problem = scenario_problem(load_scenario("gwo-scenario-1"), clearance_m=0.0)
+    optimum = OptimalPlanner().plan(problem, np.random.default_rng(0)).stats.extra["optimum_length_m"]
+    for (scenario, planner), row in rows.items():
+        assert 0 <= row["feasible_runs"] <= row["runs"] == 2
+        if scenario == "adl-abc-path-1":         # no path exists there: every run fails, the note says why
+            assert row["optimum_length_m"] is None and row["feasible_runs"] == 0
+            assert "no collision-free path" in row["note"] or row["paper_length_m"] is None
+            continue
+        assert row["optimum_length_m"] == pytest.approx(optimum)
+        if row["median_length_m"] is not None:
+            assert row["best_length_m"] <= row["median_length_m"]
+            assert row["ratio_to_optimum"] == pytest.approx(row["median_length_m"] / optimum)
+            assert row["best_length_m"] >= optimum - 1e-9
+        # A paper value below the exact optimum is flagged impossible, any other is not.
+        paper = row["paper_length_m"]
+        assert ("impossible" in row["note"]) == (paper is not None and paper < optimum)

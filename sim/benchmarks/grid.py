@@ -203,7 +203,8 @@ def bench_peers(names: list[str] | None, repeats: int = 20) -> list[dict[str, An
         from pathfinding.finder.a_star import AStarFinder
     except ImportError:
         return {"skipped": "the pathfinding package is not importable (pip install swarmnav[bench])"}
-    from swarmnav.planners.grid_search import ADJACENCY, astar_cells
+    from swarmnav.planners.grid_graph import ADJACENCY
+    from swarmnav.planners.grid_search import astar_cells
 
     ours_s = theirs_s = ours_cold_s = 0.0
     plans = 0

@@ -51,7 +51,7 @@ DEFAULT_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3",
 DEFAULT_PLANNERS = ("abc", "adl_abc", "gwo", "pso")
 PEERS = (("gwo", "mealpy.OriginalGWO"), ("abc", "mealpy.OriginalABC"))
 
-# Lengths the papers report for their best path (seed 004 Sects. 6.1-6.3; seed 001 Table 2).
+# Lengths the papers report for their best path (Abdulla & Hadi 2025 Sects. 6.1-6.3; Kamil et al. 2020 Table 2).
 PAPER_LENGTHS_M: dict[tuple[str, str], float] = {
     ("gwo-scenario-1", "abc"): 14.255, ("gwo-scenario-1", "gwo"): 14.0541,
     ("gwo-scenario-2", "abc"): 14.8913, ("gwo-scenario-2", "gwo"): 14.566,

@@ -1,0 +1,182 @@
+"""Contracts every registered planner keeps, run over the ``PLANNERS`` registry and every
+bundled scenario: what it returns, what it supports, its evaluation budget and its
+resource caps."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import list_scenarios, load_scenario
+from swarmnav.planners import PLANNERS, make_planner, register
+from swarmnav.planners.errors import BudgetExceeded, NoPathFound, PlanningError
+from swarmnav.planners.problem import scenario_problem
+from swarmnav.sim import cli
+
+SCENARIOS = list_scenarios()
+
+
+def fields_of(name: str) -> set[str]:
+    return {f.name for f in dataclasses.fields(PLANNERS[name]) if f.init}
+
+
+def small_budget(name: str) -> dict:
+    """Parameters that keep a run short, chosen by the fields a planner has."""
+    fields = fields_of(name)
+    params = {}
+    if "population" in fields:
+        params.update(population=20, iterations=20)
+    if "ants" in fields:
+        params.update(ants=10, iterations=10)
+    return params
+
+
+@pytest.fixture(scope="module")
+def problems():
+    return {name: scenario_problem(load_scenario(name)) for name in SCENARIOS}
+
+
+def test_every_planner_declares_its_name_and_the_obstacles_it_supports():
+    for name, cls in PLANNERS.items():
+        assert cls.name == name
+        assert cls.supports and cls.supports <= {"discs", "boxes"}, name
+
+    @dataclasses.dataclass
+    class Undeclared:
+        name = "undeclared"
+
+        def plan(self, problem, rng):
+            raise NotImplementedError
+
+    with pytest.raises(TypeError):
+        register(Undeclared)
+    with pytest.raises(ValueError):
+        register(PLANNERS["astar"])
+
+
+@pytest.mark.parametrize("planner_name", sorted(PLANNERS))
+def test_every_planner_on_every_bundled_scenario_it_supports(planner_name, problems):
+    """A returned path starts and ends exactly at the endpoints and passes the exact check
+    (``straight`` returns the bare segment); failures are typed; a scenario with an obstacle
+    kind the planner does not support is a ConfigError naming the planner."""
+    cls = PLANNERS[planner_name]
+    planned = 0
+    for scenario_name, problem in problems.items():
+        planner = make_planner(planner_name, small_budget(planner_name))
+        if not problem.obstacle_kinds <= cls.supports:
+            with pytest.raises(ConfigError) as err:
+                planner.plan(problem, np.random.default_rng(0))
+            assert err.value.field == "planner.name"
+            continue
+        try:
+            path = planner.plan(problem, np.random.default_rng(0))
+        except PlanningError:
+            continue
+        planned += 1
+        assert np.array_equal(path.waypoints[0], problem.start.xy), scenario_name
+        assert np.array_equal(path.waypoints[-1], problem.goal.xy), scenario_name
+        if planner_name == "straight":
+            assert len(path.waypoints) == 2
+        else:
+            assert problem.is_collision_free(path.waypoints), scenario_name
+        assert path.stats.length_m >= np.hypot(*(problem.goal.xy - problem.start.xy)) - 1e-9
+    assert planned >= 3, planner_name
+
+
+def budgeted_planners() -> list[str]:
+    return sorted(name for name in PLANNERS if "max_evaluations" in fields_of(name))
+
+
+def test_the_swarm_planners_are_the_budgeted_ones():
+    assert {"abc", "adl_abc", "gwo", "pso", "iaco", "immas", "maco"} <= set(budgeted_planners())
+
+
+@pytest.mark.parametrize("planner_name", budgeted_planners())
+@pytest.mark.parametrize("scenario_name", ["dense-field-30", "restaurant-table-5"])
+def test_max_evaluations_holds_repair_included(planner_name, scenario_name, capsys):
+    """``swarmnav plan S --planner P --set max_evaluations=100 --json`` reports at most 100."""
+    code = cli.main(["plan", scenario_name, "--planner", planner_name, "--set", "max_evaluations=100",
+                     "--json", "--seed", "1"])
+    out, err = capsys.readouterr()
+    if code == 3:
+        assert "BudgetExceeded" in err or "NoPathFound" in err
+        return
+    assert code == 0, err
+    assert json.loads(out)["evaluations"] <= 100
+
+
+def test_the_repair_counts_against_the_budget():
+    """Without a budget the repair would spend its own evaluations; with one it stops at it."""
+    problem = scenario_problem(load_scenario("dense-field-30"))
+    unlimited = make_planner("abc", {"population": 10, "iterations": 5})
+    repaired = None
+    for seed in range(20):
+        try:
+            path = unlimited.plan(problem, np.random.default_rng(seed))
+        except NoPathFound:
+            continue
+        if path.stats.extra["repaired"] == "fine_penalty":
+            repaired = (seed, path.stats.evaluations)
+            break
+    assert repaired is not None, "no seed needed the fine-penalty repair"
+    seed, spent = repaired
+    search_only = spent - path.stats.extra["repair_rounds"] * 10 - 1
+    assert search_only > 0
+    budget = search_only + 3          # room for the repair's first evaluation and a part of one batch
+    limited = make_planner("abc", {"population": 10, "iterations": 5, "max_evaluations": budget})
+    try:
+        path = limited.plan(problem, np.random.default_rng(seed))
+    except BudgetExceeded:
+        return
+    assert path.stats.evaluations <= budget
+
+
+def test_budget_spent_without_a_path_is_budget_exceeded():
+    problem = scenario_problem(load_scenario("dense-field-30"))
+    with pytest.raises(BudgetExceeded):
+        make_planner("gwo", {"max_evaluations": 60}).plan(problem, np.random.default_rng(1))
+    # Without a budget the same failure is NoPathFound.
+    with pytest.raises(NoPathFound) as err:
+        make_planner("gwo", {"population": 4, "iterations": 1, "repair_rounds": 0}).plan(
+            problem, np.random.default_rng(1))
+    assert not isinstance(err.value, BudgetExceeded)
+
+
+@pytest.mark.parametrize("planner_name", sorted(PLANNERS))
+def test_same_seed_same_path(planner_name, problems):
+    problem = problems["restaurant-table-2" if "discs" in PLANNERS[planner_name].supports else "iaco-complex"]
+    params = small_budget(planner_name)
+    try:
+        one = make_planner(planner_name, params).plan(problem, np.random.default_rng(7))
+    except PlanningError as exc:
+        with pytest.raises(type(exc)):
+            make_planner(planner_name, params).plan(problem, np.random.default_rng(7))
+        return
+    two = make_planner(planner_name, params).plan(problem, np.random.default_rng(7))
+    assert one.same_as(two)
+
+
+# -- caps: each oversized request is refused before anything is allocated ----------
+
+@pytest.mark.parametrize("planner_name, setting, field, needed", [
+    ("gwo", "population=100000000", "planner.params.population", "10,000,000,000"),
+    ("abc", "population=100000000", "planner.params.population", "10,000,000,000"),
+    ("maco", "nodes=1000000", "planner.params.nodes", "1000000"),
+    ("maco", "ants=100000000", "planner.params.ants", "100000000"),
+    ("iaco", "ants=100000000", "planner.params.ants", "100000000"),
+    ("astar", "cell_m=0.0001", "planner.params.cell_m", "10,000,000,000"),
+    ("immas", "cell_m=0.0001", "planner.params.cell_m", "10,000,000,000"),
+    ("iaco", "cell_m=0.005", "planner.params.cell_m", "4,000,000"),
+    ("gwo", "iterations=nan", "planner.params.iterations", "nan"),
+    ("iaco", "iterations=nan", "planner.params.iterations", "nan"),
+])
+def test_oversized_or_bad_numbers_are_config_errors_naming_the_field(planner_name, setting, field, needed, capsys):
+    code = cli.main(["plan", "gwo-scenario-1", "--planner", planner_name, "--set", setting, "--json"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert field in err and needed in err
+    assert len(err.strip().splitlines()) == 1
