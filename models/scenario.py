@@ -32,6 +32,8 @@ MAX_GRID_CELLS = 16_000_000    # the planning grid: 200 x 200 m at 0.05 m per ce
 MAX_CONTROL_STEPS = 1_000_000  # time_limit_s x control_hz (the runner keeps every pose): 5.5 h at 50 Hz
 MAX_PHYSICS_STEPS = 200_000_000  # time_limit_s / timestep_s: 111 h at 500 Hz
 MAX_TRACK_SAMPLES = 20_000_000   # control steps x moving obstacles (positions computed up front)
+MIN_LENGTH_M = 0.001           # obstacle radii and heights, map cells, sensor range: MuJoCo's XML keeps ~6 digits
+MIN_TIMESTEP_S = 1e-6
 MAX_WALK_STEPS = 100_000       # random-walk periods over all walks, drawn up front (about 3 s of work)
 
 
@@ -149,7 +151,7 @@ class _Table:
         return self.data[key]
 
     def number(self, key: str, default: Any = ..., *, positive: bool = False,
-               non_negative: bool = False) -> float:
+               non_negative: bool = False, minimum: float | None = None) -> float:
         value = self.raw(key, default)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self.fail(key, f"expected a number, got {value!r}")
@@ -160,6 +162,8 @@ class _Table:
             self.fail(key, f"must be positive, got {value:g}")
         if non_negative and value < 0:
             self.fail(key, f"must not be negative, got {value:g}")
+        if minimum is not None and value < minimum:
+            self.fail(key, f"must be at least {minimum:g}, got {value:g}")
         return value
 
     def integer(self, key: str, default: Any = ..., *, minimum: int | None = None,
@@ -276,7 +280,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
 
     sensors = top.table("sensors", {})
     sensor_count = sensors.integer("count", 12, minimum=1, maximum=MAX_SENSORS)
-    sensor_range_m = sensors.number("range_m", 0.4, positive=True)
+    sensor_range_m = sensors.number("range_m", 0.4, positive=True, minimum=MIN_LENGTH_M)
     sensors.close()
 
     planner = top.table("planner", {})
@@ -294,7 +298,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     navigator.close()
 
     sim_t = top.table("sim", {})
-    sim = SimSettings(timestep_s=sim_t.number("timestep_s", 0.002, positive=True),
+    sim = SimSettings(timestep_s=sim_t.number("timestep_s", 0.002, positive=True, minimum=MIN_TIMESTEP_S),
                       control_hz=sim_t.number("control_hz", 50.0, positive=True),
                       stop_on_collision=sim_t.boolean("stop_on_collision", False))
     cell_m = sim_t.number("cell_m", 0.05, positive=True)
@@ -320,8 +324,8 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         if not (0.0 <= x <= width_m and 0.0 <= y <= height_m):
             t.fail("x" if not 0.0 <= x <= width_m else "y",
                    f"the centre ({x:g}, {y:g}) must lie in the arena [0, {width_m:g}] x [0, {height_m:g}]")
-        radius = t.number("radius_m", positive=True)
-        height = t.number("height_m", 0.5, positive=True)
+        radius = t.number("radius_m", positive=True, minimum=MIN_LENGTH_M)
+        height = t.number("height_m", 0.5, positive=True, minimum=MIN_LENGTH_M)
         motion_raw = t.raw("motion", None)
         parsed.append((t, x, y, radius, height, motion_raw))
         if motion_raw is None:
@@ -485,7 +489,7 @@ def _parse_map(top: _Table, source: str, width_m: float, height_m: float
 
     t = top.table("map")
     name = t.string("file")
-    cell_m = t.number("cell_m", positive=True)
+    cell_m = t.number("cell_m", positive=True, minimum=MIN_LENGTH_M)
     pairs = t.raw("pairs", [])
     t.close()
     if not isinstance(pairs, list) or not all(

@@ -99,7 +99,7 @@ OVERSIZED = [
     (lambda t: t + "\n[sim]\ncell_m = 0.0001\n", "sim.cell_m", "2.5e+09"),
     (lambda t: t.replace("time_limit_s = 30.0", "time_limit_s = 1e12"), "time_limit_s", "5e+14"),
     (lambda t: t.replace("time_limit_s = 30.0", "time_limit_s = 1e300"), "time_limit_s", ""),
-    (lambda t: t + "\n[sim]\ntimestep_s = 1e-300\ncontrol_hz = 1e300\n", "time_limit_s", ""),
+    (lambda t: t + "\n[sim]\ntimestep_s = 1e-6\ncontrol_hz = 1e6\n", "time_limit_s", "3e+07"),
     (lambda t: t.replace("radius_m = 0.5\n", "radius_m = 0.5\nmotion = { kind = \"random_walk\", "
                                            "step_m = 0.1, period_s = 1e-9 }\n"),
      "obstacles[0].motion.period_s", "3e+10"),
@@ -307,3 +307,14 @@ def test_an_unanticipated_exception_is_reported_as_a_bug_with_its_traceback_save
     saved = list(tmp_path.glob("swarmnav-bug-*.txt"))
     assert len(saved) == 1 and str(saved[0]) in lines[0]
     assert "Traceback" in saved[0].read_text() and "no such key" in saved[0].read_text()
+
+
+@pytest.mark.parametrize("edit, field", [
+    (lambda t: t.replace("radius_m = 0.5", "radius_m = 1e-300"), "obstacles[0].radius_m"),
+    (lambda t: t.replace("radius_m = 0.5", "radius_m = 0.5\nheight_m = 1e-300"), "obstacles[0].height_m"),
+    (lambda t: t.replace("range_m = 0.4", "range_m = 1e-300"), "sensors.range_m"),
+    (lambda t: t + "\n[sim]\ntimestep_s = 1e-300\n", "sim.timestep_s"),
+])
+def test_sizes_too_small_for_the_mujoco_model_are_refused_not_a_bug(tmp_path, capsys, edit, field):
+    # Each parsed before and then failed to compile (MuJoCo's XML rounds them to 0).
+    assert f": {field}:" in bad_input(capsys, "run", write(tmp_path, edit(BASE)), "--no-log")
