@@ -160,12 +160,12 @@ def ten_thousand_discs_text(count: int = 10_000, seed: int = 7) -> str:
 
 def test_ten_thousand_discs_plan_with_astar_and_build_a_scene():
     from swarmnav.planners.problem import scenario_problem
-    from swarmnav.sim.runner import plan_scenario
+    from swarmnav.sim.episode import EpisodeSpec, plan_episode
 
     t0 = time.perf_counter()
     scenario = parse_scenario(ten_thousand_discs_text(), "<10k>")
     t1 = time.perf_counter()
-    path = plan_scenario(scenario, "astar", {}, 0)[0]
+    path = plan_episode(EpisodeSpec(scenario, planner="astar", seed=0)).path
     t2 = time.perf_counter()
     scene = compile_scene(scenario)
     t3 = time.perf_counter()
