@@ -48,11 +48,15 @@ class MovingAIScenario:
         return self.goal_row, self.goal_col
 
 
-def parse_map(text: str, source: str = "<map>") -> np.ndarray:
+def parse_map(text: str, source: str = "<map>", max_cells: int | None = None) -> np.ndarray:
     """Occupied cells of a Moving AI map, in file order (row 0 = the file's first map row).
 
+    Every row is checked before the grid is allocated, so a header that
+    declares more cells than the file holds (or than ``max_cells``) costs nothing.
+
     Raises:
-        ConfigError: a malformed header, a wrong row count or width, or an unknown character.
+        ConfigError: a malformed header, a wrong row count or width, an unknown
+            character, or more than ``max_cells`` cells.
     """
     lines = text.splitlines()
     header: dict[str, str] = {}
@@ -72,29 +76,36 @@ def parse_map(text: str, source: str = "<map>") -> np.ndarray:
         raise ConfigError("header", "needs integer 'height' and 'width'", source) from None
     if height < 1 or width < 1:
         raise ConfigError("header", f"height and width must be positive, got {height} x {width}", source)
+    if max_cells is not None and height * width > max_cells:
+        raise ConfigError("header", f"a {width} x {height} map has {height * width:,} cells "
+                          f"(at most {max_cells:,})", source)
     rows = [line.rstrip("\r\n") for line in lines[i + 1:i + 1 + height]]
     if len(rows) != height:
         raise ConfigError("map", f"expected {height} rows, found {len(rows)}", source)
-    occupied = np.zeros((height, width), dtype=bool)
     for r, row in enumerate(rows):
         if len(row) < width:
             raise ConfigError(f"map row {r}", f"expected {width} characters, found {len(row)}", source)
-        for c, ch in enumerate(row[:width]):
-            if ch in BLOCKED:
-                occupied[r, c] = True
-            elif ch not in PASSABLE:
-                raise ConfigError(f"map row {r}", f"unknown character {ch!r} at column {c}", source)
+    # One code point per cell, classified with NumPy rather than per character.
+    codes = np.frombuffer("".join(row[:width] for row in rows).encode("utf-32-le"),
+                          dtype=np.uint32).reshape(height, width)
+    occupied = np.isin(codes, [ord(ch) for ch in BLOCKED])
+    unknown = ~occupied & ~np.isin(codes, [ord(ch) for ch in PASSABLE])
+    if unknown.any():
+        r, c = np.argwhere(unknown)[0]
+        raise ConfigError(f"map row {r}", f"unknown character {chr(codes[r, c])!r} at column {c}", source)
     return occupied
 
 
-def read_map(path: str | os.PathLike) -> np.ndarray:
-    """:func:`parse_map` of a file."""
+def read_map(path: str | os.PathLike, max_cells: int | None = None) -> np.ndarray:
+    """:func:`parse_map` of a file (a text file: a binary one is a ConfigError)."""
     path = FilePath(path)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
-        raise ConfigError("map", f"cannot be read ({exc})", str(path)) from None
-    return parse_map(text, str(path))
+        raise ConfigError("map", f"cannot be read ({exc.strerror or exc})", str(path)) from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError("map", f"is not a text map (byte {exc.start} is not UTF-8)", str(path)) from None
+    return parse_map(text, str(path), max_cells)
 
 
 def format_map(occupied_file_order: np.ndarray) -> str:

@@ -22,6 +22,20 @@ from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoi
 SCENARIO_DIR = FilePath(__file__).resolve().parent / "scenarios"
 MOTION_KINDS = ("linear", "random_walk", "waypoints")
 
+# Stated maxima (README "Limits"), each checked before anything of that size is
+# allocated, so an oversized request is a ConfigError naming the field, not an
+# exhausted memory.
+MAX_NAME_CHARS = 64            # ``name`` becomes part of the default log file name
+MAX_SENSORS = 360              # rangefinders, evenly spaced (1 degree apart at most)
+MIN_ROBOT_RADIUS_M = 0.05      # smaller robots than the base scaled to 1/3 of its size are not modelled
+MAX_GRID_CELLS = 16_000_000    # the planning grid: 200 x 200 m at 0.05 m per cell
+MAX_CONTROL_STEPS = 1_000_000  # time_limit_s x control_hz (the runner keeps every pose): 5.5 h at 50 Hz
+MAX_PHYSICS_STEPS = 200_000_000  # time_limit_s / timestep_s: 111 h at 500 Hz
+MAX_TRACK_SAMPLES = 20_000_000   # control steps x moving obstacles (positions computed up front)
+MIN_LENGTH_M = 0.001           # obstacle radii and heights, map cells, sensor range: MuJoCo's XML keeps ~6 digits
+MIN_TIMESTEP_S = 1e-6
+MAX_WALK_STEPS = 100_000       # random-walk periods over all walks, drawn up front (about 3 s of work)
+
 
 @dataclass(frozen=True)
 class Obstacle:
@@ -137,7 +151,7 @@ class _Table:
         return self.data[key]
 
     def number(self, key: str, default: Any = ..., *, positive: bool = False,
-               non_negative: bool = False) -> float:
+               non_negative: bool = False, minimum: float | None = None) -> float:
         value = self.raw(key, default)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self.fail(key, f"expected a number, got {value!r}")
@@ -148,14 +162,19 @@ class _Table:
             self.fail(key, f"must be positive, got {value:g}")
         if non_negative and value < 0:
             self.fail(key, f"must not be negative, got {value:g}")
+        if minimum is not None and value < minimum:
+            self.fail(key, f"must be at least {minimum:g}, got {value:g}")
         return value
 
-    def integer(self, key: str, default: Any = ..., *, minimum: int | None = None) -> int:
+    def integer(self, key: str, default: Any = ..., *, minimum: int | None = None,
+                maximum: int | None = None) -> int:
         value = self.raw(key, default)
         if isinstance(value, bool) or not isinstance(value, int):
             self.fail(key, f"expected an integer, got {value!r}")
         if minimum is not None and value < minimum:
             self.fail(key, f"must be at least {minimum}, got {value}")
+        if maximum is not None and value > maximum:
+            self.fail(key, f"must be at most {maximum}, got {value}")
         return int(value)
 
     def boolean(self, key: str, default: Any = ...) -> bool:
@@ -179,7 +198,9 @@ class _Table:
         """Reject keys that were never read."""
         unknown = sorted(set(self.data) - self.used)
         if unknown:
-            self.fail(unknown[0], "unknown key")
+            key = unknown[0]
+            # A key that would not read as one (empty, control characters) is shown quoted.
+            self.fail(key if key.isprintable() and key.strip() else repr(key), "unknown key")
 
 
 def list_scenarios() -> list[str]:
@@ -224,6 +245,9 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     top = _Table(data, "", source)
 
     name = top.string("name")
+    problem = name_problem(name)
+    if problem:
+        top.fail("name", problem)
     description = top.string("description", "")
     seed = top.integer("seed", 0, minimum=0)
     time_limit_s = top.number("time_limit_s", 150.0, positive=True)
@@ -236,6 +260,9 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
 
     robot = top.table("robot", {})
     robot_radius_m = robot.number("radius_m", 0.15, positive=True)
+    if robot_radius_m < MIN_ROBOT_RADIUS_M:
+        robot.fail("radius_m", f"must be at least {MIN_ROBOT_RADIUS_M:g} m (the smallest base modelled), "
+                               f"got {robot_radius_m:g}")
     max_speed_m_s = robot.number("max_speed_m_s", 0.2, positive=True)
     clearance_m = robot.number("clearance_m", 0.05, non_negative=True)
     robot.close()
@@ -252,8 +279,8 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     goal_t.close()
 
     sensors = top.table("sensors", {})
-    sensor_count = sensors.integer("count", 12, minimum=1)
-    sensor_range_m = sensors.number("range_m", 0.4, positive=True)
+    sensor_count = sensors.integer("count", 12, minimum=1, maximum=MAX_SENSORS)
+    sensor_range_m = sensors.number("range_m", 0.4, positive=True, minimum=MIN_LENGTH_M)
     sensors.close()
 
     planner = top.table("planner", {})
@@ -271,17 +298,16 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     navigator.close()
 
     sim_t = top.table("sim", {})
-    sim = SimSettings(timestep_s=sim_t.number("timestep_s", 0.002, positive=True),
+    sim = SimSettings(timestep_s=sim_t.number("timestep_s", 0.002, positive=True, minimum=MIN_TIMESTEP_S),
                       control_hz=sim_t.number("control_hz", 50.0, positive=True),
                       stop_on_collision=sim_t.boolean("stop_on_collision", False))
     cell_m = sim_t.number("cell_m", 0.05, positive=True)
     sim_t.close()
-    steps_per_control = 1.0 / (sim.control_hz * sim.timestep_s)
-    if abs(steps_per_control - round(steps_per_control)) > 1e-9 or round(steps_per_control) < 1:
-        raise ConfigError("sim.control_hz", "the control period must be a whole number of physics "
-                          f"timesteps (got {steps_per_control:g} steps)", source)
+    _check_run_size(time_limit_s, sim, source)
 
     boxes, map_grid, map_cell_m = _parse_map(top, source, width_m, height_m)
+    if map_cell_m is None:
+        _check_grid_size(width_m, height_m, cell_m, "sim.cell_m" if sim_t.has("cell_m") else "arena", source)
 
     raw_obstacles = top.raw("obstacles", [])
     if not isinstance(raw_obstacles, list):
@@ -295,8 +321,11 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     parsed = []
     for i, t in enumerate(static_tables):
         x, y = t.number("x"), t.number("y")
-        radius = t.number("radius_m", positive=True)
-        height = t.number("height_m", 0.5, positive=True)
+        if not (0.0 <= x <= width_m and 0.0 <= y <= height_m):
+            t.fail("x" if not 0.0 <= x <= width_m else "y",
+                   f"the centre ({x:g}, {y:g}) must lie in the arena [0, {width_m:g}] x [0, {height_m:g}]")
+        radius = t.number("radius_m", positive=True, minimum=MIN_LENGTH_M)
+        height = t.number("height_m", 0.5, positive=True, minimum=MIN_LENGTH_M)
         motion_raw = t.raw("motion", None)
         parsed.append((t, x, y, radius, height, motion_raw))
         if motion_raw is None:
@@ -305,6 +334,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     static_centres_arr = np.array(static_centres, dtype=float).reshape(-1, 2)
     static_radii_arr = np.array(static_radii, dtype=float)
 
+    _check_motion_size(parsed, time_limit_s, sim, source)
     obstacles = []
     for i, (t, x, y, radius, height, motion_raw) in enumerate(parsed):
         motion = None
@@ -325,11 +355,16 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
             else:
                 points = m.raw("points")
                 if (not isinstance(points, list) or not points
-                        or not all(isinstance(p, list) and len(p) == 2 for p in points)):
-                    m.fail("points", "expected a non-empty array of [x, y] pairs")
+                        or not all(isinstance(p, list) and len(p) == 2 and all(
+                            isinstance(v, (int, float)) and not isinstance(v, bool) for v in p) for p in points)):
+                    m.fail("points", "expected a non-empty array of [x, y] number pairs")
                 arr = np.array(points, dtype=float)
                 if not np.all(np.isfinite(arr)):
                     m.fail("points", "must be finite")
+                outside = np.flatnonzero((arr < 0.0).any(axis=1) | (arr[:, 0] > width_m) | (arr[:, 1] > height_m))
+                if len(outside):
+                    m.fail(f"points[{outside[0]}]", f"({arr[outside[0], 0]:g}, {arr[outside[0], 1]:g}) must lie "
+                                                    f"in the arena [0, {width_m:g}] x [0, {height_m:g}]")
                 motion = WaypointMotion(np.vstack([[x, y], arr]), m.number("speed_m_s", positive=True))
             m.close()
         t.close()
@@ -359,6 +394,82 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     return scenario
 
 
+def name_problem(name: str) -> str | None:
+    """Why a scenario name cannot be part of a file name, or None.
+
+    The name is used in the default log path, so it must be a plain file-name
+    part: printable, no path separator, not ``.`` or ``..``, at most
+    :data:`MAX_NAME_CHARS` characters.
+    """
+    if not name.strip():
+        return "must not be empty"
+    if len(name) > MAX_NAME_CHARS:
+        return f"must be at most {MAX_NAME_CHARS} characters, got {len(name)}"
+    bad = next((ch for ch in name if not ch.isprintable()), None)
+    if bad is not None:
+        return f"must be printable, has {bad!r}"
+    if "/" in name or "\\" in name:
+        return f"must not contain a path separator ('/' or '\\'), got {name!r}"
+    if name in (".", ".."):
+        return f"must name a file, got {name!r}"
+    return None
+
+
+def _check_run_size(time_limit_s: float, sim: SimSettings, source: str) -> None:
+    """The physics and control step counts of a run, against their stated maxima."""
+    physics_steps = time_limit_s / sim.timestep_s
+    if not physics_steps <= MAX_PHYSICS_STEPS:
+        raise ConfigError("time_limit_s", f"{time_limit_s:g} s at a {sim.timestep_s:g} s timestep needs "
+                          f"{physics_steps:.4g} physics steps (at most {MAX_PHYSICS_STEPS:,})", source)
+    steps_per_control = 1.0 / (sim.control_hz * sim.timestep_s)
+    if not math.isfinite(steps_per_control) or abs(steps_per_control - round(steps_per_control)) > 1e-9 \
+            or round(steps_per_control) < 1:
+        raise ConfigError("sim.control_hz", "the control period must be a whole number of physics "
+                          f"timesteps (got {steps_per_control:g} steps)", source)
+    control_steps = time_limit_s * sim.control_hz
+    if not control_steps <= MAX_CONTROL_STEPS:
+        raise ConfigError("time_limit_s", f"{time_limit_s:g} s at {sim.control_hz:g} Hz needs {control_steps:.4g} "
+                          f"control steps (at most {MAX_CONTROL_STEPS:,})", source)
+
+
+def _check_grid_size(width_m: float, height_m: float, cell_m: float, field_name: str, source: str) -> None:
+    """The planning grid of the arena at ``cell_m``, against :data:`MAX_GRID_CELLS`."""
+    cells = math.ceil(min(width_m / cell_m, 1e300)) * math.ceil(min(height_m / cell_m, 1e300))
+    if cells > MAX_GRID_CELLS:
+        smallest = math.sqrt(width_m * height_m / MAX_GRID_CELLS)
+        raise ConfigError(field_name, f"a {width_m:g} x {height_m:g} m arena at {cell_m:g} m per cell needs "
+                          f"{cells:.4g} grid cells (at most {MAX_GRID_CELLS:,}; a cell of about "
+                          f"{smallest:.3g} m or more fits)", source)
+
+
+def _check_motion_size(parsed: list, time_limit_s: float, sim: SimSettings, source: str) -> None:
+    """Precomputed obstacle motion against :data:`MAX_TRACK_SAMPLES` and :data:`MAX_WALK_STEPS`.
+
+    Only the raw ``kind`` and ``period_s`` are looked at here; their types are
+    checked (with the same field names) when the motion is parsed.
+    """
+    moving = [(i, raw) for i, (_t, _x, _y, _r, _h, raw) in enumerate(parsed) if raw is not None]
+    control_steps = math.floor(time_limit_s * sim.control_hz + 1e-9) + 1
+    if moving and control_steps * len(moving) > MAX_TRACK_SAMPLES:
+        raise ConfigError("time_limit_s", f"{len(moving)} moving obstacles over {control_steps:,} control steps "
+                          f"need {control_steps * len(moving):,} precomputed positions "
+                          f"(at most {MAX_TRACK_SAMPLES:,})", source)
+    walk_steps = 0
+    for i, raw in moving:
+        if not isinstance(raw, dict) or raw.get("kind") != "random_walk":
+            continue
+        period = raw.get("period_s")
+        if isinstance(period, bool) or not isinstance(period, (int, float)) or not period > 0 \
+                or not math.isfinite(period):
+            continue  # reported as a type or range error when the motion is parsed
+        walk_steps += math.ceil(min(time_limit_s / period, 1e300)) + 2
+        if walk_steps > MAX_WALK_STEPS:
+            raise ConfigError(f"obstacles[{i}].motion.period_s",
+                              f"random walks with periods down to {period:g} s over {time_limit_s:g} s need "
+                              f"{walk_steps:.4g} steps drawn up front (at most {MAX_WALK_STEPS:,} over all walks)",
+                              source)
+
+
 def _parse_map(top: _Table, source: str, width_m: float, height_m: float
                ) -> tuple[tuple[Box, ...], OccupancyGrid | None, float | None]:
     """The optional ``[map]`` table: a Moving AI ``.map`` file and its cell size.
@@ -378,7 +489,7 @@ def _parse_map(top: _Table, source: str, width_m: float, height_m: float
 
     t = top.table("map")
     name = t.string("file")
-    cell_m = t.number("cell_m", positive=True)
+    cell_m = t.number("cell_m", positive=True, minimum=MIN_LENGTH_M)
     pairs = t.raw("pairs", [])
     t.close()
     if not isinstance(pairs, list) or not all(
@@ -391,10 +502,13 @@ def _parse_map(top: _Table, source: str, width_m: float, height_m: float
     if path is None:
         raise ConfigError("map.file", f"no map file {name!r} beside the scenario or under models/maps/", source)
     try:
-        occupied = read_map(path)
+        occupied = read_map(path, MAX_GRID_CELLS)
     except ConfigError as exc:
         raise ConfigError("map.file", f"{path.name}: {exc.field}: {exc.problem}", source) from None
     rows, cols = occupied.shape
+    if rows * cols > MAX_GRID_CELLS:
+        raise ConfigError("map.file", f"a {cols} x {rows} map has {rows * cols:,} cells "
+                          f"(at most {MAX_GRID_CELLS:,})", source)
     if abs(cols * cell_m - width_m) > 1e-6 or abs(rows * cell_m - height_m) > 1e-6:
         raise ConfigError("map.cell_m", f"a {cols} x {rows} map at {cell_m:g} m per cell spans "
                           f"{cols * cell_m:g} x {rows * cell_m:g} m, not the arena's {width_m:g} x {height_m:g} m",

@@ -1,8 +1,9 @@
 """The ``swarmnav`` command line.
 
-Exit codes: 0 the command ran (whether or not the goal was reached); 2 bad
-input (one line on stderr naming the file, the field and the problem); 3 the
-planner found no path.
+Exit codes: 0 the command ran (whether or not the goal was reached); 1 a bug
+(an exception nothing anticipated: one line saying so and where the full
+traceback was saved); 2 bad input (one line on stderr naming the file, the
+field and the problem); 3 the planner found no path.
 """
 
 from __future__ import annotations
@@ -20,14 +21,14 @@ from typing import Any, Callable
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
-from swarmnav.sim import log_commands, plot, replay
+from swarmnav.sim import log_commands, options, plot, replay
 from swarmnav.sim.benchmarks import env as bench_env
 from swarmnav.sim.benchmarks import grid as bench_grid
 from swarmnav.sim.benchmarks import planners as bench_planners
 from swarmnav.sim.benchmarks import render as bench_render
 from swarmnav.sim.benchmarks import sim as bench_sim
 
-EXIT_OK, EXIT_BAD_INPUT, EXIT_NO_PATH = 0, 2, 3
+EXIT_OK, EXIT_BUG, EXIT_BAD_INPUT, EXIT_NO_PATH = 0, 1, 2, 3
 
 
 class UserError(Exception):
@@ -172,8 +173,8 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Any, str]] = [
 def _add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", help="bundled scenario name or path to a .toml file")
     p.add_argument("--planner", help="planner name (default: the scenario's)")
-    p.add_argument("--seed", type=int, help="the planner's and navigator's random seed (default: the scenario's)")
-    p.add_argument("--world-seed", type=int, help="seed of the random obstacle motions (default: the scenario's seed)")
+    p.add_argument("--seed", type=options.seed, help="the planner's and navigator's random seed (default: the scenario's)")
+    p.add_argument("--world-seed", type=options.seed, help="seed of the random obstacle motions (default: the scenario's seed)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="planner parameter (repeatable)")
     p.add_argument("--navigator", help="navigator name (default: the scenario's, else follow)")
     p.add_argument("--navigator-set", action="append", metavar="KEY=VALUE", help="navigator parameter (repeatable)")
@@ -256,6 +257,28 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("swarmnav: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:  # nothing anticipated it: a bug of ours, reported in one line
+        print(f"swarmnav: bug: {_report_bug(exc)}", file=sys.stderr)
+        return EXIT_BUG
+
+
+def _report_bug(exc: Exception) -> str:
+    """Save the full traceback of an unanticipated exception; one line saying what and where."""
+    import tempfile
+    import traceback
+
+    frame = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
+    where = f" at {FilePath(frame.filename).name}:{frame.lineno}" if frame else ""
+    what = f"{type(exc).__name__}{where}: {exc}".replace("\n", " ")
+    try:
+        fd, name = tempfile.mkstemp(prefix=f"swarmnav-bug-{time.strftime('%Y%m%d-%H%M%S')}-", suffix=".txt")
+        with os.fdopen(fd, "w", encoding="utf-8") as out:
+            out.write(f"swarmnav {' '.join(sys.argv[1:])}\n")
+            out.write("".join(traceback.format_exception(exc)))
+        saved = f"full traceback saved to {name}"
+    except OSError as save_error:
+        saved = f"the traceback could not be saved ({save_error.strerror or save_error})"
+    return f"{what} ({saved}; please report it)"
 
 
 if __name__ == "__main__":

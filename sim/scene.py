@@ -54,7 +54,7 @@ class CompiledScene:
     range_cutoff_m: float
     range_offset_m: float          # distance of the rangefinder sites from the base origin
     range_height_m: float          # their height above the base origin
-    robot_geom_ids: np.ndarray
+    robot_geom_ids: np.ndarray     # every robot geom that collides: chassis, casters, wheel tyres
     chassis_geom_id: int
     obstacles: tuple[ObstacleGeom, ...]
     is_robot_geom: np.ndarray      # (ngeom,) bool
@@ -68,7 +68,7 @@ def build_spec(scenario: Scenario) -> mujoco.MjSpec:
     spec.option.timestep = scenario.sim.timestep_s
 
     radius = scenario.robot_radius_m
-    spec.geom("chassis").size = [radius, 0.04, 0.0]
+    _fit_base(spec, radius)
     _set_rangefinders(spec, scenario.sensor_count, radius, scenario.sensor_range_m)
 
     width, height = scenario.arena_width_m, scenario.arena_height_m
@@ -107,6 +107,35 @@ def build_spec(scenario: Scenario) -> mujoco.MjSpec:
     return spec
 
 
+def _fit_base(spec: mujoco.MjSpec, radius_m: float) -> None:
+    """Give the chassis the scenario's radius, so that the whole robot fits in it.
+
+    The base in ``robot.xml`` (wheels at +-0.11 m, 0.04 m tyres, casters) has a
+    footprint of exactly the chassis radius it declares.  A larger robot keeps
+    that base under a wider chassis.  A smaller one scales the whole base with
+    the radius (positions and sizes of every geom, the wheel bodies and the
+    sites), so no wheel or caster sticks out of the radius the planners plan
+    for; the wheel speed limit grows by the same factor, which keeps the top
+    linear speed (wheel radius x wheel speed) of the full-size base.  Masses are
+    unchanged.
+    """
+    chassis = spec.geom("chassis")
+    base_radius_m = float(chassis.size[0])
+    if radius_m < base_radius_m:
+        scale = radius_m / base_radius_m
+        for body in (spec.body(name) for name in ROBOT_BODIES):
+            if body.name != "base_link":
+                body.pos = np.asarray(body.pos) * scale
+            for geom in body.geoms:
+                geom.pos = np.asarray(geom.pos) * scale
+                geom.size = np.asarray(geom.size) * scale
+            for site in body.sites:
+                site.pos = np.asarray(site.pos) * scale
+        for actuator in spec.actuators:
+            actuator.ctrlrange = np.asarray(actuator.ctrlrange) / scale
+    chassis.size = [radius_m, chassis.size[1], 0.0]
+
+
 def _set_rangefinders(spec: mujoco.MjSpec, count: int, body_radius_m: float, cutoff_m: float) -> None:
     """Place ``count`` rangefinders evenly on the rim, pointing outward, above the wheels."""
     template = spec.site("range_site_00")
@@ -114,15 +143,18 @@ def _set_rangefinders(spec: mujoco.MjSpec, count: int, body_radius_m: float, cut
     base = spec.body("base_link")
     existing = [s for s in spec.sites if s.name.startswith("range_site_")]
     if len(existing) != count:
+        # The XML's own sensor is the template (what it measures lives in intprm).
+        data_spec = np.array(spec.sensor("range_00").intprm)
         for sensor in [s for s in spec.sensors if s.name.startswith("range_")]:
             spec.delete(sensor)
         for site in existing:
             spec.delete(site)
+        site_class = spec.find_default("range")
         for k in range(count):
-            base.add_site(name=f"range_site_{k:02d}", classname=template.classname if False else spec.default,
-                          size=[0.008, 0, 0], rgba=[1, 0.3, 0.1, 1], group=4)
-            spec.add_sensor(name=f"range_{k:02d}", type=mujoco.mjtSensor.mjSENS_RANGEFINDER,
-                            objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"range_site_{k:02d}")
+            base.add_site(name=f"range_site_{k:02d}", default=site_class)
+            sensor = spec.add_sensor(name=f"range_{k:02d}", type=mujoco.mjtSensor.mjSENS_RANGEFINDER,
+                                     objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"range_site_{k:02d}")
+            sensor.intprm = data_spec
     rim = body_radius_m + 0.005
     for k in range(count):
         angle = 2.0 * math.pi * k / count
@@ -160,17 +192,17 @@ def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
                           abs(model.actuator("right_wheel_motor").ctrlrange).min()))
     drive = DriveGeometry(wheel_radius_m=wheel_radius, track_m=track, max_wheel_speed_rad_s=max_wheel)
 
-    range_ids = sorted((model.sensor(i).name, i) for i in range(model.nsensor)
-                       if model.sensor_type[i] == mujoco.mjtSensor.mjSENS_RANGEFINDER)
-    range_adr = np.array([model.sensor_adr[i] for _, i in range_ids], dtype=np.int64)
+    # In model order, which is the order of the angles (names stop sorting by angle past 100 sensors).
+    range_ids = [i for i in range(model.nsensor) if model.sensor_type[i] == mujoco.mjtSensor.mjSENS_RANGEFINDER]
+    range_adr = np.array([model.sensor_adr[i] for i in range_ids], dtype=np.int64)
     angles, offsets, heights = [], [], []
-    for _, i in range_ids:
+    for i in range_ids:
         site = model.sensor_objid[i]
         p = model.site_pos[site]
         angles.append(math.atan2(p[1], p[0]) % (2.0 * math.pi))
         offsets.append(math.hypot(p[0], p[1]))
         heights.append(float(p[2]))
-    cutoff = float(model.sensor_cutoff[range_ids[0][1]]) if range_ids else 0.0
+    cutoff = float(model.sensor_cutoff[range_ids[0]]) if range_ids else 0.0
 
     robot_bodies = {model.body(n).id for n in ROBOT_BODIES}
     is_robot = np.array([model.geom_bodyid[g] in robot_bodies and model.geom_contype[g] + model.geom_conaffinity[g] > 0

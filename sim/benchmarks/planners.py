@@ -45,6 +45,7 @@ from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.path_cost import PathObjective
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.problem import scenario_problem
+from swarmnav.sim import options
 
 DEFAULT_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3",
                      "adl-abc-path-1", "adl-abc-path-2", "adl-abc-path-3")
@@ -66,13 +67,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``swarmnav bench planners``."""
     parser.add_argument("--scenarios", nargs="+", default=list(DEFAULT_SCENARIOS), metavar="NAME")
     parser.add_argument("--planners", nargs="+", default=list(DEFAULT_PLANNERS), metavar="NAME")
-    parser.add_argument("--seeds", type=int, default=10, help="runs per planner and scenario (default 10)")
-    parser.add_argument("--population", type=int, default=50)
-    parser.add_argument("--iterations", type=int, default=100)
-    parser.add_argument("--clearance-m", type=float, default=0.0,
+    parser.add_argument("--seeds", type=options.positive_int, default=10, help="runs per planner and scenario (default 10)")
+    parser.add_argument("--population", type=options.positive_int, default=50)
+    parser.add_argument("--iterations", type=options.positive_int, default=100)
+    parser.add_argument("--clearance-m", type=options.non_negative_float, default=0.0,
                         help="clearance beyond the robot radius (default 0, as in the papers)")
     parser.add_argument("--peer-scenario", default="gwo-scenario-1")
-    parser.add_argument("--peer-runs", type=int, default=3, help="mealpy runs per peer (0: none)")
+    parser.add_argument("--peer-runs", type=options.non_negative_int, default=3, help="mealpy runs per peer (0: none)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
 
 

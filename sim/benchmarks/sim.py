@@ -15,7 +15,9 @@ from pathlib import Path as FilePath
 
 import mujoco
 
-from swarmnav.models.scenario import load_scenario
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import MAX_CONTROL_STEPS, load_scenario
+from swarmnav.sim import options
 from swarmnav.sim.episode import Episode, EpisodeSpec, plan_episode, run_episode
 from swarmnav.sim.runner import Simulation
 
@@ -46,6 +48,9 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
     every measurement covers the same simulated time.
     """
     scenario = load_scenario(scenario_name)
+    if not duration_s * scenario.sim.control_hz <= MAX_CONTROL_STEPS:
+        raise ConfigError("--duration", f"{duration_s:g} s at {scenario.sim.control_hz:g} Hz needs "
+                          f"{duration_s * scenario.sim.control_hz:.4g} control steps (at most {MAX_CONTROL_STEPS:,})")
     planned = plan_episode(EpisodeSpec(scenario))
     simulation = Simulation(planned.spec.scenario)
     bare, closed, ratios, realtime, logging, logging_ratios = [], [], [], [], [], []
@@ -91,8 +96,8 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default="dense-field-30")
-    parser.add_argument("--duration", type=float, default=20.0, help="simulated seconds per measurement")
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--duration", type=options.positive_float, default=20.0, help="simulated seconds per measurement")
+    parser.add_argument("--repeats", type=options.positive_int, default=3)
     parser.add_argument("--json", action="store_true")
 
 
