@@ -93,6 +93,8 @@ class Scenario:
     boxes: tuple[Box, ...] = ()
     world_seed: int = 0  # random obstacle motions are drawn from it; the file's ``seed`` by default
     map_grid: OccupancyGrid | None = field(default=None, repr=False)
+    # [map].pairs: start/goal cells (column, row from the bottom) as [x0, y0, x1, y1], for `bench grid`
+    map_pairs: tuple[tuple[int, int, int, int], ...] = ()
 
     @property
     def bounds(self) -> Rect:
@@ -305,7 +307,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     sim_t.close()
     _check_run_size(time_limit_s, sim, source)
 
-    boxes, map_grid, map_cell_m = _parse_map(top, source, width_m, height_m)
+    boxes, map_grid, map_cell_m, map_pairs = _parse_map(top, source, width_m, height_m)
     if map_cell_m is None:
         _check_grid_size(width_m, height_m, cell_m, "sim.cell_m" if sim_t.has("cell_m") else "arena", source)
 
@@ -389,7 +391,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         planner_name=planner_name, planner_params=dict(params),
         navigator_name=navigator_name, navigator_params=dict(navigator_params), obstacles=tuple(obstacles),
         sim=sim, cell_m=cell_m, source_text=text, source_path=source, boxes=boxes, world_seed=seed,
-        map_grid=map_grid)
+        map_grid=map_grid, map_pairs=map_pairs)
     _check_endpoints(scenario, source)
     return scenario
 
@@ -471,7 +473,7 @@ def _check_motion_size(parsed: list, time_limit_s: float, sim: SimSettings, sour
 
 
 def _parse_map(top: _Table, source: str, width_m: float, height_m: float
-               ) -> tuple[tuple[Box, ...], OccupancyGrid | None, float | None]:
+               ) -> tuple[tuple[Box, ...], OccupancyGrid | None, float | None, tuple[tuple[int, ...], ...]]:
     """The optional ``[map]`` table: a Moving AI ``.map`` file and its cell size.
 
     ``file`` is looked up beside the scenario, then under ``models/maps/``.  The
@@ -481,10 +483,10 @@ def _parse_map(top: _Table, source: str, width_m: float, height_m: float
     for ``swarmnav bench grid``.
 
     Returns:
-        (boxes, the map's world grid before inflation or None, cell_m or None).
+        (boxes, the map's world grid before inflation or None, cell_m or None, the start/goal pairs).
     """
     if not top.has("map"):
-        return (), None, None
+        return (), None, None, ()
     from swarmnav.models.grid_map import map_to_grid, merge_boxes, read_map
 
     t = top.table("map")
@@ -518,7 +520,7 @@ def _parse_map(top: _Table, source: str, width_m: float, height_m: float
             if not (0 <= x < cols and 0 <= y < rows):
                 raise ConfigError(f"map.pairs[{i}]", f"cell ({x}, {y}) is outside the {cols} x {rows} map", source)
     grid = map_to_grid(occupied, cell_m)
-    return merge_boxes(grid.occupied, cell_m), grid, cell_m
+    return merge_boxes(grid.occupied, cell_m), grid, cell_m, tuple(tuple(p) for p in pairs)
 
 
 def _check_endpoints(scenario: Scenario, source: str) -> None:

@@ -35,6 +35,13 @@ class UserError(Exception):
     """A bad command-line value or file that is not a scenario (exit 2)."""
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line on stderr (and exit 2), like every other bad input."""
+
+    def error(self, message: str):
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def parse_settings(pairs: list[str] | None, option: str = "--set") -> dict[str, Any]:
     """``KEY=VALUE`` pairs of an option; values are read as TOML (numbers, booleans, arrays) or else strings."""
     params: dict[str, Any] = {}
@@ -182,7 +189,7 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="swarmnav", description="Plan, simulate, log and replay swarm path planners for a wheeled robot in MuJoCo.")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 

@@ -157,3 +157,13 @@ def test_bad_planner_parameters_from_set_exit_2(capsys, planner, setting, field)
     assert code == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and field in err and "Traceback" not in err
     assert err.startswith("swarmnav: error: --set: ")
+
+
+@pytest.mark.parametrize("argv", [["run", "gwo-scenario-1", "--seed", "abc"], ["bogus"], ["log"],
+                                  ["plan", "gwo-scenario-1", "--camera", "side"]])
+def test_a_malformed_command_line_is_one_line_and_exit_2(capsys, argv):
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2
+    assert err.count("\n") == 1 and "error:" in err

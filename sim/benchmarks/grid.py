@@ -24,7 +24,6 @@ import json
 import statistics
 import sys
 import time
-import tomllib
 from typing import Any
 
 import numpy as np
@@ -66,7 +65,7 @@ def _problems(scenario, all_pairs: bool):
     problem = scenario_problem(scenario)
     if not all_pairs:
         return [(scenario.name, problem)]
-    pairs = tomllib.loads(scenario.source_text).get("map", {}).get("pairs", [])
+    pairs = scenario.map_pairs
     cell = scenario.cell_m
     out = []
     for x0, y0, x1, y1 in pairs:
