@@ -8,6 +8,8 @@ from __future__ import annotations
 from typing import Any
 
 from swarmnav.controllers.navigators.follow import FollowNavigator
+from swarmnav.controllers.navigators.iaco_local import IacoLocalNavigator
+from swarmnav.controllers.navigators.immas_stepwise import ImmasStepwiseNavigator
 from swarmnav.models.parameters import build_component
 
 NAVIGATORS: dict[str, type] = {}
@@ -24,7 +26,7 @@ def register(cls: type) -> type:
     return cls
 
 
-for _cls in (FollowNavigator,):
+for _cls in (FollowNavigator, IacoLocalNavigator, ImmasStepwiseNavigator):
     register(_cls)
 
 
