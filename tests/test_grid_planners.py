@@ -25,7 +25,7 @@ from swarmnav.models.grid_map import benchmark_sets, format_map, map_to_grid, me
 from swarmnav.planners.problem import scenario_problem
 
 GRID_PLANNERS = ("astar", "dijkstra", "theta_star", "dstar_lite", "immas", "iaco")
-MAP_SCENARIOS = [n for n in list_scenarios() if n.startswith(("immas-", "iaco-"))]
+MAP_SCENARIOS = [n for n in list_scenarios() if n.startswith(("immas-", "iaco-")) and "dynamic" not in n]
 FAST = {"iaco": {"ants": 20, "iterations": 15}}
 
 
