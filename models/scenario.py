@@ -375,10 +375,11 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     top.close()
     if map_cell_m is not None:
         cell_m = map_cell_m
-        if obstacles:
-            # Discs beside a map: rasterise both at the map's resolution (conservative margin).
+        if any(not ob.moving for ob in obstacles):
+            # Static discs beside a map: rasterise both at the map's resolution (conservative margin).
             map_grid = None
         else:
+            # Only moving obstacles (seeds 000 and 003): plan on the static map, as the papers do.
             from swarmnav.models.grid_map import inflated_map_grid
             map_grid = inflated_map_grid(map_grid.occupied, map_cell_m, robot_radius_m + clearance_m, boxes)
 

@@ -221,11 +221,17 @@ def scenario_problem(scenario: Scenario, cell_m: float | None = None, at_time_s:
                      clearance_m: float | None = None) -> Problem:
     """A scenario's planning problem, with its obstacles frozen at ``at_time_s``."""
     clearance_m = scenario.clearance_m if clearance_m is None else clearance_m
-    return Problem(start=scenario.start, goal=scenario.goal,
-                   bounds=scenario.planning_bounds(scenario.robot_radius_m + clearance_m),
-                   obstacles=scenario.discs_at(at_time_s), robot_radius_m=scenario.robot_radius_m,
+    bounds = scenario.planning_bounds(scenario.robot_radius_m + clearance_m)
+    discs = scenario.discs_at(at_time_s)
+    grid = scenario.map_grid
+    if grid is not None and discs:
+        # A map with moving obstacles: the map's own cells plus the discs where they are now.
+        frozen = rasterise(bounds, discs, (), scenario.robot_radius_m + clearance_m, grid.cell_m)
+        grid = OccupancyGrid(grid.occupied | frozen.occupied, grid.cell_m, grid.origin_m)
+    return Problem(start=scenario.start, goal=scenario.goal, bounds=bounds,
+                   obstacles=discs, robot_radius_m=scenario.robot_radius_m,
                    clearance_m=clearance_m, boxes=scenario.boxes, cell_m=cell_m or scenario.cell_m,
-                   grid_override=scenario.map_grid)
+                   grid_override=grid)
 
 
 def map_problem(occupied: np.ndarray, cell_m: float, start_cell: tuple[int, int], goal_cell: tuple[int, int],

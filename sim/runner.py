@@ -34,6 +34,7 @@ from swarmnav.models.scenario import Scenario
 from swarmnav.models.world import Pose2D
 from swarmnav.sim.clearance import ClearanceProbe
 from swarmnav.sim.contact import ContactMonitor
+from swarmnav.sim.detector import detect
 from swarmnav.sim.recording import ObstacleInfo, Recorder, RunContext, StepFrame
 from swarmnav.sim.scene import CompiledScene, compile_scene
 from swarmnav.sim.sensing import base_twist, ranges_from_sensors, yaw_from_quaternion
@@ -195,6 +196,8 @@ class StepLoop:
         self.times_s = np.arange(self.n_max + 1) * self.dt_s
         self.obstacle_track_m = simulation.obstacle_positions(self.times_s)  # (T, M, 2)
         self.mocap_index = simulation._mocap_index
+        self.moving_radii_m = np.array([simulation.scenario.obstacles[ob.scenario_index].radius_m
+                                        for ob in simulation._moving], dtype=float)
         self.monitor = ContactMonitor(self.model, scene.is_robot_geom, scene.is_obstacle_geom, recorder,
                                       release_s=self.dt_s)
         # Contacts that are not collisions (wheels and casters on the floor), counted at the
@@ -244,7 +247,9 @@ class StepLoop:
                            ranges_m=ranges_from_sensors(data.sensordata[scene.range_sensor_adr],
                                                         scene.range_cutoff_m),
                            range_angles_rad=scene.range_angles_rad, range_offset_m=scene.range_offset_m,
-                           range_cutoff_m=scene.range_cutoff_m)
+                           range_cutoff_m=scene.range_cutoff_m,
+                           detections=detect(self.obstacle_track_m, step, self.dt_s, self.moving_radii_m, x, y,
+                                             self.simulation.scenario.sensor_range_m))
 
     def outcome(self, pose: Pose2D, goal: GoalChecker, stop_on_collision: bool) -> str:
         """"goal_reached", "collision" (when stopping on one), "timeout", or "" to go on."""

@@ -31,7 +31,7 @@ from swarmnav.planners.problem import scenario_problem
 
 # Every planner that avoids obstacles on a grid map (``straight`` does not avoid them).
 MAP_PLANNERS = sorted(name for name, cls in PLANNERS.items() if "boxes" in cls.supports and name != "straight")
-MAP_SCENARIOS = [n for n in list_scenarios() if n.startswith(("immas-", "iaco-"))]
+MAP_SCENARIOS = [n for n in list_scenarios() if n.startswith(("immas-", "iaco-")) and "dynamic" not in n]
 FAST = {"iaco": {"ants": 20, "iterations": 15}}
 
 

@@ -8,6 +8,8 @@ from __future__ import annotations
 from typing import Any
 
 from swarmnav.controllers.navigators.follow import FollowNavigator
+from swarmnav.controllers.navigators.iaco_local import IacoLocalNavigator
+from swarmnav.controllers.navigators.immas_stepwise import ImmasStepwiseNavigator
 from swarmnav.controllers.navigators.policy import PolicyNavigator
 from swarmnav.models.parameters import build_component
 
@@ -25,7 +27,7 @@ def register(cls: type) -> type:
     return cls
 
 
-for _cls in (FollowNavigator, PolicyNavigator):
+for _cls in (FollowNavigator, PolicyNavigator, IacoLocalNavigator, ImmasStepwiseNavigator):
     register(_cls)
 
 

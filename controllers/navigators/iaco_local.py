@@ -1,0 +1,281 @@
+"""``iaco_local``: global IACO path plus local avoidance by collision type, Gong, Yang, Yuan & Wang (2022), seed 003 §4.
+
+The method of §4.3: plan an IACO path on the static map (Steps 1-2), then walk
+it cell by cell; each time the robot reaches a cell it classifies every sensed
+moving obstacle (:mod:`controllers.navigators.collision_types`) and acts
+(Step 3) until it reaches the goal (Step 4):
+
+* type 1 (crossing, the wait-and-avoid strategy of the paper's ref. [24], Fig. 5):
+  go on to the cell before the crossing point (the first path cell within reach
+  of the obstacle's track), stop, and wait until going on along the original path
+  meets the obstacle no more;
+* type 2 (head-on): Eq. (12) for each escape cell of Eq. (13) (even size) or
+  Eq. (14) (odd size) that is free (static map, and no sensed obstacle on it)
+  and connected to the goal; timing by Eqs. (15)-(17): go on D cells, or act
+  now: move to the escape cell and replan IACO from each usable candidate,
+  keeping the shortest (escape moves + IACO length);
+* type 3 (overtaken from behind): as type 2 with Eqs. (18)-(20);
+* type 4 (catching a slower obstacle): the type-2 manoeuvre once ``ng <= rg = V_rob / V_obs``.
+
+``strategy = "wait_only"`` applies type 1's action to every type: ref. [24]'s
+strategy, the comparison of §5.4.
+
+Our choices where the paper is silent:
+
+* Time base: one step is the robot's move to the next cell at its top speed
+  (``cell_m / max_speed`` per straight cell); obstacles' Step_scale is their
+  speed over the robot's.  The robot senses at each cell it reaches (§5.4: "detects
+  environmental information every time it moves a grid"), and while waiting at
+  every control step.
+* When Eq. (12) fails for every candidate ("too_close") the robot still escapes
+  to the best candidate (the paper does not say what to do); the event says so.
+* A crossing obstacle that is predicted to miss the robot, or a same-line
+  obstacle moving away, is no conflict (type 0) and is not logged.
+* Replanning runs ``setup.planner`` when it is ``iaco``, else a default
+  :class:`~planners.improved_ant_colony.ImprovedAntColonyPlanner`, on the static
+  map (:func:`~controllers.navigators.cell_path.static_grid`) from the escape cell.
+* Reach of an obstacle: its radius + the robot's inflation (radius and
+  clearance) + ``margin_m``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+from scipy import ndimage
+
+from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigators.cell_path import (Cell, CellWalker, cells_of_path, grid_problem, heading_of,
+                                                       static_grid, step_line)
+from swarmnav.controllers.navigators.collision_types import (CATCHING_UP, CROSSING, FROM_BEHIND, HEAD_ON,
+                                                             NO_CONFLICT, Encounter, classify, escape_offsets,
+                                                             first_band_index, precondition_x,
+                                                             predicted_meeting_s, timing)
+from swarmnav.models.errors import ConfigError
+from swarmnav.planners.errors import PlanningError
+from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
+from swarmnav.planners.problem import Path
+
+STRATEGIES = ("paper", "wait_only")
+
+
+@dataclass
+class IacoLocalNavigator:
+    """Seed 003's global IACO path with local avoidance by collision type.
+
+    Args:
+        strategy: "paper" (§4.2's four strategies) or "wait_only" (ref. [24]: type 1's action for every type).
+        same_line_deg: largest angle between robot and obstacle directions that counts as one line.
+        margin_m: extra distance kept from an obstacle's footprint in the predictions.
+        horizon_cells: how many robot steps ahead conflicts are predicted.
+        reach_m: distance to a cell's centre at which the robot has reached it.
+        lead_steps: robot steps added to the escape's in Eq. (12) (ours; 0 = the paper), for the
+            time our differential-drive robot needs to turn in place towards the escape cell,
+            which the paper's grid robot does not spend.
+    """
+
+    name: ClassVar[str] = "iaco_local"
+    strategy: str = "paper"
+    same_line_deg: float = 15.0
+    margin_m: float = 0.05
+    horizon_cells: int = 12
+    reach_m: float = 0.1
+    lead_steps: int = 0
+    counts: dict[str, int] = field(default_factory=dict, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        for key, ok, problem in (
+                ("strategy", self.strategy in STRATEGIES, f"must be one of: {', '.join(STRATEGIES)}"),
+                ("same_line_deg", 0.0 <= self.same_line_deg < 90.0, "must lie in [0, 90)"),
+                ("margin_m", self.margin_m >= 0.0, "must not be negative"),
+                ("horizon_cells", self.horizon_cells >= 1, "must be at least 1"),
+                ("reach_m", self.reach_m > 0.0, "must be positive"),
+                ("lead_steps", self.lead_steps >= 0, "must not be negative")):
+            if not ok:
+                raise ConfigError(f"navigator.params.{key}", f"{problem}, got {getattr(self, key)!r}")
+
+    def reset(self, setup: NavigationSetup) -> None:
+        self.setup = setup
+        problem = setup.problem
+        self.grid = static_grid(problem)
+        self.planner = setup.planner if isinstance(setup.planner, ImprovedAntColonyPlanner) \
+            else ImprovedAntColonyPlanner()
+        self.inflation_m = problem.inflation_m
+        self.speed_m_s = setup.max_speed_m_s
+        self.step_s = self.grid.cell_m / self.speed_m_s
+        start = self.grid.cell_of(problem.start.x_m, problem.start.y_m)
+        goal = self.grid.cell_of(problem.goal.x_m, problem.goal.y_m)
+        self.goal_cell = goal
+        free = ~self.grid.occupied
+        self.labels, _ = ndimage.label(free, structure=np.ones((3, 3), dtype=bool))
+        replanned = not (setup.path.stats.extra.get("raw_cells") and not problem.obstacles
+                         and isinstance(setup.planner, ImprovedAntColonyPlanner))
+        if replanned:  # Step 2: the IACO path on the static map (the first plan saw the moving obstacles at t = 0)
+            cells = cells_of_path(self.planner.plan(grid_problem(problem, self.grid, start), setup.rng), self.grid)
+        else:
+            cells = cells_of_path(setup.path, self.grid)
+        self.walker = CellWalker(setup.controller, self.grid, self.reach_m)
+        handed = self.walker.start(cells)
+        self._pending_path = handed if replanned else None
+        self.wait_index: int | None = None
+        self.escape_index: int | None = None  # the escape cell's index while the manoeuvre runs
+        self.waiting = False
+        self.counts = {"type1": 0, "type2": 0, "type3": 0, "type4": 0, "waits": 0, "escapes": 0, "replans": 0}
+        self._first = True
+
+    # -- one control step -------------------------------------------------------------------------
+    def step(self, observation: Observation) -> NavigationStep:
+        events: list[tuple[str, dict[str, Any]]] = []
+        new_path, self._pending_path = self._pending_path, None
+        if self.waiting:
+            if self._conflicts(observation, self.walker.index):
+                # Hold on the wait cell's centre (a stop would leave the robot up to reach_m short).
+                centre = self.walker.centre(self.walker.cell)
+                self.setup.controller.reset(Path.from_waypoints(np.array([centre, centre]), 0.0))
+                return NavigationStep(self.setup.controller.command(observation.pose, observation.twist),
+                                      new_path, tuple(events))
+            self.waiting = False
+            self.wait_index = None
+            events.append(("resume", {"cell": list(self.walker.cell)}))
+            self.walker.start(self.walker.cells, self.walker.index)
+        command, reached = self.walker.command(observation.pose, observation.twist)
+        if reached and self.escape_index is not None and self.walker.index >= self.escape_index:
+            self.escape_index = None
+        if (reached or self._first) and not self.walker.at_end and self.escape_index is None:
+            self._first = False
+            decided = self._decide(observation, events)
+            if decided is not None:
+                new_path = decided
+                command, _ = self.walker.command(observation.pose, observation.twist)
+        if self.wait_index is not None and self.walker.index >= self.wait_index and not self.waiting:
+            self.waiting = True
+            self.counts["waits"] += 1
+            events.append(("wait", {"cell": list(self.walker.cell)}))
+        if self.waiting:
+            centre = self.walker.centre(self.walker.cell)
+            self.setup.controller.reset(Path.from_waypoints(np.array([centre, centre]), 0.0))
+            command = self.setup.controller.command(observation.pose, observation.twist)
+        return NavigationStep(command, new_path, tuple(events))
+
+    # -- Step 3 -------------------------------------------------------------------------------------
+    def _path_xy(self, index: int) -> np.ndarray:
+        return self.grid.centres_m(np.array(self.walker.cells[index:index + self.horizon_cells + 1]))
+
+    def _reach_m(self, det: DetectedObstacle) -> float:
+        return det.radius_m + self.inflation_m + self.margin_m
+
+    def _conflicts(self, observation: Observation, index: int) -> bool:
+        """Would going on now along the path from cell ``index`` meet a sensed obstacle?"""
+        path = self._path_xy(index)
+        horizon = self.horizon_cells * self.step_s * math.sqrt(2.0)
+        return any(predicted_meeting_s(path, self.speed_m_s, (d.x_m, d.y_m), (d.vx_m_s, d.vy_m_s),
+                                       self._reach_m(d), horizon) is not None for d in observation.detections)
+
+    def _decide(self, observation: Observation, events: list) -> Any:
+        """Classify every sensed obstacle at this cell; act on the nearest conflict."""
+        index = self.walker.index
+        here = self.walker.cell
+        heading = heading_of(self.walker.cells, index)
+        robot_xy = self.walker.centre(here)
+        path = self._path_xy(index)
+        horizon = self.horizon_cells * self.step_s * math.sqrt(2.0)
+        found = []
+        for det in observation.detections:
+            xy, v = np.array([det.x_m, det.y_m]), np.array([det.vx_m_s, det.vy_m_s])
+            meet = predicted_meeting_s(path, self.speed_m_s, xy, v, self._reach_m(det), horizon)
+            enc = classify(robot_xy, heading, xy, v, det.radius_m, self.inflation_m, self.speed_m_s,
+                           self.grid.cell_m, meet is not None, math.radians(self.same_line_deg))
+            if enc.kind == NO_CONFLICT or (enc.kind != CROSSING and meet is None):
+                continue
+            found.append((meet, det, enc))
+        found.sort(key=lambda item: item[0])
+        for meet, det, enc in found:
+            self.counts[f"type{enc.kind}"] += 1
+            action, extra = self._action(observation, det, enc, path)
+            handed = extra.pop("_path", None)
+            events.append(("collision_type", {**enc.details(), "track_id": det.track_id, "action": action,
+                                              "cell": list(here), **extra}))
+            if action == "escape":
+                return handed
+            if action in ("wait", "go_to_wait"):
+                return None
+        return None
+
+    def _action(self, observation: Observation, det: DetectedObstacle, enc: Encounter, path: np.ndarray
+                ) -> tuple[str, dict[str, Any]]:
+        index = self.walker.index
+        if self.strategy == "wait_only" or enc.kind == CROSSING:
+            band = first_band_index(path, (det.x_m, det.y_m), (det.vx_m_s, det.vy_m_s), self._reach_m(det),
+                                    self.horizon_cells * self.step_s * math.sqrt(2.0))
+            stop = index + max(0, (band if band is not None else 0) - 1)
+            self.wait_index = stop
+            return ("wait" if stop == index else "go_to_wait"), {"wait_cell": list(self.walker.cells[stop])}
+        if enc.kind == CATCHING_UP:
+            rg = math.inf if enc.step_scale <= 0 else 1.0 / enc.step_scale
+            if enc.ng > rg:
+                return "go_on", {"rg": rg if math.isfinite(rg) else None}
+            return self._escape(observation, det, enc, -math.inf)
+        offsets = escape_offsets(heading_of(self.walker.cells, index), enc.grid_scale)
+        xs = [precondition_x(math.hypot(*o), enc.step_scale, enc.grid_scale, self.lead_steps) for o in offsets]
+        usable = [x for o, x in zip(offsets, xs) if self._candidate_ok(observation, o, det)]
+        if not usable:
+            return "no_escape_cell", {}
+        when, d = timing(enc.kind, enc.ng, min(usable), enc.step_scale)
+        if when == "go_on":
+            return "go_on", {"D": d, "X": min(usable)}
+        return self._escape(observation, det, enc, enc.ng if when == "act" else -math.inf, too_close=when == "too_close")
+
+    def _candidate_ok(self, observation: Observation, offset: Cell, det: DetectedObstacle | None = None) -> bool:
+        here = self.walker.cell
+        cell = (here[0] + offset[0], here[1] + offset[1])
+        rows, cols = self.grid.shape
+        if not (0 <= cell[0] < rows and 0 <= cell[1] < cols):
+            return False
+        if any(self.grid.occupied[c] for c in step_line(here, cell)[1:]):
+            return False
+        if self.labels[cell] != self.labels[self.goal_cell]:
+            return False
+        centre = self.walker.centre(cell)
+        if det is not None and math.hypot(det.vx_m_s, det.vy_m_s) > 0:
+            # An escape cell lies off the obstacle's track (ours: the paper's obstacles are centred on the robot's line).
+            w = np.array([det.vx_m_s, det.vy_m_s]) / math.hypot(det.vx_m_s, det.vy_m_s)
+            rel = centre - np.array([det.x_m, det.y_m])
+            if abs(rel[0] * w[1] - rel[1] * w[0]) < det.radius_m + self.inflation_m:
+                return False
+        return all(math.hypot(centre[0] - d.x_m, centre[1] - d.y_m) >= d.radius_m + self.inflation_m
+                   for d in observation.detections)
+
+    def _escape(self, observation: Observation, det: DetectedObstacle, enc: Encounter, ng_limit: float, too_close: bool = False
+                ) -> tuple[str, dict[str, Any]]:
+        """Move to an escape cell (Eqs. 13-14) and replan IACO from each usable one, keeping the shortest."""
+        here = self.walker.cell
+        heading = heading_of(self.walker.cells, self.walker.index)
+        best = None
+        tried = 0
+        for offset in escape_offsets(heading, enc.grid_scale):
+            x = precondition_x(math.hypot(*offset), enc.step_scale, enc.grid_scale, self.lead_steps)
+            if not self._candidate_ok(observation, offset, det) or (x > ng_limit and ng_limit != -math.inf):
+                continue
+            cell = (here[0] + offset[0], here[1] + offset[1])
+            tried += 1
+            try:
+                path = self.planner.plan(grid_problem(self.setup.problem, self.grid, cell), self.setup.rng)
+            except PlanningError:
+                continue
+            moves = step_line(here, cell)
+            length = sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(moves, moves[1:])) \
+                * self.grid.cell_m + path.stats.length_m
+            if best is None or length < best[0]:
+                best = (length, moves + cells_of_path(path, self.grid)[1:], cell)
+        if best is None:
+            return "no_escape_cell", {"candidates": tried}
+        self.counts["escapes"] += 1
+        self.counts["replans"] += tried
+        handed = self.walker.start(best[1])
+        self.wait_index = None
+        self.escape_index = len(step_line(here, best[2])) - 1
+        return "escape", {"escape_cell": list(best[2]), "candidates": tried, "too_close": too_close,
+                          "new_length_m": round(best[0], 4), "_path": handed}

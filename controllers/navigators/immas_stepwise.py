@@ -1,0 +1,270 @@
+"""``immas_stepwise``: IMMAS's robot walking among random-walk obstacles, Hasan, Abdullah & Saleh (2023), seed 000.
+
+Algorithm 1 (pheromone propagation from the goal, clean weights, gate raising,
+tight-tunnel closing; :func:`planners.max_min_ant_system.analyse_environment`)
+runs once before the robot moves.  Then Algorithm 3 walks the robot cell by
+cell: at each step the dynamic obstacles move (UpdateDynObs, line 10; the
+scenario's ``random_walk`` motion), the neighbours an obstacle occupies
+("Dobstacle", line 12) are excluded, and the next cell is the neighbour with the
+smallest value of Eq. (3)'s numerator ``(tau + clean)^alpha * eta^beta`` (lines
+13-20), alpha = 3 and beta = 1 (line 4).  When an obstacle moves onto the
+robot's next cell, the robot moves instead to the neighbour with the least
+chance of contact (§4.1, Fig. 3-b).  No replanning, as the paper.  Each move adds
+the new cell's route cost k to the total arc cost (line 25).
+
+Our choices where the paper is silent or ambiguous:
+
+* Minimum, not maximum: the pseudo-code keeps the smallest P (lines 14-20) and the
+  prose the "optimal" one; with tau the propagated route cost (it grows away from the
+  goal), clean a penalty near walls and eta a distance, the smallest value is the
+  optimal one, so both agree (the same reading as the ``immas`` planner).
+* As in the ``immas`` planner the robot does not re-enter a cell while an unvisited
+  candidate is left; otherwise it may (the planner follows the propagation tree,
+  which a dynamic obstacle may block).
+* "Least chance of contact": the free neighbour with the fewest obstacle-occupied
+  cells among its own 8 neighbours (cells an obstacle could step onto next), ties
+  broken by Eq. (3).  With no free neighbour the robot stays.
+* An obstacle occupies the cells whose centres lie within its radius plus the
+  robot's inflation (radius and clearance) of its centre: where the robot, on that
+  cell's centre, would touch it.
+* In the closed loop (continuous time) the robot decides at each cell it reaches,
+  from the sensed obstacles now and extrapolated over one robot step
+  (``cell_m / max_speed``), and diverts while moving if an obstacle comes onto its
+  target cell.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, ClassVar, Iterable
+
+import numpy as np
+
+from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, static_grid
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.world import OccupancyGrid
+from swarmnav.planners.max_min_ant_system import (EnvironmentAnalysis, MaxMinAntSystemPlanner, analyse_environment,
+                                                  tour_scores)
+
+
+def occupied_cells(grid: OccupancyGrid, centres_m: np.ndarray, reach_m: np.ndarray) -> np.ndarray:
+    """(rows, cols) cells whose centres lie within ``reach_m[i]`` of obstacle centre ``i`` ("Dobstacle")."""
+    rows, cols = grid.shape
+    out = np.zeros((rows, cols), dtype=bool)
+    xs = grid.origin_m[0] + (np.arange(cols) + 0.5) * grid.cell_m
+    ys = grid.origin_m[1] + (np.arange(rows) + 0.5) * grid.cell_m
+    for (x, y), r in zip(np.asarray(centres_m, dtype=float).reshape(-1, 2), np.asarray(reach_m, dtype=float)):
+        out |= (ys[:, None] - y) ** 2 + (xs[None, :] - x) ** 2 < r * r
+    return out
+
+
+@dataclass
+class StepwiseWalk:
+    """Algorithm 3's choice of the next cell on the result of Algorithm 1."""
+
+    analysis: EnvironmentAnalysis
+    goal: Cell
+    alpha: float = 3.0
+    beta: float = 1.0
+
+    def __post_init__(self) -> None:
+        rows, cols = self.analysis.blocked.shape
+        rr, cc = np.mgrid[0:rows, 0:cols]
+        self.eta = np.hypot(rr - self.goal[0], cc - self.goal[1])
+
+    def neighbours(self, here: Cell, dynamic: np.ndarray) -> list[Cell]:
+        """Free neighbours: not an obstacle, not a Dobstacle, no corner cut, reached by the propagation."""
+        a = self.analysis
+        rows, cols = a.blocked.shape
+        r, c = here
+        out = []
+        for dr, dc in MOVES:
+            yr, yc = r + dr, c + dc
+            if not (0 <= yr < rows and 0 <= yc < cols) or a.blocked[yr, yc] or dynamic[yr, yc]:
+                continue
+            if dr and dc and (a.blocked[r, yc] or a.blocked[yr, c]):
+                continue
+            if math.isfinite(a.route_cost[yr, yc]):
+                out.append((yr, yc))
+        return out
+
+    def scores(self, cells: list[Cell]) -> np.ndarray:
+        idx = np.array(cells)
+        a = self.analysis
+        return tour_scores(a.pheromone[idx[:, 0], idx[:, 1]], a.clean[idx[:, 0], idx[:, 1]],
+                           self.eta[idx[:, 0], idx[:, 1]], self.alpha, self.beta)
+
+    def choose(self, here: Cell, visited: np.ndarray, dynamic: np.ndarray) -> Cell | None:
+        """Lines 11-20: the free neighbour with the smallest Eq. (3) value (unvisited ones first)."""
+        free = self.neighbours(here, dynamic)
+        fresh = [cell for cell in free if not visited[cell]]
+        pool = fresh or free
+        if not pool:
+            return None
+        return pool[int(np.argmin(self.scores(pool)))]
+
+    def divert(self, here: Cell, dynamic: np.ndarray) -> Cell | None:
+        """§4.1: the free neighbour with the least chance of contact, ties by Eq. (3)."""
+        free = self.neighbours(here, dynamic)
+        if not free:
+            return None
+        padded = np.pad(dynamic.astype(np.int64), 1)
+        contact = np.array([padded[r:r + 3, c:c + 3].sum() for r, c in free])
+        scores = self.scores(free)
+        order = np.lexsort((scores, contact))
+        return free[int(order[0])]
+
+
+@dataclass
+class WalkResult:
+    """A grid-level run of Algorithm 3 among moving obstacles: the paper's figures."""
+
+    cells: list[Cell]
+    moves: int
+    total_arc_cost: float
+    diverts: int
+    stays: int
+    reached: bool
+    time_s: float
+    obstacle_cells: list[np.ndarray] = field(repr=False, default_factory=list)
+
+
+def stepwise_walk(walk: StepwiseWalk, start: Cell, dynamic_at: Callable[[int], np.ndarray],
+                  max_moves: int) -> WalkResult:
+    """Algorithm 3 on the grid: at step k the robot is at ``cells[k]`` and the obstacles occupy ``dynamic_at(k)``.
+
+    Each step: choose the next cell among the neighbours free at step k; the
+    obstacles move (step k + 1); if one is now on the chosen cell, divert (§4.1);
+    move.  Time is the wall time of the walk (Algorithm 1 not included).
+    """
+    t0 = time.perf_counter()
+    shape = walk.analysis.blocked.shape
+    visited = np.zeros(shape, dtype=bool)
+    visited[start] = True
+    cells = [start]
+    cost = 0.0
+    diverts = stays = 0
+    occupied = [dynamic_at(0)]
+    here = start
+    for k in range(max_moves):
+        if here == walk.goal:
+            break
+        nxt = walk.choose(here, visited, occupied[k])
+        occupied.append(dynamic_at(k + 1))
+        if nxt is None or occupied[k + 1][nxt]:
+            nxt = walk.divert(here, occupied[k + 1])
+            diverts += nxt is not None
+        if nxt is None:
+            stays += 1
+            nxt = here
+        else:
+            cost += float(walk.analysis.route_cost[nxt])
+        here = nxt
+        visited[here] = True
+        cells.append(here)
+    return WalkResult(cells, len(cells) - 1 - stays, cost, diverts, stays, here == walk.goal,
+                      time.perf_counter() - t0, occupied)
+
+
+@dataclass
+class ImmasStepwiseNavigator:
+    """Seed 000's robot: Algorithm 1 once, then Algorithm 3 cell by cell among moving obstacles.
+
+    Args:
+        alpha, beta: Eq. (3)'s weights; None takes the scenario's ``immas`` planner's, else 3 and 1 (line 4).
+        reach_m: distance to a cell's centre at which the robot has reached it.
+    """
+
+    name: ClassVar[str] = "immas_stepwise"
+    alpha: float | None = None
+    beta: float | None = None
+    reach_m: float = 0.1
+
+    def __post_init__(self) -> None:
+        for key, ok, problem in (("alpha", self.alpha is None or self.alpha >= 0, "must not be negative"),
+                                 ("beta", self.beta is None or self.beta >= 0, "must not be negative"),
+                                 ("reach_m", self.reach_m > 0, "must be positive")):
+            if not ok:
+                raise ConfigError(f"navigator.params.{key}", f"{problem}, got {getattr(self, key)!r}")
+
+    def reset(self, setup: NavigationSetup) -> None:
+        problem = setup.problem
+        self.grid = grid = static_grid(problem)
+        planner = setup.planner if isinstance(setup.planner, MaxMinAntSystemPlanner) else MaxMinAntSystemPlanner()
+        alpha = planner.alpha if self.alpha is None and isinstance(setup.planner, MaxMinAntSystemPlanner) \
+            else (3.0 if self.alpha is None else self.alpha)
+        beta = planner.beta if self.beta is None and isinstance(setup.planner, MaxMinAntSystemPlanner) \
+            else (1.0 if self.beta is None else self.beta)
+        start = grid.cell_of(problem.start.x_m, problem.start.y_m)
+        goal = grid.cell_of(problem.goal.x_m, problem.goal.y_m)
+        t0 = time.perf_counter()
+        analysis = analyse_environment(grid.occupied, start, goal, planner.rho, planner.clean_weight,
+                                       planner.diagonal_factor, planner.close_gates_and_tunnels)
+        self.analysis_time_s = time.perf_counter() - t0
+        self.walk = StepwiseWalk(analysis, goal, alpha, beta)
+        self.walker = CellWalker(setup.controller, grid, self.reach_m)
+        self.walker.start([start])
+        self.visited = np.zeros(grid.shape, dtype=bool)
+        self.visited[start] = True
+        self.inflation_m = problem.inflation_m
+        self.step_s = grid.cell_m / setup.max_speed_m_s
+        self.moves = 0
+        self.arc_cost = 0.0
+        self.diverts = 0
+        self.target: Cell | None = None
+        self._diverted = False
+        self._started = False
+
+    def _dynamic(self, observation: Observation, ahead_s: Iterable[float]) -> np.ndarray:
+        dets = observation.detections
+        if not dets:
+            return np.zeros(self.grid.shape, dtype=bool)
+        xy = np.array([[d.x_m, d.y_m] for d in dets])
+        v = np.array([[d.vx_m_s, d.vy_m_s] for d in dets])
+        reach = np.array([d.radius_m for d in dets]) + self.inflation_m
+        out = np.zeros(self.grid.shape, dtype=bool)
+        for t in ahead_s:
+            out |= occupied_cells(self.grid, xy + t * v, reach)
+        return out
+
+    def _go(self, here: Cell, target: Cell) -> Any:
+        self.target = target
+        return self.walker.start([here, target])
+
+    def step(self, observation: Observation) -> NavigationStep:
+        events: list[tuple[str, dict[str, Any]]] = []
+        new_path = None
+        command, reached = self.walker.command(observation.pose, observation.twist)
+        if reached or not self._started:
+            if self._started:
+                here = self.walker.cell
+                self.visited[here] = True
+                self.moves += 1
+                self.arc_cost += float(self.walk.analysis.route_cost[here])
+                events.append(("immas_move", {"cell": list(here), "moves": self.moves,
+                                              "total_arc_cost": round(self.arc_cost, 4),
+                                              "diverted": self._diverted}))
+            self._started = True
+            self._diverted = False
+            here = self.walker.cell
+            if here != self.walk.goal:
+                nxt = self.walk.choose(here, self.visited, self._dynamic(observation, (0.0, self.step_s)))
+                if nxt is not None:
+                    new_path = self._go(here, nxt)
+                    command, _ = self.walker.command(observation.pose, observation.twist)
+                else:
+                    self.walker.start([here])
+                    command, _ = self.walker.command(observation.pose, observation.twist)
+        elif self.target is not None and not self._diverted and self._dynamic(observation, (0.0,))[self.target]:
+            here = self.walker.cells[0]
+            other = self.walk.divert(here, self._dynamic(observation, (0.0, self.step_s)))
+            self._diverted = True
+            self.diverts += 1
+            events.append(("immas_divert", {"from": list(here), "blocked": list(self.target),
+                                            "to": None if other is None else list(other)}))
+            new_path = self._go(here, other if other is not None else here)
+            command, _ = self.walker.command(observation.pose, observation.twist)
+        return NavigationStep(command, new_path, tuple(events))
