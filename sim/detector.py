@@ -1,7 +1,7 @@
 """A minimal ``detector`` sensing model: every moving obstacle whose surface lies within range.
 
-Exact centre, radius and velocity (finite difference of the obstacle's known
-track over one control period), as seed 003 §2.1 assumes its sensors report
+Exact centre and radius, and the velocity from the last control period (a
+backward difference: the robot never sees where an obstacle will be), as seed 003 §2.1 assumes its sensors report
 direction, step length, size and shape.  Placeholder for the navigation work's
 detector (issue 10); the track id is the obstacle's index among the moving ones.
 """
@@ -19,10 +19,7 @@ def detect(track_m: np.ndarray, step: int, dt_s: float, radii_m: np.ndarray, x_m
     if track_m.shape[1] == 0:
         return ()
     here = track_m[step]
-    after = track_m[min(step + 1, len(track_m) - 1)]
-    before = track_m[max(step - 1, 0)]
-    span = (min(step + 1, len(track_m) - 1) - max(step - 1, 0)) * dt_s
-    velocity = (after - before) / span if span > 0 else np.zeros_like(here)
+    velocity = (here - track_m[step - 1]) / dt_s if step > 0 else np.zeros_like(here)
     gap = np.hypot(here[:, 0] - x_m, here[:, 1] - y_m) - radii_m
     return tuple(DetectedObstacle(float(here[i, 0]), float(here[i, 1]), float(radii_m[i]),
                                   float(velocity[i, 0]), float(velocity[i, 1]), int(i))
