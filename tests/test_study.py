@@ -122,6 +122,9 @@ def test_a_raising_planner_and_a_run_past_the_wall_limit_are_rows(tmp_path, caps
     assert rows.loc["gwo-scenario-1", "outcome"] == "timeout"
     assert rows.loc["gwo-scenario-1", "cell_wall_s"] < 10
     assert not rows.success.any()
+    assert main(["report", str(tmp_path / "out")]) == 0  # a report of failures only still counts them
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "| gwo | 1 | 1 | error 1 | 0 |" in report and "| gwo | 1 | 1 | timeout 1 | 0 |" in report
 
 
 def _markdown_table(text: str, first_header: str) -> list[list[str]]:
@@ -195,3 +198,14 @@ def test_studies_lists_every_bundled_study(capsys):
     assert [s["name"] for s in listed] == list_studies() and len(listed) >= 5
     for entry in listed:
         assert entry["cells"] == len(expand(load_study(entry["name"]))) > 0
+
+
+def test_paper_values_are_flagged_where_impossible():
+    from swarmnav.sim.study.statistics import impossible
+    rows = [{"planner": "gwo", "outcome": "ok", "plan_length_m": 14.3, "straight_line_m": 14.142},
+            {"planner": "optimal", "outcome": "ok", "plan_length_m": 14.2, "straight_line_m": 14.142}]
+    assert "straight line" in impossible("plan_length_m", 14.0, rows)
+    assert "exact optimum" in impossible("plan_length_m", 14.15, rows)
+    assert impossible("plan_length_m", 14.25, rows) is None
+    rows[1].update(outcome="no_path", plan_length_m=None)
+    assert "no collision-free path" in impossible("plan_length_m", 14.25, rows)

@@ -23,7 +23,9 @@ def _png(fig) -> bytes:
     return buffer.getvalue()
 
 
-def box_plots(arms: dict[str, list[dict[str, Any]]], metrics: list[str]) -> bytes:
+def box_plots(arms: dict[str, list[dict[str, Any]]], metrics: list[str]) -> bytes | None:
+    if not metrics:  # every run failed: nothing to draw
+        return None
     fig, axes = plt.subplots(1, len(metrics), figsize=(4.2 * len(metrics), 3.6), squeeze=False)
     names = list(arms)
     for ax, metric in zip(axes[0], metrics):

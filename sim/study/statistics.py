@@ -170,13 +170,17 @@ def friedman(arms: dict[str, list[dict[str, Any]]], metric: str) -> dict[str, An
 
 
 def impossible(metric: str, paper_value: float, scenario_rows: list[dict[str, Any]]) -> str | None:
-    """Why a paper's value cannot be (below the straight line, or below the exact optimum the rows hold)."""
+    """Why a paper's value cannot be: below the straight line, no path at all, or below the exact optimum
+    (when the study ran the ``optimal`` planner)."""
     if not metric.endswith("length_m"):
         return None
     straight = [r["straight_line_m"] for r in scenario_rows if r.get("straight_line_m") is not None]
     if straight and paper_value < min(straight) - 1e-9:
         return f"impossible: below the straight line ({min(straight):.4f} m)"
-    optimum = values([r for r in scenario_rows if r["planner"] == "optimal"], "plan_length_m")
+    optimal_rows = [r for r in scenario_rows if r["planner"] == "optimal"]
+    if optimal_rows and all(r["outcome"] == "no_path" for r in optimal_rows):
+        return "impossible: no collision-free path exists (the exact optimum finds none)"
+    optimum = values(optimal_rows, "plan_length_m")
     if optimum.size and paper_value < optimum.min() - 1e-6:
         return f"impossible: below the exact optimum ({optimum.min():.4f} m)"
     return None
