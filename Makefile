@@ -11,7 +11,9 @@ DEMO_SCENARIO ?= gwo-scenario-1
 DEMO_PLANNER ?= astar
 export MUJOCO_GL ?= egl
 
-.PHONY: demo test bench install clean
+STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin)))")
+
+.PHONY: demo test bench install clean studies
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -38,6 +40,13 @@ bench: $(STAMP)
 	$(BIN)/swarmnav bench planners
 	$(BIN)/swarmnav bench grid
 	$(BIN)/swarmnav bench render
+	$(BIN)/swarmnav bench study
+
+# Every bundled study into studies/<name>/ (rows resume if interrupted), with report.html and report.md.
+studies: $(STAMP)
+	for s in $(STUDIES); do \
+		$(BIN)/swarmnav study $$s --out studies/$$s && $(BIN)/swarmnav report studies/$$s || exit 1; \
+	done
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -27,6 +27,8 @@ from swarmnav.sim.benchmarks import grid as bench_grid
 from swarmnav.sim.benchmarks import planners as bench_planners
 from swarmnav.sim.benchmarks import render as bench_render
 from swarmnav.sim.benchmarks import sim as bench_sim
+from swarmnav.sim.benchmarks import study as bench_study
+from swarmnav.sim.study import cli as study_cli
 
 EXIT_OK, EXIT_BUG, EXIT_BAD_INPUT, EXIT_NO_PATH = 0, 1, 2, 3
 
@@ -174,6 +176,10 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Any, str]] = [
     (("log", "recover"), log_commands, "rewrite a truncated log as a complete one"),
     (("replay",), replay, "re-render or re-simulate a log"),
     (("plot",), plot, "plot a log to PNG"),
+    (("study",), study_cli, "run a study (scenarios x planners x navigators x seeds) into Parquet rows"),
+    (("studies",), study_cli, "list the bundled studies"),
+    (("report",), study_cli, "an HTML and Markdown report of a study's rows"),
+    (("bench", "study"), bench_study, "study harness: parallel efficiency, overhead per cell, Ray vs local"),
 ]
 
 

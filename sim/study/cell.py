@@ -1,0 +1,185 @@
+"""One study cell: plan (and simulate) through the one episode function, and turn the result into rows.
+
+This is the function every engine runs, in a worker process or a Ray task.  A
+failure never escapes: a planner that finds no path is an outcome ``no_path``
+row, one that raises anything else an ``error`` row with the message, and a run
+past the study's wall limit a ``timeout`` row.
+
+Outcome (``outcome``) is the harness's: ``ok``, ``no_path``, ``error`` or
+``timeout``.  The simulation's own end (``goal_reached``, ``timeout`` in simulated
+time, ``collision``) is ``run_outcome``.  ``success`` is: plan-only, a
+collision-free plan; physics, the goal reached with no collision.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+import signal
+import threading
+import time
+from pathlib import Path as FilePath
+from typing import Any
+
+import numpy as np
+
+from swarmnav.models.scenario import load_scenario
+from swarmnav.planners.errors import PlanningError
+from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
+from swarmnav.sim.study.grid import Cell
+from swarmnav.sim.versions import software_versions
+
+BEND_TOLERANCE_RAD = 1e-6  # a turn smaller than this between two segments is no bend
+
+
+class WallLimitExceeded(BaseException):
+    """Raised in the cell by SIGALRM at the wall limit (a BaseException, so planners' ``except Exception``
+    cannot swallow it)."""
+
+
+def bends(waypoints: np.ndarray) -> int:
+    """Interior waypoints where the heading changes (IACO, Li et al. 2023, Table 3 'bends')."""
+    if len(waypoints) < 3:
+        return 0
+    seg = np.diff(waypoints, axis=0)
+    seg = seg[np.hypot(seg[:, 0], seg[:, 1]) > 0]
+    if len(seg) < 2:
+        return 0
+    heading = np.arctan2(seg[:, 1], seg[:, 0])
+    turn = np.abs((np.diff(heading) + np.pi) % (2 * np.pi) - np.pi)
+    return int(np.count_nonzero(turn > BEND_TOLERANCE_RAD))
+
+
+def _json_safe(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {str(k): _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _json_safe(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, (str, int, float, bool)) or value is None:
+        return value
+    return repr(value)
+
+
+class _WallLimit:
+    """SIGALRM after ``limit_s`` when running on a main thread; elsewhere the limit is checked afterwards."""
+
+    def __init__(self, limit_s: float):
+        self.limit_s = limit_s
+        self.armed = threading.current_thread() is threading.main_thread()
+
+    def __enter__(self):
+        if self.armed:
+            self.previous = signal.signal(signal.SIGALRM, self._fire)
+            signal.setitimer(signal.ITIMER_REAL, self.limit_s)
+        return self
+
+    def _fire(self, signum, frame):
+        raise WallLimitExceeded()
+
+    def __exit__(self, *exc):
+        if self.armed:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+            signal.signal(signal.SIGALRM, self.previous)
+        return False
+
+
+@functools.cache
+def _versions_json() -> str:
+    return json.dumps(software_versions("numpy", "scipy"), sort_keys=True)
+
+
+def base_row(cell: Cell) -> dict[str, Any]:
+    return {"study": cell.study, "config_hash": cell.config_hash, "scenario": cell.scenario_name,
+            "scenario_ref": cell.scenario, "planner": cell.planner, "label": cell.label,
+            "planner_params": json.dumps(cell.planner_params, sort_keys=True), "navigator": cell.navigator,
+            "navigator_label": cell.navigator_label,
+            "navigator_params": json.dumps(cell.navigator_params, sort_keys=True), "seed": cell.seed,
+            "world_seed": cell.world_seed, "mode": cell.mode}
+
+
+def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """Run one cell; return its run row and its best-cost history rows (``progress``)."""
+    row = base_row(cell)
+    row["versions"] = _versions_json()
+    progress: list[dict[str, Any]] = []
+    started = time.perf_counter()
+    try:
+        with _WallLimit(cell.wall_limit_s):
+            scenario = load_scenario(cell.scenario)
+            row["straight_line_m"] = math.hypot(scenario.goal.x_m - scenario.start.x_m,
+                                                scenario.goal.y_m - scenario.start.y_m)
+            spec = EpisodeSpec(scenario, cell.planner, cell.planner_params, cell.navigator, cell.navigator_params,
+                               seed=cell.seed, world_seed=cell.world_seed)
+            episode = plan_episode(spec)
+            if cell.physics:
+                recorders = []
+                if logs_dir is not None:
+                    from swarmnav.sim.mcap_log import McapRecorder
+                    log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
+                    recorders.append(McapRecorder(log_path, overwrite=True))
+                    row["log"] = str(log_path)
+                episode = run_episode(spec, recorders, planned=episode, time_limit_s=cell.time_limit_s)
+        row["outcome"] = "ok"
+    except WallLimitExceeded:
+        row.update(outcome="timeout", error=f"exceeded the wall limit of {cell.wall_limit_s:g} s")
+        episode = None
+    except PlanningError as exc:
+        row.update(outcome="no_path", error=f"{type(exc).__name__}: {exc}")
+        episode = None
+    except Exception as exc:  # noqa: BLE001 - a failing run is a row, never the end of the study
+        row.update(outcome="error", error=f"{type(exc).__name__}: {exc}")
+        episode = None
+    row["cell_wall_s"] = time.perf_counter() - started
+    if episode is not None and row["cell_wall_s"] > cell.wall_limit_s:  # the limit could not be armed here
+        row.update(outcome="timeout", error=f"exceeded the wall limit of {cell.wall_limit_s:g} s")
+    if episode is not None:
+        _add_metrics(row, episode)
+        progress = _progress_rows(cell, episode)
+    row["success"] = _success(row)
+    return row, progress
+
+
+def _add_metrics(row: dict[str, Any], episode) -> None:
+    plan = episode.plan_summary()
+    stats = episode.path.stats
+    row.update(plan_length_m=plan["length_m"], plan_time_s=plan["plan_time_s"],
+               plan_iterations=plan["iterations"], plan_evaluations=plan["evaluations"],
+               plan_collision_free=plan["collision_free"], plan_waypoints=json.dumps(plan["waypoints"]),
+               plan_bends=bends(episode.path.waypoints),
+               plan_convergence_iteration=stats.extra.get("convergence_iteration"),
+               plan_extra=json.dumps(_json_safe(stats.extra), sort_keys=True))
+    if episode.result is not None:
+        run = episode.result.summary()
+        row.update(reached=run["reached"], run_outcome=run["outcome"], collisions=run["collisions"],
+                   first_collision_s=run["first_collision_s"], sim_time_s=run["sim_time_s"],
+                   wall_time_s=run["wall_time_s"], path_length_m=run["path_length_m"],
+                   min_clearance_m=run["min_clearance_m"])
+
+
+def _progress_rows(cell: Cell, episode) -> list[dict[str, Any]]:
+    """Best cost per iteration.  The planners record a best-cost history but not the evaluations spent per
+    iteration, so ``evaluations`` is the run's total spread evenly over its iterations and
+    ``evaluations_estimated`` says so."""
+    stats = episode.path.stats
+    history = stats.cost_history
+    if not history:
+        return []
+    steps = max(len(history) - 1, 1)
+    return [{"config_hash": cell.config_hash, "iteration": i, "best_cost": float(cost),
+             "evaluations": int(round(stats.evaluations * i / steps)), "evaluations_estimated": True}
+            for i, cost in enumerate(history)]
+
+
+def _success(row: dict[str, Any]) -> bool:
+    if row.get("outcome") != "ok":
+        return False
+    if row["mode"] == "physics":
+        return bool(row.get("reached")) and row.get("collisions") == 0
+    return bool(row.get("plan_collision_free"))

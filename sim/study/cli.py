@@ -1,0 +1,90 @@
+"""The ``swarmnav study``, ``studies`` and ``report`` subcommands.
+
+Heavy modules (the engines, pyarrow, matplotlib, Ray) are imported inside the run
+functions, so that building the parser (every ``swarmnav`` command) stays fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path as FilePath
+
+
+def add_study_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", help="bundled study name (see `swarmnav studies`) or path to a study .toml")
+    p.add_argument("--out", help="directory of the rows (default: studies/<study name>); run again to resume")
+    p.add_argument("--workers", type=int, help="worker processes, or local Ray CPUs (default: the number of cores)")
+    p.add_argument("--engine", choices=("local", "ray"), default="local",
+                   help="local processes, or Ray tasks (needs the ray extra: pip install 'swarmnav[ray]')")
+    p.add_argument("--address", help="with --engine ray: the cluster to join (default: a local instance)")
+    p.add_argument("--logs", action="store_true", help="keep the MCAP log of every physics run in DIR/logs/")
+    p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
+
+
+def run_study(args: argparse.Namespace) -> int:
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.sim.study.spec import load_study
+    if args.workers is not None and args.workers < 1:
+        raise ConfigError("--workers", f"must be at least 1, got {args.workers}")
+    if args.address and args.engine != "ray":
+        raise ConfigError("--address", "needs --engine ray")
+    if args.engine == "ray":
+        try:
+            import ray  # noqa: F401
+        except ImportError:
+            raise ConfigError("--engine", "ray is not installed (pip install 'swarmnav[ray]')") from None
+    study = load_study(args.file)
+    from swarmnav.sim.study.execute import run_study as execute
+    out = args.out or str(FilePath("studies") / study.name)
+    summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,
+                      show_progress=not args.json and sys.stderr.isatty())
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        print(f"{summary['study']}: {summary['cells']} cells, {summary['skipped']} already in {summary['out']}, "
+              f"ran {summary['ran']} in {summary['wall_s']:.1f} s on {summary['engine']}; "
+              f"{summary['failed']} failed "
+              + (f"({', '.join(f'{k} {v}' for k, v in sorted(summary['outcomes'].items()) if k != 'ok')})"
+                 if summary["failed"] else ""))
+        print(f"rows: {FilePath(out) / 'runs.parquet'}  report: swarmnav report {out}")
+    return 0
+
+
+def add_studies_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--json", action="store_true")
+
+
+def run_studies(args: argparse.Namespace) -> int:
+    from swarmnav.sim.study.grid import expand
+    from swarmnav.sim.study.spec import list_studies, load_study
+    rows = []
+    for name in list_studies():
+        study = load_study(name)
+        rows.append({"name": name, "mode": study.mode, "cells": len(expand(study)),
+                     "scenarios": [FilePath(s).stem for s in study.scenarios],
+                     "planners": [p.label for p in study.planners], "description": study.description})
+    if args.json:
+        print(json.dumps(rows))
+    else:
+        for r in rows:
+            print(f"{r['name']:<24} {r['mode']:<8} {r['cells']:>5} runs  {r['description']}")
+    return 0
+
+
+def add_report_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("dir", help="a study's output directory (holding runs.parquet)")
+    p.add_argument("--out", help="HTML report path (default: DIR/report.html); the Markdown twin goes beside it")
+
+
+def run_report(args: argparse.Namespace) -> int:
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.sim.study.report import write_report
+    directory = FilePath(args.dir)
+    if not (directory / "runs.parquet").is_dir():
+        raise ConfigError("dir", "holds no runs.parquet (run `swarmnav study` first)", str(directory))
+    html_path = FilePath(args.out) if args.out else directory / "report.html"
+    markdown_path = write_report(directory, html_path)
+    print(f"report: {html_path}  markdown: {markdown_path}")
+    return 0

@@ -1,0 +1,112 @@
+"""Engines that run study cells: separate local processes, or Ray tasks.
+
+Both call the same :func:`swarmnav.sim.study.cell.run_cell` and yield each
+cell's ``(row, progress)`` as it finishes (in finishing order).  Workers run with
+one thread for NumPy's BLAS and OpenMP and ``MUJOCO_GL`` set (no rendering
+happens in workers), set in the environment the workers start with, so it holds
+before anything in them imports NumPy or MuJoCo.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import os
+import threading
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from typing import Any, Iterator, Sequence
+
+from swarmnav.sim.study.cell import run_cell
+from swarmnav.sim.study.grid import Cell
+
+WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+                      "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
+PARENT_POLL_S = 0.5
+
+Result = tuple[dict[str, Any], list[dict[str, Any]]]
+
+
+def worker_environment() -> dict[str, str]:
+    return {**WORKER_ENVIRONMENT, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+
+
+@contextlib.contextmanager
+def _environment(values: dict[str, str]):
+    saved = {k: os.environ.get(k) for k in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
+def _exit_with_parent(parent_pid: int) -> None:
+    """Worker initializer: end this worker when the study's process is gone (killed, not just stopped)."""
+    def watch() -> None:
+        import time
+        while os.getppid() == parent_pid:
+            time.sleep(PARENT_POLL_S)
+        os._exit(1)
+    threading.Thread(target=watch, daemon=True).start()
+
+
+def run_local(cells: Sequence[Cell], workers: int, logs_dir: str | None = None) -> Iterator[Result]:
+    """Run the cells on ``workers`` spawned processes; on an early exit (Ctrl-C, SIGTERM) the workers
+    this engine started are terminated."""
+    if not cells:
+        return
+    before = set(multiprocessing.active_children())
+    context = multiprocessing.get_context("spawn")
+    with _environment(worker_environment()):
+        executor = ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                       initializer=_exit_with_parent, initargs=(os.getpid(),))
+        pending = {executor.submit(run_cell, cell, logs_dir) for cell in cells}
+    finished = False
+    try:
+        while pending:
+            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for future in done:
+                yield future.result()
+        finished = True
+    finally:
+        if finished:
+            executor.shutdown(wait=True)
+        else:
+            executor.shutdown(wait=False, cancel_futures=True)
+            for process in set(multiprocessing.active_children()) - before:
+                process.terminate()
+
+
+def start_ray(address: str | None, workers: int | None) -> None:
+    """Connect to the cluster at ``address``, or start a local instance with ``workers`` CPUs."""
+    import ray
+    if ray.is_initialized():
+        return
+    runtime_env = {"env_vars": worker_environment()}
+    if address:
+        ray.init(address=address, runtime_env=runtime_env, log_to_driver=False)
+    else:
+        ray.init(num_cpus=workers, runtime_env=runtime_env, include_dashboard=False, log_to_driver=False)
+
+
+def run_ray(cells: Sequence[Cell], address: str | None = None, workers: int | None = None,
+            logs_dir: str | None = None) -> Iterator[Result]:
+    """Run the cells as Ray tasks (one CPU each) on a local instance or the cluster at ``address``."""
+    if not cells:
+        return
+    import ray
+    start_ray(address, workers)
+    task = ray.remote(num_cpus=1, max_retries=0)(run_cell)
+    pending = [task.remote(cell, logs_dir) for cell in cells]
+    try:
+        while pending:
+            done, pending = ray.wait(pending, num_returns=1)
+            for ref in done:
+                yield ray.get(ref)
+    finally:
+        for ref in pending:
+            ray.cancel(ref, force=True)

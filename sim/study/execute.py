@@ -1,0 +1,107 @@
+"""Run a study into a directory: expand, skip the cells already there, run the rest, write rows as they finish.
+
+``DIR/study.json`` records the study's name, description, mode, reference
+planner and the paper's values (what the report needs beside the rows);
+``DIR/runs.parquet`` and ``DIR/progress.parquet`` hold the rows (see ``rows``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import sys
+import time
+from pathlib import Path as FilePath
+from typing import Any, Iterator, TextIO
+
+from swarmnav.models.errors import ConfigError
+from swarmnav.sim.study.engines import run_local, run_ray
+from swarmnav.sim.study.grid import Cell, expand
+from swarmnav.sim.study.rows import RowWriter, done_hashes
+from swarmnav.sim.study.spec import Study
+
+METADATA = "study.json"
+
+
+def study_metadata(study: Study) -> dict[str, Any]:
+    return {"name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
+            "reference": study.reference, "planners": [p.label for p in study.planners],
+            "paper": [dataclasses.asdict(p) for p in study.paper]}
+
+
+def _write_metadata(study: Study, out_dir: FilePath) -> None:
+    path = out_dir / METADATA
+    if path.exists():
+        try:
+            previous = json.loads(path.read_text(encoding="utf-8")).get("name")
+        except (OSError, ValueError):
+            previous = None
+        if previous != study.name:
+            raise ConfigError("--out", f"holds the rows of study {previous!r}, not {study.name!r} "
+                                       "(choose another directory)", str(out_dir))
+    out_dir.mkdir(parents=True, exist_ok=True)
+    temporary = out_dir / f".{METADATA}.tmp"
+    temporary.write_text(json.dumps(study_metadata(study), indent=2) + "\n", encoding="utf-8")
+    os.replace(temporary, path)
+
+
+class ProgressBar:
+    """done / total, failures, rate and time left, redrawn on one stderr line."""
+
+    def __init__(self, total: int, stream: TextIO):
+        self.total, self.stream = total, stream
+        self.started = time.monotonic()
+
+    def update(self, done: int, failed: int) -> None:
+        elapsed = time.monotonic() - self.started
+        rate = done / elapsed if elapsed > 0 else 0.0
+        left = (self.total - done) / rate if rate > 0 else float("nan")
+        width = 30
+        filled = int(width * done / self.total) if self.total else width
+        self.stream.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{self.total}  failed {failed}  "
+                          f"{rate:.2f} runs/s  {left:.0f} s left ")
+        self.stream.flush()
+
+    def close(self) -> None:
+        self.stream.write("\n")
+        self.stream.flush()
+
+
+def pending_cells(study: Study, out_dir: FilePath) -> tuple[list[Cell], int]:
+    """The cells without a row yet, and how many the study has in all."""
+    cells = expand(study)
+    done = done_hashes(out_dir)
+    return [c for c in cells if c.config_hash not in done], len(cells)
+
+
+def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local", workers: int | None = None,
+              address: str | None = None, logs: bool = False, show_progress: bool = False) -> dict[str, Any]:
+    """Run every cell of ``study`` that ``out_dir`` does not hold yet; return a summary of this invocation."""
+    out_dir = FilePath(out_dir)
+    _write_metadata(study, out_dir)
+    todo, total = pending_cells(study, out_dir)
+    workers = workers or os.cpu_count() or 1
+    logs_dir = str((out_dir / "logs").resolve()) if logs else None
+    results: Iterator = (run_ray(todo, address, None if address else workers, logs_dir) if engine == "ray"
+                         else run_local(todo, workers, logs_dir))
+    writer = RowWriter(out_dir)
+    bar = ProgressBar(len(todo), sys.stderr) if show_progress and todo else None
+    counts: dict[str, int] = {}
+    started = time.perf_counter()
+    try:
+        for row, progress in results:
+            writer.add(row, progress)
+            counts[row["outcome"]] = counts.get(row["outcome"], 0) + 1
+            if bar:
+                bar.update(sum(counts.values()), sum(v for k, v in counts.items() if k != "ok"))
+    finally:
+        writer.flush()
+        if bar:
+            bar.close()
+        if hasattr(results, "close"):
+            results.close()
+    ran = sum(counts.values())
+    return {"study": study.name, "out": str(out_dir), "cells": total, "skipped": total - len(todo), "ran": ran,
+            "failed": ran - counts.get("ok", 0), "outcomes": counts, "engine": engine, "workers": workers,
+            "wall_s": round(time.perf_counter() - started, 3)}

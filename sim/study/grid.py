@@ -1,0 +1,83 @@
+"""A study's grid: every (scenario, planner setting, navigator setting, seed, world seed) cell.
+
+A cell's configuration hash covers what decides its result: the scenario file's
+bytes, the planner and navigator with their labels and parameters, both seeds, the mode and
+the simulated-time limit.  Resuming skips the cells whose hash is already in the
+rows; an edited scenario or parameter is a new cell.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from pathlib import Path as FilePath
+from typing import Any
+
+from swarmnav.models.scenario import resolve_scenario_path
+from swarmnav.sim.study.spec import Component, Study
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One run of a study (picklable: it crosses process and Ray boundaries)."""
+
+    study: str
+    scenario: str  # bundled name or path, for load_scenario
+    scenario_name: str
+    planner: str
+    label: str  # the planner entry's label, plus the swept values
+    planner_params: dict[str, Any]
+    navigator: str
+    navigator_label: str
+    navigator_params: dict[str, Any]
+    seed: int
+    world_seed: int | None
+    mode: str
+    time_limit_s: float | None
+    wall_limit_s: float
+    config_hash: str
+
+    @property
+    def physics(self) -> bool:
+        return self.mode == "physics"
+
+
+def _sweep_label(component: Component, setting: dict[str, Any]) -> str:
+    if not component.swept:
+        return component.label
+    return component.label + "(" + ", ".join(f"{k}={setting[k]}" for k in component.swept) + ")"
+
+
+def config_hash(config: dict[str, Any]) -> str:
+    """16 hex digits of SHA-256 over the canonical JSON of a cell's configuration."""
+    text = json.dumps(config, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def expand(study: Study) -> list[Cell]:
+    """Every cell of the study, in a fixed order (scenario, planner, setting, navigator, world seed, seed)."""
+    cells: list[Cell] = []
+    scenario_digest = {s: hashlib.sha256(resolve_scenario_path(s).read_bytes()).hexdigest() for s in study.scenarios}
+    for scenario in study.scenarios:
+        for planner in study.planners:
+            for planner_params in planner.settings():
+                for navigator in study.navigators:
+                    for navigator_params in navigator.settings():
+                        for world_seed in study.world_seeds:
+                            for seed in study.seeds:
+                                config = {"scenario_sha256": scenario_digest[scenario], "planner": planner.name,
+                                          "label": planner.label, "navigator_label": navigator.label,
+                                          "planner_params": planner_params, "navigator": navigator.name,
+                                          "navigator_params": navigator_params, "seed": seed,
+                                          "world_seed": world_seed, "mode": study.mode,
+                                          "time_limit_s": study.time_limit_s}
+                                cells.append(Cell(
+                                    study=study.name, scenario=scenario, scenario_name=FilePath(scenario).stem,
+                                    planner=planner.name, label=_sweep_label(planner, planner_params),
+                                    planner_params=planner_params, navigator=navigator.name,
+                                    navigator_label=_sweep_label(navigator, navigator_params),
+                                    navigator_params=navigator_params, seed=seed, world_seed=world_seed,
+                                    mode=study.mode, time_limit_s=study.time_limit_s,
+                                    wall_limit_s=study.wall_limit_s, config_hash=config_hash(config)))
+    return cells

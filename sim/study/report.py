@@ -1,0 +1,198 @@
+"""``swarmnav report DIR``: a self-contained HTML report of a study's rows, and its Markdown twin.
+
+It reads only ``DIR/runs.parquet``, ``DIR/progress.parquet`` and ``DIR/study.json``
+(the reference planner and the paper's values); the only other file it opens is
+each scenario's, to draw the obstacles under the paths.  The HTML embeds its
+images (base64 PNG); the Markdown links the same PNGs, written to
+``<report>_files/`` beside it.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import math
+from pathlib import Path as FilePath
+from typing import Any
+
+from swarmnav.sim.study import figures
+from swarmnav.sim.study.rows import PROGRESS, RUNS, read_table
+from swarmnav.sim.study.statistics import (arm_counts, by_scenario, compare, friedman, impossible, summarise,
+                                           values)
+
+PLAN_METRICS = ["plan_length_m", "plan_time_s", "plan_iterations", "plan_convergence_iteration", "plan_bends",
+                "plan_evaluations"]
+RUN_METRICS = ["path_length_m", "sim_time_s", "min_clearance_m", "collisions"]
+TEST_METRIC = "plan_length_m"  # the metric of the tests between planners (seed 003 Table 4 tests path lengths)
+
+
+def _fmt(x: Any, digits: int = 4) -> str:
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "–"
+    if isinstance(x, float):
+        return f"{x:.{digits}g}" if abs(x) < 1e-3 and x != 0 else f"{x:.{digits}f}".rstrip("0").rstrip(".")
+    return str(x)
+
+
+class _Document:
+    """Builds the HTML and the Markdown side by side."""
+
+    def __init__(self, title: str, files_dir: FilePath):
+        self.html = [f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
+                     "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}"
+                     "table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 6px;"
+                     "font-size:13px;text-align:right}th{background:#eee}td:first-child{text-align:left}"
+                     ".flag{color:#b00}</style></head><body>", f"<h1>{html.escape(title)}</h1>"]
+        self.markdown = [f"# {title}", ""]
+        self.files_dir = files_dir
+        self.images = 0
+
+    def heading(self, text: str, level: int = 2) -> None:
+        self.html.append(f"<h{level}>{html.escape(text)}</h{level}>")
+        self.markdown += ["#" * level + " " + text, ""]
+
+    def paragraph(self, text: str) -> None:
+        self.html.append(f"<p>{html.escape(text)}</p>")
+        self.markdown += [text, ""]
+
+    def table(self, header: list[str], rows: list[list[str]]) -> None:
+        self.html.append("<table><tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in header) + "</tr>"
+                         + "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in rows)
+                         + "</table>")
+        self.markdown += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        self.markdown += ["| " + " | ".join(c.replace("|", "\\|") for c in r) + " |" for r in rows]
+        self.markdown.append("")
+
+    def image(self, png: bytes | None, caption: str) -> None:
+        if png is None:
+            return
+        self.images += 1
+        name = f"figure-{self.images:03d}.png"
+        self.files_dir.mkdir(parents=True, exist_ok=True)
+        (self.files_dir / name).write_bytes(png)
+        self.html.append(f"<figure><img src='data:image/png;base64,{base64.b64encode(png).decode()}'>"
+                         f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+        self.markdown += [f"![{caption}]({self.files_dir.name}/{name})", ""]
+
+
+def count_rows(arms: dict[str, list[dict[str, Any]]]) -> tuple[list[str], list[list[str]]]:
+    """Runs, failures by outcome and success rate per arm."""
+    header = ["planner", "runs", "failed", "outcomes", "success %"]
+    rows = []
+    for name, arm_rows in arms.items():
+        c = arm_counts(arm_rows)
+        rows.append([name, str(c["runs"]), str(c["failed"]),
+                     ", ".join(f"{k} {v}" for k, v in sorted(c["outcomes"].items())),
+                     _fmt(100 * c["success_rate"], 1)])
+    return header, rows
+
+
+def metric_rows(arms: dict[str, list[dict[str, Any]]], metrics: list[str]) -> tuple[list[str], list[list[str]]]:
+    """Mean, sample std, median and best of each metric per arm, over the runs that produced it."""
+    header = ["planner", "metric", "n", "mean", "std", "median", "best"]
+    rows = []
+    for metric in metrics:
+        for name, arm_rows in arms.items():
+            s = summarise(arm_rows, metric)
+            if s is not None:
+                rows.append([name, metric, str(s.n), _fmt(s.mean), _fmt(s.std), _fmt(s.median), _fmt(s.best)])
+    return header, rows
+
+
+def _present(rows: list[dict[str, Any]], metrics: list[str]) -> list[str]:
+    return [m for m in metrics if any(r.get(m) is not None for r in rows)]
+
+
+def _scenario(ref: str):
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.models.scenario import load_scenario
+    try:
+        return load_scenario(ref)
+    except ConfigError:
+        return None
+
+
+def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePath:
+    """Write the HTML report and its Markdown twin (``.md`` beside it); return the Markdown path."""
+    directory, html_path = FilePath(directory), FilePath(html_path)
+    runs = read_table(directory, RUNS).to_pylist()
+    progress: dict[str, list[tuple[int, float, int]]] = {}
+    seen = set()
+    for p in read_table(directory, PROGRESS).to_pylist():
+        key = (p["config_hash"], p["iteration"])
+        if key not in seen:  # a part may repeat after a resumed crash; the values are the same
+            seen.add(key)
+            progress.setdefault(p["config_hash"], []).append((p["iteration"], p["best_cost"], p["evaluations"]))
+    meta_path = directory / "study.json"
+    meta = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
+    title = f"Study {meta.get('name', directory.name)}"
+    markdown_path = html_path.with_suffix(".md")
+    doc = _Document(title, html_path.parent / f"{html_path.stem}_files")
+    if meta.get("description"):
+        doc.paragraph(meta["description"])
+    failed = sum(r["outcome"] != "ok" for r in runs)
+    doc.paragraph(f"{len(runs)} runs, {failed} failed (no path, error or wall-limit timeout; counted, never "
+                  f"dropped). Mode: {meta.get('mode', '?')}. Statistics compare {TEST_METRIC} against the "
+                  f"reference planner {meta.get('reference', '?')!r}.")
+    for scenario, arms in by_scenario(runs).items():
+        scenario_rows = [r for rows in arms.values() for r in rows]
+        doc.heading(f"Scenario {scenario}")
+        metrics = _present(scenario_rows, PLAN_METRICS + RUN_METRICS)
+        doc.table(*count_rows(arms))
+        doc.table(*metric_rows(arms, metrics))
+        errors = sorted({r["error"] for r in scenario_rows if r.get("error")})
+        if errors:
+            doc.paragraph("Failures: " + "; ".join(errors[:5]) + (" …" if len(errors) > 5 else ""))
+        _statistics(doc, arms, meta.get("reference"))
+        _paper_values(doc, scenario, arms, scenario_rows, meta.get("paper", []))
+        doc.image(figures.box_plots(arms, _present(scenario_rows, ["plan_length_m", "plan_time_s", "path_length_m",
+                                                                   "sim_time_s", "min_clearance_m"])),
+                  f"{scenario}: distributions over runs")
+        doc.image(figures.success_bars(arms), f"{scenario}: success rate")
+        doc.image(figures.convergence(arms, progress), f"{scenario}: median best cost with interquartile band")
+        doc.image(figures.paths(arms, _scenario(scenario_rows[0]["scenario_ref"])),
+                  f"{scenario}: the plan of one seed per planner")
+    doc.html.append("</body></html>")
+    html_path.parent.mkdir(parents=True, exist_ok=True)
+    html_path.write_text("\n".join(doc.html), encoding="utf-8")
+    markdown_path.write_text("\n".join(doc.markdown) + "\n", encoding="utf-8")
+    return markdown_path
+
+
+def _statistics(doc: _Document, arms: dict[str, list[dict[str, Any]]], reference: str | None) -> None:
+    if len(arms) < 2:
+        return
+    reference = reference if reference in arms else next((a for a in arms if a.split("(")[0] == reference),
+                                                        next(iter(arms)))
+    comparisons = compare(arms, reference, TEST_METRIC)
+    doc.paragraph(f"{TEST_METRIC}: {reference} against each planner. Wilcoxon rank-sum (scipy.stats.ranksums) "
+                  "with Cliff's delta (> 0: the reference's values are larger); Wilcoxon signed-rank on runs "
+                  "paired by seed and world seed, with the matched-pairs rank-biserial correlation; Holm-adjusted.")
+    doc.table(["against", "n ref", "n other", "rank-sum p", "Holm p", "Cliff's delta", "pairs", "signed-rank p",
+               "Holm p", "rank-biserial"],
+              [[c.other, str(c.n_ref), str(c.n_other), _fmt(c.ranksum_p), _fmt(c.ranksum_p_holm),
+                _fmt(c.cliffs_delta, 3), str(c.n_pairs), _fmt(c.signed_rank_p), _fmt(c.signed_rank_p_holm),
+                _fmt(c.rank_biserial, 3)] for c in comparisons])
+    result = friedman(arms, TEST_METRIC)
+    if result is not None:
+        doc.paragraph(f"Friedman test across all {len(arms)} planners on {result['blocks']} seeds every planner "
+                      f"completed: chi² = {_fmt(result['statistic'])}, p = {_fmt(result['p'])}, "
+                      f"Kendall's W = {_fmt(result['kendall_w'], 3)}.")
+
+
+def _paper_values(doc: _Document, scenario: str, arms, scenario_rows, paper: list[dict[str, Any]]) -> None:
+    entries = [p for p in paper if p["scenario"] == scenario]
+    if not entries:
+        return
+    rows = []
+    for p in entries:
+        mine = [r for name, rs in arms.items() if name == p["planner"] or name.startswith(p["planner"] + "(")
+                for r in rs]
+        v = values(mine, p["metric"])
+        ours = f"{_fmt(float(v.mean()))} ± {_fmt(float(v.std(ddof=1)) if v.size > 1 else float('nan'))}" \
+            if v.size else "–"
+        flag = impossible(p["metric"], p["value"], scenario_rows) or ""
+        rows.append([p["planner"], p["metric"], _fmt(p["value"]), ours, str(v.size), p.get("note", ""), flag])
+    doc.paragraph("The paper's values beside ours (mean ± std over our completed runs).")
+    doc.table(["planner", "metric", "paper", "ours", "our runs", "source", "check"], rows)

@@ -1,0 +1,296 @@
+"""A study file: which scenarios, planners (with swept parameters), navigators and seeds to run.
+
+TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) or any path::
+
+    name = "gwo-vs-abc"              # default: the file stem
+    description = "..."
+    scenarios = ["gwo-scenario-*"]   # bundled names, paths, or glob patterns of either
+    mode = "plan"                    # "plan" (plan only) or "physics" (plan, then simulate)
+    seeds = 10                       # a count (0..N-1) or a list of planner seeds
+    world_seeds = [0]                # optional: seeds of the random obstacle motions (default: the scenario's)
+    wall_limit_s = 120               # per run; past it the run becomes an outcome "timeout" row
+    reference = "gwo"                # the planner label (or one swept arm, "maco(p0=0.9)") the statistics
+                                     # compare against (default: the first)
+
+    [[planners]]
+    name = "gwo"                     # a name in the planner registry
+    label = "GWO"                    # optional; default: the name
+    params = { population = 50, iterations = [50, 100] }   # a list sweeps that parameter
+
+    [[navigators]]                   # optional; default: one navigator, follow
+    name = "follow"
+
+    [[paper]]                        # optional: a paper's value to print beside ours
+    scenario = "gwo-scenario-1"
+    planner = "GWO"                  # a planner label
+    metric = "plan_length_m"
+    value = 14.14
+    note = "Table 2"
+
+Every problem is a :class:`ConfigError` naming the field (``planners[1].params.alpha``).
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import glob
+import itertools
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path as FilePath
+from typing import Any
+
+from swarmnav.controllers.navigators import make_navigator
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, resolve_scenario_path
+from swarmnav.planners import make_planner
+
+STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
+MODES = ("plan", "physics")
+TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "world_seeds", "wall_limit_s",
+            "time_limit_s", "reference", "planners", "navigators", "paper"}
+
+
+@dataclass(frozen=True)
+class Component:
+    """A planner or navigator entry: a registry name, a label, and its parameter grid."""
+
+    name: str
+    label: str
+    params: dict[str, Any]  # a list value is a sweep
+    swept: tuple[str, ...]  # the keys that sweep
+
+    def settings(self) -> list[dict[str, Any]]:
+        """Every parameter table of the sweep (the Cartesian product of the lists), in file order."""
+        fixed = {k: v for k, v in self.params.items() if k not in self.swept}
+        lists = [self.params[k] for k in self.swept]
+        return [{**fixed, **dict(zip(self.swept, combo))} for combo in itertools.product(*lists)]
+
+
+@dataclass(frozen=True)
+class PaperValue:
+    scenario: str
+    planner: str
+    metric: str
+    value: float
+    note: str
+
+
+@dataclass(frozen=True)
+class Study:
+    name: str
+    description: str
+    source: str
+    scenarios: tuple[str, ...]  # bundled names or file paths, each loadable by load_scenario
+    mode: str
+    seeds: tuple[int, ...]
+    world_seeds: tuple[int | None, ...]
+    wall_limit_s: float
+    time_limit_s: float | None  # simulated-time limit override (physics); None = the scenario's
+    reference: str
+    planners: tuple[Component, ...]
+    navigators: tuple[Component, ...]
+    paper: tuple[PaperValue, ...]
+
+    @property
+    def physics(self) -> bool:
+        return self.mode == "physics"
+
+
+def list_studies() -> list[str]:
+    """Names of the bundled studies (file stems under models/studies/)."""
+    return sorted(p.stem for p in STUDY_DIR.glob("*.toml"))
+
+
+def resolve_study_path(name_or_path: str) -> FilePath:
+    candidate = FilePath(name_or_path)
+    if candidate.suffix == ".toml" or candidate.exists() or "/" in name_or_path:
+        if not candidate.is_file():
+            raise ConfigError("study", "file does not exist", str(candidate))
+        return candidate
+    bundled = STUDY_DIR / f"{name_or_path}.toml"
+    if not bundled.is_file():
+        raise ConfigError("study", f"no bundled study named {name_or_path!r} (see `swarmnav studies`)", name_or_path)
+    return bundled
+
+
+def load_study(name_or_path: str) -> Study:
+    """Read and validate a study file (bundled name or path).
+
+    Raises:
+        ConfigError: missing file, malformed TOML, or any field that breaks the schema.
+    """
+    path = resolve_study_path(str(name_or_path))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError("study", f"cannot be read ({exc})", str(path)) from None
+    return parse_study(text, str(path), default_name=path.stem)
+
+
+def _fail(source: str, field: str, problem: str):
+    raise ConfigError(field, problem, source)
+
+
+def _string(source: str, data: dict, key: str, field: str, default: Any = ...) -> str:
+    if key not in data:
+        if default is ...:
+            _fail(source, field, "is required")
+        return default
+    if not isinstance(data[key], str) or not data[key]:
+        _fail(source, field, f"expected a non-empty string, got {data[key]!r}")
+    return data[key]
+
+
+def _number(source: str, value: Any, field: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value:
+        _fail(source, field, f"expected a number, got {value!r}")
+    return float(value)
+
+
+def _scenarios(source: str, value: Any) -> tuple[str, ...]:
+    if not isinstance(value, list) or not value:
+        _fail(source, "scenarios", "expected a non-empty list of scenario names, paths or patterns")
+    bundled = list_scenarios()
+    base = FilePath(source).parent if source and not source.startswith("<") else FilePath(".")
+    out: list[str] = []
+    for i, item in enumerate(value):
+        field = f"scenarios[{i}]"
+        if not isinstance(item, str) or not item:
+            _fail(source, field, f"expected a scenario name, path or pattern, got {item!r}")
+        is_path = item.endswith(".toml") or "/" in item
+        if any(c in item for c in "*?["):
+            found = (sorted(glob.glob(str(base / item))) if is_path else fnmatch.filter(bundled, item))
+            if not found:
+                _fail(source, field, f"pattern {item!r} matches no scenario")
+        else:
+            target = str(base / item) if is_path and not FilePath(item).is_absolute() else item
+            try:
+                resolve_scenario_path(target)
+            except ConfigError as exc:
+                _fail(source, field, f"{exc.problem} ({item!r})")
+            found = [target]
+        out.extend(s for s in found if s not in out)
+    return tuple(out)
+
+
+def _seeds(source: str, data: dict, key: str, default: Any) -> tuple:
+    value = data.get(key, default)
+    if isinstance(value, bool):
+        _fail(source, key, f"expected a count or a list of integers, got {value!r}")
+    if isinstance(value, int):
+        if value < 1:
+            _fail(source, key, f"empty grid: the count must be at least 1, got {value}")
+        return tuple(range(value))
+    if not isinstance(value, list) or not value:
+        _fail(source, key, "empty grid: expected a count or a non-empty list of integers")
+    for i, seed in enumerate(value):
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            _fail(source, f"{key}[{i}]", f"expected a non-negative integer, got {seed!r}")
+    if len(set(value)) != len(value):
+        _fail(source, key, "lists a seed twice")
+    return tuple(value)
+
+
+def _components(source: str, value: Any, key: str, kind: str, make) -> tuple[Component, ...]:
+    if not isinstance(value, list) or not value:
+        _fail(source, key, f"empty grid: expected a non-empty array of [[{key}]] tables")
+    out: list[Component] = []
+    for i, entry in enumerate(value):
+        where = f"{key}[{i}]"
+        if not isinstance(entry, dict):
+            _fail(source, where, "expected a table")
+        for k in sorted(set(entry) - {"name", "label", "params"}):
+            _fail(source, f"{where}.{k}", "unknown key")
+        name = _string(source, entry, "name", f"{where}.name")
+        label = _string(source, entry, "label", f"{where}.label", name)
+        params = entry.get("params", {})
+        if not isinstance(params, dict):
+            _fail(source, f"{where}.params", "expected a table")
+        swept = tuple(k for k, v in params.items() if isinstance(v, list))
+        for k in swept:
+            if not params[k]:
+                _fail(source, f"{where}.params.{k}", "empty grid: the sweep lists no value")
+        component = Component(name, label, dict(params), swept)
+        for setting in component.settings():  # every combination builds: names and every swept value checked
+            try:
+                make(name, setting, source)
+            except ConfigError as exc:
+                field = exc.field.replace(f"{kind}.", f"{where}.", 1)
+                if field == f"{where}.params" and swept:
+                    field = f"{where}.params"
+                _fail(source, field, exc.problem)
+        out.append(component)
+    labels = [c.label for c in out]
+    for i, label in enumerate(labels):
+        if label in labels[:i]:
+            _fail(source, f"{key}[{i}].label", f"label {label!r} is used twice (give each entry its own label)")
+    return tuple(out)
+
+
+def _paper(source: str, value: Any, scenarios: tuple[str, ...], labels: list[str]) -> tuple[PaperValue, ...]:
+    if not isinstance(value, list):
+        _fail(source, "paper", "expected an array of [[paper]] tables")
+    out = []
+    names = {FilePath(s).stem for s in scenarios}
+    for i, entry in enumerate(value):
+        where = f"paper[{i}]"
+        if not isinstance(entry, dict):
+            _fail(source, where, "expected a table")
+        for k in sorted(set(entry) - {"scenario", "planner", "metric", "value", "note"}):
+            _fail(source, f"{where}.{k}", "unknown key")
+        scenario = _string(source, entry, "scenario", f"{where}.scenario")
+        if scenario not in names:
+            _fail(source, f"{where}.scenario", f"{scenario!r} is not among the study's scenarios")
+        planner = _string(source, entry, "planner", f"{where}.planner")
+        if planner not in labels:
+            _fail(source, f"{where}.planner", f"{planner!r} is not a planner label of the study "
+                                              f"({', '.join(labels)})")
+        metric = _string(source, entry, "metric", f"{where}.metric")
+        if "value" not in entry:
+            _fail(source, f"{where}.value", "is required")
+        out.append(PaperValue(scenario, planner, metric, _number(source, entry["value"], f"{where}.value"),
+                              _string(source, entry, "note", f"{where}.note", "")))
+    return tuple(out)
+
+
+def parse_study(text: str, source: str = "<string>", default_name: str = "study") -> Study:
+    """Validate study TOML text (see :func:`load_study`)."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError("toml", f"malformed TOML ({exc})", source) from None
+    for key in sorted(set(data) - TOP_KEYS):
+        _fail(source, key, "unknown key")
+    name = _string(source, data, "name", "name", default_name)
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        _fail(source, "description", f"expected a string, got {description!r}")
+    if "scenarios" not in data:
+        _fail(source, "scenarios", "is required")
+    scenarios = _scenarios(source, data["scenarios"])
+    mode = _string(source, data, "mode", "mode", "plan")
+    if mode not in MODES:
+        _fail(source, "mode", f"unknown value {mode!r} (expected one of: {', '.join(MODES)})")
+    seeds = _seeds(source, data, "seeds", 1)
+    world_seeds: tuple = _seeds(source, data, "world_seeds", [0]) if "world_seeds" in data else (None,)
+    wall_limit_s = _number(source, data.get("wall_limit_s", 600.0), "wall_limit_s")
+    if wall_limit_s <= 0:
+        _fail(source, "wall_limit_s", f"must be positive, got {wall_limit_s:g}")
+    time_limit_s = None
+    if "time_limit_s" in data:
+        time_limit_s = _number(source, data["time_limit_s"], "time_limit_s")
+        if time_limit_s <= 0:
+            _fail(source, "time_limit_s", f"must be positive, got {time_limit_s:g}")
+    if "planners" not in data:
+        _fail(source, "planners", "is required")
+    planners = _components(source, data["planners"], "planners", "planner", make_planner)
+    navigators = _components(source, data.get("navigators", [{"name": "follow"}]), "navigators", "navigator",
+                             make_navigator)
+    labels = [p.label for p in planners]
+    reference = _string(source, data, "reference", "reference", labels[0])
+    if reference not in labels and not any(reference.startswith(f"{label}(") for label in labels):
+        _fail(source, "reference", f"{reference!r} is not a planner label of the study ({', '.join(labels)})")
+    paper = _paper(source, data.get("paper", []), scenarios, labels)
+    return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
+                 reference, planners, navigators, paper)

@@ -1,0 +1,186 @@
+"""Summaries and tests over a study's rows (plain dicts as read from ``runs.parquet``).
+
+* per arm (planner label, navigator label): runs, failures, success rate, and
+  mean ± std (sample, ddof = 1), median and best of each metric over the runs
+  that produced it;
+* between arms on one scenario: the Wilcoxon rank-sum test (``scipy.stats.ranksums``,
+  as Li et al. 2023, seed 003, Table 4 use it on path lengths) with Cliff's delta;
+  the Wilcoxon signed-rank test (``scipy.stats.wilcoxon``) on the runs that pair by
+  (seed, world seed) with the matched-pairs rank-biserial correlation; Holm's
+  step-down correction over the comparisons against the reference planner; and the
+  Friedman test across all arms on the seeds every arm completed, with Kendall's W.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from dataclasses import dataclass
+from typing import Any, Iterable
+
+import numpy as np
+from scipy import stats
+
+LOWER_IS_BETTER = {"min_clearance_m": False}  # every other metric: lower is better
+
+
+def arm(row: dict[str, Any]) -> str:
+    """The name of a row's arm: the planner label, with the navigator's when it is not plain follow."""
+    navigator = row.get("navigator_label") or "follow"
+    return row["label"] if navigator == "follow" else f"{row['label']} + {navigator}"
+
+
+def by_scenario(rows: Iterable[dict[str, Any]]) -> dict[str, dict[str, list[dict[str, Any]]]]:
+    """scenario -> arm -> rows, both in first-seen order."""
+    out: dict[str, dict[str, list[dict[str, Any]]]] = {}
+    for row in rows:
+        out.setdefault(row["scenario"], {}).setdefault(arm(row), []).append(row)
+    return out
+
+
+def values(rows: list[dict[str, Any]], metric: str) -> np.ndarray:
+    return np.array([r[metric] for r in rows if r.get(metric) is not None and r.get("outcome") == "ok"], dtype=float)
+
+
+@dataclass
+class MetricSummary:
+    n: int
+    mean: float
+    std: float
+    median: float
+    best: float
+
+
+def summarise(rows: list[dict[str, Any]], metric: str) -> MetricSummary | None:
+    v = values(rows, metric)
+    if v.size == 0:
+        return None
+    best = float(v.max() if not LOWER_IS_BETTER.get(metric, True) else v.min())
+    return MetricSummary(int(v.size), float(v.mean()), float(v.std(ddof=1)) if v.size > 1 else float("nan"),
+                         float(np.median(v)), best)
+
+
+def arm_counts(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    n = len(rows)
+    outcomes: dict[str, int] = defaultdict(int)
+    for r in rows:
+        outcomes[r["outcome"]] += 1
+    successes = sum(bool(r["success"]) for r in rows)
+    return {"runs": n, "successes": successes, "success_rate": successes / n if n else float("nan"),
+            "failed": n - outcomes.get("ok", 0), "outcomes": dict(outcomes)}
+
+
+def cliffs_delta(a: np.ndarray, b: np.ndarray) -> float:
+    """P(a > b) - P(a < b) over all pairs (Cliff 1993)."""
+    diff = a[:, None] - b[None, :]
+    return float((np.count_nonzero(diff > 0) - np.count_nonzero(diff < 0)) / diff.size)
+
+
+def paired(ref_rows: list[dict[str, Any]], other_rows: list[dict[str, Any]], metric: str
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """Values of the runs of two arms that share (seed, world seed), both with the metric."""
+    def keyed(rows):
+        return {(r["seed"], r["world_seed"]): r[metric] for r in rows
+                if r.get("outcome") == "ok" and r.get(metric) is not None}
+    a, b = keyed(ref_rows), keyed(other_rows)
+    keys = sorted(set(a) & set(b), key=lambda k: (k[0], -1 if k[1] is None else k[1]))
+    return np.array([a[k] for k in keys], dtype=float), np.array([b[k] for k in keys], dtype=float)
+
+
+def rank_biserial_paired(a: np.ndarray, b: np.ndarray) -> float:
+    """Matched-pairs rank-biserial correlation (W+ - W-) / (W+ + W-) over the non-zero differences."""
+    d = a - b
+    d = d[d != 0]
+    if d.size == 0:
+        return 0.0
+    ranks = stats.rankdata(np.abs(d))
+    return float((ranks[d > 0].sum() - ranks[d < 0].sum()) / ranks.sum())
+
+
+def holm(p_values: list[float]) -> list[float]:
+    """Holm's (1979) step-down adjusted p-values, in the input order (NaN stays NaN)."""
+    finite = [(p, i) for i, p in enumerate(p_values) if not math.isnan(p)]
+    finite.sort()
+    m = len(finite)
+    adjusted = [float("nan")] * len(p_values)
+    running = 0.0
+    for k, (p, i) in enumerate(finite):
+        running = max(running, min(1.0, (m - k) * p))
+        adjusted[i] = running
+    return adjusted
+
+
+@dataclass
+class Comparison:
+    other: str
+    n_ref: int
+    n_other: int
+    ranksum_p: float
+    cliffs_delta: float  # > 0: the reference's values tend to be larger
+    n_pairs: int
+    signed_rank_p: float
+    rank_biserial: float
+    ranksum_p_holm: float = float("nan")
+    signed_rank_p_holm: float = float("nan")
+
+
+def compare(arms: dict[str, list[dict[str, Any]]], reference: str, metric: str) -> list[Comparison]:
+    """The reference arm against every other arm of one scenario, Holm-corrected within the family."""
+    if reference not in arms:
+        return []
+    ref = values(arms[reference], metric)
+    out = []
+    for name, rows in arms.items():
+        if name == reference:
+            continue
+        other = values(rows, metric)
+        p = float(stats.ranksums(ref, other).pvalue) if ref.size and other.size else float("nan")
+        delta = cliffs_delta(ref, other) if ref.size and other.size else float("nan")
+        a, b = paired(arms[reference], rows, metric)
+        if a.size and np.any(a != b):
+            p_signed = float(stats.wilcoxon(a, b).pvalue)
+        else:  # no pairs, or every pair equal: the test is undefined
+            p_signed = float("nan")
+        out.append(Comparison(name, int(ref.size), int(other.size), p, delta, int(a.size), p_signed,
+                              rank_biserial_paired(a, b) if a.size else float("nan")))
+    for attribute in ("ranksum_p", "signed_rank_p"):
+        for c, adjusted in zip(out, holm([getattr(c, attribute) for c in out])):
+            setattr(c, f"{attribute}_holm", adjusted)
+    return out
+
+
+def friedman(arms: dict[str, list[dict[str, Any]]], metric: str) -> dict[str, Any] | None:
+    """Friedman's test across all arms (at least 3) on the (seed, world seed) blocks every arm completed."""
+    if len(arms) < 3:
+        return None
+    keyed = [{(r["seed"], r["world_seed"]): r[metric] for r in rows
+              if r.get("outcome") == "ok" and r.get(metric) is not None} for rows in arms.values()]
+    blocks = sorted(set.intersection(*(set(k) for k in keyed)), key=str)
+    if len(blocks) < 2:
+        return {"blocks": len(blocks), "statistic": float("nan"), "p": float("nan"), "kendall_w": float("nan")}
+    samples = [np.array([k[b] for b in blocks], dtype=float) for k in keyed]
+    try:
+        result = stats.friedmanchisquare(*samples)
+        statistic, p = float(result.statistic), float(result.pvalue)
+    except ValueError:
+        statistic, p = float("nan"), float("nan")
+    k = len(samples)
+    return {"blocks": len(blocks), "statistic": statistic, "p": p,
+            "kendall_w": statistic / (len(blocks) * (k - 1)) if math.isfinite(statistic) else float("nan")}
+
+
+def impossible(metric: str, paper_value: float, scenario_rows: list[dict[str, Any]]) -> str | None:
+    """Why a paper's value cannot be: below the straight line, no path at all, or below the exact optimum
+    (when the study ran the ``optimal`` planner)."""
+    if not metric.endswith("length_m"):
+        return None
+    straight = [r["straight_line_m"] for r in scenario_rows if r.get("straight_line_m") is not None]
+    if straight and paper_value < min(straight) - 1e-9:
+        return f"impossible: below the straight line ({min(straight):.4f} m)"
+    optimal_rows = [r for r in scenario_rows if r["planner"] == "optimal"]
+    if optimal_rows and all(r["outcome"] == "no_path" for r in optimal_rows):
+        return "impossible: no collision-free path exists (the exact optimum finds none)"
+    optimum = values(optimal_rows, "plan_length_m")
+    if optimum.size and paper_value < optimum.min() - 1e-6:
+        return f"impossible: below the exact optimum ({optimum.min():.4f} m)"
+    return None

@@ -1,0 +1,211 @@
+"""Studies: the grid runs through the one episode function, rows resume, failures are rows, the report agrees."""
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy import stats
+
+from swarmnav.models.scenario import load_scenario
+from swarmnav.planners.errors import PlanningError
+from swarmnav.sim.cli import main
+from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
+from swarmnav.sim.study.grid import expand
+from swarmnav.sim.study.rows import TIMING_COLUMNS
+from swarmnav.sim.study.spec import list_studies, load_study
+
+TINY = """
+name = "tiny"
+scenarios = ["gwo-scenario-1", "restaurant-table-2"]
+mode = "physics"
+time_limit_s = {time_limit_s}
+seeds = 3
+[[planners]]
+name = "astar"
+[[planners]]
+name = "gwo"
+params = {{ population = 10, iterations = 10 }}
+"""
+TINY_TIME_LIMIT_S = 4.0
+
+
+def write(tmp_path: Path, text: str, name: str = "study.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    """The tiny study (2 scenarios x 2 planners x 3 seeds, physics, 4 s simulated) run on 2 local workers."""
+    base = tmp_path_factory.mktemp("tiny")
+    path = write(base, TINY.format(time_limit_s=TINY_TIME_LIMIT_S))
+    assert main(["study", str(path), "--out", str(base / "out"), "--workers", "2", "--json"]) == 0
+    return path, base / "out"
+
+
+def test_tiny_study_rows_equal_the_same_episodes(tiny):
+    path, out = tiny
+    rows = pd.read_parquet(out / "runs.parquet")
+    assert len(rows) == 12 and rows["config_hash"].is_unique
+    for row in rows.to_dict("records"):
+        spec = EpisodeSpec(load_scenario(row["scenario"]), row["planner"], json.loads(row["planner_params"]),
+                           seed=int(row["seed"]))
+        try:
+            planned = plan_episode(spec)
+        except PlanningError as exc:
+            assert row["outcome"] == "no_path" and type(exc).__name__ in row["error"]
+            continue
+        summary = run_episode(spec, planned=planned, time_limit_s=TINY_TIME_LIMIT_S).summary()
+        assert row["outcome"] == "ok"
+        for key in ("reached", "collisions", "sim_time_s", "path_length_m", "min_clearance_m"):
+            assert row[key] == summary[key], key
+        assert row["run_outcome"] == summary["outcome"]
+        plan = summary["plan"]
+        assert row["plan_length_m"] == plan["length_m"] and row["plan_iterations"] == plan["iterations"]
+        assert row["plan_evaluations"] == plan["evaluations"]
+        assert json.loads(row["plan_waypoints"]) == plan["waypoints"]
+        assert row["navigator"] == summary["navigator"] and row["world_seed"] is None or math.isnan(row["world_seed"])
+    progress = pd.read_parquet(out / "progress.parquet")
+    gwo = rows[(rows.planner == "gwo") & (rows.outcome == "ok")]
+    assert set(gwo.config_hash) <= set(progress.config_hash)
+    one = progress[progress.config_hash == gwo.config_hash.iloc[0]].sort_values("iteration")
+    assert len(one) == gwo.plan_iterations.iloc[0] + 1 and np.all(np.diff(one.best_cost) <= 0)
+
+
+def test_running_again_skips_every_cell(tiny, capsys):
+    path, out = tiny
+    assert main(["study", str(path), "--out", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["skipped"] == 12 and summary["ran"] == 0
+    assert len(pd.read_parquet(out / "runs.parquet")) == 12
+
+
+def test_resume_after_a_kill_runs_each_cell_once(tmp_path):
+    path = write(tmp_path, 'name = "resume"\nscenarios = ["gwo-scenario-1"]\nseeds = 40\n'
+                           '[[planners]]\nname = "gwo"\nparams = { population = 20, iterations = 40 }\n')
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out), "--workers", "1",
+               "--json"]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while not list((out / "runs.parquet").glob("part-*.parquet")) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    before = pd.read_parquet(out / "runs.parquet")
+    assert 0 < len(before) < 40  # killed part-way, with its flushed rows readable
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL, timeout=120)
+    after = pd.read_parquet(out / "runs.parquet")
+    assert len(after) == 40 and after["config_hash"].is_unique
+    assert set(after.config_hash) == {c.config_hash for c in expand(load_study(str(path)))}
+    assert set(after.seed) == set(range(40))
+
+
+def test_a_raising_planner_and_a_run_past_the_wall_limit_are_rows(tmp_path, capsys):
+    # gwo raises on a grid map (it plans among discs only); 20000 iterations outlast a 1 s wall limit.
+    path = write(tmp_path, 'name = "failing"\nscenarios = ["iaco-simple", "gwo-scenario-1"]\nwall_limit_s = 1.0\n'
+                           '[[planners]]\nname = "gwo"\nparams = { population = 50, iterations = 20000 }\n')
+    assert main(["study", str(path), "--out", str(tmp_path / "out"), "--workers", "2"]) == 0
+    assert "2 failed" in capsys.readouterr().out
+    rows = pd.read_parquet(tmp_path / "out" / "runs.parquet").set_index("scenario")
+    assert rows.loc["iaco-simple", "outcome"] == "error"
+    assert rows.loc["iaco-simple", "error"].startswith("ConfigError: planner.name: gwo")
+    assert rows.loc["gwo-scenario-1", "outcome"] == "timeout"
+    assert rows.loc["gwo-scenario-1", "cell_wall_s"] < 10
+    assert not rows.success.any()
+    assert main(["report", str(tmp_path / "out")]) == 0  # a report of failures only still counts them
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "| gwo | 1 | 1 | error 1 | 0 |" in report and "| gwo | 1 | 1 | timeout 1 | 0 |" in report
+
+
+def _markdown_table(text: str, first_header: str) -> list[list[str]]:
+    lines = text.splitlines()
+    out = []
+    for i, line in enumerate(lines):
+        if line.startswith(f"| {first_header} |"):
+            j = i + 2
+            while j < len(lines) and lines[j].startswith("|"):
+                out.append([c.strip() for c in lines[j].strip("|").split(" | ")])
+                j += 1
+    return out
+
+
+def test_report_tables_and_wilcoxon_agree_with_the_rows(tiny, tmp_path):
+    _, out = tiny
+    html = tmp_path / "r.html"
+    assert main(["report", str(out), "--out", str(html)]) == 0
+    text = (tmp_path / "r.md").read_text()
+    assert "data:image/png;base64," in html.read_text() and "src='http" not in html.read_text()
+    rows = pd.read_parquet(out / "runs.parquet")
+    metric_table = _markdown_table(text, "planner | metric")
+    checked = 0
+    for scenario, group in rows.groupby("scenario"):
+        section = text.split(f"## Scenario {scenario}")[1].split("## Scenario")[0]
+        counts = {r[0]: r for r in _markdown_table(section, "planner | runs")}
+        for label, runs in group.groupby("label"):
+            assert int(counts[label][1]) == len(runs)
+            assert int(counts[label][2]) == int((runs.outcome != "ok").sum())
+            assert float(counts[label][4]) == pytest.approx(100 * runs.success.mean(), abs=0.05)
+            lengths = runs.loc[runs.outcome == "ok", "plan_length_m"].to_numpy()
+            table = [r for r in _markdown_table(section, "planner | metric")
+                     if r[0] == label and r[1] == "plan_length_m"][0]
+            assert int(table[2]) == lengths.size
+            assert float(table[3]) == pytest.approx(lengths.mean(), rel=1e-4)
+            assert float(table[5]) == pytest.approx(np.median(lengths), rel=1e-4)
+            assert float(table[6]) == pytest.approx(lengths.min(), rel=1e-4)
+            checked += 1
+        ok = group[group.outcome == "ok"]
+        p = stats.ranksums(ok[ok.label == "astar"].plan_length_m, ok[ok.label == "gwo"].plan_length_m).pvalue
+        tests = _markdown_table(section, "against")
+        assert tests[0][0] == "gwo" and float(tests[0][3]) == pytest.approx(p, rel=1e-3)
+    assert checked == 4 and metric_table
+
+
+BAD_STUDIES = {
+    "unknown planner": ('scenarios = ["gwo-scenario-1"]\n[[planners]]\nname = "nope"\n', "planners[0].name"),
+    "unknown key": ('scenarios = ["gwo-scenario-1"]\ncolour = 1\n[[planners]]\nname = "astar"\n', "colour"),
+    "empty grid": ('scenarios = ["gwo-scenario-1"]\nseeds = []\n[[planners]]\nname = "astar"\n', "seeds"),
+    "empty sweep": ('scenarios = ["gwo-scenario-1"]\n[[planners]]\nname = "gwo"\nparams = { iterations = [] }\n',
+                    "planners[0].params.iterations"),
+    "sweep over a missing parameter": ('scenarios = ["gwo-scenario-1"]\n[[planners]]\nname = "astar"\n'
+                                       'params = { wolves = [10, 20] }\n', "planners[0].params.wolves"),
+    "no scenario matches": ('scenarios = ["nothing-*"]\n[[planners]]\nname = "astar"\n', "scenarios[0]"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_STUDIES))
+def test_bad_study_files_exit_2_naming_the_field(case, tmp_path, capsys):
+    text, field = BAD_STUDIES[case]
+    path = write(tmp_path, text)
+    assert main(["study", str(path), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{path}: {field}:" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_studies_lists_every_bundled_study(capsys):
+    assert main(["studies", "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)
+    assert [s["name"] for s in listed] == list_studies() and len(listed) >= 5
+    for entry in listed:
+        assert entry["cells"] == len(expand(load_study(entry["name"]))) > 0
+
+
+def test_paper_values_are_flagged_where_impossible():
+    from swarmnav.sim.study.statistics import impossible
+    rows = [{"planner": "gwo", "outcome": "ok", "plan_length_m": 14.3, "straight_line_m": 14.142},
+            {"planner": "optimal", "outcome": "ok", "plan_length_m": 14.2, "straight_line_m": 14.142}]
+    assert "straight line" in impossible("plan_length_m", 14.0, rows)
+    assert "exact optimum" in impossible("plan_length_m", 14.15, rows)
+    assert impossible("plan_length_m", 14.25, rows) is None
+    rows[1].update(outcome="no_path", plan_length_m=None)
+    assert "no collision-free path" in impossible("plan_length_m", 14.25, rows)
