@@ -1,4 +1,4 @@
-"""Offscreen rendering of a run with EGL, and MP4 output through imageio-ffmpeg.
+"""Offscreen rendering of a run with EGL, and MP4 output (:mod:`sim.video_file`).
 
 The only module that knows about EGL: ``MUJOCO_GL`` is set to ``egl`` here (unless
 the user chose another backend) before ``mujoco`` is imported, so rendering works
@@ -28,12 +28,12 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
-import imageio_ffmpeg  # noqa: E402
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-from swarmnav.models.errors import ConfigError
+from swarmnav.models.errors import ConfigError  # noqa: E402
 from swarmnav.sim.recording import RunContext, StepFrame  # noqa: E402
+from swarmnav.sim.video_file import VideoWriter  # noqa: E402
 
 CAMERAS = ("top", "chase")
 PATH_RGBA = np.array([0.1, 0.75, 0.2, 1.0], dtype=np.float32)
@@ -111,14 +111,15 @@ class ScenePoser:
     def beams(self, range_m: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Beam segments (K, 3) start, (K, 3) end and hit flags from sensor readings.
 
-        ``range_m`` are distances from each site (``inf``, NaN or negative = nothing seen).
+        ``range_m`` are distances from each site, ``inf`` where nothing is in range (the
+        runner's convention; a miss is drawn at the sensor's cutoff length).
         """
         starts = self.data.site_xpos[self.beam_sites].copy()
         axes = self.data.site_xmat[self.beam_sites].reshape(-1, 3, 3)[:, :, 2]
         if range_m is None:
             range_m = np.full(len(starts), np.inf)
         ranges = np.asarray(range_m, dtype=float)[: len(starts)]
-        hit = np.isfinite(ranges) & (ranges >= 0.0)
+        hit = np.isfinite(ranges)
         cutoff = np.where(self.beam_cutoff_m > 0, self.beam_cutoff_m, 0.4)
         length = np.where(hit, ranges, cutoff)
         return starts, starts + axes * length[:, None], hit
@@ -203,36 +204,6 @@ class SceneRenderer:
             self._renderer = None
 
 
-class VideoWriter:
-    """Frames to an H.264 MP4 through imageio-ffmpeg's bundled ffmpeg."""
-
-    def __init__(self, path: str | Path, width: int, height: int, fps: float):
-        check_video_size(width, height, fps)
-        self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.frames = 0
-        self._writer = imageio_ffmpeg.write_frames(
-            str(self.path),
-            (width, height),
-            fps=fps,
-            codec="libx264",
-            macro_block_size=1,
-            quality=None,
-            output_params=["-preset", "veryfast", "-crf", "23"],
-            ffmpeg_log_level="error",
-        )
-        self._writer.send(None)
-
-    def add(self, frame: np.ndarray) -> None:
-        self._writer.send(np.ascontiguousarray(frame))
-        self.frames += 1
-
-    def close(self) -> None:
-        if self._writer is not None:
-            self._writer.close()
-            self._writer = None
-
-
 class VideoRecorder:
     """A Recorder that renders a run to MP4 at a fixed frame rate of simulated time.
 
@@ -313,65 +284,3 @@ class VideoRecorder:
             self._renderer = None
         if self._video is not None:
             self._video.close()
-
-
-def video_info(path: str | Path) -> tuple[int, float]:
-    """(frame count, seconds) of a video file, counted by decoding it."""
-    return imageio_ffmpeg.count_frames_and_secs(str(path))
-
-
-def read_video_frames(path: str | Path, every: int = 1) -> list[np.ndarray]:
-    """Decode an MP4 into (H, W, 3) uint8 frames (every ``every``-th one)."""
-    reader = imageio_ffmpeg.read_frames(str(path))
-    meta = next(reader)
-    width, height = meta["size"]
-    frames = []
-    for index, raw in enumerate(reader):
-        if index % every == 0:
-            frames.append(np.frombuffer(raw, dtype=np.uint8).reshape(height, width, 3))
-    return frames
-
-
-def benchmark_render(
-    mjcf_xml: str, *, width: int = 640, height: int = 480, frames: int = 120, camera: str = "top",
-    fast: bool = True,
-) -> dict[str, float]:
-    """Rendered frames per second (pose + overlay + render, no encoding) for a scene.
-
-    The robot drives a circle so the chase camera moves too.  ``fast=False`` keeps
-    MuJoCo's default quality (multisampling; shadows and reflections where the
-    scene's lights and materials ask for them) for comparison.
-    """
-    model = mujoco.MjModel.from_xml_string(mjcf_xml)
-    if not fast:
-        model.vis.quality.offsamples = 4
-        model.vis.quality.shadowsize = 4096
-        model.light_castshadow[:] = 1
-        model.mat_reflectance[:] = 0.2
-    poser = ScenePoser(model)
-    renderer = SceneRenderer(model, width, height, camera, fast=fast)
-    path = np.array([[1.0, 1.0], [3.0, 2.0], [5.0, 5.0], [8.0, 9.0]])
-    try:
-        renderer.render(poser.data)  # warm-up: context, textures
-        started = time.perf_counter()
-        for k in range(frames):
-            angle = 2 * math.pi * k / max(frames, 1)
-            poser.apply(
-                np.array([5 + 2 * math.cos(angle), 5 + 2 * math.sin(angle), 0.0]),
-                np.array([math.cos(angle / 2 + math.pi / 4), 0, 0, math.sin(angle / 2 + math.pi / 4)]),
-                None,
-            )
-            renderer.render(poser.data, path_m=path, beams=poser.beams(None))
-        elapsed = time.perf_counter() - started
-    finally:
-        renderer.close()
-    return {
-        "width": width,
-        "height": height,
-        "camera": camera,
-        "frames": frames,
-        "seconds": elapsed,
-        "frames_per_s": frames / elapsed,
-        "ms_per_frame": 1e3 * elapsed / frames,
-        "mujoco_gl": os.environ.get("MUJOCO_GL", ""),
-    }

@@ -185,7 +185,8 @@ def test_sigkill_leaves_a_file_that_log_recover_completes(tmp_path, full_run, ca
 
 
 def test_replay_video_has_expected_frames_and_is_not_blank(tmp_path, full_run):
-    from swarmnav.sim.render import expected_frames, read_video_frames, video_info
+    from swarmnav.sim.render import expected_frames
+    from video_files import read_video_frames, video_info
 
     path, _ = full_run
     video = tmp_path / "top.mp4"
@@ -202,7 +203,7 @@ def test_replay_video_has_expected_frames_and_is_not_blank(tmp_path, full_run):
 
 
 def test_chase_camera_renders(tmp_path, full_run):
-    from swarmnav.sim.render import read_video_frames
+    from video_files import read_video_frames
 
     video = tmp_path / "chase.mp4"
     assert main(["replay", str(full_run[0]), "--video", str(video), "--camera", "chase", "--fps", "0.5",
