@@ -15,10 +15,16 @@ from pathlib import Path
 
 import numpy as np
 
+from swarmnav.models.errors import ConfigError
 from swarmnav.sim.log_reader import RunLog, outcome_text, read_log
 
 MAX_SWEEP_DISCS = 40
 MAX_SCANS = 400
+# The figure is 8 x 10.5 inches: 600 dpi is 4800 x 6300 pixels (about 120 MB of RGBA).
+MIN_DPI, MAX_DPI = 10, 600
+# Formats Matplotlib writes on its own without a warning (pgf needs TeX; avif and webp depend on
+# Pillow's build; eps and ps warn that they drop transparency).
+SELF_CONTAINED_FORMATS = {"png", "jpg", "jpeg", "tif", "tiff", "svg", "svgz", "pdf"}
 
 
 def range_hits_m(log: RunLog, max_scans: int = MAX_SCANS) -> np.ndarray:
@@ -70,15 +76,51 @@ def _draw_obstacles(ax, log: RunLog) -> None:
         ax.add_collection(PatchCollection(swept, fc="tab:orange", ec="none", alpha=0.08))
 
 
-def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
+def _pyplot():
     # Imported here so that the CLI starts without loading matplotlib.
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    return plt
+
+
+def image_format(out: str | Path, dpi: int) -> str:
+    """The image format of ``out`` (its extension), checked together with ``dpi``.
+
+    Raises:
+        ConfigError: no extension, one Matplotlib cannot write, a directory, or a
+            resolution outside MIN_DPI..MAX_DPI.
+    """
+    out = Path(out)
+    if not MIN_DPI <= dpi <= MAX_DPI:
+        raise ConfigError("--dpi", f"must be in {MIN_DPI}..{MAX_DPI} dots per inch, got {dpi}")
+    if out.is_dir():
+        raise ConfigError("-o", "is a directory; give an image file name such as run.png", str(out))
+    _pyplot()
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    formats = set(FigureCanvasBase.get_supported_filetypes()) & SELF_CONTAINED_FORMATS
+    suffix = out.suffix.lower().lstrip(".")
+    if suffix not in formats:
+        known = ", ".join(f".{k}" for k in sorted(formats))
+        what = f"unknown image format '.{suffix}'" if suffix else "has no extension to name the image format"
+        raise ConfigError("-o", f"{what} (one of {known})", str(out))
+    return suffix
+
+
+def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
+    """Draw the two panels of a run into exactly ``out`` (PNG, SVG, PDF, ... by extension).
+
+    Raises:
+        ConfigError: see :func:`image_format`.
+        OSError: the file cannot be written (with its name).
+    """
+    image = image_format(out, dpi)
+    plt = _pyplot()
     from matplotlib.patches import Rectangle
 
-    """Draw the two panels of a run into ``out`` (PNG, SVG, PDF by extension)."""
     fig, (ax, ax_wheels) = plt.subplots(
         2, 1, figsize=(8, 10.5), gridspec_kw={"height_ratios": [3, 1.1]}, layout="constrained"
     )
@@ -133,20 +175,26 @@ def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
     ax_wheels.legend(loc="upper right", fontsize=8, ncol=2)
 
     out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=dpi)
-    plt.close(fig)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with open(out, "wb") as stream:  # exactly this path: no extension added, no rename
+            fig.savefig(stream, format=image, dpi=dpi)
+    except OSError as error:
+        raise type(error)(error.errno, error.strerror, str(out)) from None
+    finally:
+        plt.close(fig)
     return out
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", help="an .mcap run log")
     parser.add_argument("-o", "--out", required=True, help="image to write (.png, .svg, .pdf)")
-    parser.add_argument("--dpi", type=int, default=120)
+    parser.add_argument("--dpi", type=int, default=120, help=f"dots per inch, {MIN_DPI}..{MAX_DPI}")
 
 
 def run(args: argparse.Namespace) -> int:
     """Plot a log; a truncated log is plotted as far as it goes, with a warning."""
+    image_format(args.out, args.dpi)  # before the work: a bad -o or --dpi is exit 2 at once
     log = read_log(args.log, allow_truncated=True)
     if not log.complete:
         print(f"warning: {args.log}: {log.raw.recovery_line()}", file=sys.stderr)
