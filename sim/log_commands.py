@@ -10,8 +10,44 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 
-from swarmnav.sim.log_reader import describe, read_log, recover_log
+from swarmnav.sim.log_reader import RunLog, outcome_text, read_log
+from swarmnav.sim.log_recover import recover_log
+
+
+def describe(log: RunLog) -> list[str]:
+    """Lines for ``swarmnav log info``."""
+    planner = log.metadata.get("planner", {})
+    lines = [
+        f"log:        {log.raw.path}",
+        f"scenario:   {log.scenario_name}",
+        f"planner:    {planner.get('name', '?')} {planner.get('params', '')}",
+        f"seed:       {log.metadata.get('run', {}).get('seed', '?')}",
+        f"duration:   {log.duration_s:.3f} s (simulation)",
+        f"outcome:    {outcome_text(log)}",
+        f"file:       {log.raw.recovery_line()}",
+    ]
+    recovery = log.metadata.get("recovery")
+    if recovery:
+        lines.append(f"recovered:  from {recovery.get('source')} ({recovery.get('problem') or 'complete'}); "
+                     f"{recovery.get('messages_recovered')} messages kept")
+    collisions = sum(1 for _, kind, _ in log.events if kind == "collision_begin")
+    lines.append(f"collisions: {collisions}")
+    versions = log.metadata.get("versions", {})
+    if versions:
+        lines.append("versions:   " + ", ".join(f"{k} {v}" for k, v in sorted(versions.items())))
+    lines.append("channels:")
+    width = max((len(t) for t in log.counts), default=0)
+    for topic, count in log.counts.items():
+        lines.append(f"  {topic:<{width}}  {count:>7}  {log.schema_names.get(topic, '')}")
+    if log.outcome:
+        lines.append("summary:")
+        for key, value in log.outcome.items():
+            if isinstance(value, float) and math.isfinite(value):
+                value = f"{value:.6g}"
+            lines.append(f"  {key}: {value}")
+    return lines
 
 
 def add_info_arguments(parser: argparse.ArgumentParser) -> None:

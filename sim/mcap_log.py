@@ -1,53 +1,29 @@
 """The run log: a Recorder that writes an MCAP file Foxglove opens as is.
 
 One :class:`McapRecorder` per run.  It owns one ``foxglove.Context``; the MCAP
-file and, with ``live=True``, a loopback WebSocket server for Foxglove are both
-sinks of that context, so they see exactly the same messages.
-
-Channels (Foxglove well-known protobuf schemas unless said otherwise):
-
-======================  ===============================================================
-``/tf``                 FrameTransform world -> base_link, every control step
-``/robot/pose``         PoseInFrame in ``world``, every control step
-``/planner/path``       PosesInFrame in ``world``; at the start and after any replan
-``/obstacles``          SceneUpdate, one cylinder / cube entity per obstacle with a fixed
-                        ``id``; sent once when nothing moves, otherwise every control
-                        step with *all* entities (so a seek in Foxglove, which only
-                        back-fills the latest message of a topic, still shows the static
-                        ones)
-``/range/scan``         LaserScan in ``base_link``; misses are NaN
-``/wheels``             JSON ``swarmnav.WheelSpeeds``: commanded and measured rad/s
-``/controller``         JSON ``swarmnav.ControllerState``: v, omega, active waypoint
-``/events``             JSON ``swarmnav.Event``: goal_reached, collision_begin/end, timeout
-======================  ===============================================================
-
-Time: ``log_time`` = ``publish_time`` = every message's own timestamp = simulation
-time in ns from 0.  No wall-clock time is written, so two runs with the same seed
-give identical message bytes on every channel.
+file and, with ``live=True``, a loopback WebSocket server for Foxglove
+(:mod:`sim.live_view`) are both sinks of that context, so they see exactly the
+same messages.  The channels, time stamps and names are in :mod:`sim.log_format`.
 
 Metadata records: ``scenario`` (name, TOML text), ``planner`` and ``navigator`` (name, JSON params),
 ``run`` (seed, world seed, time steps, sensor layout, obstacles), ``versions`` and, from
 ``finish``, ``outcome`` (the runner's summary, JSON-encoded values).  Attachment:
 ``scene.xml``, the compiled MJCF.  Everything needed to re-simulate is in the file.
 
-Writer choice: the foxglove SDK (Rust core, ~63k messages/s here against ~37k for
-mcap + protobuf and ~22k for plain mcap + JSON) with ``disable_seeking=True``, so
-the file is written strictly front to back and a killed process never leaves a
-half-rewritten chunk header behind.  ``flush`` closes the current chunk; we flush at
-least once per simulated second (``flush_interval_s``), so a SIGKILL loses at most
-that much and ``swarmnav log recover`` rebuilds an indexed file from the rest.
+The writer is the foxglove SDK with ``disable_seeking=True``, so the file is
+written strictly front to back and a killed process never leaves a
+half-rewritten chunk header behind.  It writes into a :class:`sim.log_file.LogFile`,
+so a failure to open or to write (a full disk) is an ``OSError`` naming the file.
+``flush`` closes the current chunk; we flush at least once per simulated second
+(``flush_interval_s``), so a SIGKILL loses at most that much and ``swarmnav log
+recover`` rebuilds an indexed file from the rest.
 """
 
 from __future__ import annotations
 
-import importlib.metadata
-import json
-import math
-import sys
-import threading
-import time
+import logging
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import foxglove
 import numpy as np
@@ -59,11 +35,7 @@ from foxglove.channels import (
     SceneUpdateChannel,
 )
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
-from foxglove.websocket import ServerListener
 from foxglove.messages import (
-    Color,
-    CubePrimitive,
-    CylinderPrimitive,
     FrameTransform,
     LaserScan,
     Pose,
@@ -72,169 +44,49 @@ from foxglove.messages import (
     Quaternion,
     SceneEntity,
     SceneUpdate,
-    Timestamp,
     Vector3,
 )
 
-from swarmnav.models.errors import ConfigError
+from swarmnav.sim.live_view import DEFAULT_LIVE_HOST, DEFAULT_LIVE_PORT, LiveServer
+from swarmnav.sim.log_file import LogFile
+from swarmnav.sim.log_format import (
+    BASE_FRAME,
+    CONTROLLER_SCHEMA,
+    EVENT_SCHEMA,
+    LOG_PROFILE,
+    MJCF_ATTACHMENT,
+    TOPICS,
+    WHEELS_SCHEMA,
+    WORLD_FRAME,
+    default_log_path,
+    dumps,
+    scan_from_ranges,
+    time_ns,
+    writer_versions,
+)
+from swarmnav.sim.log_messages import json_schema, obstacle_entity, run_metadata, stamp, yaw_quaternion
+from swarmnav.sim.pacing import RealTimePacer
 from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
 
-TOPICS = (
-    "/tf",
-    "/robot/pose",
-    "/planner/path",
-    "/obstacles",
-    "/range/scan",
-    "/wheels",
-    "/controller",
-    "/events",
-)
-WORLD_FRAME = "world"
-BASE_FRAME = "base_link"
-MJCF_ATTACHMENT = "scene.xml"
-LOG_PROFILE = "swarmnav"
-DEFAULT_LIVE_PORT = 8765
-
-WHEELS_SCHEMA = {
-    "title": "swarmnav.WheelSpeeds",
-    "type": "object",
-    "properties": {
-        "command_left_rad_s": {"type": "number"},
-        "command_right_rad_s": {"type": "number"},
-        "measured_left_rad_s": {"type": "number"},
-        "measured_right_rad_s": {"type": "number"},
-    },
-}
-CONTROLLER_SCHEMA = {
-    "title": "swarmnav.ControllerState",
-    "type": "object",
-    "properties": {
-        "linear_m_s": {"type": "number"},
-        "angular_rad_s": {"type": "number"},
-        "waypoint_index": {"type": "integer"},
-    },
-}
-EVENT_SCHEMA = {
-    "title": "swarmnav.Event",
-    "type": "object",
-    "properties": {
-        "kind": {
-            "type": "string",
-            "description": "goal_reached | collision_begin | collision_end | timeout",
-        },
-        "details": {"type": "object"},
-    },
-}
-
-_STATIC_COLOUR = (0.55, 0.35, 0.25, 1.0)
-_MOVING_COLOUR = (0.85, 0.25, 0.2, 1.0)
+# TOPICS and default_log_path live in sim.log_format; re-exported for existing callers.
+__all__ = ["McapRecorder", "TOPICS", "default_log_path"]
 
 
-def time_ns(time_s: float) -> int:
-    """Simulation seconds to the integer nanoseconds used as MCAP log time."""
-    return int(round(time_s * 1e9))
+class _WriteFailureFilter(logging.Filter):
+    """Drops foxglove's per-message "error logging message: McapError(...)" lines.
 
-
-def _stamp(t_ns: int) -> Timestamp:
-    return Timestamp(t_ns // 1_000_000_000, t_ns % 1_000_000_000)
-
-
-def _json_value(value: Any) -> Any:
-    """Turn numpy scalars / arrays (and anything else odd) into JSON-able values."""
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, Path):
-        return str(value)
-    return str(value)
-
-
-def dumps(value: Any) -> str:
-    """Deterministic JSON text for metadata values and JSON messages."""
-    return json.dumps(value, sort_keys=True, default=_json_value)
-
-
-def _json_schema(schema: dict[str, Any]) -> foxglove.Schema:
-    return foxglove.Schema(
-        name=schema["title"], encoding="jsonschema", data=json.dumps(schema).encode()
-    )
-
-
-def _obstacle_primitive(info: ObstacleInfo, x_m: float, y_m: float):
-    """A SceneEntity primitive for one obstacle (cylinder or box) at (x, y)."""
-    z_m = info.position_m[2]
-    rgba = _MOVING_COLOUR if info.moving else _STATIC_COLOUR
-    colour = Color(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3])
-    pose = Pose(position=Vector3(x=x_m, y=y_m, z=z_m), orientation=Quaternion(w=1.0))
-    if info.shape == "box":
-        hx, hy, hz = info.size_m
-        return "cubes", CubePrimitive(
-            pose=pose, size=Vector3(x=2 * hx, y=2 * hy, z=2 * hz), color=colour
-        )
-    radius_m, half_height_m = info.size_m[0], info.size_m[1]
-    # bottom_scale / top_scale default to 0, which draws nothing: set both to 1.
-    return "cylinders", CylinderPrimitive(
-        pose=pose,
-        size=Vector3(x=2 * radius_m, y=2 * radius_m, z=2 * half_height_m),
-        bottom_scale=1.0,
-        top_scale=1.0,
-        color=colour,
-    )
-
-
-def _obstacle_entity(info: ObstacleInfo, x_m: float, y_m: float, t_ns: int) -> SceneEntity:
-    kind, primitive = _obstacle_primitive(info, x_m, y_m)
-    return SceneEntity(
-        timestamp=_stamp(t_ns), frame_id=WORLD_FRAME, id=info.entity_id, **{kind: [primitive]}
-    )
-
-
-def _yaw_quaternion(yaw_rad: float) -> Quaternion:
-    return Quaternion(z=math.sin(0.5 * yaw_rad), w=math.cos(0.5 * yaw_rad))
-
-
-def beam_origin(context: RunContext) -> tuple[float, float]:
-    """(distance from base_link's origin, height) of the rangefinder sites.
-
-    The rangefinders sit on the rim of the body and point outward, so a beam's
-    reading plus this distance is the range from base_link's origin that a
-    LaserScan needs.
-    """
-    return float(context.sensor_offset_m), float(context.sensor_height_m)
-
-
-def versions(run_versions: dict[str, str]) -> dict[str, str]:
-    """The run's versions (swarmnav, MuJoCo, Python) plus the log writer's."""
-    try:
-        writer = importlib.metadata.version("foxglove-sdk")
-    except importlib.metadata.PackageNotFoundError:
-        writer = "unknown"
-    return {"foxglove_sdk": writer, **run_versions}
-
-
-class _LateSubscribers(ServerListener):
-    """Server listener: remembers topics a Foxglove client subscribed to.
-
-    The path and the static obstacles are sent once, at t = 0; a client that
-    connects later would never see them.  The recorder re-sends them on the next
-    step after such a subscription (to every sink, so the MCAP file gets the
-    extra copy too, but only when someone actually watched).
+    Once a write to the file failed, foxglove logs one such warning for every
+    further message; the recorder reports the failure itself, once, as an
+    ``OSError`` naming the file.
     """
 
-    def __init__(self) -> None:
-        super().__init__()
-        self._lock = threading.Lock()
-        self._topics: set[str] = set()
+    def filter(self, record: logging.LogRecord) -> bool:
+        return "McapError" not in record.getMessage()
 
-    def on_subscribe(self, client, channel) -> None:
-        with self._lock:
-            self._topics.add(channel.topic)
 
-    def take(self) -> set[str]:
-        with self._lock:
-            topics, self._topics = self._topics, set()
-        return topics
+_FOXGLOVE_SINK_LOGGER = logging.getLogger("foxglove.log_sink_set")
+if not any(isinstance(f, _WriteFailureFilter) for f in _FOXGLOVE_SINK_LOGGER.filters):
+    _FOXGLOVE_SINK_LOGGER.addFilter(_WriteFailureFilter())
 
 
 class McapRecorder:
@@ -248,9 +100,17 @@ class McapRecorder:
         live_host, live_port: where the live server listens (loopback by default;
             port 0 picks a free one, see :attr:`live_port_bound`).
         live_speed: with ``live``, hold the run to this multiple of real time so a
-            viewer can follow it (``None`` or 0: as fast as it goes).  Only the
-            pacing uses the wall clock; nothing of it reaches the log.
+            viewer can follow it (``None`` or 0: as fast as it goes), through a
+            :class:`sim.pacing.RealTimePacer`.
+        on_live: called with the server's URL once it listens (the caller prints it;
+            the recorder never prints).
         overwrite: replace an existing file instead of refusing.
+
+    Errors: ``start`` raises ``ConfigError`` for a live port it cannot serve
+    (before the file exists) and ``OSError`` (with the file name) when the file
+    cannot be created; any call raises ``OSError`` (with the file name and, e.g.,
+    "No space left on device") once a write failed.  Everything written before
+    the failure stays readable by ``swarmnav log recover``.
     """
 
     def __init__(
@@ -259,103 +119,88 @@ class McapRecorder:
         *,
         flush_interval_s: float = 1.0,
         live: bool = False,
-        live_host: str = "127.0.0.1",
+        live_host: str = DEFAULT_LIVE_HOST,
         live_port: int = DEFAULT_LIVE_PORT,
         live_speed: float | None = 1.0,
+        on_live: Callable[[str], None] | None = None,
         overwrite: bool = False,
     ):
-        if flush_interval_s <= 0:
+        if not flush_interval_s > 0:
             raise ValueError("flush_interval_s must be positive")
         self.file_path = Path(path)
         self.flush_interval_s = float(flush_interval_s)
         self.live = live
         self.live_host = live_host
         self.live_port = live_port
-        self.live_speed = live_speed if live and live_speed else None
+        self.on_live = on_live
         self.overwrite = overwrite
         self.messages_written = 0
-        self._listener: _LateSubscribers | None = None
-        self._wall_start_s = 0.0
-        self._last_path: PosesInFrame | None = None
         self.flushes = 0
+        self._pacer = RealTimePacer(live_speed) if live and live_speed else None
+        self._server: LiveServer | None = None
+        self._file: LogFile | None = None
         self._writer = None
-        self._server = None
-        self._context: RunContext | None = None
+        self._last_path: PosesInFrame | None = None
         self._next_flush_ns = 0
         self._last_ns = 0
         self._moving_infos: tuple[ObstacleInfo, ...] = ()
         self._static_entities: list[SceneEntity] = []
+        self._json_channels: list[foxglove.Channel] = []
 
     # -- Recorder protocol -------------------------------------------------
 
     def start(self, context: RunContext) -> None:
-        """Open the file (and server), write metadata, attachment and t=0 obstacles."""
-        self._context = context
-        self.file_path.parent.mkdir(parents=True, exist_ok=True)
+        """Open the server (if live) and the file, write metadata, attachment and t=0 obstacles."""
+        angles = np.asarray(context.sensor_angles_rad, dtype=float)
+        if angles.size > 2 and not np.allclose(np.diff(angles), angles[1] - angles[0]):
+            raise ValueError("LaserScan needs evenly spaced sensor angles")
         self._fox = foxglove.Context()
+        if self.live:
+            # Before the file: a busy port leaves nothing behind.
+            self._server = LiveServer(self._fox, f"swarmnav {context.scenario_name}",
+                                      host=self.live_host, port=self.live_port)
+        try:
+            self._file = LogFile(self.file_path, overwrite=self.overwrite)
+        except OSError:
+            self._stop_server()
+            raise
         options = MCAPWriteOptions(
             compression=MCAPCompression.Zstd,
             profile=LOG_PROFILE,
             disable_seeking=True,
             compression_threads=0,  # the 2 cores belong to the simulation
         )
-        self._writer = foxglove.open_mcap(
-            self.file_path, allow_overwrite=self.overwrite, context=self._fox, writer_options=options
-        )
-        if self.live:
-            self._listener = _LateSubscribers()
-            try:
-                self._server = foxglove.start_server(
-                    name=f"swarmnav {context.scenario_name}",
-                    host=self.live_host,
-                    port=self.live_port,
-                    context=self._fox,
-                    server_listener=self._listener,
-                )
-            except Exception as error:  # foxglove raises its own error types
-                self._writer.close()
-                self._writer = None
-                raise ConfigError(
-                    "--live", f"cannot serve on {self.live_host}:{self.live_port} ({error})"
-                ) from error
-            self._wall_start_s = time.perf_counter()
-            # The one line a user needs to connect; the CLI cannot know the port earlier.
-            print(f"live view: ws://{self.live_host}:{self._server.port} "
-                  f"(Foxglove: Open connection > Foxglove WebSocket)", file=sys.stderr)
+        self._writer = foxglove.open_mcap(self._file, context=self._fox, writer_options=options)
         self._tf = FrameTransformChannel("/tf", context=self._fox)
         self._pose = PoseInFrameChannel("/robot/pose", context=self._fox)
         self._path = PosesInFrameChannel("/planner/path", context=self._fox)
         self._obstacles = SceneUpdateChannel("/obstacles", context=self._fox)
         self._scan = LaserScanChannel("/range/scan", context=self._fox)
-        self._wheels = foxglove.Channel(
-            "/wheels", schema=_json_schema(WHEELS_SCHEMA), message_encoding="json", context=self._fox
-        )
-        self._controller = foxglove.Channel(
-            "/controller", schema=_json_schema(CONTROLLER_SCHEMA), message_encoding="json", context=self._fox
-        )
-        self._events = foxglove.Channel(
-            "/events", schema=_json_schema(EVENT_SCHEMA), message_encoding="json", context=self._fox
-        )
-        self._write_run_records(context)
+        self._wheels, self._controller, self._events = self._json_channels = [
+            foxglove.Channel(topic, schema=json_schema(schema), message_encoding="json", context=self._fox)
+            for topic, schema in (("/wheels", WHEELS_SCHEMA), ("/controller", CONTROLLER_SCHEMA),
+                                  ("/events", EVENT_SCHEMA))
+        ]
+        self._guard(self._write_run_records, context)
 
-        angles = np.asarray(context.sensor_angles_rad, dtype=float)
         self._scan_start_rad = float(angles[0]) if angles.size else 0.0
         self._scan_end_rad = float(angles[-1]) if angles.size else 0.0
-        if angles.size > 2 and not np.allclose(np.diff(angles), angles[1] - angles[0]):
-            raise ValueError("LaserScan needs evenly spaced sensor angles")
-        # Rangefinders sit on the body's rim; a LaserScan has one origin, so ranges
-        # are reported from base_link's origin: distance + rim offset.
-        self._beam_offset_m, height_m = beam_origin(context)
-        self._scan_pose = Pose(position=Vector3(z=height_m), orientation=Quaternion(w=1.0))
+        self._beam_offset_m = float(context.sensor_offset_m)
+        self._scan_pose = Pose(position=Vector3(z=float(context.sensor_height_m)), orientation=Quaternion(w=1.0))
         self._moving_infos = tuple(o for o in context.obstacles if o.moving)
         self._static_entities = [
-            _obstacle_entity(o, o.position_m[0], o.position_m[1], 0)
+            obstacle_entity(o, o.position_m[0], o.position_m[1], 0)
             for o in context.obstacles
             if not o.moving
         ]
         self._obstacles.log(self._scene_update(0, None), log_time=0)
         self.messages_written += 1
         self._next_flush_ns = time_ns(self.flush_interval_s)
+        if self._pacer is not None:
+            self._pacer.start(context)
+        if self._server is not None and self.on_live is not None:
+            self.on_live(self._server.url)
+        self._raise_write_error()
 
     def path(self, time_s: float, waypoints_m: np.ndarray) -> None:
         """Log the planned path (at the start and after every replan)."""
@@ -367,10 +212,10 @@ class McapRecorder:
         headings = np.arctan2(deltas[:, 1], deltas[:, 0]) if len(deltas) else np.zeros(0)
         headings = np.append(headings, headings[-1] if len(headings) else 0.0)
         poses = [
-            Pose(position=Vector3(x=float(x), y=float(y), z=0.01), orientation=_yaw_quaternion(float(h)))
+            Pose(position=Vector3(x=float(x), y=float(y), z=0.01), orientation=yaw_quaternion(float(h)))
             for (x, y), h in zip(points[:, :2], headings)
         ]
-        message = PosesInFrame(timestamp=_stamp(t_ns), frame_id=WORLD_FRAME, poses=poses)
+        message = PosesInFrame(timestamp=stamp(t_ns), frame_id=WORLD_FRAME, poses=poses)
         self._path.log(message, log_time=t_ns)
         self._last_path = message
         self._after_write(t_ns, 1)
@@ -378,14 +223,14 @@ class McapRecorder:
     def step(self, frame: StepFrame) -> None:
         """Log one control step on every per-step channel."""
         t_ns = time_ns(frame.time_s)
-        stamp = _stamp(t_ns)
+        time_stamp = stamp(t_ns)
         px, py, pz = (float(v) for v in frame.position_m)
         qw, qx, qy, qz = (float(v) for v in frame.quaternion_wxyz)
         translation = Vector3(x=px, y=py, z=pz)
         rotation = Quaternion(x=qx, y=qy, z=qz, w=qw)
         self._tf.log(
             FrameTransform(
-                timestamp=stamp,
+                timestamp=time_stamp,
                 parent_frame_id=WORLD_FRAME,
                 child_frame_id=BASE_FRAME,
                 translation=translation,
@@ -395,22 +240,20 @@ class McapRecorder:
         )
         self._pose.log(
             PoseInFrame(
-                timestamp=stamp,
+                timestamp=time_stamp,
                 frame_id=WORLD_FRAME,
                 pose=Pose(position=translation, orientation=rotation),
             ),
             log_time=t_ns,
         )
-        ranges = np.asarray(frame.range_m, dtype=float)
-        ranges = np.where(np.isfinite(ranges) & (ranges >= 0.0), ranges + self._beam_offset_m, np.nan)
         self._scan.log(
             LaserScan(
-                timestamp=stamp,
+                timestamp=time_stamp,
                 frame_id=BASE_FRAME,
                 pose=self._scan_pose,
                 start_angle=self._scan_start_rad,
                 end_angle=self._scan_end_rad,  # inclusive
-                ranges=ranges.tolist(),
+                ranges=scan_from_ranges(frame.range_m, self._beam_offset_m).tolist(),
             ),
             log_time=t_ns,
         )
@@ -438,7 +281,7 @@ class McapRecorder:
             log_time=t_ns,
         )
         written = 5
-        late = self._listener.take() if self._listener is not None else ()
+        late = self._server.late_topics() if self._server is not None else ()
         if self._moving_infos or "/obstacles" in late:
             self._obstacles.log(self._scene_update(t_ns, frame.moving_obstacles_m), log_time=t_ns)
             written += 1
@@ -446,10 +289,8 @@ class McapRecorder:
             self._path.log(self._last_path, log_time=t_ns)
             written += 1
         self._after_write(t_ns, written)
-        if self.live_speed:
-            ahead_s = frame.time_s / self.live_speed - (time.perf_counter() - self._wall_start_s)
-            if ahead_s > 0:
-                time.sleep(ahead_s)
+        if self._pacer is not None:
+            self._pacer.step(frame)
 
     def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
         """Log a discrete event and flush, so it survives a crash right after."""
@@ -459,22 +300,33 @@ class McapRecorder:
         self._flush()
 
     def finish(self, summary: dict[str, Any]) -> None:
-        """Write the outcome, close the file (indexed summary section) and the server."""
+        """Write the outcome, close the file (indexed summary section) and the server.
+
+        After a failed write nothing more is written: the file is closed as it is
+        (and stays recoverable), and no second error is raised.
+        """
         if self._writer is None:
+            self._stop_server()
             return
+        writer, log_file = self._writer, self._file
+        self._writer = None
         try:
-            # Wall-clock figures would make two identical runs' logs differ: left out.
-            outcome = {k: dumps(v) for k, v in summary.items() if not k.startswith("wall_")}
-            self._writer.write_metadata("outcome", outcome)
-            self._writer.close()
+            if log_file.error is None:
+                # Wall-clock figures would make two identical runs' logs differ: left out.
+                outcome = {k: dumps(v) for k, v in summary.items() if not k.startswith("wall_")}
+                self._guard(writer.write_metadata, "outcome", outcome)
+                self._guard(writer.close)
+            else:
+                try:
+                    writer.close()
+                except RuntimeError:
+                    pass  # the write error was reported when it happened
         finally:
-            self._writer = None
-            for channel in (self._wheels, self._controller, self._events):
-                # foxglove keeps every JSON Channel in a module-level dict: drop ours.
-                foxglove.channel._channels_by_id.pop(channel.id(), None)
-            if self._server is not None:
-                self._server.stop()
-                self._server = None
+            log_file.close()
+            for channel in self._json_channels:
+                # foxglove keeps JSON channels in a registry of its own; closing is its public API.
+                channel.close()
+            self._stop_server()
 
     # -- helpers -----------------------------------------------------------
 
@@ -482,6 +334,23 @@ class McapRecorder:
     def live_port_bound(self) -> int | None:
         """The port the live server actually listens on (``live_port=0`` picks one)."""
         return None if self._server is None else self._server.port
+
+    def _stop_server(self) -> None:
+        if self._server is not None:
+            self._server.stop()
+            self._server = None
+
+    def _raise_write_error(self) -> None:
+        if self._file is not None and self._file.error is not None:
+            raise self._file.error
+
+    def _guard(self, call: Callable, *args: Any) -> Any:
+        """Run a writer call; a failed write surfaces as the file's own OSError."""
+        try:
+            return call(*args)
+        except RuntimeError:
+            self._raise_write_error()
+            raise
 
     def _write_run_records(self, context: RunContext) -> None:
         writer = self._writer
@@ -494,33 +363,8 @@ class McapRecorder:
         writer.write_metadata(
             "navigator", {"name": context.navigator_name, "params": dumps(context.navigator_params)}
         )
-        writer.write_metadata(
-            "run",
-            {
-                "seed": str(int(context.seed)),
-                "world_seed": str(int(context.world_seed)),
-                "control_dt_s": repr(float(context.control_dt_s)),
-                "physics_dt_s": repr(float(context.physics_dt_s)),
-                "sensor_angles_rad": dumps([float(a) for a in context.sensor_angles_rad]),
-                "sensor_range_m": repr(float(context.sensor_range_m)),
-                "sensor_offset_m": repr(beam_origin(context)[0]),
-                "sensor_height_m": repr(beam_origin(context)[1]),
-                "arena_size_m": dumps(list(context.arena_size_m)),
-                "obstacles": dumps(
-                    [
-                        {
-                            "entity_id": o.entity_id,
-                            "shape": o.shape,
-                            "size_m": list(o.size_m),
-                            "position_m": list(o.position_m),
-                            "moving": bool(o.moving),
-                        }
-                        for o in context.obstacles
-                    ]
-                ),
-            },
-        )
-        writer.write_metadata("versions", versions(context.versions))
+        writer.write_metadata("run", run_metadata(context))
+        writer.write_metadata("versions", writer_versions(context.versions))
         writer.attach(
             log_time=0,
             create_time=0,
@@ -534,7 +378,7 @@ class McapRecorder:
         if moving_xy_m is None:
             moving_xy_m = np.array([o.position_m[:2] for o in self._moving_infos]).reshape(-1, 2)
         for info, (x_m, y_m) in zip(self._moving_infos, np.asarray(moving_xy_m, dtype=float)):
-            entities.append(_obstacle_entity(info, float(x_m), float(y_m), t_ns))
+            entities.append(obstacle_entity(info, float(x_m), float(y_m), t_ns))
         return SceneUpdate(entities=entities)
 
     def _after_write(self, t_ns: int, count: int) -> None:
@@ -542,16 +386,14 @@ class McapRecorder:
         self._last_ns = max(self._last_ns, t_ns)
         if t_ns >= self._next_flush_ns:
             self._flush()
+        elif self._file.error is not None:  # a chunk filled up and could not be written
+            raise self._file.error
 
     def _flush(self) -> None:
         if self._writer is None:
             return
-        self._writer.flush()
+        self._guard(self._writer.flush)
+        self._raise_write_error()
         self.flushes += 1
         step_ns = time_ns(self.flush_interval_s)
         self._next_flush_ns = (self._last_ns // step_ns + 1) * step_ns
-
-
-def default_log_path(scenario: str, planner: str, seed: int, stamp: str, directory: str | Path = "logs") -> Path:
-    """``logs/<scenario>_<planner>_seed<N>_<stamp>.mcap`` (the caller supplies the stamp)."""
-    return Path(directory) / f"{scenario}_{planner}_seed{seed}_{stamp}.mcap"

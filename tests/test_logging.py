@@ -21,9 +21,11 @@ from mcap_protobuf.decoder import DecoderFactory  # noqa: E402
 
 from swarmnav.models.scenario import load_scenario  # noqa: E402
 from swarmnav.sim.cli import main  # noqa: E402
-from swarmnav.sim.log_reader import read_log, read_records  # noqa: E402
-from swarmnav.sim.mcap_log import TOPICS, McapRecorder  # noqa: E402
 from swarmnav.sim.episode import EpisodeSpec, run_episode  # noqa: E402
+from swarmnav.sim.log_format import TOPICS  # noqa: E402
+from swarmnav.sim.log_reader import read_log  # noqa: E402
+from swarmnav.sim.mcap_log import McapRecorder  # noqa: E402
+from swarmnav.sim.mcap_records import read_records  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 SCENARIO = "gwo-scenario-2"  # moving obstacles and collisions: every channel has traffic

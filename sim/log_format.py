@@ -1,0 +1,134 @@
+"""The run log's format: channels, schemas, names, time stamps and the scan convention.
+
+Shared by the writer (:mod:`sim.mcap_log`) and the readers (:mod:`sim.mcap_records`,
+:mod:`sim.log_reader`), so both sides agree on one table.
+
+Channels (Foxglove well-known protobuf schemas unless said otherwise):
+
+======================  ===============================================================
+``/tf``                 FrameTransform world -> base_link, every control step
+``/robot/pose``         PoseInFrame in ``world``, every control step
+``/planner/path``       PosesInFrame in ``world``; at the start and after any replan
+``/obstacles``          SceneUpdate, one cylinder / cube entity per obstacle with a fixed
+                        ``id``; sent once when nothing moves, otherwise every control
+                        step with *all* entities (so a seek in Foxglove, which only
+                        back-fills the latest message of a topic, still shows the static
+                        ones)
+``/range/scan``         LaserScan in ``base_link``; misses are NaN
+``/wheels``             JSON ``swarmnav.WheelSpeeds``: commanded and measured rad/s
+``/controller``         JSON ``swarmnav.ControllerState``: v, omega, active waypoint
+``/events``             JSON ``swarmnav.Event``: goal_reached, collision_begin/end, timeout
+======================  ===============================================================
+
+Time: ``log_time`` = ``publish_time`` = every message's own timestamp = simulation
+time in ns from 0.  No wall-clock time is written, so two runs with the same seed
+give identical message bytes on every channel.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+WORLD_FRAME = "world"
+BASE_FRAME = "base_link"
+MJCF_ATTACHMENT = "scene.xml"
+LOG_PROFILE = "swarmnav"
+
+WHEELS_SCHEMA = {
+    "title": "swarmnav.WheelSpeeds",
+    "type": "object",
+    "properties": {
+        "command_left_rad_s": {"type": "number"},
+        "command_right_rad_s": {"type": "number"},
+        "measured_left_rad_s": {"type": "number"},
+        "measured_right_rad_s": {"type": "number"},
+    },
+}
+CONTROLLER_SCHEMA = {
+    "title": "swarmnav.ControllerState",
+    "type": "object",
+    "properties": {
+        "linear_m_s": {"type": "number"},
+        "angular_rad_s": {"type": "number"},
+        "waypoint_index": {"type": "integer"},
+    },
+}
+EVENT_SCHEMA = {
+    "title": "swarmnav.Event",
+    "type": "object",
+    "properties": {
+        "kind": {
+            "type": "string",
+            "description": "goal_reached | collision_begin | collision_end | timeout",
+        },
+        "details": {"type": "object"},
+    },
+}
+
+# topic -> (message encoding, schema name): what a reader may expect on each channel.
+CHANNELS: dict[str, tuple[str, str]] = {
+    "/tf": ("protobuf", "foxglove.FrameTransform"),
+    "/robot/pose": ("protobuf", "foxglove.PoseInFrame"),
+    "/planner/path": ("protobuf", "foxglove.PosesInFrame"),
+    "/obstacles": ("protobuf", "foxglove.SceneUpdate"),
+    "/range/scan": ("protobuf", "foxglove.LaserScan"),
+    "/wheels": ("json", WHEELS_SCHEMA["title"]),
+    "/controller": ("json", CONTROLLER_SCHEMA["title"]),
+    "/events": ("json", EVENT_SCHEMA["title"]),
+}
+TOPICS = tuple(CHANNELS)
+
+
+def time_ns(time_s: float) -> int:
+    """Simulation seconds to the integer nanoseconds used as MCAP log time."""
+    return int(round(time_s * 1e9))
+
+
+def _json_value(value: Any) -> Any:
+    """Turn numpy scalars / arrays (and anything else odd) into JSON-able values."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return str(value)
+
+
+def dumps(value: Any) -> str:
+    """Deterministic JSON text for metadata values and JSON messages."""
+    return json.dumps(value, sort_keys=True, default=_json_value)
+
+
+def scan_from_ranges(range_m: np.ndarray, beam_offset_m: float) -> np.ndarray:
+    """Sensor ranges (from each site, ``inf`` = nothing in range) to LaserScan ranges.
+
+    A LaserScan has one origin, base_link's, and the rangefinders sit on the rim
+    of the body pointing outward: a reading plus the rim offset is the range from
+    that origin.  Nothing in range is NaN in the log.
+    """
+    ranges = np.asarray(range_m, dtype=float)
+    return np.where(np.isinf(ranges), np.nan, ranges + beam_offset_m)
+
+
+def ranges_from_scan(scan_m: np.ndarray, beam_offset_m: float) -> np.ndarray:
+    """The inverse of :func:`scan_from_ranges`: back to distances from the sites, ``inf`` for NaN."""
+    scan = np.asarray(scan_m, dtype=float)
+    return np.where(np.isnan(scan), np.inf, scan - beam_offset_m)
+
+
+def writer_versions(run_versions: dict[str, str]) -> dict[str, str]:
+    """The run's versions (swarmnav, MuJoCo, Python) plus the log writer's."""
+    try:
+        writer = importlib.metadata.version("foxglove-sdk")
+    except importlib.metadata.PackageNotFoundError:
+        writer = "unknown"
+    return {"foxglove_sdk": writer, **run_versions}
+
+
+def default_log_path(scenario: str, planner: str, seed: int, stamp: str, directory: str | Path = "logs") -> Path:
+    """``logs/<scenario>_<planner>_seed<N>_<stamp>.mcap`` (the caller supplies the stamp)."""
+    return Path(directory) / f"{scenario}_{planner}_seed{seed}_{stamp}.mcap"
