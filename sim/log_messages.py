@@ -96,3 +96,32 @@ def run_metadata(context: RunContext) -> dict[str, str]:
             ]
         ),
     }
+
+
+# The JSON messages of every step, formatted directly: the keys in sorted order and the
+# numbers as ``repr`` writes them, which is what ``dumps`` (json with sort_keys) writes for
+# finite floats, so the bytes are the same; anything non-finite goes through ``dumps``.
+_WHEELS_JSON = ('{"command_left_rad_s": %r, "command_right_rad_s": %r, '
+                '"measured_left_rad_s": %r, "measured_right_rad_s": %r}')
+_CONTROLLER_JSON = '{"angular_rad_s": %r, "linear_m_s": %r, "waypoint_index": %d}'
+
+
+def _finite(*values: float) -> bool:
+    return all(-math.inf < v < math.inf for v in values)
+
+
+def wheels_json(command_rad_s: Any, measured_rad_s: Any) -> str:
+    """``/wheels`` text for commanded and measured (left, right) wheel speeds."""
+    values = (float(command_rad_s[0]), float(command_rad_s[1]), float(measured_rad_s[0]), float(measured_rad_s[1]))
+    if _finite(*values):
+        return _WHEELS_JSON % values
+    keys = ("command_left_rad_s", "command_right_rad_s", "measured_left_rad_s", "measured_right_rad_s")
+    return dumps(dict(zip(keys, values)))
+
+
+def controller_json(linear_m_s: float, angular_rad_s: float, waypoint_index: int) -> str:
+    """``/controller`` text for the controller's (v, omega) and active waypoint."""
+    linear, angular, index = float(linear_m_s), float(angular_rad_s), int(waypoint_index)
+    if _finite(linear, angular):
+        return _CONTROLLER_JSON % (angular, linear, index)
+    return dumps({"linear_m_s": linear, "angular_rad_s": angular, "waypoint_index": index})

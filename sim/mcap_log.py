@@ -64,7 +64,15 @@ from swarmnav.sim.log_format import (
     time_ns,
     writer_versions,
 )
-from swarmnav.sim.log_messages import json_schema, obstacle_entity, run_metadata, stamp, yaw_quaternion
+from swarmnav.sim.log_messages import (
+    controller_json,
+    json_schema,
+    obstacle_entity,
+    run_metadata,
+    stamp,
+    wheels_json,
+    yaw_quaternion,
+)
 from swarmnav.sim.pacing import RealTimePacer
 from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
 
@@ -224,8 +232,8 @@ class McapRecorder:
         """Log one control step on every per-step channel."""
         t_ns = time_ns(frame.time_s)
         time_stamp = stamp(t_ns)
-        px, py, pz = (float(v) for v in frame.position_m)
-        qw, qx, qy, qz = (float(v) for v in frame.quaternion_wxyz)
+        px, py, pz = np.asarray(frame.position_m, dtype=float).tolist()
+        qw, qx, qy, qz = np.asarray(frame.quaternion_wxyz, dtype=float).tolist()
         translation = Vector3(x=px, y=py, z=pz)
         rotation = Quaternion(x=qx, y=qy, z=qz, w=qw)
         self._tf.log(
@@ -257,29 +265,9 @@ class McapRecorder:
             ),
             log_time=t_ns,
         )
-        command = frame.wheel_command_rad_s
-        measured = frame.wheel_measured_rad_s
-        self._wheels.log(
-            dumps(
-                {
-                    "command_left_rad_s": float(command[0]),
-                    "command_right_rad_s": float(command[1]),
-                    "measured_left_rad_s": float(measured[0]),
-                    "measured_right_rad_s": float(measured[1]),
-                }
-            ),
-            log_time=t_ns,
-        )
-        self._controller.log(
-            dumps(
-                {
-                    "linear_m_s": float(frame.linear_m_s),
-                    "angular_rad_s": float(frame.angular_rad_s),
-                    "waypoint_index": int(frame.waypoint_index),
-                }
-            ),
-            log_time=t_ns,
-        )
+        self._wheels.log(wheels_json(frame.wheel_command_rad_s, frame.wheel_measured_rad_s), log_time=t_ns)
+        self._controller.log(controller_json(frame.linear_m_s, frame.angular_rad_s, frame.waypoint_index),
+                             log_time=t_ns)
         written = 5
         late = self._server.late_topics() if self._server is not None else ()
         if self._moving_infos or "/obstacles" in late:

@@ -303,3 +303,24 @@ def test_render_benchmark_runs(capsys):
 def test_bad_video_size_is_a_config_error(full_run, tmp_path, capsys):
     assert main(["replay", str(full_run[0]), "--video", str(tmp_path / "x.mp4"), "--width", "641"]) == 2
     assert "--width" in capsys.readouterr().err
+
+
+def test_step_json_is_the_same_text_as_sorted_json_dumps():
+    """The per-step JSON is formatted directly for speed; it must stay byte-identical to
+    json.dumps(sort_keys=True), including edge values and non-finite ones."""
+    import json
+
+    from swarmnav.sim.log_messages import controller_json, wheels_json
+
+    rng = np.random.default_rng(7)
+    edge = [0.0, -0.0, 1e-300, -1e300, 5e-324, 0.1, 1 / 3, math.pi, 12.5, math.nan, math.inf, -math.inf]
+    samples = list(rng.normal(0, 20, (200, 4))) + [np.array(rng.choice(edge, 4)) for _ in range(200)]
+    for command_l, command_r, measured_l, measured_r in samples:
+        expected = json.dumps({"command_left_rad_s": float(command_l), "command_right_rad_s": float(command_r),
+                               "measured_left_rad_s": float(measured_l), "measured_right_rad_s": float(measured_r)},
+                              sort_keys=True)
+        assert wheels_json(np.array([command_l, command_r]), (measured_l, measured_r)) == expected
+        index = int(rng.integers(0, 1000))
+        expected = json.dumps({"linear_m_s": float(command_l), "angular_rad_s": float(measured_r),
+                               "waypoint_index": index}, sort_keys=True)
+        assert controller_json(np.float64(command_l), measured_r, np.int64(index)) == expected
