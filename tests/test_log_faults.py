@@ -130,6 +130,19 @@ def test_every_cut_is_read_cleanly_or_refused_with_exit_2(small_log, tmp_path, c
                 assert len(captured.err.strip().splitlines()) == 1 and str(cut) in captured.err
 
 
+def test_a_damaged_chunk_ends_the_read_and_keeps_the_chunks_before_it(small_log, tmp_path, capsys):
+    chunks = chunk_ends_and_messages(small_log)
+    data = bytearray(small_log.read_bytes())
+    data[chunks[2][0] - 40] ^= 0xFF  # inside the third chunk's compressed bytes
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(bytes(data))
+    raw = read_records(damaged)
+    assert not raw.complete and raw.problem.startswith("corrupt record")
+    assert [(raw.topic_of(m), m.log_time, m.data) for m in raw.messages] == chunks[0][1] + chunks[1][1]
+    assert main(["log", "info", str(damaged)]) == 2
+    assert "corrupt record" in one_error_line(capsys)
+
+
 @pytest.mark.parametrize("size", range(0, 9))
 def test_tiny_files_are_refused_in_one_line(small_log, tmp_path, capsys, size):
     tiny = tmp_path / "tiny.mcap"
