@@ -40,7 +40,7 @@ def mujoco_default_quality(model: mujoco.MjModel) -> None:
 
 def benchmark_render(
     mjcf_xml: str, *, width: int = 640, height: int = 480, frames: int = 120, camera: str = "top",
-    fast: bool = True,
+    fast: bool = True, grid_m: tuple[float, float] | None = None,
 ) -> dict[str, float]:
     """Rendered frames per second (pose + overlay + render, no encoding) for a scene.
 
@@ -52,7 +52,7 @@ def benchmark_render(
     if not fast:
         mujoco_default_quality(model)
     poser = ScenePoser(model)
-    renderer = SceneRenderer(model, width, height, camera, fast=fast)
+    renderer = SceneRenderer(model, width, height, camera, fast=fast, grid_m=grid_m)
     path = np.array([[1.0, 1.0], [3.0, 2.0], [5.0, 5.0], [8.0, 9.0]])
     try:
         renderer.render(poser.data)  # warm-up: context, textures
@@ -101,10 +101,12 @@ def run(args: argparse.Namespace) -> int:
     if args.frames < 1:
         raise ConfigError("--frames", f"must be at least 1, got {args.frames}")
     frames = min(args.frames, QUICK_FRAMES) if args.quick else args.frames
-    scene = compile_scene(load_scenario(args.scenario))
+    scenario = load_scenario(args.scenario)
+    scene = compile_scene(scenario)
+    grid_m = (scenario.arena_width_m, scenario.arena_height_m)  # as VideoRecorder draws it
     figures = {"scenario": args.scenario,
                **benchmark_render(scene.xml, width=args.width, height=args.height,
-                                  frames=frames, camera=args.camera),
+                                  frames=frames, camera=args.camera, grid_m=grid_m),
                "target_frames_per_s": TARGET_FRAMES_PER_S}
     figures["meets_target"] = figures["frames_per_s"] >= TARGET_FRAMES_PER_S
     if args.compare_defaults:
