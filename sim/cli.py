@@ -134,9 +134,14 @@ def cmd_run(args: argparse.Namespace) -> int:
         from swarmnav.sim.mcap_log import McapRecorder, default_log_path
         log_path = FilePath(args.out) if args.out else default_log_path(
             planned.spec.scenario.name, planned.spec.planner, planned.spec.seed, time.strftime("%Y%m%d-%H%M%S"))
+        if log_path.is_dir():
+            raise UserError(f"{log_path}: --out: Is a directory (give a file path)")
         if log_path.exists() and not args.overwrite:
             raise UserError(f"{log_path}: --out: file exists (use --overwrite)")
-        recorders.append(McapRecorder(log_path, live=args.live, overwrite=True))
+        recorders.append(McapRecorder(
+            log_path, live=args.live, overwrite=True,
+            on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove WebSocket)",
+                                      file=sys.stderr)))
     elif args.live:
         raise UserError("--live: needs the log (drop --no-log)")
     if args.video:

@@ -33,6 +33,8 @@ from swarmnav.sim.verify_report import TrajectoryCapture, VerifyReport, compare_
 DEFAULT_FPS = 30.0
 
 
+EXIT_DIFFERENT = 4  # replay --verify: the re-simulation differs from the log
+
 def context_from_log(log: RunLog) -> RunContext:
     """The :class:`RunContext` a log was written with (as far as a renderer needs it)."""
     if not log.mjcf_xml:
@@ -170,7 +172,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Exit 0 on success (a log that ends early passes when its steps are equal), 1 when
+    """Exit 0 on success (a log that ends early passes when its steps are equal), 4 when
     --verify finds a difference, 2 on bad input."""
     if not args.video and not args.verify:
         raise ConfigError("replay", "nothing to do: give --video OUT.mp4 and/or --verify")
@@ -192,7 +194,7 @@ def run(args: argparse.Namespace) -> int:
         results["verify"] = report.as_dict()
         if not args.json:
             print("\n".join(report.lines()))
-        status = 0 if report.passed else 1
+        status = 0 if report.passed else EXIT_DIFFERENT
     if args.json:
         print(json.dumps(results, sort_keys=True, default=str))
     sys.stdout.flush()

@@ -167,3 +167,11 @@ def test_a_malformed_command_line_is_one_line_and_exit_2(capsys, argv):
     err = capsys.readouterr().err
     assert exit_info.value.code == 2
     assert err.count("\n") == 1 and "error:" in err
+
+
+def test_out_naming_a_directory_is_one_line_and_leaves_it_alone(tmp_path, capsys):
+    before = sorted(tmp_path.iterdir())
+    code = main(["run", "gwo-scenario-1", "--planner", "straight", "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Is a directory" in err and str(tmp_path) in err
+    assert sorted(tmp_path.iterdir()) == before

@@ -303,7 +303,7 @@ class _OneBeamOff(McapRecorder):
 def test_verify_fails_when_only_a_range_scan_differs(tmp_path, capsys):
     path = tmp_path / "beam.mcap"
     run_episode(EpisodeSpec(load_scenario(SCENARIO)), [_OneBeamOff(path)], time_limit_s=0.4)
-    assert main(["replay", str(path), "--verify"]) == 1
+    assert main(["replay", str(path), "--verify"]) == 4
     out = capsys.readouterr().out
     assert "DIFFERENT" in out and "range scans: differ" in out
     assert "max position deviation:   0.000e+00 m" in out
