@@ -9,6 +9,7 @@ from typing import Any
 
 from swarmnav.controllers.navigators.follow import FollowNavigator
 from swarmnav.controllers.navigators.policy import PolicyNavigator
+from swarmnav.controllers.navigators.replan import ReplanNavigator
 from swarmnav.models.parameters import build_component
 
 NAVIGATORS: dict[str, type] = {}
@@ -25,7 +26,7 @@ def register(cls: type) -> type:
     return cls
 
 
-for _cls in (FollowNavigator, PolicyNavigator):
+for _cls in (FollowNavigator, PolicyNavigator, ReplanNavigator):
     register(_cls)
 
 
