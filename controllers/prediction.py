@@ -72,7 +72,9 @@ def polyline_gap_m(polyline: np.ndarray, discs: list[Disc], inflation_m: float) 
 def time_to_collision_s(position_m: np.ndarray, velocities_m_s: np.ndarray, centres_m: np.ndarray,
                         obstacle_velocities_m_s: np.ndarray, radii_m: np.ndarray) -> np.ndarray:
     """(V, N) first time at which a point moving from ``position_m`` with each of V constant velocities
-    comes within ``radii_m`` of each of N discs moving with constant velocities (inf if never; 0 if inside).
+    comes within ``radii_m`` of each of N discs moving with constant velocities (inf if never).
+
+    A point already within a disc gets 0 if the relative motion closes in, inf if it separates.
 
     Solves |d + q t| = R for the smallest t >= 0, d the disc's centre relative to the
     point and q = w - u the relative velocity (the velocity obstacle's defining test,
@@ -89,4 +91,33 @@ def time_to_collision_s(position_m: np.ndarray, velocities_m_s: np.ndarray, cent
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (-b - np.sqrt(np.maximum(disc, 0.0))) / (2.0 * a)
     t = np.where((disc >= 0.0) & (a > 1e-12) & (t >= 0.0), t, np.inf)
-    return np.where(c <= 0.0, 0.0, t)
+    return np.where(c <= 0.0, np.where(b >= 0.0, np.inf, 0.0), t)
+
+
+class LocalObstacles:
+    """The known map's discs and boxes near the robot, plus the sensed obstacles, as arrays.
+
+    Built once from the map problem; :meth:`near` returns what lies within
+    ``reach_m`` of a point: disc centres (N, 2), their velocities (N, 2, zero for
+    the map's), radii (N,), and boxes (B, 4) as (x_min, y_min, x_max, y_max).
+    """
+
+    def __init__(self, map_centres_m: np.ndarray, map_radii_m: np.ndarray, map_boxes_m: np.ndarray):
+        self.centres = np.asarray(map_centres_m, dtype=float).reshape(-1, 2)
+        self.radii = np.asarray(map_radii_m, dtype=float).reshape(-1)
+        self.boxes = np.asarray(map_boxes_m, dtype=float).reshape(-1, 4)
+
+    def near(self, x_m: float, y_m: float, reach_m: float, detections: tuple[DetectedObstacle, ...]
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        keep = np.hypot(self.centres[:, 0] - x_m, self.centres[:, 1] - y_m) - self.radii <= reach_m
+        centres, radii = self.centres[keep], self.radii[keep]
+        velocities = np.zeros_like(centres)
+        if detections:
+            dc, dv, dr = detection_arrays(detections)
+            centres, velocities, radii = np.vstack([centres, dc]), np.vstack([velocities, dv]), np.concatenate([radii, dr])
+        boxes = self.boxes
+        if len(boxes):
+            gap_x = np.maximum(np.maximum(boxes[:, 0] - x_m, x_m - boxes[:, 2]), 0.0)
+            gap_y = np.maximum(np.maximum(boxes[:, 1] - y_m, y_m - boxes[:, 3]), 0.0)
+            boxes = boxes[np.hypot(gap_x, gap_y) <= reach_m]
+        return centres, velocities, radii, boxes

@@ -66,11 +66,11 @@ class HitTracker:
 
     default_radius_m: float = 0.3
     gate_m: float = 0.5
-    window_s: float = 0.6
-    min_span_s: float = 0.15
+    window_s: float = 1.0
+    min_span_s: float = 0.3
     keep_s: float = 1.0
-    max_speed_m_s: float = 1.0
-    max_radius_m: float = 1.5
+    max_speed_m_s: float = 0.5
+    max_radius_m: float = 0.6
 
     def __post_init__(self) -> None:
         self.reset()

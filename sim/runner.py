@@ -65,6 +65,7 @@ class RunResult:
     replan_wall_s: float = 0.0
     safety_triggers: int = 0
     reference_length_m: float | None = None  # L*: the shortest path among the static obstacles
+    navigator_wall_s: float = 0.0  # wall time spent in navigator.step (not in summary(): benchmarks read it)
 
     @property
     def success(self) -> bool:
@@ -170,6 +171,7 @@ class Simulation:
         loop = StepLoop(self, recorder, scenario.time_limit_s if time_limit_s is None else time_limit_s)
         goal = setup.goal
         outcome = ""
+        navigator_wall_s = 0.0
         wall0 = time.perf_counter()
         try:
             navigator.reset(setup)
@@ -184,7 +186,9 @@ class Simulation:
                 if outcome:
                     loop.stop(observation, outcome)
                     break
+                nav0 = time.perf_counter()
                 decision = navigator.step(observation)
+                navigator_wall_s += time.perf_counter() - nav0
                 loop.count_events(decision.events)
                 if recorder is not None:
                     if decision.new_path is not None:
@@ -195,6 +199,7 @@ class Simulation:
                 loop.advance()
             result = loop.result(outcome, time.perf_counter() - wall0)
             result.reference_length_m = reference_length_m
+            result.navigator_wall_s = navigator_wall_s
             result.replan_wall_s = float(getattr(navigator, "replan_wall_s", 0.0))
         except BaseException as exc:
             if recorder is not None:

@@ -9,7 +9,9 @@ from typing import Any
 
 from swarmnav.controllers.navigators.follow import FollowNavigator
 from swarmnav.controllers.navigators.policy import PolicyNavigator
+from swarmnav.controllers.navigators.dwa import DynamicWindowNavigator
 from swarmnav.controllers.navigators.replan import ReplanNavigator
+from swarmnav.controllers.navigators.velocity_obstacle import VelocityObstacleNavigator
 from swarmnav.models.parameters import build_component
 
 NAVIGATORS: dict[str, type] = {}
@@ -26,7 +28,7 @@ def register(cls: type) -> type:
     return cls
 
 
-for _cls in (FollowNavigator, PolicyNavigator, ReplanNavigator):
+for _cls in (FollowNavigator, PolicyNavigator, ReplanNavigator, DynamicWindowNavigator, VelocityObstacleNavigator):
     register(_cls)
 
 

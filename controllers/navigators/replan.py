@@ -47,7 +47,7 @@ from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_di
 from swarmnav.controllers.safety_filter import SafetyFilter
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import Disc, Pose2D, rasterise
-from swarmnav.planners.errors import PlanningError
+from swarmnav.planners.errors import PlanningError, StartBlocked
 from swarmnav.planners.problem import Path, Problem
 
 
@@ -74,9 +74,16 @@ def keep_outside(discs: list[Disc], points: list[tuple[float, float]], inflation
     return out
 
 
+def endpoint_room_m(known: Problem) -> float:
+    """How far a sensed disc's inflated rim is kept from the start and goal: the inflation plus
+    1.5 cells, so that grid planners, which block cells whose centres come within the inflation
+    plus half a cell diagonal, still find the endpoints' cells free."""
+    return known.inflation_m + 1.5 * known.cell_m
+
+
 def sensed_problem(known: Problem, pose: Pose2D, sensed: list[Disc]) -> Problem:
     """The known map from the current pose, plus the sensed (swept) discs kept off the start and goal."""
-    discs = keep_outside(sensed, [(pose.x_m, pose.y_m), (known.goal.x_m, known.goal.y_m)], known.inflation_m)
+    discs = keep_outside(sensed, [(pose.x_m, pose.y_m), (known.goal.x_m, known.goal.y_m)], endpoint_room_m(known))
     start = Pose2D(pose.x_m, pose.y_m, pose.heading_rad)
     problem = replace(known, start=start, obstacles=tuple(known.obstacles) + tuple(discs))
     if known.grid_override is not None and discs:
@@ -104,10 +111,10 @@ class ReplanNavigator:
 
     name: ClassVar[str] = "replan"
 
-    lookahead_m: float = 1.5
-    horizon_s: float = 3.0
+    lookahead_m: float = 2.5
+    horizon_s: float = 6.0
     margin_m: float = 0.05
-    cooldown_s: float = 1.0
+    cooldown_s: float = 0.5
     retry_s: float = 0.5
     planning_latency_s: float = 0.0
     safety_filter: bool = False
@@ -164,8 +171,11 @@ class ReplanNavigator:
         """A reason to replan ("blocked by sensed obstacle") or ""."""
         if not observation.detections:
             return ""
-        ahead = path_ahead(observation.pose, self.path.waypoints, self.controller.waypoint_index, self.lookahead_m)
-        sweeps = swept_discs(observation.detections, self.horizon_s)
+        pose = observation.pose
+        ahead = path_ahead(pose, self.path.waypoints, self.controller.waypoint_index, self.lookahead_m)
+        # The same discs a replan would plan around (kept off the robot), so a fresh path is not blocked at once.
+        sweeps = keep_outside(swept_discs(observation.detections, self.horizon_s), [(pose.x_m, pose.y_m)],
+                              endpoint_room_m(self.known))
         inflation = self.known.robot_radius_m + self.margin_m
         return "blocked by sensed obstacle" if polyline_gap_m(ahead, sweeps, inflation) < 0.0 else ""
 
@@ -176,7 +186,12 @@ class ReplanNavigator:
         problem = sensed_problem(self.known, observation.pose, swept_discs(observation.detections, self.horizon_s))
         wall0 = time.perf_counter()
         try:
-            path = self.setup.planner.plan(problem, self.setup.rng)
+            try:
+                path = self.setup.planner.plan(problem, self.setup.rng)
+            except StartBlocked:
+                # The robot has cut within the clearance of a known obstacle: plan with no clearance.
+                problem = replace(problem, clearance_m=0.0)
+                path = self.setup.planner.plan(problem, self.setup.rng)
             ok = problem.is_collision_free(path.waypoints, tolerance_m=1e-6)
             why = "" if ok else "the planner's path is not collision-free"
         except PlanningError as exc:
