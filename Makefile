@@ -1,5 +1,5 @@
 # Two commands do all set-up on a fresh machine:
-#   make demo   simulate a bundled scenario end to end (log, video, summary)
+#   make demo   seed 004's moving obstacles, planned by GWO, driven with replan (log, video, plot)
 #   make test   run the test suite
 # Each creates .venv and installs swarmnav into it on first use.
 
@@ -7,8 +7,9 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
-DEMO_SCENARIO ?= gwo-scenario-1
-DEMO_PLANNER ?= astar
+DEMO_SCENARIO ?= gwo-scenario-2
+DEMO_PLANNER ?= gwo
+DEMO_NAVIGATOR ?= replan
 export MUJOCO_GL ?= egl
 
 STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin)))")
@@ -25,7 +26,7 @@ install: $(STAMP)
 
 demo: $(STAMP)
 	mkdir -p logs
-	$(BIN)/swarmnav run $(DEMO_SCENARIO) --planner $(DEMO_PLANNER) --seed 0 \
+	$(BIN)/swarmnav run $(DEMO_SCENARIO) --planner $(DEMO_PLANNER) --navigator $(DEMO_NAVIGATOR) --seed 0 \
 		--out logs/demo.mcap --overwrite --video logs/demo.mp4 --json > logs/demo.json
 	$(BIN)/swarmnav log info logs/demo.mcap
 	$(BIN)/swarmnav plot logs/demo.mcap -o logs/demo.png

@@ -57,8 +57,9 @@ class Observation:
             ``inf`` where nothing is in range.
         range_angles_rad: (K,) beam directions in the base frame, CCW from +x.
         range_offset_m: distance of the sensor sites from the base's centre.
-        detections: moving obstacles reported by the ``detector`` sensing model
-            (empty with the rangefinder model, whose hits a tracker turns into estimates).
+        detections: moving obstacles as sensed: exact within range with the ``detector``
+            sensing model, the tracker's estimates from the rays' unknown hits with
+            ``rangefinder`` (both computed in ``sim/detector.py``).
         range_cutoff_m: the rangefinders' reach (``inf``: unknown).
     """
 
@@ -85,6 +86,8 @@ class NavigationSetup:
         goal: the goal checker.
         control_dt_s: the control period.
         max_speed_m_s: the robot's speed limit.
+        known_problem: what the robot knows in advance for replanning: ``problem``
+            without the moving obstacles (the map); None = ``problem``.
     """
 
     path: Path
@@ -95,6 +98,12 @@ class NavigationSetup:
     goal: GoalChecker
     control_dt_s: float
     max_speed_m_s: float
+    known_problem: Problem | None = None
+
+    @property
+    def map_problem(self) -> Problem:
+        """The known map (static obstacles only) as a planning problem."""
+        return self.known_problem if self.known_problem is not None else self.problem
 
 
 @dataclass(frozen=True, eq=False)

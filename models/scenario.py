@@ -60,6 +60,10 @@ class SimSettings:
     timestep_s: float = 0.002
     control_hz: float = 50.0
     stop_on_collision: bool = False
+    danger_m: float = 0.1  # clearance below which time counts as "in danger" (navigation metrics)
+
+
+SENSOR_MODELS = ("rangefinder", "detector")
 
 
 @dataclass(frozen=True, eq=False)
@@ -95,6 +99,8 @@ class Scenario:
     map_grid: OccupancyGrid | None = field(default=None, repr=False)
     # [map].pairs: start/goal cells (column, row from the bottom) as [x0, y0, x1, y1], for `bench grid`
     map_pairs: tuple[tuple[int, int, int, int], ...] = ()
+    # How moving obstacles are sensed: "rangefinder" (rays, tracked) or "detector" (true state within range_m).
+    sensor_model: str = "rangefinder"
 
     @property
     def bounds(self) -> Rect:
@@ -283,6 +289,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     sensors = top.table("sensors", {})
     sensor_count = sensors.integer("count", 12, minimum=1, maximum=MAX_SENSORS)
     sensor_range_m = sensors.number("range_m", 0.4, positive=True, minimum=MIN_LENGTH_M)
+    sensor_model = sensors.string("model", "rangefinder", choices=SENSOR_MODELS)
     sensors.close()
 
     planner = top.table("planner", {})
@@ -302,7 +309,8 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     sim_t = top.table("sim", {})
     sim = SimSettings(timestep_s=sim_t.number("timestep_s", 0.002, positive=True, minimum=MIN_TIMESTEP_S),
                       control_hz=sim_t.number("control_hz", 50.0, positive=True),
-                      stop_on_collision=sim_t.boolean("stop_on_collision", False))
+                      stop_on_collision=sim_t.boolean("stop_on_collision", False),
+                      danger_m=sim_t.number("danger_m", 0.1, non_negative=True))
     cell_m = sim_t.number("cell_m", 0.05, positive=True)
     sim_t.close()
     _check_run_size(time_limit_s, sim, source)
@@ -392,7 +400,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         planner_name=planner_name, planner_params=dict(params),
         navigator_name=navigator_name, navigator_params=dict(navigator_params), obstacles=tuple(obstacles),
         sim=sim, cell_m=cell_m, source_text=text, source_path=source, boxes=boxes, world_seed=seed,
-        map_grid=map_grid, map_pairs=map_pairs)
+        map_grid=map_grid, map_pairs=map_pairs, sensor_model=sensor_model)
     _check_endpoints(scenario, source)
     return scenario
 

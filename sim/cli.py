@@ -24,6 +24,7 @@ from swarmnav.planners.errors import PlanningError
 from swarmnav.sim import log_commands, options, plot, replay
 from swarmnav.sim.benchmarks import env as bench_env
 from swarmnav.sim.benchmarks import grid as bench_grid
+from swarmnav.sim.benchmarks import navigation as bench_navigation
 from swarmnav.sim.benchmarks import planners as bench_planners
 from swarmnav.sim.benchmarks import render as bench_render
 from swarmnav.sim.benchmarks import sim as bench_sim
@@ -88,6 +89,8 @@ def _blame_options(args: argparse.Namespace, exc: ConfigError) -> ConfigError:
 
 def cmd_scenarios(args: argparse.Namespace) -> int:
     from swarmnav.models.scenario import list_scenarios, load_scenario
+    if getattr(args, "scenarios_command", None) == "generate":
+        return cmd_generate(args)
     rows = []
     for name in list_scenarios():
         s = load_scenario(name)
@@ -100,6 +103,39 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
         for r in rows:
             print(f"{r['name']:<24} {r['obstacles']:>3} obstacles ({r['moving']} moving)  {r['description']}")
     return EXIT_OK
+
+
+def cmd_generate(args: argparse.Namespace) -> int:
+    """``scenarios generate KIND --seed N``: write (or print) a generated scenario; it must load back."""
+    from dataclasses import fields
+    from swarmnav.models.scenario import parse_scenario
+    from swarmnav.models.scenario_generator import GeneratorOptions, generate
+    options = GeneratorOptions(**{f.name: getattr(args, f.name) for f in fields(GeneratorOptions)
+                                  if getattr(args, f.name, None) is not None})
+    text = generate(args.kind, args.seed, options)
+    parse_scenario(text, args.out or "<generated>")
+    if args.out:
+        out = FilePath(args.out)
+        if out.exists() and not args.overwrite:
+            raise UserError(f"{out}: --out: file exists (use --overwrite)")
+        out.write_text(text, encoding="utf-8")
+    else:
+        sys.stdout.write(text)
+    return EXIT_OK
+
+
+def _add_generate_options(p: argparse.ArgumentParser) -> None:
+    from swarmnav.models.scenario_generator import KINDS, GeneratorOptions
+    p.add_argument("kind", metavar="KIND", help=f"one of: {', '.join(KINDS)}")
+    p.add_argument("--seed", type=int, required=True, help="the layout's seed (same seed, same file)")
+    p.add_argument("--out", help="write the TOML here (default: print it)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
+    for name, kind in (("obstacles", int), ("speed_ratio", float), ("radius_min_m", float),
+                       ("radius_max_m", float), ("arena_m", float), ("sensor_model", str), ("range_m", float),
+                       ("sensor_count", int), ("robot_speed_m_s", float), ("time_limit_s", float),
+                       ("planner", str), ("navigator", str), ("name", str)):
+        p.add_argument(f"--{name.replace('_', '-')}", dest=name, type=kind,
+                       help=f"default: {getattr(GeneratorOptions(), name)!r}")
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
@@ -177,6 +213,7 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Any, str]] = [
     (("bench", "grid"), bench_grid, "grid planners, Moving AI optima and the pathfinding peer"),
     (("bench", "render"), bench_render, "offscreen rendering frames per second"),
     (("bench", "env"), bench_env, "the Gymnasium environment vs the closed-loop runner and bare mj_step"),
+    (("bench", "navigation"), bench_navigation, "every navigator on the dynamic suite (dyn-*) x world seeds"),
     (("log", "info"), log_commands, "what a log holds"),
     (("log", "recover"), log_commands, "rewrite a truncated log as a complete one"),
     (("replay",), replay, "re-render or re-simulate a log"),
@@ -204,9 +241,12 @@ def build_parser() -> argparse.ArgumentParser:
         prog="swarmnav", description="Plan, simulate, log and replay swarm path planners for a wheeled robot in MuJoCo.")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("scenarios", help="list the bundled scenarios")
+    p = sub.add_parser("scenarios", help="list the bundled scenarios, or generate one")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_scenarios)
+    gen = p.add_subparsers(dest="scenarios_command", metavar="generate").add_parser(
+        "generate", help="write a dynamic scenario (crossing, head_on, overtake, crowd) from a seed")
+    _add_generate_options(gen)
 
     p = sub.add_parser("plan", help="plan a path for a scenario")
     _add_run_options(p)

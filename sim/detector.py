@@ -1,9 +1,21 @@
-"""A minimal ``detector`` sensing model: every moving obstacle whose surface lies within range.
+"""The two sensing models of moving obstacles, as plain data for the navigator.
 
-Exact centre and radius, and the velocity from the last control period (a
-backward difference: the robot never sees where an obstacle will be), as seed 003 §2.1 assumes its sensors report
-direction, step length, size and shape.  Placeholder for the navigation work's
-detector (issue 10); the track id is the obstacle's index among the moving ones.
+Chosen per scenario by ``sensors.model``:
+
+* ``rangefinder`` (default): the MuJoCo rangefinder rays.  A hit that lies on
+  known static geometry (a static cylinder, a map box, an arena wall: the map
+  the robot is given in advance) within ``STATIC_HIT_TOLERANCE_M`` is dropped;
+  the rest are points of unknown obstacles, which a
+  :class:`~controllers.tracking.HitTracker` turns into discs with velocities.
+  Only what the rays saw.
+* ``detector``: an idealised obstacle detector (the sensor seed 003 assumes:
+  "direction, step length, size and shape").  Computed here from the true state:
+  each moving obstacle's centre, radius and velocity (finite difference over
+  one control step of its scripted motion), reported once its surface is within
+  ``sensors.range_m`` of the robot's rim.  Nothing beyond the range.
+
+Both give :class:`~controllers.navigator.DetectedObstacle` tuples; the log and
+``run --json`` name the model through the scenario.
 """
 
 from __future__ import annotations
@@ -11,16 +23,91 @@ from __future__ import annotations
 import numpy as np
 
 from swarmnav.controllers.navigator import DetectedObstacle
+from swarmnav.controllers.tracking import HitTracker
+from swarmnav.models.scenario import Scenario
+from swarmnav.models.world import Pose2D
+
+STATIC_HIT_TOLERANCE_M = 0.02  # a hit this close to a known surface is the map's, not an unknown obstacle's
 
 
-def detect(track_m: np.ndarray, step: int, dt_s: float, radii_m: np.ndarray, x_m: float, y_m: float,
-           range_m: float) -> tuple[DetectedObstacle, ...]:
-    """Detections at control step ``step`` from the (T, M, 2) obstacle track."""
-    if track_m.shape[1] == 0:
-        return ()
-    here = track_m[step]
-    velocity = (here - track_m[step - 1]) / dt_s if step > 0 else np.zeros_like(here)
-    gap = np.hypot(here[:, 0] - x_m, here[:, 1] - y_m) - radii_m
-    return tuple(DetectedObstacle(float(here[i, 0]), float(here[i, 1]), float(radii_m[i]),
-                                  float(velocity[i, 0]), float(velocity[i, 1]), int(i))
-                 for i in np.flatnonzero(gap <= range_m))
+def hit_points(pose: Pose2D, ranges_m: np.ndarray, angles_rad: np.ndarray, offset_m: float
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """World positions of the finite rangefinder hits (N, 2) and of the sensors that made them (N, 2)."""
+    hit = np.isfinite(ranges_m)
+    world = pose.heading_rad + np.asarray(angles_rad)[hit]
+    direction = np.column_stack([np.cos(world), np.sin(world)])
+    origins = np.array([pose.x_m, pose.y_m]) + offset_m * direction
+    return origins + np.asarray(ranges_m)[hit][:, None] * direction, origins
+
+
+def known_surface_gap_m(points_m: np.ndarray, scenario: Scenario) -> np.ndarray:
+    """(N,) distance from each point to the nearest known static surface (inf with none)."""
+    pts = np.asarray(points_m, dtype=float).reshape(-1, 2)
+    gap = np.full(len(pts), np.inf)
+    discs = [(ob.x_m, ob.y_m, ob.radius_m) for ob in scenario.obstacles if not ob.moving]
+    if discs:
+        d = np.array(discs)
+        gap = np.minimum(gap, np.min(np.abs(np.hypot(pts[:, None, 0] - d[:, 0], pts[:, None, 1] - d[:, 1])
+                                            - d[:, 2]), axis=1))
+    if scenario.boxes:
+        b = np.array([[bx.x_min_m, bx.y_min_m, bx.x_max_m, bx.y_max_m] for bx in scenario.boxes])
+        dx = np.maximum(np.maximum(b[:, 0] - pts[:, None, 0], pts[:, None, 0] - b[:, 2]), 0.0)
+        dy = np.maximum(np.maximum(b[:, 1] - pts[:, None, 1], pts[:, None, 1] - b[:, 3]), 0.0)
+        gap = np.minimum(gap, np.min(np.hypot(dx, dy), axis=1))
+    if scenario.walls:
+        w, h = scenario.arena_width_m, scenario.arena_height_m
+        walls = np.column_stack([pts[:, 0], w - pts[:, 0], pts[:, 1], h - pts[:, 1]])
+        gap = np.minimum(gap, np.abs(walls).min(axis=1))
+    return gap
+
+
+class ObstacleSensing:
+    """One run's sensing of moving obstacles: ``sense(step, pose, ranges) -> detections``.
+
+    Args:
+        scenario: gives the model, the range, the robot radius and the known map.
+        track_m: (T, M, 2) positions of the moving obstacles at every control step (the runner's).
+        radii_m: (M,) their radii.
+        dt_s: the control period.
+        angles_rad, offset_m: the rangefinders' beam directions and distance from the base centre.
+    """
+
+    def __init__(self, scenario: Scenario, track_m: np.ndarray, radii_m: np.ndarray, dt_s: float,
+                 angles_rad: np.ndarray, offset_m: float):
+        self.model = scenario.sensor_model
+        self.range_m = scenario.sensor_range_m
+        self.robot_radius_m = scenario.robot_radius_m
+        self.scenario = scenario
+        self.track_m = track_m
+        self.radii_m = np.asarray(radii_m, dtype=float)
+        self.dt_s = dt_s
+        self.angles_rad = angles_rad
+        self.offset_m = offset_m
+        self.tracker = HitTracker()
+        # Velocities by forward difference of the scripted track (backward at the last step).
+        if track_m.shape[1] and len(track_m) > 1:
+            diff = np.diff(track_m, axis=0) / dt_s
+            self.velocity_m_s = np.concatenate([diff, diff[-1:]], axis=0)
+        else:
+            self.velocity_m_s = np.zeros_like(track_m)
+
+    def sense(self, step: int, time_s: float, pose: Pose2D, ranges_m: np.ndarray) -> tuple[DetectedObstacle, ...]:
+        if self.model == "detector":
+            return self.detect(step, pose)
+        hits, origins = hit_points(pose, ranges_m, self.angles_rad, self.offset_m)
+        unknown = known_surface_gap_m(hits, self.scenario) > STATIC_HIT_TOLERANCE_M
+        return self.tracker.update(time_s, hits[unknown], origins[unknown])
+
+    def detect(self, step: int, pose: Pose2D) -> tuple[DetectedObstacle, ...]:
+        """The ``detector`` model: the true moving obstacles whose surface is within range of the rim."""
+        if not self.track_m.shape[1]:
+            return ()
+        centres = self.track_m[step]
+        gap = np.hypot(centres[:, 0] - pose.x_m, centres[:, 1] - pose.y_m) - self.radii_m - self.robot_radius_m
+        out = []
+        for i in np.flatnonzero(gap <= self.range_m):
+            vx, vy = self.velocity_m_s[step, i]
+            out.append(DetectedObstacle(float(centres[i, 0]), float(centres[i, 1]), float(self.radii_m[i]),
+                                        float(vx), float(vy), int(i)))
+        return tuple(out)
+

@@ -16,7 +16,7 @@ randomness, ``world_seed`` every random obstacle motion.  The planner draws from
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Sequence
 
 import numpy as np
@@ -26,6 +26,9 @@ from swarmnav.controllers.navigators import make_navigator
 from swarmnav.controllers.point_to_point import PointToPointController
 from swarmnav.models.scenario import Scenario
 from swarmnav.planners import make_planner
+from swarmnav.planners.errors import PlanningError
+from swarmnav.planners.optimal import OptimalPlanner
+from swarmnav.planners.grid_search import ThetaStarPlanner
 from swarmnav.planners.problem import Path, Problem, scenario_problem
 from swarmnav.sim.recording import Recorder, RecorderGroup
 from swarmnav.sim.runner import RunResult, Simulation
@@ -111,6 +114,31 @@ def plan_episode(spec: EpisodeSpec) -> Episode:
     return Episode(spec, problem, path)
 
 
+def static_problem(scenario: Scenario) -> Problem:
+    """The scenario's problem with its moving obstacles left out: what the robot knows in advance (the map)."""
+    return scenario_problem(replace(scenario, obstacles=tuple(ob for ob in scenario.obstacles if not ob.moving)))
+
+
+_REFERENCE_LENGTHS: dict[str, float | None] = {}
+
+
+def reference_length_m(scenario: Scenario) -> float | None:
+    """L* for SPL: the exact shortest path among the static discs (``optimal``), or Theta* on a map.
+
+    None when there is no path among the static obstacles.  Cached by the
+    scenario's text (the static geometry does not depend on the world seed).
+    """
+    key = scenario.source_text or scenario.name
+    if key not in _REFERENCE_LENGTHS:
+        problem = static_problem(scenario)
+        planner = ThetaStarPlanner() if problem.boxes or problem.grid_override is not None else OptimalPlanner()
+        try:
+            _REFERENCE_LENGTHS[key] = planner.plan(problem, np.random.default_rng(0)).stats.length_m
+        except PlanningError:
+            _REFERENCE_LENGTHS[key] = None
+    return _REFERENCE_LENGTHS[key]
+
+
 def run_episode(spec: EpisodeSpec, recorders: Sequence[Recorder] = (), *, scene: CompiledScene | None = None,
                 time_limit_s: float | None = None, stop_on_collision: bool | None = None,
                 simulation: Simulation | None = None, planned: Episode | None = None) -> Episode:
@@ -134,10 +162,11 @@ def run_episode(spec: EpisodeSpec, recorders: Sequence[Recorder] = (), *, scene:
         rng=np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(NAVIGATOR_STREAM,))),
         controller=PointToPointController(simulation.scene.drive, max_speed_m_s=scenario.max_speed_m_s),
         goal=simulation.goal_checker(), control_dt_s=simulation.control_dt_s,
-        max_speed_m_s=scenario.max_speed_m_s)
+        max_speed_m_s=scenario.max_speed_m_s, known_problem=static_problem(scenario))
     recorder = RecorderGroup(list(recorders)) if recorders else None
     context = simulation.context(spec.planner, spec.planner_params, spec.seed, spec.navigator,
                                  spec.navigator_params) if recorder is not None else None
     episode.result = simulation.run(navigator, setup, recorder=recorder, context=context,
-                                    time_limit_s=time_limit_s, stop_on_collision=stop_on_collision)
+                                    time_limit_s=time_limit_s, stop_on_collision=stop_on_collision,
+                                    reference_length_m=reference_length_m(scenario))
     return episode

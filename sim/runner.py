@@ -34,7 +34,7 @@ from swarmnav.models.scenario import Scenario
 from swarmnav.models.world import Pose2D
 from swarmnav.sim.clearance import ClearanceProbe
 from swarmnav.sim.contact import ContactMonitor
-from swarmnav.sim.detector import detect
+from swarmnav.sim.detector import ObstacleSensing
 from swarmnav.sim.recording import ObstacleInfo, Recorder, RunContext, StepFrame
 from swarmnav.sim.scene import CompiledScene, compile_scene
 from swarmnav.sim.sensing import base_twist, ranges_from_sensors, yaw_from_quaternion
@@ -58,13 +58,43 @@ class RunResult:
     poses: np.ndarray = field(repr=False)  # (T, 3) x, y, heading
     wheel_command_rad_s: np.ndarray = field(repr=False)  # (T, 2)
     collision_points_m: np.ndarray = field(repr=False)  # (C, 2) base position at each collision start
+    # Navigation metrics (seed 004 dynamic runs; see summary()).
+    time_in_danger_s: float = 0.0
+    stopped_s: float = 0.0
+    replans: int = 0
+    replan_wall_s: float = 0.0
+    safety_triggers: int = 0
+    reference_length_m: float | None = None  # L*: the shortest path among the static obstacles
+    navigator_wall_s: float = 0.0  # wall time spent in navigator.step (not in summary(): benchmarks read it)
+
+    @property
+    def success(self) -> bool:
+        """Reached the goal before the time limit with no collision."""
+        return self.reached and self.collisions == 0
+
+    @property
+    def spl(self) -> float | None:
+        """Success weighted by path length (Anderson et al. 2018, Eq. 1 for one episode): S L* / max(L, L*)."""
+        if self.reference_length_m is None:
+            return None
+        if not self.success:
+            return 0.0
+        return self.reference_length_m / max(self.path_length_m, self.reference_length_m)
 
     def summary(self) -> dict[str, Any]:
         return {"reached": self.reached, "outcome": self.outcome, "collisions": self.collisions,
                 "first_collision_s": self.first_collision_s, "sim_time_s": round(self.sim_time_s, 6),
                 "wall_time_s": round(self.wall_time_s, 4), "path_length_m": self.path_length_m,
                 # None when the scene has no obstacle (JSON has no infinity).
-                "min_clearance_m": self.min_clearance_m if math.isfinite(self.min_clearance_m) else None}
+                "min_clearance_m": self.min_clearance_m if math.isfinite(self.min_clearance_m) else None,
+                "success": self.success, "time_to_goal_s": round(self.sim_time_s, 6) if self.reached else None,
+                "spl": self.spl, "time_in_danger_s": round(self.time_in_danger_s, 6), "replans": self.replans,
+                "replan_wall_s": round(self.replan_wall_s, 4), "stopped_s": round(self.stopped_s, 6),
+                "safety_triggers": self.safety_triggers}
+
+    def log_summary(self) -> dict[str, Any]:
+        """:meth:`summary` without wall-clock figures other than ``wall_*`` (which the log writer drops)."""
+        return {k: v for k, v in self.summary().items() if k != "replan_wall_s"}
 
 
 class Simulation:
@@ -130,17 +160,18 @@ class Simulation:
 
     def run(self, navigator: Navigator, setup: NavigationSetup, recorder: Recorder | None = None,
             context: RunContext | None = None, time_limit_s: float | None = None,
-            stop_on_collision: bool | None = None) -> RunResult:
+            stop_on_collision: bool | None = None, reference_length_m: float | None = None) -> RunResult:
         """Drive the robot with ``navigator`` until goal, timeout or (optionally) first collision.
 
         The recorder, when given, is finished even if the loop raises, so what it
-        wrote stays readable.
+        wrote stays readable.  ``reference_length_m`` (L*) gives the result its SPL.
         """
         scenario = self.scenario
         stop_on_collision = scenario.sim.stop_on_collision if stop_on_collision is None else stop_on_collision
         loop = StepLoop(self, recorder, scenario.time_limit_s if time_limit_s is None else time_limit_s)
         goal = setup.goal
         outcome = ""
+        navigator_wall_s = 0.0
         wall0 = time.perf_counter()
         try:
             navigator.reset(setup)
@@ -155,7 +186,10 @@ class Simulation:
                 if outcome:
                     loop.stop(observation, outcome)
                     break
+                nav0 = time.perf_counter()
                 decision = navigator.step(observation)
+                navigator_wall_s += time.perf_counter() - nav0
+                loop.count_events(decision.events)
                 if recorder is not None:
                     if decision.new_path is not None:
                         recorder.path(observation.time_s, decision.new_path.waypoints)
@@ -164,13 +198,16 @@ class Simulation:
                 loop.apply(observation, decision.command)
                 loop.advance()
             result = loop.result(outcome, time.perf_counter() - wall0)
+            result.reference_length_m = reference_length_m
+            result.navigator_wall_s = navigator_wall_s
+            result.replan_wall_s = float(getattr(navigator, "replan_wall_s", 0.0))
         except BaseException as exc:
             if recorder is not None:
                 stopped = isinstance(exc, (KeyboardInterrupt, SystemExit))
                 recorder.finish({"outcome": "interrupted" if stopped else "error", "sim_time_s": loop.time_s})
             raise
         if recorder is not None:
-            recorder.finish(result.summary())
+            recorder.finish(result.log_summary())
         return result
 
 
@@ -196,8 +233,6 @@ class StepLoop:
         self.times_s = np.arange(self.n_max + 1) * self.dt_s
         self.obstacle_track_m = simulation.obstacle_positions(self.times_s)  # (T, M, 2)
         self.mocap_index = simulation._mocap_index
-        self.moving_radii_m = np.array([simulation.scenario.obstacles[ob.scenario_index].radius_m
-                                        for ob in simulation._moving], dtype=float)
         self.monitor = ContactMonitor(self.model, scene.is_robot_geom, scene.is_obstacle_geom, recorder,
                                       release_s=self.dt_s)
         # Contacts that are not collisions (wheels and casters on the floor), counted at the
@@ -215,7 +250,13 @@ class StepLoop:
         self.clearance_m = math.inf  # at the last observation
         self.length_m = 0.0
         self.waypoint_index = 0  # of the last command, recorded with the final step
+        self.in_danger = False
         self.step = 0
+        radii = [simulation.scenario.obstacles[ob.scenario_index].radius_m for ob in simulation._moving]
+        self.sensing = ObstacleSensing(simulation.scenario, self.obstacle_track_m, np.array(radii), self.dt_s,
+                                       scene.range_angles_rad, scene.range_offset_m)
+        self.danger_m = simulation.scenario.sim.danger_m
+        self.danger_steps = self.stopped_steps = self.replans = self.safety_triggers = 0
 
     @property
     def time_s(self) -> float:
@@ -242,14 +283,22 @@ class StepLoop:
         self.clearance_m = gap = self.clearance.measure(data, x, y)
         if gap < self.min_clearance_m:
             self.min_clearance_m = gap
+        self.in_danger = gap < self.danger_m
         v, omega = base_twist(data.qvel, scene.free_qvel_adr, heading)
-        return Observation(time_s=self.time_s, pose=Pose2D(x, y, heading), twist=Twist(v, omega),
-                           ranges_m=ranges_from_sensors(data.sensordata[scene.range_sensor_adr],
-                                                        scene.range_cutoff_m),
+        pose = Pose2D(x, y, heading)
+        ranges = ranges_from_sensors(data.sensordata[scene.range_sensor_adr], scene.range_cutoff_m)
+        return Observation(time_s=self.time_s, pose=pose, twist=Twist(v, omega), ranges_m=ranges,
                            range_angles_rad=scene.range_angles_rad, range_offset_m=scene.range_offset_m,
                            range_cutoff_m=scene.range_cutoff_m,
-                           detections=detect(self.obstacle_track_m, step, self.dt_s, self.moving_radii_m, x, y,
-                                             self.simulation.scenario.sensor_range_m))
+                           detections=self.sensing.sense(step, self.time_s, pose, ranges))
+
+    def count_events(self, events) -> None:
+        """Count the navigator's replans and safety-filter triggers."""
+        for kind, _ in events:
+            if kind == "replan":
+                self.replans += 1
+            elif kind == "safety_trigger":
+                self.safety_triggers += 1
 
     def outcome(self, pose: Pose2D, goal: GoalChecker, stop_on_collision: bool) -> str:
         """"goal_reached", "collision" (when stopping on one), "timeout", or "" to go on."""
@@ -268,6 +317,8 @@ class StepLoop:
         self.data.ctrl[1] = right
         self.wheel_cmd[self.step] = (left, right)
         self.waypoint_index = command.waypoint_index
+        self.danger_steps += self.in_danger
+        self.stopped_steps += left == 0.0 and right == 0.0
         if self.recorder is not None:
             self.recorder.step(self._frame(observation, command))
 
@@ -307,7 +358,9 @@ class StepLoop:
             path_length_m=self.length_m, min_clearance_m=float(self.min_clearance_m), steps=step,
             times_s=self.times_s[:step + 1].copy(), poses=self.poses[:step + 1].copy(),
             wheel_command_rad_s=self.wheel_cmd[:step + 1].copy(),
-            collision_points_m=np.array(monitor.points, dtype=float).reshape(-1, 2))
+            collision_points_m=np.array(monitor.points, dtype=float).reshape(-1, 2),
+            time_in_danger_s=self.danger_steps * self.dt_s, stopped_s=self.stopped_steps * self.dt_s,
+            replans=self.replans, safety_triggers=self.safety_triggers)
 
     def _frame(self, observation: Observation, command: ControlCommand) -> StepFrame:
         data, scene, adr = self.data, self.scene, self.qadr

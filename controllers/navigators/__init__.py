@@ -11,6 +11,9 @@ from swarmnav.controllers.navigators.follow import FollowNavigator
 from swarmnav.controllers.navigators.iaco_local import IacoLocalNavigator
 from swarmnav.controllers.navigators.immas_stepwise import ImmasStepwiseNavigator
 from swarmnav.controllers.navigators.policy import PolicyNavigator
+from swarmnav.controllers.navigators.dwa import DynamicWindowNavigator
+from swarmnav.controllers.navigators.replan import ReplanNavigator
+from swarmnav.controllers.navigators.velocity_obstacle import VelocityObstacleNavigator
 from swarmnav.models.parameters import build_component
 
 NAVIGATORS: dict[str, type] = {}
@@ -27,7 +30,8 @@ def register(cls: type) -> type:
     return cls
 
 
-for _cls in (FollowNavigator, PolicyNavigator, IacoLocalNavigator, ImmasStepwiseNavigator):
+for _cls in (FollowNavigator, ReplanNavigator, DynamicWindowNavigator, VelocityObstacleNavigator,
+             IacoLocalNavigator, ImmasStepwiseNavigator, PolicyNavigator):
     register(_cls)
 
 

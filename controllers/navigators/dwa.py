@@ -1,0 +1,177 @@
+"""``dwa``: the Dynamic Window Approach (Fox, Burgard & Thrun 1997), guided by the global path,
+with sensed obstacles predicted forward by their estimated velocities.
+
+As in the paper (§§ 3-4): the search space is the robot's translational and
+rotational velocities (v, omega), each held constant over the prediction
+(circular arcs, §3.1); the *dynamic window* V_d keeps the pairs reachable from
+the measured (v, omega) within one window of the acceleration limits
+(Eq. 13); *admissible* pairs V_a are those from which the robot can still stop
+before the nearest obstacle on its arc, v <= sqrt(2 dist(v, omega) a_v) and
+|omega| <= sqrt(2 dist(v, omega) a_omega) (Eq. 12); among V_r = V_s ∩ V_a ∩ V_d
+the pair maximising
+
+    G(v, omega) = sigma(alpha heading + beta dist + gamma velocity)     (Eq. 14)
+
+is commanded.  sigma is the paper's smoothing, here a normalisation of each
+term to [0, 1] over the window.
+
+Where we differ or the paper is silent (our choices):
+
+* **Guidance**: ``heading`` measures the alignment at the arc's end with the
+  direction to a carrot point ``lookahead_m`` along the global path
+  (:class:`~controllers.guidance.PathCarrot`), not to the goal: the global path
+  says how to get around the known map.
+* **Moving obstacles**: the paper's obstacles are static points of the
+  occupancy grid (and PythonRobotics' DWA treats them so).  Here every sensed
+  obstacle moves along its estimated velocity at each simulated step of the
+  arc, so ``dist`` is the arc length the robot can drive before its disc
+  (radius plus ``margin_m``) would meet an obstacle *at that time*; the known
+  map's discs and boxes stand still.
+* ``dist`` is capped at ``dist_cap_m`` (the paper caps it at a constant too)
+  and arcs are simulated for ``horizon_s`` in steps of ``sim_step_s``.
+* With no admissible pair the robot brakes at full deceleration and turns
+  toward the carrot (nothing the window allows is safe).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from swarmnav.controllers.controller import ControlCommand
+from swarmnav.controllers.guidance import PathCarrot
+from swarmnav.controllers.kinematics import wheel_speeds
+from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigators.replan import check_positive
+from swarmnav.controllers.prediction import LocalObstacles
+from swarmnav.controllers.safety_filter import SafetyFilter
+from swarmnav.models.world import wrap_angle_rad
+
+
+@dataclass
+class DynamicWindowNavigator:
+    """Fox, Burgard & Thrun (1997) with the global path as guidance and moving obstacles predicted.
+
+    Args:
+        alpha, beta, gamma: weights of heading, clearance and velocity in G (Eq. 14).
+        accel_m_s2, angular_accel_rad_s2: the acceleration limits of the window.
+        window_s: the time over which the window is open (the paper's cycle, 0.25 s).
+        max_angular_rad_s: turn-rate limit.
+        v_samples, omega_samples: grid resolution over the window.
+        horizon_s, sim_step_s: how far and how finely arcs are simulated.
+        dist_cap_m: ``dist`` beyond this counts as free.
+        margin_m: extra distance kept beyond the robot radius.
+        lookahead_m: the carrot's distance along the path.
+        safety_filter, time_before_collision_s: the optional Nav2-style filter.
+    """
+
+    name: ClassVar[str] = "dwa"
+
+    alpha: float = 1.0
+    beta: float = 1.2
+    gamma: float = 0.3
+    accel_m_s2: float = 0.5
+    angular_accel_rad_s2: float = 3.0
+    window_s: float = 0.25
+    max_angular_rad_s: float = 1.2
+    v_samples: int = 7
+    omega_samples: int = 15
+    horizon_s: float = 3.0
+    sim_step_s: float = 0.15
+    dist_cap_m: float = 1.0
+    margin_m: float = 0.05
+    lookahead_m: float = 1.0
+    safety_filter: bool = False
+    time_before_collision_s: float = 1.0
+
+    def __post_init__(self) -> None:
+        check_positive(self, ("accel_m_s2", "angular_accel_rad_s2", "window_s", "max_angular_rad_s", "horizon_s",
+                              "sim_step_s", "dist_cap_m", "lookahead_m", "time_before_collision_s"),
+                       ("alpha", "beta", "gamma", "margin_m"))
+        check_positive(self, ("v_samples", "omega_samples"))
+
+    def reset(self, setup: NavigationSetup) -> None:
+        known = setup.map_problem
+        self.geometry = setup.controller.geometry
+        self.max_speed = setup.max_speed_m_s
+        self.inflation = known.robot_radius_m + self.margin_m
+        self.local = LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m)
+        self.carrot = PathCarrot(setup.path.waypoints, self.lookahead_m)
+        self.goal = np.array([setup.goal.x_m, setup.goal.y_m])
+        self.times = np.arange(1, int(round(self.horizon_s / self.sim_step_s)) + 1) * self.sim_step_s  # (T,)
+        self.filter = SafetyFilter(self.geometry, known.robot_radius_m,
+                                   self.time_before_collision_s) if self.safety_filter else None
+        self.reach = self.max_speed * self.horizon_s + 1.0
+
+    def step(self, observation: Observation) -> NavigationStep:
+        pose, twist = observation.pose, observation.twist
+        target = self.carrot.update(pose)
+        # Dynamic window (Eq. 13), clipped to the robot's limits V_s.
+        dv, dw = self.accel_m_s2 * self.window_s, self.angular_accel_rad_s2 * self.window_s
+        vs = np.linspace(max(0.0, twist.linear_m_s - dv), min(self.max_speed, twist.linear_m_s + dv), self.v_samples)
+        ws = np.linspace(max(-self.max_angular_rad_s, twist.angular_rad_s - dw),
+                         min(self.max_angular_rad_s, twist.angular_rad_s + dw), self.omega_samples)
+        v, w = (a.ravel() for a in np.meshgrid(vs, ws, indexing="ij"))           # (K,)
+        # Arcs, sampled at self.times (exact circular motion, straight when omega ~ 0).
+        t = self.times[None, :]
+        theta = pose.heading_rad + w[:, None] * t                                  # (K, T)
+        small = np.abs(w) < 1e-6
+        safe_w = np.where(small, 1.0, w)[:, None]
+        x = np.where(small[:, None], pose.x_m + v[:, None] * t * math.cos(pose.heading_rad),
+                     pose.x_m + v[:, None] / safe_w * (np.sin(theta) - math.sin(pose.heading_rad)))
+        y = np.where(small[:, None], pose.y_m + v[:, None] * t * math.sin(pose.heading_rad),
+                     pose.y_m - v[:, None] / safe_w * (np.cos(theta) - math.cos(pose.heading_rad)))
+        gap = self._gaps(pose.x_m, pose.y_m, x, y, observation)                    # (K, T)
+        hit = gap < 0.0
+        first = np.where(hit.any(axis=1), hit.argmax(axis=1), len(self.times))
+        t_free = np.where(first > 0, self.times[np.maximum(first - 1, 0)], 0.0)
+        free = first == len(self.times)
+        dist = np.where(free, self.dist_cap_m, np.minimum(np.abs(v) * t_free, self.dist_cap_m))  # arc before contact
+        admissible = (v <= np.sqrt(2.0 * dist * self.accel_m_s2) + 1e-9) & \
+                     (np.abs(w) <= np.sqrt(2.0 * dist * self.angular_accel_rad_s2) + 1e-9)
+        # The three terms of G, each normalised to [0, 1].
+        bearing = np.arctan2(target[1] - y[:, -1], target[0] - x[:, -1])
+        heading = 1.0 - np.abs(wrap_angle_rad(bearing - theta[:, -1])) / math.pi
+        clearance = dist / self.dist_cap_m
+        remaining = float(np.hypot(*(self.goal - (pose.x_m, pose.y_m))))
+        v_top = min(self.max_speed, max(remaining, 0.05))  # no reward for overshooting the goal
+        velocity = 1.0 - np.abs(v - v_top) / max(self.max_speed, 1e-9)
+        score = self.alpha * _norm(heading) + self.beta * _norm(clearance) + self.gamma * _norm(velocity)
+        if admissible.any():
+            k = int(np.argmax(np.where(admissible, score, -np.inf)))
+            v_cmd, w_cmd = float(v[k]), float(w[k])
+        else:
+            v_cmd = max(0.0, twist.linear_m_s - dv)
+            err = wrap_angle_rad(math.atan2(target[1] - pose.y_m, target[0] - pose.x_m) - pose.heading_rad)
+            w_cmd = float(np.clip(2.0 * err, -self.max_angular_rad_s, self.max_angular_rad_s))
+        command = ControlCommand(wheel_speeds(v_cmd, w_cmd, self.geometry), v_cmd, w_cmd, 0)
+        events = []
+        if self.filter is not None:
+            command, triggered = self.filter.apply(pose, command, observation.detections)
+            if triggered:
+                events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
+        return NavigationStep(command, None, tuple(events))
+
+    def _gaps(self, x0: float, y0: float, x: np.ndarray, y: np.ndarray, observation: Observation) -> np.ndarray:
+        """(K, T) smallest gap between the robot's disc on each arc and every obstacle at that time."""
+        centres, velocities, radii, boxes = self.local.near(x0, y0, self.reach, observation.detections)
+        gap = np.full(x.shape, np.inf)
+        if len(centres):
+            ox = centres[:, 0][None, :] + velocities[:, 0][None, :] * self.times[:, None]   # (T, N)
+            oy = centres[:, 1][None, :] + velocities[:, 1][None, :] * self.times[:, None]
+            d = np.hypot(x[:, :, None] - ox[None], y[:, :, None] - oy[None]) - radii - self.inflation
+            gap = d.min(axis=2)
+        if len(boxes):
+            dx = np.maximum(np.maximum(boxes[:, 0] - x[..., None], x[..., None] - boxes[:, 2]), 0.0)
+            dy = np.maximum(np.maximum(boxes[:, 1] - y[..., None], y[..., None] - boxes[:, 3]), 0.0)
+            gap = np.minimum(gap, (np.hypot(dx, dy) - self.inflation).min(axis=2))
+        return gap
+
+
+def _norm(values: np.ndarray) -> np.ndarray:
+    """The paper's smoothing sigma, as a normalisation to [0, 1] over the window."""
+    lo, hi = float(values.min()), float(values.max())
+    return (values - lo) / (hi - lo) if hi > lo else np.zeros_like(values)

@@ -1,0 +1,219 @@
+"""``replan``: follow the path, and plan again when a sensed obstacle's sweep blocks the way ahead.
+
+After Abdulla & Hadi (2025, seed 004, §5 and Figs. 9-10): the robot follows the
+path its planner found, its 12 sensors watch a range around it (§5.2), and when
+an obstacle is detected "the robot decided to deviate from its initial path and
+instead used the ABC and GWO algorithms to create new paths".  The paper gives
+neither the trigger, nor the planning budget, nor whether obstacle velocities
+are used; our choices:
+
+* **Trigger**: a sensed obstacle (``Observation.detections``: in range, or a
+  track still coasting) whose footprint, swept along its estimated velocity
+  over ``horizon_s`` (:func:`~controllers.prediction.swept_discs`) and grown by
+  the robot radius plus ``margin_m``, comes within reach of the path ahead of
+  the robot (the next ``lookahead_m`` of it).  Velocities are used.
+* **Replanning**: with the scenario's own planner (any registered planner, the
+  run's generator), from the current pose to the goal, on the known map (the
+  static obstacles only: ``NavigationSetup.map_problem``) plus the swept discs
+  of every sensed obstacle.  A swept disc that would contain the robot's
+  current position (an obstacle already close) is shrunk to leave it outside,
+  or dropped; likewise for the goal.  A path the planner returns that is not
+  collision-free on that problem counts as a failure (swarm planners return
+  their best attempt).
+* **Cooldown**: at least ``cooldown_s`` between two replans.
+* **No path**: stop, wait ``retry_s``, try again (while waiting, an obstacle
+  may still run into the robot: that counts as a collision, as in BARN).
+* **Latency**: a new path takes effect ``planning_latency_s`` of simulated time
+  after the replan (default 0); meanwhile the robot drives on the old path.
+* **Safety filter** (off by default, ``safety_filter = true``): the Nav2
+  "approach" filter of :mod:`controllers.safety_filter` on every command.
+
+Events: ``replan`` (reason, the obstacles' track ids, planning wall time is
+not logged: it is not deterministic), ``replan_failed``, ``safety_trigger``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar
+
+import numpy as np
+
+from swarmnav.controllers.controller import ControlCommand
+from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_discs
+from swarmnav.controllers.safety_filter import SafetyFilter
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.world import Disc, Pose2D, rasterise
+from swarmnav.planners.errors import PlanningError, StartBlocked
+from swarmnav.planners.problem import Path, Problem
+
+
+def check_positive(owner: Any, names: tuple[str, ...], non_negative: tuple[str, ...] = ()) -> None:
+    """ConfigError naming ``navigator.params.NAME`` for a parameter that must be positive (or >= 0)."""
+    for name in names:
+        if not getattr(owner, name) > 0:
+            raise ConfigError(f"navigator.params.{name}", f"must be positive, got {getattr(owner, name)!r}")
+    for name in non_negative:
+        if not getattr(owner, name) >= 0:
+            raise ConfigError(f"navigator.params.{name}", f"must not be negative, got {getattr(owner, name)!r}")
+
+
+def keep_outside(discs: list[Disc], points: list[tuple[float, float]], inflation_m: float) -> list[Disc]:
+    """Shrink (or drop) discs so that none, grown by ``inflation_m``, contains any of the points."""
+    out = []
+    for d in discs:
+        radius = d.radius_m
+        for x, y in points:
+            room = math.hypot(d.x_m - x, d.y_m - y) - inflation_m - 1e-3
+            radius = min(radius, room)
+        if radius > 0.02:
+            out.append(Disc(d.x_m, d.y_m, radius))
+    return out
+
+
+def endpoint_room_m(known: Problem) -> float:
+    """How far a sensed disc's inflated rim is kept from the start and goal: the inflation plus
+    1.5 cells, so that grid planners, which block cells whose centres come within the inflation
+    plus half a cell diagonal, still find the endpoints' cells free."""
+    return known.inflation_m + 1.5 * known.cell_m
+
+
+def sensed_problem(known: Problem, pose: Pose2D, sensed: list[Disc]) -> Problem:
+    """The known map from the current pose, plus the sensed (swept) discs kept off the start and goal."""
+    discs = keep_outside(sensed, [(pose.x_m, pose.y_m), (known.goal.x_m, known.goal.y_m)], endpoint_room_m(known))
+    start = Pose2D(pose.x_m, pose.y_m, pose.heading_rad)
+    problem = replace(known, start=start, obstacles=tuple(known.obstacles) + tuple(discs))
+    if known.grid_override is not None and discs:
+        # A bare map grid: mark the sensed discs on it as well.
+        extra = rasterise(known.bounds, tuple(discs), (), known.inflation_m, known.grid_override.cell_m)
+        grid = replace(known.grid_override, occupied=known.grid_override.occupied | extra.occupied)
+        problem = replace(problem, grid_override=grid)
+    return problem
+
+
+@dataclass
+class ReplanNavigator:
+    """Follow, and replan with the scenario's planner when a sensed sweep blocks the path ahead.
+
+    Args:
+        lookahead_m: how much of the path ahead is checked.
+        horizon_s: how far obstacles are predicted (swept) along their estimated velocity.
+        margin_m: extra distance kept beyond the robot radius in the trigger.
+        cooldown_s: least simulated time between two replans.
+        retry_s: wait after a failed replan before trying again (stopped meanwhile).
+        planning_latency_s: simulated time before a new path takes effect.
+        safety_filter: apply the Nav2-style safety filter to every command.
+        time_before_collision_s: the safety filter's threshold.
+    """
+
+    name: ClassVar[str] = "replan"
+
+    lookahead_m: float = 2.5
+    horizon_s: float = 6.0
+    margin_m: float = 0.05
+    cooldown_s: float = 0.5
+    retry_s: float = 0.5
+    planning_latency_s: float = 0.0
+    safety_filter: bool = False
+    time_before_collision_s: float = 1.0
+
+    def __post_init__(self) -> None:
+        check_positive(self, ("lookahead_m", "horizon_s", "retry_s", "time_before_collision_s"),
+                       ("margin_m", "cooldown_s", "planning_latency_s"))
+
+    def reset(self, setup: NavigationSetup) -> None:
+        self.setup = setup
+        self.known = setup.map_problem
+        self.controller = setup.controller
+        self.path = setup.path
+        self.controller.reset(setup.path)
+        self.next_replan_s = 0.0
+        self.pending: tuple[float, Path] | None = None
+        self.waiting_until_s: float | None = None
+        self.replan_wall_s = 0.0
+        self.filter = SafetyFilter(setup.controller.geometry, setup.problem.robot_radius_m,
+                                   self.time_before_collision_s) if self.safety_filter else None
+
+    # -- the step ------------------------------------------------------------
+    def step(self, observation: Observation) -> NavigationStep:
+        t = observation.time_s
+        events: list[tuple[str, dict[str, Any]]] = []
+        new_path = None
+        if self.pending is not None and t >= self.pending[0] - 1e-9:
+            new_path = self._adopt(self.pending[1])
+            self.pending = None
+        if self.waiting_until_s is not None:
+            if t < self.waiting_until_s - 1e-9:
+                return self._finish(observation, ControlCommand.stop(self.controller.waypoint_index), events, None)
+            reason = "retry"
+        else:
+            reason = self.blocked(observation)
+        if reason and t >= self.next_replan_s - 1e-9 and self.pending is None:
+            planned = self._replan(observation, reason, events)
+            if planned is None:
+                self.waiting_until_s = t + self.retry_s
+                return self._finish(observation, ControlCommand.stop(self.controller.waypoint_index), events,
+                                    new_path)
+            self.waiting_until_s = None
+            if self.planning_latency_s > 0:
+                self.pending = (t + self.planning_latency_s, planned)
+            else:
+                new_path = self._adopt(planned)
+        elif reason == "retry":
+            self.waiting_until_s = None
+        command = self.controller.command(observation.pose, observation.twist)
+        return self._finish(observation, command, events, new_path)
+
+    def blocked(self, observation: Observation) -> str:
+        """A reason to replan ("blocked by sensed obstacle") or ""."""
+        if not observation.detections:
+            return ""
+        pose = observation.pose
+        ahead = path_ahead(pose, self.path.waypoints, self.controller.waypoint_index, self.lookahead_m)
+        # The same discs a replan would plan around (kept off the robot), so a fresh path is not blocked at once.
+        sweeps = keep_outside(swept_discs(observation.detections, self.horizon_s), [(pose.x_m, pose.y_m)],
+                              endpoint_room_m(self.known))
+        inflation = self.known.robot_radius_m + self.margin_m
+        return "blocked by sensed obstacle" if polyline_gap_m(ahead, sweeps, inflation) < 0.0 else ""
+
+    # -- helpers -------------------------------------------------------------
+    def _replan(self, observation: Observation, reason: str, events: list) -> Path | None:
+        t = observation.time_s
+        self.next_replan_s = t + self.cooldown_s
+        problem = sensed_problem(self.known, observation.pose, swept_discs(observation.detections, self.horizon_s))
+        wall0 = time.perf_counter()
+        try:
+            try:
+                path = self.setup.planner.plan(problem, self.setup.rng)
+            except StartBlocked:
+                # The robot has cut within the clearance of a known obstacle: plan with no clearance.
+                problem = replace(problem, clearance_m=0.0)
+                path = self.setup.planner.plan(problem, self.setup.rng)
+            ok = problem.is_collision_free(path.waypoints, tolerance_m=1e-6)
+            why = "" if ok else "the planner's path is not collision-free"
+        except PlanningError as exc:
+            path, why = None, f"{type(exc).__name__}: {exc}"
+        self.replan_wall_s += time.perf_counter() - wall0
+        tracks = [d.track_id for d in observation.detections]
+        if why:
+            events.append(("replan_failed", {"reason": reason, "why": why, "tracks": tracks}))
+            return None
+        events.append(("replan", {"reason": reason, "tracks": tracks, "length_m": round(path.stats.length_m, 6),
+                                  "takes_effect_s": round(t + self.planning_latency_s, 6)}))
+        return path
+
+    def _adopt(self, path: Path) -> Path:
+        self.path = path
+        self.controller.reset(path)
+        return path
+
+    def _finish(self, observation: Observation, command: ControlCommand, events: list,
+                new_path: Path | None) -> NavigationStep:
+        if self.filter is not None:
+            command, triggered = self.filter.apply(observation.pose, command, observation.detections)
+            if triggered:
+                events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
+        return NavigationStep(command, new_path, tuple(events))

@@ -1,0 +1,139 @@
+"""``velocity_obstacle``: velocity obstacles (Fiorini & Shiller 1998), the robot taking the whole
+avoidance, guided by the global path, converted to (v, omega) for the differential drive.
+
+Fiorini & Shiller (1998): the collision cone CC_i of obstacle B_i is the set
+of relative velocities whose ray from the robot meets B_i grown by the
+robot's radius (Eq. 2); the velocity obstacle VO_i = CC_i ⊕ v_i is that cone
+translated by the obstacle's velocity (Eq. 3): a robot velocity in VO_i
+collides with B_i at some time if both keep their velocities.  A velocity
+outside the union of the VO_i (Eq. 4) avoids every obstacle; the paper
+restricts the VO to collisions within a time horizon T_h (§ 4) and picks,
+among the reachable avoidance velocities, one by a heuristic (e.g. toward the
+goal, fastest).  Here:
+
+* The cylinders do not react: the robot takes the whole avoidance (no
+  reciprocity).  Sensed obstacles move with their estimated velocities; the
+  known map's discs are VOs of still obstacles; a map box is in the way of a
+  velocity when the straight segment the robot would drive within T_h passes
+  within the inflation of it.
+* Candidate velocities are a polar grid in the world frame (``speed_samples``
+  speeds up to the robot's limit x ``heading_samples`` directions around the
+  current heading, within ``max_turn_rad``); membership in the truncated VO is
+  decided by the time to collision (:func:`~controllers.prediction.time_to_collision_s`)
+  being below ``time_horizon_s``.
+* Choice (ours; the paper leaves the heuristic open): the admissible velocity
+  nearest the *preferred* one, full speed toward a carrot ``lookahead_m`` along
+  the global path (slowed near the goal).  With none admissible, the one with
+  the latest time to collision.
+* Conversion to (v, omega) (ours; the paper's robot is holonomic in the
+  plane): omega = ``heading_gain`` x the heading error to the chosen velocity,
+  v = its speed x cos(error), zero when the error exceeds ``turn_in_place_rad``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from swarmnav.controllers.controller import ControlCommand
+from swarmnav.controllers.guidance import PathCarrot
+from swarmnav.controllers.kinematics import wheel_speeds
+from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigators.replan import check_positive
+from swarmnav.controllers.prediction import LocalObstacles, time_to_collision_s
+from swarmnav.controllers.safety_filter import SafetyFilter
+from swarmnav.models.geometry import segment_box_distances
+from swarmnav.models.world import wrap_angle_rad
+
+
+@dataclass
+class VelocityObstacleNavigator:
+    """Fiorini & Shiller (1998) velocity obstacles, non-reciprocal, for a differential drive.
+
+    Args:
+        time_horizon_s: T_h, collisions later than this do not exclude a velocity.
+        speed_samples, heading_samples: the candidate grid.
+        max_turn_rad: candidate directions lie within this of the current heading.
+        margin_m: extra distance kept beyond the robot radius.
+        lookahead_m: the carrot's distance along the global path.
+        heading_gain, max_angular_rad_s, turn_in_place_rad: the (v, omega) conversion.
+        safety_filter, time_before_collision_s: the optional Nav2-style filter.
+    """
+
+    name: ClassVar[str] = "velocity_obstacle"
+
+    time_horizon_s: float = 4.0
+    speed_samples: int = 5
+    heading_samples: int = 25
+    max_turn_rad: float = math.pi
+    margin_m: float = 0.05
+    lookahead_m: float = 1.0
+    heading_gain: float = 2.5
+    max_angular_rad_s: float = 1.2
+    turn_in_place_rad: float = math.radians(60.0)
+    safety_filter: bool = False
+    time_before_collision_s: float = 1.0
+
+    def __post_init__(self) -> None:
+        check_positive(self, ("time_horizon_s", "max_turn_rad", "lookahead_m", "heading_gain", "max_angular_rad_s",
+                              "turn_in_place_rad", "time_before_collision_s", "speed_samples", "heading_samples"),
+                       ("margin_m",))
+
+    def reset(self, setup: NavigationSetup) -> None:
+        known = setup.map_problem
+        self.geometry = setup.controller.geometry
+        self.max_speed = setup.max_speed_m_s
+        self.inflation = known.robot_radius_m + self.margin_m
+        self.local = LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m)
+        self.carrot = PathCarrot(setup.path.waypoints, self.lookahead_m)
+        self.goal = np.array([setup.goal.x_m, setup.goal.y_m])
+        self.filter = SafetyFilter(self.geometry, known.robot_radius_m,
+                                   self.time_before_collision_s) if self.safety_filter else None
+        speeds = np.linspace(self.max_speed / self.speed_samples, self.max_speed, self.speed_samples)
+        offsets = np.linspace(-self.max_turn_rad, self.max_turn_rad, self.heading_samples)
+        self.speeds, self.offsets = (a.ravel() for a in np.meshgrid(speeds, offsets, indexing="ij"))
+        self.reach = self.max_speed * self.time_horizon_s + 1.0
+
+    def step(self, observation: Observation) -> NavigationStep:
+        pose = observation.pose
+        p = np.array([pose.x_m, pose.y_m])
+        target = self.carrot.update(pose)
+        to_target = target - p
+        remaining = float(np.hypot(*(self.goal - p)))
+        preferred_speed = min(self.max_speed, remaining)
+        preferred = preferred_speed * to_target / max(float(np.hypot(*to_target)), 1e-9)
+        directions = pose.heading_rad + self.offsets
+        candidates = np.column_stack([self.speeds * np.cos(directions), self.speeds * np.sin(directions)])
+        candidates = np.vstack([candidates, [[0.0, 0.0]]])                           # (K, 2), standing still last
+        centres, velocities, radii, boxes = self.local.near(pose.x_m, pose.y_m, self.reach, observation.detections)
+        ttc = np.full(len(candidates), np.inf)
+        if len(centres):
+            ttc = time_to_collision_s(p, candidates, centres, velocities, radii + self.inflation).min(axis=1)
+        if len(boxes):
+            ends = p + candidates * self.time_horizon_s
+            d = segment_box_distances(np.repeat(p[None, :], len(ends), axis=0), ends, boxes).min(axis=1)
+            ttc = np.where(d < self.inflation, np.minimum(ttc, self.time_horizon_s * 0.5), ttc)
+        admissible = ttc >= self.time_horizon_s
+        cost = np.hypot(*(candidates - preferred).T)
+        if admissible.any():
+            k = int(np.argmin(np.where(admissible, cost, np.inf)))
+        else:
+            k = int(np.argmax(ttc - 1e-6 * cost))
+        chosen = candidates[k]
+        speed = float(np.hypot(*chosen))
+        if speed < 1e-9:
+            v, omega = 0.0, 0.0
+        else:
+            error = wrap_angle_rad(math.atan2(chosen[1], chosen[0]) - pose.heading_rad)
+            omega = float(np.clip(self.heading_gain * error, -self.max_angular_rad_s, self.max_angular_rad_s))
+            v = speed * math.cos(error) if abs(error) < self.turn_in_place_rad else 0.0
+        command = ControlCommand(wheel_speeds(v, omega, self.geometry), v, omega, 0)
+        events = []
+        if self.filter is not None:
+            command, triggered = self.filter.apply(pose, command, observation.detections)
+            if triggered:
+                events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
+        return NavigationStep(command, None, tuple(events))

@@ -1,0 +1,128 @@
+"""``swarmnav bench navigation``: every navigator on the bundled dynamic suite, the way navigation
+benchmarks report it (BARN, Nav2, CrowdNav): success, collisions, timeouts, SPL, danger, cost.
+
+Every navigator x every scenario of the suite (the bundled ``dyn-*`` files,
+made by ``swarmnav scenarios generate``) x N world seeds (run k uses world
+seed k and planner seed k).  One row per navigator; every run counts in every
+rate (failures are never dropped from the denominators).  ``mean_time_to_goal_s``
+averages the successful runs only.  ``navigator_us_per_step`` is the wall time
+measured around the navigator's ``step`` call per control step;
+``realtime_factor`` is simulated over wall time of whole runs (physics, sensing,
+navigator).  Scenarios whose obstacles all move on fixed lines give the same run
+for every world seed; they are still counted once per seed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+from swarmnav.controllers.navigators import NAVIGATORS
+from swarmnav.models.scenario import list_scenarios, load_scenario
+from swarmnav.sim.episode import EpisodeSpec, run_episode
+from swarmnav.sim.runner import Simulation
+
+SUITE_PREFIX = "dyn-"
+
+
+def default_navigators() -> list[str]:
+    """Every registered navigator that runs with its default parameters (``policy`` needs a callable)."""
+    from swarmnav.controllers.navigators import make_navigator
+    from swarmnav.models.errors import ConfigError
+    names = []
+    for name in NAVIGATORS:
+        try:
+            make_navigator(name)
+        except ConfigError:
+            continue
+        names.append(name)
+    return names
+
+
+def suite_names() -> list[str]:
+    """The bundled dynamic suite: scenarios named ``dyn-*``."""
+    return [name for name in list_scenarios() if name.startswith(SUITE_PREFIX)]
+
+
+def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, scenarios: list[str] | None = None,
+                         progress: bool = False) -> list[dict[str, Any]]:
+    """One row per navigator (see the module docstring)."""
+    navigators = navigators or default_navigators()
+    names = scenarios or suite_names()
+    loaded = [load_scenario(n) for n in names]
+    total = len(navigators) * len(loaded) * seeds
+    done = 0
+    runs: dict[str, list[dict[str, Any]]] = {n: [] for n in navigators}
+    for scenario in loaded:
+        for k in range(seeds):
+            world = scenario.with_world_seed(k)
+            simulation = Simulation(world)
+            for nav in navigators:
+                episode = run_episode(EpisodeSpec(world, navigator=nav, seed=k, world_seed=k), simulation=simulation)
+                r = episode.result
+                runs[nav].append({"success": r.success, "collided": r.collisions > 0, "timeout": r.outcome == "timeout",
+                                  "time_to_goal_s": r.sim_time_s if r.success else None, "spl": r.spl or 0.0,
+                                  "danger_s": r.time_in_danger_s, "replans": r.replans, "steps": r.steps,
+                                  "navigator_s": r.navigator_wall_s, "sim_s": r.sim_time_s, "wall_s": r.wall_time_s})
+                done += 1
+                if progress:
+                    sys.stderr.write(f"\rbench navigation: {done}/{total} runs ({scenario.name}, seed {k}, {nav})"
+                                     + " " * 10)
+                    sys.stderr.flush()
+    if progress:
+        sys.stderr.write("\n")
+    return [_row(nav, rows) for nav, rows in runs.items()]
+
+
+def _mean(values: list[float]) -> float | None:
+    return sum(values) / len(values) if values else None
+
+
+def _row(navigator: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
+    n = len(rows)
+    reached = [r["time_to_goal_s"] for r in rows if r["success"]]
+    steps = sum(r["steps"] for r in rows)
+    return {
+        "navigator": navigator, "runs": n,
+        "success_rate": sum(r["success"] for r in rows) / n,
+        "collision_rate": sum(r["collided"] for r in rows) / n,
+        "timeout_rate": sum(r["timeout"] for r in rows) / n,
+        "mean_time_to_goal_s": _mean(reached),
+        "mean_spl": _mean([r["spl"] for r in rows]),
+        "mean_time_in_danger_s": _mean([r["danger_s"] for r in rows]),
+        "mean_replans": _mean([r["replans"] for r in rows]),
+        "navigator_us_per_step": 1e6 * sum(r["navigator_s"] for r in rows) / max(steps, 1),
+        "realtime_factor": sum(r["sim_s"] for r in rows) / max(sum(r["wall_s"] for r in rows), 1e-9),
+    }
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--seeds", type=int, default=5, help="world seeds per scenario (default 5)")
+    parser.add_argument("--navigator", action="append", help="only these navigators (repeatable)")
+    parser.add_argument("--scenario", action="append", help="only these scenarios (repeatable; default: the dyn-* suite)")
+    parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
+
+
+def run(args: argparse.Namespace) -> int:
+    from swarmnav.models.errors import ConfigError
+    if args.seeds < 1:
+        raise ConfigError("--seeds", f"must be at least 1, got {args.seeds}")
+    for name in args.navigator or []:
+        if name not in NAVIGATORS:
+            raise ConfigError("--navigator", f"unknown navigator {name!r} (known: {', '.join(sorted(NAVIGATORS))})")
+    rows = benchmark_navigation(args.seeds, args.navigator, args.scenario,
+                                progress=not args.json and sys.stderr.isatty())
+    if args.json:
+        print(json.dumps(rows))
+        return 0
+    header = (f"{'navigator':<18} {'runs':>4} {'success':>7} {'collide':>7} {'timeout':>7} {'t_goal_s':>8} "
+              f"{'SPL':>5} {'danger_s':>8} {'replans':>7} {'us/step':>8} {'x_realtime':>10}")
+    print(header)
+    for r in rows:
+        t_goal = f"{r['mean_time_to_goal_s']:.1f}" if r["mean_time_to_goal_s"] is not None else "-"
+        print(f"{r['navigator']:<18} {r['runs']:>4} {r['success_rate']:>7.2f} {r['collision_rate']:>7.2f} "
+              f"{r['timeout_rate']:>7.2f} {t_goal:>8} {r['mean_spl']:>5.2f} {r['mean_time_in_danger_s']:>8.2f} "
+              f"{r['mean_replans']:>7.1f} {r['navigator_us_per_step']:>8.0f} {r['realtime_factor']:>10.1f}")
+    return 0

@@ -1,0 +1,137 @@
+"""Online navigators among moving obstacles, in physics; the safety filter; the generator; bad input."""
+
+import math
+
+import numpy as np
+import pytest
+
+from swarmnav.controllers.controller import ControlCommand
+from swarmnav.controllers.kinematics import DriveGeometry, WheelSpeeds
+from swarmnav.controllers.navigator import DetectedObstacle
+from swarmnav.controllers.safety_filter import SafetyFilter
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import parse_scenario
+from swarmnav.models.scenario_generator import GeneratorOptions, generate
+from swarmnav.models.world import Pose2D
+from swarmnav.sim.cli import main
+from swarmnav.sim.episode import EpisodeSpec, run_episode
+
+ONLINE = ("replan", "dwa", "velocity_obstacle")
+
+
+def short_case(kind: str, sensor_model: str = "rangefinder", **options) -> str:
+    """A 5 m arena with one obstacle at half the robot's speed (a 2.5 m drive)."""
+    base = dict(obstacles=1, arena_m=5.0, speed_ratio=0.5, sensor_model=sensor_model, range_m=1.0)
+    base.update(options)
+    return generate(kind, 7, GeneratorOptions(**base))
+
+
+@pytest.mark.parametrize("kind, sensor_model", [("head_on", "detector"), ("crossing", "rangefinder")])
+def test_follow_collides_in_the_short_cases(kind, sensor_model):
+    """The cases are hard enough: the plan made at t = 0, followed blindly, is run into."""
+    result = run_episode(EpisodeSpec(parse_scenario(short_case(kind, sensor_model)), navigator="follow")).result
+    assert result.collisions > 0
+
+
+@pytest.mark.parametrize("navigator", ONLINE)
+@pytest.mark.parametrize("kind, sensor_model", [("head_on", "detector"), ("crossing", "rangefinder")])
+def test_online_navigators_reach_the_goal_without_collision(navigator, kind, sensor_model):
+    result = run_episode(EpisodeSpec(parse_scenario(short_case(kind, sensor_model)), navigator=navigator)).result
+    summary = result.summary()
+    assert result.success and result.collisions == 0, summary
+    assert summary["time_to_goal_s"] == pytest.approx(result.sim_time_s)
+    assert 0.0 < summary["spl"] <= 1.0
+
+
+def test_replan_replans_and_reports_it_in_the_metrics():
+    result = run_episode(EpisodeSpec(parse_scenario(short_case("crossing")), navigator="replan")).result
+    assert result.replans >= 1 and result.replan_wall_s > 0.0
+
+
+GEOMETRY = DriveGeometry(wheel_radius_m=0.05, track_m=0.3, max_wheel_speed_rad_s=20.0)
+
+
+def test_safety_filter_slows_for_a_far_obstacle_and_stops_for_a_near_one():
+    filt = SafetyFilter(GEOMETRY, robot_radius_m=0.15, time_before_collision_s=2.0)
+    forward = ControlCommand(WheelSpeeds(4.0, 4.0), 0.2, 0.0, 1)
+    pose = Pose2D(0.0, 0.0, 0.0)
+    still_far = DetectedObstacle(1.2, 0.0, 0.3, 0.0, 0.0, 0)  # 0.72 m gap: 3.6 s at 0.2 m/s
+    out, triggered = filt.apply(pose, forward, (still_far,))
+    assert out.linear_m_s == pytest.approx(0.2) and not triggered
+    closer = DetectedObstacle(0.8, 0.0, 0.3, 0.0, 0.0, 0)     # 0.32 m gap with the margin: 1.6 s at 0.2 m/s
+    out, triggered = filt.apply(pose, forward, (closer,))
+    assert 0.0 < out.linear_m_s < 0.2 and triggered and filt.triggers == 1
+    charging = DetectedObstacle(0.8, 0.0, 0.3, -0.3, 0.0, 0)  # drives at the robot: no forward speed is safe
+    out, triggered = filt.apply(pose, forward, (charging,))
+    assert out.linear_m_s == 0.0 and not triggered and filt.triggers == 1  # still the same trigger
+
+
+def test_safety_filter_stops_the_robot_before_an_obstacle_that_drives_straight_at_it():
+    text = short_case("head_on", "detector", speed_ratio=0.8, range_m=1.5, navigator="replan")
+    scenario = parse_scenario(text)
+    # No replanning within reach (lookahead shorter than anything): the filter alone acts.
+    params = {"lookahead_m": 1e-3, "safety_filter": True, "time_before_collision_s": 3.0}
+    result = run_episode(EpisodeSpec(scenario, navigator_params=params), time_limit_s=20.0).result
+    assert result.safety_triggers >= 1 and result.collisions >= 1  # obstacles do not yield
+    step = int(round(result.first_collision_s / (result.times_s[1] - result.times_s[0])))
+    wheels = result.wheel_command_rad_s[max(step - 5, 0):step + 1]
+    assert np.allclose(wheels.sum(axis=1), 0.0)  # zero forward speed before and at contact
+    moved = np.hypot(*(result.poses[step, :2] - result.poses[step - 25, :2]))
+    assert moved < 0.01  # stood still for the half second before contact
+
+
+def test_same_scenario_seeds_and_navigator_give_the_same_trajectory_and_log_bytes(tmp_path):
+    from swarmnav.sim.mcap_log import McapRecorder
+    scenario = parse_scenario(short_case("crossing"))
+    logs, poses = [], []
+    for k in range(2):
+        path = tmp_path / f"run{k}.mcap"
+        result = run_episode(EpisodeSpec(scenario, navigator="replan"), [McapRecorder(path, overwrite=True)],
+                             time_limit_s=12.0).result
+        logs.append(path.read_bytes())
+        poses.append(result.poses)
+    assert np.array_equal(poses[0], poses[1])
+    assert logs[0] == logs[1]
+
+
+def test_generator_is_a_function_of_kind_seed_and_options():
+    a = generate("crowd", 3, GeneratorOptions(obstacles=4))
+    assert a == generate("crowd", 3, GeneratorOptions(obstacles=4))
+    assert a != generate("crowd", 4, GeneratorOptions(obstacles=4))
+    scenario = parse_scenario(a)
+    assert sum(ob.moving for ob in scenario.obstacles) == 4
+    assert "swarmnav scenarios generate crowd --seed 3" in scenario.description
+
+
+@pytest.mark.parametrize("argv, field", [
+    (["run", "dyn-crossing-1", "--navigator", "nope", "--no-log"], "navigator.name"),
+    (["run", "dyn-crossing-1", "--navigator", "replan", "--navigator-set", "horizon_s=-1", "--no-log"],
+     "navigator.params.horizon_s"),
+    (["run", "dyn-crossing-1", "--navigator", "dwa", "--navigator-set", "alpha=fast", "--no-log"],
+     "navigator.params.alpha"),
+    (["scenarios", "generate", "head_on", "--seed", "1", "--obstacles", "40"], "--obstacles"),
+    (["scenarios", "generate", "sideways", "--seed", "1"], "KIND"),
+])
+def test_bad_navigation_input_exits_2_with_one_line_naming_the_field(argv, field, capsys):
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and len(err.strip().splitlines()) == 1 and field in err, err
+
+
+def test_an_unknown_sensing_model_in_a_scenario_exits_2_naming_it(tmp_path, capsys):
+    path = tmp_path / "bad.toml"
+    path.write_text(short_case("crossing").replace('model = "rangefinder"', 'model = "sonar"'))
+    assert main(["run", str(path), "--no-log"]) == 2
+    err = capsys.readouterr().err
+    assert "sensors.model" in err and len(err.strip().splitlines()) == 1
+    with pytest.raises(ConfigError):
+        parse_scenario(path.read_text())
+
+
+def test_time_in_danger_counts_control_steps_below_danger_m():
+    scenario = parse_scenario(short_case("crossing"))
+    result = run_episode(EpisodeSpec(scenario, navigator="follow")).result
+    assert result.collisions > 0 and result.time_in_danger_s > 0.0
+    assert not result.success and result.spl == 0.0
+    assert math.isclose(result.time_in_danger_s / (result.times_s[1] - result.times_s[0]),
+                        round(result.time_in_danger_s / (result.times_s[1] - result.times_s[0])))
