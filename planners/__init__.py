@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from swarmnav.planners.ant_system import AntSystemPlanner
 from swarmnav.planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
 from swarmnav.planners.dstar_lite import DStarLitePlanner
 from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, ThetaStarPlanner
@@ -44,7 +45,7 @@ def register(cls: type) -> type:
 
 
 for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,
-             MaxMinAntSystemPlanner, ImprovedAntColonyPlanner, WaiterAntColonyPlanner,
+             MaxMinAntSystemPlanner, ImprovedAntColonyPlanner, WaiterAntColonyPlanner, AntSystemPlanner,
              OptimalPlanner, BeeColonyPlanner, AdaptiveLimitBeeColonyPlanner, GreyWolfPlanner,
              ParticleSwarmPlanner):
     register(_cls)

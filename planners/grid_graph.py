@@ -5,9 +5,10 @@ All grid planners search the same graph: 8-connected with **no corner cutting**
 convention, so A* and Dijkstra reproduce the benchmark's optimal octile lengths.
 
 * :data:`DIRECTIONS` and :data:`STEP_COSTS`: the 8 moves and their costs in cells;
-* :func:`neighbour_table`: the legal moves of every cell, found once per grid with
-  NumPy, kept as one 8-bit mask per cell (:data:`ADJACENCY`, cached by the grid's
-  content) and read through :func:`moves_by_mask`;
+* :func:`neighbour_table`: the legal moves of every cell as flat indices (the ant
+  colonies'), and :func:`move_masks`: the same as one 8-bit mask per cell, the
+  searches' (:data:`ADJACENCY`, cached by the grid's content), read through
+  :func:`moves_by_mask`;
 * :func:`grid_line_of_sight` and :func:`line_cells`: which cells a segment between
   two cell centres enters;
 * :func:`grid_endpoints`, :func:`cells_to_waypoints`: from metres to cells and back.
@@ -110,36 +111,51 @@ def moves_by_mask(cols: int) -> tuple[tuple[tuple[int, float], ...], ...]:
 
 
 _MOVES_BY_MASK: dict[int, tuple] = {}
-_MASK_BITS = 1 << np.arange(8, dtype=np.int64)
+
+
+def move_masks(occupied: np.ndarray) -> np.ndarray:
+    """(rows * cols,) uint8: bit k set where move k of :data:`DIRECTIONS` is legal from the cell
+    (the same rule as :func:`neighbour_table`, without building the (N, 8) table)."""
+    occ = np.asarray(occupied, dtype=bool)
+    rows, cols = occ.shape
+    free = ~occ
+    pad = np.zeros((rows + 2, cols + 2), dtype=bool)
+    pad[1:-1, 1:-1] = free
+    masks = np.zeros((rows, cols), dtype=np.uint8)
+    for k, (dr, dc) in enumerate(DIRECTIONS):
+        ok = free & pad[1 + dr:rows + 1 + dr, 1 + dc:cols + 1 + dc]
+        if dr and dc:
+            ok &= pad[1 + dr:rows + 1 + dr, 1:cols + 1] & pad[1:rows + 1, 1 + dc:cols + 1 + dc]
+        masks |= ok.view(np.uint8) << k
+    return masks.reshape(-1)
 
 
 class _AdjacencyCache:
-    """Neighbour tables and legal-move masks of recently seen grids, keyed by content.
+    """Legal-move masks of recently seen grids, keyed by content.
 
     A search reads the moves out of cell ``u`` as ``moves_by_mask(cols)[masks[u]]``,
-    offsets to add to ``u``: building that for a new grid is one vectorised
-    table and a list of N small ints (a fraction of a millisecond on 50 x 50),
-    not N Python lists.
+    offsets to add to ``u``: building that for a new grid is a few vectorised
+    boolean operations (:func:`move_masks`) and a list of N small ints, not N
+    Python lists.
     """
 
     def __init__(self, size: int = 16):
         self.size = size
-        self.entries: OrderedDict[tuple, tuple[np.ndarray, list[int]]] = OrderedDict()
+        self.entries: OrderedDict[tuple, list[int]] = OrderedDict()
 
-    def get(self, occupied: np.ndarray) -> tuple[np.ndarray, list[int]]:
-        """(neighbour table (N, 8), legal-move mask of every cell as a list)."""
+    def get(self, occupied: np.ndarray) -> list[int]:
+        """The legal-move mask of every cell, as a list."""
         occ = np.ascontiguousarray(occupied, dtype=bool)
         key = (occ.shape, occ.tobytes())
         hit = self.entries.get(key)
         if hit is not None:
             self.entries.move_to_end(key)
             return hit
-        table = neighbour_table(occ)
-        masks = ((table >= 0) @ _MASK_BITS).tolist()
-        self.entries[key] = (table, masks)
+        masks = move_masks(occ).tolist()
+        self.entries[key] = masks
         if len(self.entries) > self.size:
             self.entries.popitem(last=False)
-        return table, masks
+        return masks
 
 
 ADJACENCY = _AdjacencyCache()

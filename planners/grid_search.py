@@ -58,7 +58,7 @@ def astar_cells(occupied: np.ndarray, start: Cell, goal: Cell,
     occupied = np.asarray(occupied, dtype=bool)
     check_cells(occupied, start, goal)
     rows, cols = occupied.shape
-    _, masks = ADJACENCY.get(occupied)
+    masks = ADJACENCY.get(occupied)
     moves = moves_by_mask(cols)
     s = start[0] * cols + start[1]
     t = goal[0] * cols + goal[1]
@@ -131,7 +131,7 @@ def theta_star_cells(occupied: np.ndarray, start: Cell, goal: Cell,
     occupied = np.asarray(occupied, dtype=bool)
     check_cells(occupied, start, goal)
     rows, cols = occupied.shape
-    _, masks = ADJACENCY.get(occupied)
+    masks = ADJACENCY.get(occupied)
     moves = moves_by_mask(cols)
     free = (~occupied).tolist()
     los = line_of_sight or (lambda p, q: grid_line_of_sight(free, p, q))

@@ -17,20 +17,27 @@ import numpy as np
 from swarmnav.models.geometry import segment_box_distance
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.grid_graph import Cell, grid_line_of_sight, line_cells
+from swarmnav.planners.obstacle_buckets import ClearanceBuckets
 from swarmnav.planners.problem import Problem
 
 
-def segments_clear(problem: Problem, a: np.ndarray, bs: np.ndarray, tolerance_m: float = 1e-9) -> np.ndarray:
+def segments_clear(problem: Problem, a: np.ndarray, bs: np.ndarray, tolerance_m: float = 1e-9,
+                   buckets: ClearanceBuckets | None = None) -> np.ndarray:
     """For each end point in ``bs`` (K, 2), whether the segment from ``a`` stays in the bounds
-    and keeps the inflation (:meth:`~planners.problem.Problem.segment_clearances_m`).
+    and keeps the inflation (:meth:`~planners.problem.Problem.segment_clearances_m` ``>= -tolerance_m``).
 
+    With ``buckets`` (:func:`clearance_buckets` of the same problem) only the obstacles
+    near each segment are measured (the same decision; the tests compare them).
     A grid given directly without boxes (a bare map) is tested cell by cell with
     :func:`grid_line_of_sight`.
     """
     bs = np.asarray(bs, dtype=float).reshape(-1, 2)
     a = np.asarray(a, dtype=float).reshape(1, 2)
     ok = problem.in_bounds(bs, tolerance_m)
-    ok &= problem.segment_clearances_m(a, bs, cull_beyond_m=0.0) >= -tolerance_m
+    if buckets is not None:
+        ok &= buckets.segments_clear(a, bs, tolerance_m)
+    else:
+        ok &= problem.segment_clearances_m(a, bs, cull_beyond_m=0.0) >= -tolerance_m
     if not problem.boxes and problem.grid_override is not None:
         grid = problem.grid
         free = (~grid.occupied).tolist()
@@ -38,6 +45,20 @@ def segments_clear(problem: Problem, a: np.ndarray, bs: np.ndarray, tolerance_m:
         for k in np.flatnonzero(ok):
             ok[k] = grid_line_of_sight(free, ca, grid.cell_of(*bs[k]))
     return ok
+
+
+#: Fewest obstacles for which :func:`exact_shortcut` files them in buckets: below it, measuring
+#: every obstacle in one NumPy call is as fast (the buckets' own NumPy calls cost as much).
+BUCKETS_FROM_OBSTACLES = 256
+
+
+def clearance_buckets(problem: Problem) -> ClearanceBuckets | None:
+    """The problem's inflated discs and boxes filed in buckets (:mod:`planners.obstacle_buckets`),
+    or None with fewer than :data:`BUCKETS_FROM_OBSTACLES` obstacles."""
+    if len(problem.obstacles) + len(problem.boxes) < BUCKETS_FROM_OBSTACLES:
+        return None
+    return ClearanceBuckets.of(problem.disc_centres_m, problem.inflated_radii_m, problem.box_array_m,
+                               problem.inflation_m)
 
 
 def boxes_by_cell(grid: OccupancyGrid, boxes: np.ndarray, reach_m: float) -> list[tuple[int, ...]]:
@@ -111,7 +132,8 @@ def box_line_of_sight(problem: Problem, grid: OccupancyGrid, tolerance_m: float 
 def exact_shortcut(problem: Problem, waypoints: np.ndarray, window: int = 32) -> np.ndarray:
     """Greedy line-of-sight shortcut: from each kept vertex jump to the farthest visible one.
 
-    Visibility is :func:`segments_clear`, evaluated ``window`` vertices at a
+    Visibility is :func:`segments_clear` (through the problem's
+    :func:`clearance_buckets`, built once, when it has many obstacles), evaluated ``window`` vertices at a
     time in one NumPy call; while the last vertex of a window is still visible
     the next window is tried too, so a long straight run collapses to one
     segment.  Consecutive vertices are assumed visible (grid moves between free
@@ -120,6 +142,7 @@ def exact_shortcut(problem: Problem, waypoints: np.ndarray, window: int = 32) ->
     pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
     if len(pts) <= 2:
         return pts.copy()
+    buckets = clearance_buckets(problem)
     kept = [0]
     i = 0
     last = len(pts) - 1
@@ -128,7 +151,7 @@ def exact_shortcut(problem: Problem, waypoints: np.ndarray, window: int = 32) ->
         lo = i + 1
         while lo <= last:
             hi = min(lo + window, last + 1)
-            visible = np.flatnonzero(segments_clear(problem, pts[i], pts[lo:hi]))
+            visible = np.flatnonzero(segments_clear(problem, pts[i], pts[lo:hi], buckets=buckets))
             if visible.size:
                 j = lo + int(visible[-1])
             if not visible.size or j != hi - 1:

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from swarmnav.models.world import Rect
+from swarmnav.planners.disc_cells import DiscCells
 from swarmnav.planners.via_points import ViaPointCurve
 
 
@@ -39,6 +40,16 @@ def length_of_columns(xt: np.ndarray, yt: np.ndarray) -> np.ndarray:
     dx *= dx
     dy *= dy
     dx += dy
+    np.sqrt(dx, out=dx)
+    return dx.sum(axis=0)
+
+
+def length_of_block(block: np.ndarray) -> np.ndarray:
+    """:func:`length_of_columns` of a (2, S, P) block (the same arithmetic, in one buffer)."""
+    d = block[:, 1:] - block[:, :-1]
+    d *= d
+    dx = d[0]
+    dx += d[1]
     np.sqrt(dx, out=dx)
     return dx.sum(axis=0)
 
@@ -70,101 +81,78 @@ def obstacle_penalty_reference(xs: np.ndarray, ys: np.ndarray, centres_m: np.nda
     return violation.mean(axis=1).sum(axis=1)
 
 
-#: Most samples per chunk of a curve whose bounding box :func:`obstacle_penalty` tests against each disc.
-PENALTY_CHUNK = 10
-
-
-def sample_boxes(xt: np.ndarray, yt: np.ndarray) -> np.ndarray:
-    """(4, P) each candidate's sample bounding box (x_min, x_max, y_min, y_max) from (S, P) samples."""
-    return np.stack([xt.min(axis=0), xt.max(axis=0), yt.min(axis=0), yt.max(axis=0)])
-
-
 def obstacle_penalty(xs: np.ndarray, ys: np.ndarray, centres_m: np.ndarray, radii_m: np.ndarray) -> np.ndarray:
     """Kamil et al. 2020's obstacle penalty, Eqs. (3)-(5), of (P, S) samples: the fast kernel
-    (:func:`obstacle_penalty_of_columns` on the transposed samples)."""
-    return obstacle_penalty_of_columns(np.ascontiguousarray(xs.T), np.ascontiguousarray(ys.T), centres_m, radii_m)
+    (:func:`obstacle_penalty_of_block` on the samples stored sample-major)."""
+    return obstacle_penalty_of_block(columns_block(xs, ys), DiscCells(centres_m, radii_m))
 
 
-def _chunk_size(samples: int) -> int:
-    """The largest chunk of at most :data:`PENALTY_CHUNK` samples that divides ``samples``
-    (at least 4), else :data:`PENALTY_CHUNK` with padding."""
-    for size in range(PENALTY_CHUNK, 3, -1):
-        if samples % size == 0:
-            return size
-    return PENALTY_CHUNK
+def columns_block(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """(2, S, P) block of (P, S) sampled curves."""
+    return np.ascontiguousarray(np.stack([xs, ys]).transpose(0, 2, 1))
 
 
-def obstacle_penalty_of_columns(xt: np.ndarray, yt: np.ndarray, centres_m: np.ndarray,
-                                radii_m: np.ndarray) -> np.ndarray:
+def obstacle_penalty_of_block(block: np.ndarray, cells: DiscCells) -> np.ndarray:
     """Kamil et al. 2020's obstacle penalty, Eqs. (3)-(5): the fast kernel, on samples stored
-    sample-major, (S, P).
+    as one contiguous (2, S, P) block (:meth:`planners.via_points.ViaPointCurve.sample_block`).
 
     The same value as :func:`obstacle_penalty_reference` (to rounding: the
-    distance is ``sqrt(dx**2 + dy**2)`` rather than ``hypot`` and the sums run in
-    another order), computed only where it can be non-zero:
-
-    * layout: samples are rows, candidates columns, so every reduction runs along
-      the long contiguous axis (NumPy reduces short rows one by one, ~30x slower);
-    * culling: each curve is cut into chunks of up to :data:`PENALTY_CHUNK`
-      samples (padded by repeating the last sample, with weight 0, when no size
-      divides the sample count); a disc can contribute to a chunk only if the
-      chunk's bounding box meets the disc's bounding square (otherwise every
-      sample is at least ``R`` away on one axis, so ``v = 0``), and only those
-      (chunk, candidate, disc) triples are computed;
-    * their terms are formed in place in one buffer (squares, root, scale,
-      ``1 - .``, clip at 0) and summed per candidate with ``bincount``.
+    distance is ``sqrt(dx**2 + dy**2)`` rather than ``hypot``, and the sums run in
+    another order), computed only where it can be non-zero: a term ``max(1 - d / R, 0)``
+    is non-zero only for a sample inside the disc, so each sample is mapped to its cell
+    of ``cells`` (:class:`planners.disc_cells.DiscCells`); samples in cells that no disc
+    meets are dropped with one lookup, and the others are paired with their cell's
+    discs only (the padding's sentinel disc gives exactly 0).  The terms are formed in
+    place in one (M, K) buffer and summed per candidate with ``bincount``.
 
     Args:
-        xt, yt: (S, P) sampled curves, one column per candidate.
-        centres_m: (C, 2) obstacle centres.
-        radii_m: (C,) radii ``R``.
+        block: (2, S, P) sampled curves, x then y.
+        cells: the discs (centres and the radii ``R`` of the penalty) and their cells.
 
     Returns:
         (P,) penalty.
     """
-    samples, count = xt.shape
-    centres = np.asarray(centres_m, dtype=float).reshape(-1, 2)
-    if centres.shape[0] == 0 or count == 0:
+    _, samples, count = block.shape
+    if cells.centres_m.shape[0] == 0 or count == 0:
         return np.zeros(count)
-    radii = np.asarray(radii_m, dtype=float).reshape(-1)
-    chunk = _chunk_size(samples)
-    chunks = -(-samples // chunk)
-    pad = chunks * chunk - samples
-    if pad:
-        xt = np.concatenate([xt, np.repeat(xt[-1:], pad, axis=0)])
-        yt = np.concatenate([yt, np.repeat(yt[-1:], pad, axis=0)])
-    x3 = xt.reshape(chunks, chunk, count)
-    y3 = yt.reshape(chunks, chunk, count)
-    cx, cy = centres[:, 0], centres[:, 1]
-    near = ((x3.min(axis=1)[..., None] <= cx + radii) & (x3.max(axis=1)[..., None] >= cx - radii)
-            & (y3.min(axis=1)[..., None] <= cy + radii) & (y3.max(axis=1)[..., None] >= cy - radii))  # (n, P, C)
-    which, cand, discs = np.nonzero(near)
-    if which.size == 0:
+    cell = cells.cells_of(block).ravel()
+    hit = np.flatnonzero(cells.occupied.take(cell, mode="clip"))    # into the (S, P) samples
+    if hit.size == 0:
         return np.zeros(count)
-    d = x3.transpose(1, 0, 2)[:, which, cand] - cx[discs]            # (chunk, K)
+    discs = cells.table.take(cell[hit], axis=1, mode="clip")       # (M, K)
+    flat = block.reshape(2, -1)
+    d = flat[0].take(hit) - cells.centre_x.take(discs)
     d *= d
-    dy = y3.transpose(1, 0, 2)[:, which, cand] - cy[discs]
+    dy = flat[1].take(hit) - cells.centre_y.take(discs)
     dy *= dy
     d += dy
     np.sqrt(d, out=d)
-    d *= 1.0 / radii[discs]
+    d *= cells.inverse_radius.take(discs)
     np.subtract(1.0, d, out=d)
     np.maximum(d, 0.0, out=d)
-    if pad:
-        d[chunk - pad:, which == chunks - 1] = 0.0
-    return np.bincount(cand, weights=d.sum(axis=0), minlength=count) / samples
+    return np.bincount(hit % count, weights=d.sum(axis=0), minlength=count) / samples
+
+
+def bounds_penalty_of_block(block: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """:func:`bounds_penalty` of a (2, S, P) block; ``low``, ``high`` are (2, 1, 1) lower and
+    upper limits of x and y.  Summed per axis and then added (the reference adds per
+    sample; equal to rounding)."""
+    out = np.clip(block, low, high)
+    out -= block
+    np.abs(out, out=out)
+    per_axis = out.sum(axis=1)
+    return (per_axis[0] + per_axis[1]) / block.shape[1]
+
+
+def bounds_limits(bounds: Rect) -> tuple[np.ndarray, np.ndarray]:
+    """(2, 1, 1) lower and upper limits of a (2, S, P) block's x and y."""
+    return (np.array([bounds.x_min_m, bounds.y_min_m]).reshape(2, 1, 1),
+            np.array([bounds.x_max_m, bounds.y_max_m]).reshape(2, 1, 1))
 
 
 def bounds_penalty_of_columns(xt: np.ndarray, yt: np.ndarray, bounds: Rect) -> np.ndarray:
-    """:func:`bounds_penalty` of (S, P) samples; only the candidates whose samples leave
-    the bounds are computed (the others get exactly 0)."""
-    boxes = sample_boxes(xt, yt)
-    out = ((boxes[0] < bounds.x_min_m) | (boxes[1] > bounds.x_max_m)
-           | (boxes[2] < bounds.y_min_m) | (boxes[3] > bounds.y_max_m))
-    penalty = np.zeros(xt.shape[1])
-    if out.any():
-        penalty[out] = bounds_penalty(xt[:, out].T, yt[:, out].T, bounds)
-    return penalty
+    """:func:`bounds_penalty` of (S, P) samples (through :func:`bounds_penalty_of_block`)."""
+    return bounds_penalty_of_block(np.stack([xt, yt]), *bounds_limits(bounds))
 
 
 def bounds_penalty(xs: np.ndarray, ys: np.ndarray, bounds: Rect, scale_m: float = 1.0) -> np.ndarray:
@@ -239,19 +227,31 @@ class PathObjective:
     smoothness_weight: float = 0.0
     penalty_weight: float = 1.0
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "cells", DiscCells(self.centres_m, self.penalty_radii_m))
+        object.__setattr__(self, "limits", bounds_limits(self.bounds))
+
     def __call__(self, population: np.ndarray) -> np.ndarray:
         """(P,) costs of a (P, 2k) population, all candidates at once."""
-        xt, yt = self.curve.sample_columns(population)
-        return self.cost_of_columns(xt, yt)
+        return self.cost_of_block(self.curve.sample_block(population))
 
     def cost_from_samples(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
         """(P,) costs of curves already sampled, (P, S) each (for peers that sample their own way)."""
-        return self.cost_of_columns(np.ascontiguousarray(xs.T), np.ascontiguousarray(ys.T))
+        return self.cost_of_block(columns_block(xs, ys))
 
     def cost_of_columns(self, xt: np.ndarray, yt: np.ndarray) -> np.ndarray:
         """(P,) costs of curves sampled sample-major, (S, P)."""
-        smoothness = smoothness_rad(xt.T, yt.T) if self.smoothness_weight else 0.0
-        cost = weighted_objective(length_of_columns(xt, yt), smoothness, self.length_weight, self.smoothness_weight)
-        penalty = obstacle_penalty_of_columns(xt, yt, self.centres_m, self.penalty_radii_m)
-        penalty = penalty + bounds_penalty_of_columns(xt, yt, self.bounds)
-        return cost + self.penalty_weight * penalty
+        return self.cost_of_block(np.stack([xt, yt]))
+
+    def cost_of_block(self, block: np.ndarray) -> np.ndarray:
+        """(P,) costs of curves sampled into one (2, S, P) block (see
+        :meth:`planners.via_points.ViaPointCurve.sample_block`)."""
+        cost = length_of_block(block)
+        if self.length_weight != 1.0 or self.smoothness_weight:
+            smoothness = smoothness_rad(block[0].T, block[1].T) if self.smoothness_weight else 0.0
+            cost = weighted_objective(cost, smoothness, self.length_weight, self.smoothness_weight)
+        penalty = obstacle_penalty_of_block(block, self.cells)
+        penalty += bounds_penalty_of_block(block, *self.limits)
+        penalty *= self.penalty_weight
+        cost += penalty
+        return cost

@@ -138,7 +138,8 @@ class ViaPointCurve:
     samples: int = 100
     _via_basis: np.ndarray = field(init=False, repr=False)
     _end_offset: np.ndarray = field(init=False, repr=False)
-    _via_basis_columns: np.ndarray = field(init=False, repr=False)
+    _block_basis: np.ndarray = field(init=False, repr=False)
+    _end_column: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.via_point_count < 1:
@@ -152,10 +153,15 @@ class ViaPointCurve:
         object.__setattr__(self, "start_m", start)
         object.__setattr__(self, "goal_m", goal)
         object.__setattr__(self, "_via_basis", np.ascontiguousarray(basis[:, 1:-1].T))  # (k, S)
-        object.__setattr__(self, "_via_basis_columns", np.ascontiguousarray(basis[:, 1:-1]))  # (S, k)
         # Contribution of the fixed end points: (2, S), x row then y row.
-        object.__setattr__(self, "_end_offset",
-                           np.outer(start, basis[:, 0]) + np.outer(goal, basis[:, -1]))
+        end_offset = np.outer(start, basis[:, 0]) + np.outer(goal, basis[:, -1])
+        object.__setattr__(self, "_end_offset", end_offset)
+        k, samples = self.via_point_count, self.samples
+        block_basis = np.zeros((2 * samples, 2 * k))
+        block_basis[:samples, :k] = basis[:, 1:-1]
+        block_basis[samples:, k:] = basis[:, 1:-1]
+        object.__setattr__(self, "_block_basis", block_basis)                  # (2S, 2k)
+        object.__setattr__(self, "_end_column", end_offset.reshape(2 * samples, 1))
 
     @property
     def dimensions(self) -> int:
@@ -189,12 +195,22 @@ class ViaPointCurve:
 
     def sample_columns(self, population: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`sample` stored sample-major: ``(xt, yt)``, each (samples, P), one column per
-        candidate (the layout the fast costs in :mod:`planners.path_cost` reduce along)."""
+        candidate (the two halves of :meth:`sample_block`)."""
+        block = self.sample_block(population)
+        return block[0], block[1]
+
+    def sample_block(self, population: np.ndarray) -> np.ndarray:
+        """Every candidate's samples as one contiguous (2, samples, P) array: ``[0]`` the x,
+        ``[1]`` the y coordinates, one column per candidate (the layout the fast costs in
+        :mod:`planners.path_cost` reduce along: samples are rows).
+
+        One matrix product for both axes, with the block-diagonal basis
+        ``[[B, 0], [0, B]]`` (2 S, 2 k) times the population's transpose (2 k, P) (one
+        BLAS call instead of two), plus the fixed end points' share."""
         pop = np.asarray(population, dtype=float).reshape(-1, self.dimensions)
-        k = self.via_point_count
-        xt = self._via_basis_columns @ pop[:, :k].T + self._end_offset[0][:, None]
-        yt = self._via_basis_columns @ pop[:, k:].T + self._end_offset[1][:, None]
-        return xt, yt
+        block = self._block_basis @ pop.T
+        block += self._end_column
+        return block.reshape(2, self.samples, pop.shape[0])
 
     def dense_waypoints(self, solution: np.ndarray, samples: int) -> np.ndarray:
         """(N, 2) waypoints of one candidate for output and the exact check.

@@ -1,6 +1,6 @@
 """The fast cost kernels against their reference implementations, on seeded random inputs
 and the edge cases: a sample exactly on a disc's edge, candidates outside the bounds, a
-disc containing the start, sample counts that no chunk size divides."""
+disc containing the start, odd sample counts, thousands of discs."""
 
 from __future__ import annotations
 
@@ -37,8 +37,10 @@ def test_fast_penalty_and_length_equal_the_reference(samples, discs):
                                obstacle_penalty_reference(xs, ys, centres, radii), rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(sampled_length_m(xs, ys), reference_length_m(xs, ys), rtol=1e-12)
     bounds = Rect(0.0, 0.0, 10.0, 10.0)
-    np.testing.assert_array_equal(bounds_penalty_of_columns(xs.T.copy(), ys.T.copy(), bounds),
-                                  bounds_penalty(xs, ys, bounds))
+    fast = bounds_penalty_of_columns(xs.T.copy(), ys.T.copy(), bounds)
+    reference = bounds_penalty(xs, ys, bounds)
+    np.testing.assert_allclose(fast, reference, rtol=1e-12, atol=0.0)
+    np.testing.assert_array_equal(fast == 0.0, reference == 0.0)
 
 
 def test_the_penalty_is_zero_exactly_where_no_sample_is_inside_a_disc():
@@ -49,3 +51,23 @@ def test_the_penalty_is_zero_exactly_where_no_sample_is_inside_a_disc():
     assert obstacle_penalty(xs, ys, centres, np.array([1.0])).tolist() == [0.0, 0.0]
     inside = obstacle_penalty(xs, ys, centres, np.array([2.0]))
     assert inside[0] == pytest.approx((0.5 + 2 * (1 - np.sqrt(2) / 2)) / 3) and inside[1] == 0.0
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_cell_culling_keeps_every_term_with_many_discs_and_far_samples(seed):
+    """Thousands of small discs of mixed sizes (the cells grow to stay under the cap), samples
+    far outside the grid on every side, and samples a hair inside or on disc edges."""
+    rng = np.random.default_rng(seed)
+    discs = 3000
+    centres = rng.uniform(0.0, 400.0, (discs, 2))
+    radii = rng.choice([0.01, 0.2, 3.0], discs)
+    xs = rng.uniform(-300.0, 700.0, (30, 64))
+    ys = rng.uniform(-300.0, 700.0, (30, 64))
+    picked = rng.integers(0, discs, 200)
+    angle = rng.uniform(0.0, 2.0 * np.pi, 200)
+    scale = rng.choice([1.0, 1.0 - 1e-12, 0.5], 200)
+    xs.flat[:200] = centres[picked, 0] + scale * radii[picked] * np.cos(angle)
+    ys.flat[:200] = centres[picked, 1] + scale * radii[picked] * np.sin(angle)
+    reference = obstacle_penalty_reference(xs, ys, centres, radii)
+    assert (reference > 0).sum() >= 3
+    np.testing.assert_allclose(obstacle_penalty(xs, ys, centres, radii), reference, rtol=1e-12, atol=1e-15)

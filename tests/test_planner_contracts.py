@@ -92,7 +92,7 @@ def budgeted_planners() -> list[str]:
 
 
 def test_the_swarm_planners_are_the_budgeted_ones():
-    assert {"abc", "adl_abc", "gwo", "pso", "iaco", "immas", "maco"} <= set(budgeted_planners())
+    assert {"abc", "adl_abc", "gwo", "pso", "iaco", "immas", "maco", "aco"} <= set(budgeted_planners())
 
 
 @pytest.mark.parametrize("planner_name", budgeted_planners())

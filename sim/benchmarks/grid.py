@@ -30,7 +30,8 @@ import numpy as np
 from swarmnav.planners.problem import scenario_problem
 from scipy import ndimage
 
-TARGETS = {"astar_plan_s": 0.005, "immas_plan_s": 0.050, "iaco_plan_s": 1.0, "iaco_median_ratio": 1.05}
+#: Issue 14's targets (astar < 3 ms, iaco < 0.3 s on the worst bundled map), and the earlier ones.
+TARGETS = {"astar_plan_s": 0.003, "immas_plan_s": 0.050, "iaco_plan_s": 0.3, "iaco_median_ratio": 1.05}
 GRID_PLANNERS = ("astar", "dijkstra", "theta_star", "dstar_lite", "immas", "iaco")
 SEEDED = {"iaco"}
 
@@ -43,6 +44,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="plan every start/goal pair of each map's [map].pairs, not only the scenario's")
     parser.add_argument("--swarm-sample", type=int, default=20,
                         help="Moving AI instances per map on which immas and iaco report their ratio")
+    parser.add_argument("--quick", action="store_true",
+                        help="the two slowest maps, 2 runs, 50 Moving AI instances a map, 1 swarm sample (under a minute)")
 
 
 def _map_scenarios(names: list[str] | None):
@@ -143,7 +146,7 @@ def bench_restaurant(runs: int) -> list[dict[str, Any]]:
              "mean_plan_time_s": statistics.fmean(times), "node_baseline_runs_colliding": crashes}]
 
 
-def bench_movingai(sample: int) -> dict[str, Any]:
+def bench_movingai(sample: int, limit: int | None = None) -> dict[str, Any]:
     from swarmnav.planners.errors import PlanningError
     from swarmnav.planners.grid_search import astar_cells, dijkstra_cells
     from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
@@ -163,7 +166,7 @@ def bench_movingai(sample: int) -> dict[str, Any]:
     t0 = time.perf_counter()
     for map_path, scen_path in sets:
         occupied = read_map(map_path)
-        scenarios = [s for s in read_scenarios(scen_path) if s.map_name.endswith(map_path.name)]
+        scenarios = [s for s in read_scenarios(scen_path) if s.map_name.endswith(map_path.name)][:limit]
         for s in scenarios:
             for search in (astar_cells, dijkstra_cells):
                 _, cost, _ = search(occupied, s.start_cell(), s.goal_cell())
@@ -258,8 +261,12 @@ def _targets(rows: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def run(args: argparse.Namespace) -> int:
+    limit = None
+    if getattr(args, "quick", False):
+        args.maps = args.maps or ["iaco-baffle", "immas-env6-rows"]
+        args.runs, args.swarm_sample, limit = min(args.runs, 2), min(args.swarm_sample, 1), 50
     rows = bench_maps(args) + bench_restaurant(args.runs)
-    movingai = bench_movingai(args.swarm_sample)
+    movingai = bench_movingai(args.swarm_sample, limit)
     peers = bench_peers(args.maps)
     result = {"rows": rows, "movingai": movingai, "peers": peers, "targets": _targets(rows)}
     if args.json:

@@ -75,6 +75,27 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--peer-scenario", default="gwo-scenario-1")
     parser.add_argument("--peer-runs", type=options.non_negative_int, default=3, help="mealpy runs per peer (0: none)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--quick", action="store_true",
+                        help="gwo-scenario-1 only, 3 seeds, 1 peer run (under a minute)")
+
+
+#: Warm median plan time targets of issue 14 (population 50 x 100 iterations, gwo-scenario-1).
+TIME_TARGETS_S = {"gwo": 0.030, "pso": 0.030, "abc": 0.060, "adl_abc": 0.060}
+
+
+def warm_median_times(problem: Problem, population: int, iterations: int, runs: int = 5) -> dict[str, float]:
+    """Warm median plan time of each planner of :data:`TIME_TARGETS_S` (one untimed run first)."""
+    out = {}
+    for name in TIME_TARGETS_S:
+        params = {"population": population, "iterations": iterations}
+        make_planner(name, params).plan(problem, np.random.default_rng(0))
+        times = []
+        for seed in range(runs):
+            t0 = time.perf_counter()
+            make_planner(name, params).plan(problem, np.random.default_rng(seed))
+            times.append(time.perf_counter() - t0)
+        out[name] = float(statistics.median(times))
+    return out
 
 
 def load_problem(name: str, clearance_m: float) -> Problem:
@@ -182,6 +203,8 @@ def _median(values: list[float]) -> float | None:
 
 def benchmark(args: argparse.Namespace) -> dict[str, Any]:
     """All figures of the benchmark as one JSON-ready object."""
+    if getattr(args, "quick", False):
+        args.scenarios, args.seeds, args.peer_runs = ["gwo-scenario-1"], min(args.seeds, 3), min(args.peer_runs, 1)
     params = {"population": args.population, "iterations": args.iterations}
     rows, notes, ours_by_key = [], [], {}
     for scenario in args.scenarios:
@@ -244,8 +267,10 @@ def benchmark(args: argparse.Namespace) -> dict[str, Any]:
                     "peer_time_basis_objective_s": basis_time,
                     "speedup_basis_objective": basis_time / our_time if our_time > 0 else math.inf,
                 })
+    speed = warm_median_times(load_problem(args.peer_scenario, args.clearance_m), 50, 100)
     return {"population": args.population, "iterations": args.iterations,
-            "clearance_m": args.clearance_m, "rows": rows, "peers": peers, "notes": notes}
+            "clearance_m": args.clearance_m, "rows": rows, "peers": peers, "notes": notes,
+            "warm_median_plan_time_s": speed}
 
 
 def _fmt(value: Any, spec: str = ".4f") -> str:
@@ -283,6 +308,10 @@ def print_table(result: dict[str, Any]) -> None:
                   f"its loop overhead alone)")
     print()
     print("targets:")
+    for name, seconds in result.get("warm_median_plan_time_s", {}).items():
+        target = TIME_TARGETS_S[name]
+        print(f"  {name} warm median plan time, 50 x 100 on gwo-scenario-1: {1e3 * seconds:.1f} ms < "
+              f"{1e3 * target:.0f} ms ({'met' if seconds < target else 'NOT met'})")
     for p in result["peers"]:
         verdict = "met" if p["speedup"] >= 10 else "NOT met"
         print(f"  {p['planner']} >= 10x faster than {p['peer']}: {p['speedup']:.1f}x ({verdict})")
