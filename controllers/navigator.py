@@ -122,6 +122,9 @@ class NavigationStep:
 
 
 class Navigator(Protocol):
+    """``uses_detections`` (optional, default True): False for a navigator that never reads
+    ``Observation.detections``, which then stays empty and costs nothing."""
+
     name: ClassVar[str]
 
     def reset(self, setup: NavigationSetup) -> None: ...

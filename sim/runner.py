@@ -175,6 +175,7 @@ class Simulation:
         wall0 = time.perf_counter()
         try:
             navigator.reset(setup)
+            loop.sense_obstacles = getattr(navigator, "uses_detections", True)
             if recorder is not None:
                 recorder.start(context)
                 recorder.path(0.0, setup.path.waypoints)
@@ -253,6 +254,9 @@ class StepLoop:
         self.in_danger = False
         self.step = 0
         radii = [simulation.scenario.obstacles[ob.scenario_index].radius_m for ob in simulation._moving]
+        # Whether observations carry detections: a navigator that never reads them
+        # (``uses_detections = False``) spares the sensing model's work.
+        self.sense_obstacles = True
         self.sensing = ObstacleSensing(simulation.scenario, self.obstacle_track_m, np.array(radii), self.dt_s,
                                        scene.range_angles_rad, scene.range_offset_m)
         self.danger_m = simulation.scenario.sim.danger_m
@@ -290,7 +294,8 @@ class StepLoop:
         return Observation(time_s=self.time_s, pose=pose, twist=Twist(v, omega), ranges_m=ranges,
                            range_angles_rad=scene.range_angles_rad, range_offset_m=scene.range_offset_m,
                            range_cutoff_m=scene.range_cutoff_m,
-                           detections=self.sensing.sense(step, self.time_s, pose, ranges))
+                           detections=self.sensing.sense(step, self.time_s, pose, ranges)
+                           if self.sense_obstacles else ())
 
     def count_events(self, events) -> None:
         """Count the navigator's replans and safety-filter triggers."""

@@ -17,6 +17,7 @@ class FollowNavigator:
     """Hands the controller the path planned at t = 0 and relays its commands."""
 
     name: ClassVar[str] = "follow"
+    uses_detections: ClassVar[bool] = False  # follows the first path whatever the sensors say
 
     def reset(self, setup: NavigationSetup) -> None:
         self._controller = setup.controller

@@ -9,13 +9,13 @@ quality settings, read from MuJoCo itself rather than written down here.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import time
 
 # Imported at the top on purpose: sim.render sets MUJOCO_GL=egl, which must happen before
 # anything imports mujoco, and the CLI imports this module before the runner's.
+from swarmnav.sim.benchmarks.figures import print_figures
 from swarmnav.sim.render import ScenePoser, SceneRenderer, check_video_size
 
 import mujoco  # noqa: E402
@@ -115,9 +115,5 @@ def run(args: argparse.Namespace) -> int:
         figures["defaults_frames_per_s"] = slow["frames_per_s"]
         figures["defaults_ms_per_frame"] = slow["ms_per_frame"]
         figures["speedup"] = figures["frames_per_s"] / slow["frames_per_s"]
-    if args.json:
-        print(json.dumps(figures))
-    else:
-        for key, value in figures.items():
-            print(f"{key:<22} {value:.4g}" if isinstance(value, float) else f"{key:<22} {value}")
+    print_figures(figures, args.json)
     return 0

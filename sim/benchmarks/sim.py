@@ -7,7 +7,6 @@ robust to a noisy machine.  Planning is done once, before timing.
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import tempfile
 import time
@@ -15,6 +14,7 @@ from pathlib import Path as FilePath
 
 import mujoco
 
+from swarmnav.sim.benchmarks.figures import print_figures
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import MAX_CONTROL_STEPS, load_scenario
 from swarmnav.sim import options
@@ -98,14 +98,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default="dense-field-30")
     parser.add_argument("--duration", type=options.positive_float, default=20.0, help="simulated seconds per measurement")
     parser.add_argument("--repeats", type=options.positive_int, default=3)
+    parser.add_argument("--quick", action="store_true", help="5 simulated seconds, 2 repeats (under a minute)")
     parser.add_argument("--json", action="store_true")
 
 
 def run(args: argparse.Namespace) -> int:
-    figures = benchmark_sim(args.scenario, duration_s=args.duration, repeats=args.repeats)
-    if args.json:
-        print(json.dumps(figures))
-    else:
-        for key, value in figures.items():
-            print(f"{key:<28} {value:.4g}" if isinstance(value, float) else f"{key:<28} {value}")
+    duration_s, repeats = (5.0, 2) if args.quick else (args.duration, args.repeats)
+    print_figures(benchmark_sim(args.scenario, duration_s=duration_s, repeats=repeats), args.json)
     return 0
