@@ -1,4 +1,4 @@
-"""Components configured by name and a parameter table (planners, navigators).
+"""Components registered by name and configured by a parameter table (planners, navigators).
 
 A component is a dataclass registered under a name; its parameters are its
 init fields.  A user's table (from a scenario file or ``--set``) is checked
@@ -54,6 +54,17 @@ def _coerce(value: Any, annotation: Any, field: str) -> Any:
             raise ConfigError(field, f"expected a string, got {value!r}")
         return value
     return value
+
+
+def register_component(registry: dict[str, type], kind: str, cls: type) -> type:
+    """Add a component class to a registry under its ``name``; a missing or taken name is an error."""
+    name = getattr(cls, "name", None)
+    if not isinstance(name, str) or not name:
+        raise TypeError(f"{cls.__name__} has no {kind} name")
+    if name in registry:
+        raise ValueError(f"{kind} name {name!r} is registered twice ({registry[name].__name__} and {cls.__name__})")
+    registry[name] = cls
+    return cls
 
 
 def build_component(registry: dict[str, type], kind: str, name: str, params: dict[str, Any] | None = None,

@@ -23,25 +23,18 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import Box, Disc, Pose2D, Rect
 from swarmnav.planners.problem import Path, Planner, PlanStats, Problem
 from swarmnav.planners.straight import StraightPlanner
-from swarmnav.models.parameters import build_component
+from swarmnav.models.parameters import build_component, register_component
 
 PLANNERS: dict[str, type] = {}
 
 
 def register(cls: type) -> type:
-    """Add a planner class to :data:`PLANNERS`; a name already taken is an error."""
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not name:
-        raise TypeError(f"{cls.__name__} has no planner name")
+    """Add a planner class to :data:`PLANNERS`: it needs a free name and the obstacles it supports."""
     supports = getattr(cls, "supports", None)
     if not isinstance(supports, frozenset) or not supports or not supports <= {"discs", "boxes"}:
         raise TypeError(f"{cls.__name__} must declare the obstacles it supports, a non-empty subset "
                         "of {'discs', 'boxes'}")
-    if name in PLANNERS:
-        raise ValueError(f"planner name {name!r} is registered twice "
-                         f"({PLANNERS[name].__name__} and {cls.__name__})")
-    PLANNERS[name] = cls
-    return cls
+    return register_component(PLANNERS, "planner", cls)
 
 
 for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,

@@ -14,20 +14,14 @@ from swarmnav.controllers.navigators.policy import PolicyNavigator
 from swarmnav.controllers.navigators.dwa import DynamicWindowNavigator
 from swarmnav.controllers.navigators.replan import ReplanNavigator
 from swarmnav.controllers.navigators.velocity_obstacle import VelocityObstacleNavigator
-from swarmnav.models.parameters import build_component
+from swarmnav.models.parameters import build_component, register_component
 
 NAVIGATORS: dict[str, type] = {}
 
 
 def register(cls: type) -> type:
-    """Add a navigator class to :data:`NAVIGATORS`; a name already taken is an error."""
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not name:
-        raise TypeError(f"{cls.__name__} has no navigator name")
-    if name in NAVIGATORS:
-        raise ValueError(f"navigator name {name!r} is registered twice")
-    NAVIGATORS[name] = cls
-    return cls
+    """Add a navigator class to :data:`NAVIGATORS`; a missing or taken name is an error."""
+    return register_component(NAVIGATORS, "navigator", cls)
 
 
 for _cls in (FollowNavigator, ReplanNavigator, DynamicWindowNavigator, VelocityObstacleNavigator,
