@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from swarmnav.controllers.navigators import NAVIGATORS
 from swarmnav.models.scenario import parse_scenario
 from swarmnav.sim.cli import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
@@ -119,3 +120,28 @@ def test_the_wheel_installs_one_namespace_and_nothing_named_models(tmp_path):
     assert "swarmnav/models/scenarios/gwo-scenario-1.toml" in names
     assert "swarmnav/sim/benchmarks/sim.py" in names
     assert "swarmnav/controllers/navigators/follow.py" in names
+
+
+NEEDS_PARAMS = {"policy": {"policy": "contract_policy:act"}}
+
+
+@pytest.fixture
+def contract_policy(tmp_path, monkeypatch):
+    (tmp_path / "contract_policy.py").write_text("def act(obs):\n    return [0.5, 0.1]\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+
+
+@pytest.mark.parametrize("name", sorted(NAVIGATORS))
+def test_every_navigator_is_deterministic_and_names_a_bad_parameter(name, contract_policy):
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.models.scenario import load_scenario
+
+    scenario = load_scenario("gwo-scenario-2")
+    spec = EpisodeSpec(scenario, "astar", navigator=name, navigator_params=NEEDS_PARAMS.get(name))
+    first = run_episode(spec, time_limit_s=3.0).result
+    second = run_episode(spec, time_limit_s=3.0).result
+    assert first.steps > 0 and np.array_equal(first.poses, second.poses)
+    with pytest.raises(ConfigError) as info:
+        plan_episode(EpisodeSpec(scenario, "astar", navigator=name,
+                                 navigator_params={**NEEDS_PARAMS.get(name, {}), "no_such_knob": 1}))
+    assert info.value.field == "navigator.params.no_such_knob"
