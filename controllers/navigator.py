@@ -19,6 +19,7 @@ import numpy as np
 
 from swarmnav.controllers.controller import ControlCommand, Controller, Twist
 from swarmnav.controllers.goal import GoalChecker
+from swarmnav.models.scenario import Scenario
 from swarmnav.models.world import Pose2D
 from swarmnav.planners.problem import Path, Planner, Problem
 
@@ -88,6 +89,8 @@ class NavigationSetup:
         max_speed_m_s: the robot's speed limit.
         known_problem: what the robot knows in advance for replanning: ``problem``
             without the moving obstacles (the map); None = ``problem``.
+        scenario: the scenario being run (its sensing model and moving obstacles'
+            sizes and speeds give the ``policy`` navigator its observation layout).
     """
 
     path: Path
@@ -99,6 +102,7 @@ class NavigationSetup:
     control_dt_s: float
     max_speed_m_s: float
     known_problem: Problem | None = None
+    scenario: Scenario | None = None
 
     @property
     def map_problem(self) -> Problem:

@@ -1,42 +1,75 @@
 """What a learned policy sees and what it answers: one convention for the environment and the ``policy`` navigator.
 
-The environment (``swarmnav.sim.env``) and the ``policy`` navigator both build
-their observations with :class:`PolicyObserver` and turn actions into wheel
-commands with :func:`action_command`, so a policy trained in the environment
-runs unchanged through ``swarmnav run``.
+The environment (``swarmnav.sim.env``) and the ``policy`` navigator both lay
+out their observations with :func:`observation_layout` and fill them with
+:class:`PolicyObserver`, and both turn actions into wheel commands with
+:func:`action_command`, so a policy trained in the environment runs unchanged
+through ``swarmnav run``.
 
-Observation (a dict of float64 arrays):
+Observation: a dict of float32 arrays, every entry bounded (the bounds are the
+environment's specs, :class:`ObservationLayout`).  Values that physics or an
+estimator can push past a bound are clipped to it; each entry says which.
 
 * ``ranges`` (K,): rangefinder distances divided by their reach, in [0, 1];
-  1 = nothing in range.
-* ``goal`` (2,): distance to the goal (m) and its bearing in the robot frame
-  (rad, in [-pi, pi), CCW from the heading).
-* ``velocity`` (2,): the measured forward speed (m/s) and turn rate (rad/s).
-* ``path`` (N, 2), only when asked for: the next N waypoints of a planned path
-  in the robot frame (m; x forward, y left).  "Next" counts from the waypoint
-  after the nearest one, never going back along the path; when fewer than N are
-  left the last (the goal) repeats.
+  1 = nothing in range.  Present with both sensing models: the robot's rays are
+  in the scene either way and are how it sees the static map.
+* ``goal`` (2,): distance to the goal (m, in [0, D] with D the arena's diagonal;
+  clipped there, which only matters off the arena of a scenario without walls)
+  and its bearing in the robot frame (rad, in [-pi, pi], CCW from the heading).
+* ``velocity`` (2,): the measured forward speed (m/s) and turn rate (rad/s),
+  bounded by what the wheels' limit gives on flat ground: |v| <= r w_max and
+  |omega| <= 2 r w_max / track (r the wheel radius, w_max the wheels' limit).
+  Clipped there (a pushing obstacle or a skid can exceed them for a step).
+* ``obstacles`` (N, 5) and ``obstacle_mask`` (N,): with the ``detector`` sensing
+  model, and with ``rangefinder`` when the tracker's estimates are asked for
+  (``tracked_obstacles``).  Row i: the sensed obstacle's centre in the robot
+  frame (m; x forward, y left), its velocity in the world rotated into the
+  robot's axes (m/s; the obstacle's own motion, not relative to the robot's),
+  and its radius (m); rows sorted by surface gap to the robot, nearest first,
+  ties by track id.  ``obstacle_mask`` is 1 for a row holding an obstacle and 0
+  for padding (all-zero rows).  N defaults to the scenario's number of moving
+  obstacles (at least 1): the ``detector`` reports only those, so none is ever
+  dropped; with a smaller N the nearest N are kept.  Bounds: centre components
+  within +-(sensor range + robot radius + largest moving radius), which holds
+  every detection exactly; velocity components within +-(fastest moving
+  obstacle's speed: ``speed_m_s``, or ``step_m / period_s`` for a random walk);
+  radius within [0, largest moving radius].  The tracker's estimates are
+  clipped to these bounds.
+* ``path`` (P, 2), only when asked for: the next P waypoints of a planned path
+  in the robot frame (m), components within +-D (clipped).  "Next" counts
+  from the waypoint after the nearest one, never going back along the path;
+  when fewer than P are left the last (the goal) repeats.
+
+Float32 because that is what learning libraries expect and store; the physics,
+the poses, the wheel commands and the reward stay float64 (the reward's
+distances are computed in float64, not read back from the float32 observation).
 
 Action (2,), in one of two modes:
 
-* ``"twist"``: a normalised (v, omega) in [-1, 1]^2, scaled by the robot's speed
-  limit and by :func:`max_turn_rate_rad_s`, then turned into wheel speeds by the
-  inverse kinematics with curvature-keeping saturation (:func:`kinematics.wheel_speeds`);
-* ``"wheels"``: left and right wheel speeds in rad/s, clipped to the wheels' limit.
+* ``"twist"`` (the default): a normalised (v, omega) in [-1, 1]^2, scaled by the
+  robot's speed limit and by :func:`max_turn_rate_rad_s`, then turned into wheel
+  speeds by the inverse kinematics with curvature-keeping saturation
+  (:func:`kinematics.wheel_speeds`);
+* ``"wheels"``: left and right wheel speeds in rad/s, clipped to the wheels' limit
+  (not normalised: Gymnasium's checker warns about it, which is why it is not the default).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.kinematics import DriveGeometry, WheelSpeeds, body_twist, wheel_speeds
-from swarmnav.controllers.navigator import Observation
+from swarmnav.controllers.navigator import DetectedObstacle, Observation
+from swarmnav.models.scenario import Scenario
 from swarmnav.models.world import wrap_angle_rad
 
 ACTION_MODES = ("twist", "wheels")
+OBSERVATION_DTYPE = np.float32
+OBSTACLE_COLUMNS = ("x_m", "y_m", "vx_m_s", "vy_m_s", "radius_m")
 
 
 def max_turn_rate_rad_s(geometry: DriveGeometry, max_speed_m_s: float) -> float:
@@ -53,7 +86,7 @@ def action_bounds(mode: str, geometry: DriveGeometry) -> tuple[float, float]:
 
 def action_command(action: np.ndarray, mode: str, geometry: DriveGeometry, max_speed_m_s: float,
                    waypoint_index: int = 0) -> ControlCommand:
-    """A (2,) action in ``mode`` -> the wheel command (out-of-range values are clipped)."""
+    """A (2,) action in ``mode`` -> the wheel command (out-of-range values are clipped; taken in float64)."""
     a0, a1 = (float(a) for a in np.asarray(action, dtype=float).reshape(2))
     if mode == "twist":
         v = min(max(a0, -1.0), 1.0) * max_speed_m_s
@@ -65,19 +98,96 @@ def action_command(action: np.ndarray, mode: str, geometry: DriveGeometry, max_s
     return ControlCommand(wheels, v, omega, waypoint_index)
 
 
+def motion_speed_bound_m_s(motion) -> float:
+    """The fastest a scripted obstacle motion moves (m/s): its speed, or a random walk's step per period."""
+    if hasattr(motion, "speed_m_s"):
+        return abs(float(motion.speed_m_s))
+    return float(motion.step_m) / float(motion.period_s)
+
+
+@dataclass(frozen=True)
+class ObservationLayout:
+    """Which entries the observation has, their sizes and their bounds (see the module docstring).
+
+    Attributes:
+        range_count: K, the rangefinders.
+        path_waypoints: P (0: no ``path``).
+        obstacle_slots: N (0: no ``obstacles`` / ``obstacle_mask``).
+        goal_distance_max_m: D, the arena's diagonal (also bounds ``path``).
+        speed_max_m_s, turn_rate_max_rad_s: the ``velocity`` bounds from the wheels' limit.
+        obstacle_offset_max_m, obstacle_speed_max_m_s, obstacle_radius_max_m: the ``obstacles`` bounds.
+    """
+
+    range_count: int
+    path_waypoints: int
+    obstacle_slots: int
+    goal_distance_max_m: float
+    speed_max_m_s: float
+    turn_rate_max_rad_s: float
+    obstacle_offset_max_m: float = 0.0
+    obstacle_speed_max_m_s: float = 0.0
+    obstacle_radius_max_m: float = 0.0
+
+    def bounds(self) -> dict[str, tuple[tuple[int, ...], np.ndarray, np.ndarray]]:
+        """Per entry: (shape, lower, upper), the bounds broadcastable to the shape (float64)."""
+        pi = math.pi
+        out = {"ranges": ((self.range_count,), np.array(0.0), np.array(1.0)),
+               "goal": ((2,), np.array([0.0, -pi]), np.array([self.goal_distance_max_m, pi])),
+               "velocity": ((2,), -np.array([self.speed_max_m_s, self.turn_rate_max_rad_s]),
+                            np.array([self.speed_max_m_s, self.turn_rate_max_rad_s]))}
+        if self.path_waypoints:
+            d = self.goal_distance_max_m
+            out["path"] = ((self.path_waypoints, 2), np.array(-d), np.array(d))
+        if self.obstacle_slots:
+            p, v, r = self.obstacle_offset_max_m, self.obstacle_speed_max_m_s, self.obstacle_radius_max_m
+            out["obstacles"] = ((self.obstacle_slots, len(OBSTACLE_COLUMNS)), np.array([-p, -p, -v, -v, 0.0]),
+                                np.array([p, p, v, v, r]))
+            out["obstacle_mask"] = ((self.obstacle_slots,), np.array(0.0), np.array(1.0))
+        return out
+
+
+def observation_layout(scenario: Scenario, geometry: DriveGeometry, path_waypoints: int = 0,
+                       obstacle_slots: int | None = None, tracked_obstacles: bool = False) -> ObservationLayout:
+    """The layout of a scenario's observations.
+
+    Args:
+        path_waypoints: P > 0 adds ``path``.
+        obstacle_slots: N for ``obstacles`` (None: the scenario's moving obstacles, at least 1).
+        tracked_obstacles: with the ``rangefinder`` model, also give the tracker's estimates as ``obstacles``
+            (the ``detector`` model always gives them).
+    """
+    moving = [ob for ob in scenario.obstacles if ob.moving]
+    wants_obstacles = scenario.sensor_model == "detector" or tracked_obstacles
+    slots = 0
+    if wants_obstacles:
+        slots = max(1, len(moving)) if obstacle_slots is None else int(obstacle_slots)
+    radius_max_m = max((ob.radius_m for ob in moving), default=0.0)
+    top_speed_m_s = geometry.wheel_radius_m * geometry.max_wheel_speed_rad_s
+    return ObservationLayout(
+        range_count=scenario.sensor_count, path_waypoints=int(path_waypoints), obstacle_slots=slots,
+        goal_distance_max_m=math.hypot(scenario.arena_width_m, scenario.arena_height_m),
+        speed_max_m_s=top_speed_m_s, turn_rate_max_rad_s=2.0 * top_speed_m_s / geometry.track_m,
+        obstacle_offset_max_m=scenario.sensor_range_m + scenario.robot_radius_m + radius_max_m,
+        obstacle_speed_max_m_s=max((motion_speed_bound_m_s(ob.motion) for ob in moving), default=0.0),
+        obstacle_radius_max_m=radius_max_m)
+
+
 class PolicyObserver:
     """Turns an :class:`Observation` into the policy's observation dict (see the module docstring).
 
     Args:
+        layout: the entries and bounds (:func:`observation_layout`).
         goal_xy_m: the goal position.
-        path_m: (P, 2) waypoints of a planned path, or None for no ``path`` entry.
-        path_waypoints: N, the number of waypoints in ``path``.
+        path_m: (M, 2) waypoints of a planned path (needed when ``layout.path_waypoints`` > 0).
     """
 
-    def __init__(self, goal_xy_m: tuple[float, float], path_m: np.ndarray | None = None, path_waypoints: int = 0):
+    def __init__(self, layout: ObservationLayout, goal_xy_m: tuple[float, float], path_m: np.ndarray | None = None):
+        self.layout = layout
         self.goal_xy_m = (float(goal_xy_m[0]), float(goal_xy_m[1]))
-        self.path_m = None if path_m is None or path_waypoints <= 0 else np.asarray(path_m, dtype=float).reshape(-1, 2)
-        self.path_waypoints = int(path_waypoints) if self.path_m is not None else 0
+        if layout.path_waypoints and path_m is None:
+            raise ValueError("the layout has a path entry but no path was given")
+        self.path_m = None if not layout.path_waypoints else np.asarray(path_m, dtype=float).reshape(-1, 2)
+        self._bounds = layout.bounds()
         self.cursor = 0  # index of the nearest waypoint so far (never decreases)
 
     def reset(self) -> None:
@@ -86,12 +196,20 @@ class PolicyObserver:
     def __call__(self, observation: Observation) -> dict[str, np.ndarray]:
         pose = observation.pose
         ranges = np.asarray(observation.ranges_m, dtype=float) / observation.range_cutoff_m
-        out = {"ranges": np.minimum(ranges, 1.0),  # inf / cutoff = inf -> 1
-               "goal": np.array(self.goal_in_robot_frame(pose.x_m, pose.y_m, pose.heading_rad)),
+        x, y, heading = pose.x_m, pose.y_m, pose.heading_rad
+        out = {"ranges": ranges,  # inf / cutoff = inf -> clipped to 1
+               "goal": np.array(self.goal_in_robot_frame(x, y, heading)),
                "velocity": np.array([observation.twist.linear_m_s, observation.twist.angular_rad_s])}
         if self.path_m is not None:
-            out["path"] = self.next_waypoints(pose.x_m, pose.y_m, pose.heading_rad)
-        return out
+            out["path"] = self.next_waypoints(x, y, heading)
+        if self.layout.obstacle_slots:
+            out["obstacles"], out["obstacle_mask"] = self.obstacle_rows(observation.detections, x, y, heading)
+        return {key: np.clip(value, self._bounds[key][1], self._bounds[key][2]).astype(OBSERVATION_DTYPE)
+                for key, value in out.items()}
+
+    def goal_distance_m(self, x_m: float, y_m: float) -> float:
+        """The straight-line distance to the goal, in float64 and unclipped (the reward's)."""
+        return math.hypot(self.goal_xy_m[0] - x_m, self.goal_xy_m[1] - y_m)
 
     def goal_in_robot_frame(self, x_m: float, y_m: float, heading_rad: float) -> tuple[float, float]:
         dx, dy = self.goal_xy_m[0] - x_m, self.goal_xy_m[1] - y_m
@@ -101,7 +219,28 @@ class PolicyObserver:
         path = self.path_m
         ahead = path[self.cursor:]
         self.cursor += int(np.argmin(np.hypot(ahead[:, 0] - x_m, ahead[:, 1] - y_m)))
-        index = np.minimum(np.arange(self.cursor + 1, self.cursor + 1 + self.path_waypoints), len(path) - 1)
-        rel = path[index] - (x_m, y_m)
-        c, s = math.cos(heading_rad), math.sin(heading_rad)
-        return np.stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]], axis=1)
+        index = np.minimum(np.arange(self.cursor + 1, self.cursor + 1 + self.layout.path_waypoints), len(path) - 1)
+        return _to_robot_frame(path[index] - (x_m, y_m), heading_rad)
+
+    def obstacle_rows(self, detections: tuple[DetectedObstacle, ...], x_m: float, y_m: float, heading_rad: float
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """(N, 5) rows [x, y, vx, vy, radius] in the robot frame, nearest first, zero-padded; (N,) mask."""
+        slots = self.layout.obstacle_slots
+        rows, mask = np.zeros((slots, len(OBSTACLE_COLUMNS))), np.zeros(slots)
+        if not detections:
+            return rows, mask
+        d = np.array([(o.x_m, o.y_m, o.vx_m_s, o.vy_m_s, o.radius_m, o.track_id) for o in detections], dtype=float)
+        gap = np.hypot(d[:, 0] - x_m, d[:, 1] - y_m) - d[:, 4]
+        keep = np.lexsort((d[:, 5], gap))[:slots]
+        n = len(keep)
+        rows[:n, 0:2] = _to_robot_frame(d[keep, 0:2] - (x_m, y_m), heading_rad)
+        rows[:n, 2:4] = _to_robot_frame(d[keep, 2:4], heading_rad)
+        rows[:n, 4] = d[keep, 4]
+        mask[:n] = 1.0
+        return rows, mask
+
+
+def _to_robot_frame(vectors: np.ndarray, heading_rad: float) -> np.ndarray:
+    """(M, 2) world-frame vectors rotated into the robot's axes (x forward, y left)."""
+    c, s = math.cos(heading_rad), math.sin(heading_rad)
+    return np.stack([c * vectors[:, 0] + s * vectors[:, 1], -s * vectors[:, 0] + c * vectors[:, 1]], axis=1)

@@ -162,7 +162,8 @@ def run_episode(spec: EpisodeSpec, recorders: Sequence[Recorder] = (), *, scene:
         rng=np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(NAVIGATOR_STREAM,))),
         controller=PointToPointController(simulation.scene.drive, max_speed_m_s=scenario.max_speed_m_s),
         goal=simulation.goal_checker(), control_dt_s=simulation.control_dt_s,
-        max_speed_m_s=scenario.max_speed_m_s, known_problem=static_problem(scenario))
+        max_speed_m_s=scenario.max_speed_m_s, known_problem=static_problem(scenario),
+        scenario=scenario)
     recorder = RecorderGroup(list(recorders)) if recorders else None
     context = simulation.context(spec.planner, spec.planner_params, spec.seed, spec.navigator,
                                  spec.navigator_params) if recorder is not None else None

@@ -124,8 +124,14 @@ def _rollout(env, seed, steps=150):
     return out, env.task.loop.poses[:steps + 1].copy()
 
 
-def test_same_seeds_and_actions_give_the_same_observations_rewards_and_costs():
+@pytest.mark.parametrize("detector", [False, True])
+def test_same_seeds_and_actions_give_the_same_observations_rewards_and_costs(detector):
     scenario = random_walk_scenario()
+    if detector:
+        text = scenario.source_text.replace("sensors = { count = 12, range_m = 0.4 }",
+                                            'sensors = { model = "detector", count = 12, range_m = 8.0 }')
+        scenario = parse_scenario(text, "random-walk-detector.toml")
+        assert scenario.sensor_model == "detector"
     a = make_environment(scenario, world_seed=7, path_planner="astar", seed=3)
     b = make_environment(scenario, world_seed=7, path_planner="astar", seed=3)
     (run_a, poses_a), (run_b, poses_b) = _rollout(a, 1), _rollout(b, 1)
@@ -134,6 +140,8 @@ def test_same_seeds_and_actions_give_the_same_observations_rewards_and_costs():
         for key in ta.observation:
             assert np.array_equal(ta.observation[key], tb.observation[key])
     assert np.array_equal(poses_a, poses_b)
+    if detector:
+        assert any(t.observation["obstacle_mask"].any() for t in run_a)
     # A second episode of the same environment repeats the first.
     run_again, poses_again = _rollout(a, 1)
     assert np.array_equal(poses_again, poses_a)
@@ -175,3 +183,54 @@ class DmEnvContract(test_utils.EnvironmentTestMixin, absltest.TestCase):
 class DmEnvContractWithPath(test_utils.EnvironmentTestMixin, absltest.TestCase):
     def make_object_under_test(self):
         return make_environment("gwo-scenario-2", time_limit_s=0.5, action="wheels", path_planner="astar")
+
+
+def test_the_detector_model_observes_the_moving_obstacles_in_the_robot_frame_nearest_first():
+    scenario = load_scenario("dyn-crossing-3")
+    moving = [ob for ob in scenario.obstacles if ob.moving]
+    env = make_environment(scenario, action="wheels", time_limit_s=40.0)
+    spec = env.observation_spec()
+    assert spec["obstacles"].shape == (len(moving), 5) and spec["obstacle_mask"].shape == (len(moving),)
+    timestep, step, seen = env.reset(), 0, 0
+    while not timestep.last():
+        obs = timestep.observation
+        for key, value in obs.items():
+            spec[key].validate(value)
+        x, y, heading = env.task.loop.poses[step]
+        t = step * env.control_timestep()
+        expected = []
+        for ob in moving:  # the true state, from the scenario's own motions
+            cx, cy = ob.trajectory().positions_at(np.array([t]))[0]
+            if math.hypot(cx - x, cy - y) - ob.radius_m - scenario.robot_radius_m <= scenario.sensor_range_m:
+                rel = (cx - x, cy - y)
+                expected.append((math.hypot(*rel) - ob.radius_m, math.cos(heading) * rel[0] + math.sin(heading) * rel[1],
+                                 -math.sin(heading) * rel[0] + math.cos(heading) * rel[1], ob.radius_m))
+        expected.sort()
+        assert obs["obstacle_mask"].tolist() == [1.0] * len(expected) + [0.0] * (len(moving) - len(expected))
+        for row, (_, rx, ry, radius) in zip(obs["obstacles"], expected):
+            assert row[[0, 1, 4]] == pytest.approx([rx, ry, radius], abs=1e-5)
+        assert not obs["obstacles"][len(expected):].any()
+        seen += len(expected)
+        timestep = env.step(np.array([8.0, 8.5]))  # a wide left curve through the crossing traffic
+        step += 1
+    assert seen > 0
+
+
+def test_the_rangefinder_model_gives_the_trackers_estimates_only_when_asked():
+    assert "obstacles" not in make_environment("gwo-scenario-2").observation_spec()
+    env = make_environment("gwo-scenario-2", tracked_obstacles=True, obstacle_slots=3, action="wheels")
+    spec = env.observation_spec()
+    assert spec["obstacles"].shape == (3, 5)
+    run = run_episode(EpisodeSpec(load_scenario("gwo-scenario-2"))).result
+    timesteps = replay_commands(env, run.wheel_command_rad_s)
+    for ts in timesteps:
+        for key, value in ts.observation.items():
+            spec[key].validate(value)
+    assert max(ts.observation["obstacle_mask"].sum() for ts in timesteps) >= 1  # the tracker saw the moving one
+
+
+class DmEnvContractDetector(test_utils.EnvironmentTestMixin, absltest.TestCase):
+    """The same checks with the detector sensing model's obstacle list."""
+
+    def make_object_under_test(self):
+        return make_environment("dyn-head-on-3", time_limit_s=0.5, path_planner="astar")

@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+import warnings
 
 import gymnasium
 import numpy as np
@@ -14,10 +15,44 @@ from swarmnav.sim.env import ENV_ID, NavigateEnv
 from swarmnav.sim.log_reader import read_log
 
 
-def test_gymnasiums_env_checker_passes():
-    check_env(NavigateEnv("restaurant-table-5", time_limit_s=0.5), skip_render_check=True)
-    check_env(NavigateEnv("gwo-scenario-2", time_limit_s=0.5, path_planner="astar", action="wheels"),
-              skip_render_check=True)
+@pytest.mark.parametrize("scenario, options", [
+    ("restaurant-table-5", {}),
+    ("gwo-scenario-2", {"path_planner": "astar", "tracked_obstacles": True}),
+    ("dyn-crowd-3", {"path_planner": "astar"}),  # the detector sensing model: the obstacle list
+])
+def test_gymnasiums_env_checker_passes_without_a_warning_in_the_default_action_mode(scenario, options):
+    env = NavigateEnv(scenario, time_limit_s=0.5, **options)
+    assert all(np.all(np.isfinite(space.low)) and np.all(np.isfinite(space.high))
+               for space in env.observation_space.values())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env, skip_render_check=True)
+
+
+def test_the_raw_wheels_action_mode_passes_with_only_the_not_normalised_warning():
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check_env(NavigateEnv("gwo-scenario-2", time_limit_s=0.5, action="wheels"), skip_render_check=True)
+    assert len(caught) == 1 and "normalized" in str(caught[0].message)
+
+
+def test_spaces_are_float32_and_the_goal_and_velocity_bounds_come_from_the_arena_and_wheels():
+    env = NavigateEnv("dyn-crowd-3")
+    scenario = load_scenario("dyn-crowd-3")
+    drive = env.task.scene.drive
+    space = env.observation_space
+    assert all(s.dtype == np.float32 for s in space.values()) and env.action_space.dtype == np.float32
+    assert space["goal"].high[0] == np.float32(np.hypot(scenario.arena_width_m, scenario.arena_height_m))
+    top_speed = drive.wheel_radius_m * drive.max_wheel_speed_rad_s
+    assert space["velocity"].high.tolist() == pytest.approx([top_speed, 2 * top_speed / drive.track_m], rel=1e-6)
+    # Full speed forward, then spinning on the spot: the measured twist stays within the bounds unclipped.
+    env.reset(seed=0)
+    for action in [[1.0, 0.0]] * 50 + [[0.0, 1.0]] * 50:
+        obs = env.step(np.array(action, dtype=np.float32))[0]
+        twist = env.task.observation.twist
+        assert obs["velocity"].tolist() == [np.float32(twist.linear_m_s), np.float32(twist.angular_rad_s)]
+        assert obs in space
+    assert abs(twist.angular_rad_s) > 0.3 * space["velocity"].high[1]  # really spinning
 
 
 def test_make_by_module_and_id_in_a_fresh_interpreter():

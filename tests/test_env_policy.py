@@ -4,7 +4,7 @@ import json
 import os
 import subprocess
 import sys
-import textwrap
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,31 +14,14 @@ from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.env import make_environment
 from swarmnav.sim.episode import EpisodeSpec, run_episode
 
-REACTIVE = textwrap.dedent('''
-    """A hand-written reactive policy: head for the goal, veer away from the nearest range hit."""
-    import numpy as np
-
-
-    def act(obs):
-        distance_m, bearing_rad = obs["goal"]
-        ranges = obs["ranges"]
-        angles = 2.0 * np.pi * np.arange(len(ranges)) / len(ranges)
-        angles = np.where(angles > np.pi, angles - 2.0 * np.pi, angles)
-        nearest = int(np.argmin(ranges))
-        turn = 2.0 * bearing_rad
-        speed = 1.0 if abs(bearing_rad) < 0.5 else 0.2
-        if ranges[nearest] < 1.0 and abs(angles[nearest]) < 1.6:
-            turn -= np.sign(angles[nearest] or 1.0) * 3.0 * (1.0 - ranges[nearest])
-            speed *= ranges[nearest]
-        return np.clip([speed, turn], -1.0, 1.0)
-''')
+TESTS_DIR = str(Path(__file__).resolve().parent)  # holds reactive_policy.py, the bundled example policy
 
 
 @pytest.fixture
 def policy_module(tmp_path, monkeypatch):
-    (tmp_path / "reactive_policy.py").write_text(REACTIVE)
+    """``reactive_policy:act`` importable here and in subprocesses; ``tmp_path`` too, for bad policies."""
     monkeypatch.syspath_prepend(str(tmp_path))
-    monkeypatch.setenv("PYTHONPATH", str(tmp_path) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([TESTS_DIR, str(tmp_path), os.environ.get("PYTHONPATH", "")]))
     return "reactive_policy:act"
 
 
@@ -57,19 +40,35 @@ def test_a_reactive_policy_runs_through_swarmnav_run_among_moving_obstacles(poli
     assert summary["path_length_m"] > 14.0  # at least the straight line from (0, 0) to (10, 10)
 
 
-def test_the_policy_navigator_and_the_environment_drive_the_same_trajectory(policy_module):
+@pytest.mark.parametrize("name", ["gwo-scenario-2", "dyn-crossing-3"])  # rangefinder, detector
+def test_the_policy_navigator_and_the_environment_drive_the_same_trajectory(policy_module, name):
     import reactive_policy
-    scenario = load_scenario("gwo-scenario-2")
-    run = run_episode(EpisodeSpec(scenario, navigator="policy", navigator_params={"policy": policy_module}),
+    scenario = load_scenario(name)
+    seen = []
+
+    def recording_policy(obs):
+        seen.append(obs)
+        return reactive_policy.act(obs)
+
+    reactive_policy.recording = recording_policy
+    run = run_episode(EpisodeSpec(scenario, navigator="policy", navigator_params={"policy": "reactive_policy:recording"}),
                       time_limit_s=20.0).result
     env = make_environment(scenario, time_limit_s=20.0)
     timestep = env.reset()
+    observations = []
     while not timestep.last():
+        observations.append(timestep.observation)
         timestep = env.step(reactive_policy.act(timestep.observation))
     loop = env.task.loop
     assert loop.step == run.steps
     assert np.array_equal(loop.poses[:loop.step + 1], run.poses)
     assert np.array_equal(loop.wheel_cmd[:loop.step], run.wheel_command_rad_s[:-1])
+    # The navigator's policy saw exactly the environment's observations, entry by entry.
+    assert len(seen) == len(observations)
+    for a, b in zip(seen, observations):
+        assert sorted(a) == sorted(b) and all(np.array_equal(a[k], b[k]) and a[k].dtype == b[k].dtype for k in a)
+    if scenario.sensor_model == "detector":
+        assert "obstacles" in observations[0] and max(o["obstacle_mask"].sum() for o in observations) >= 1
 
 
 @pytest.mark.parametrize("value", ["no_such_module_xyz:act", "reactive_policy:no_such_function", "reactive_policy",

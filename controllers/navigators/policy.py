@@ -21,7 +21,7 @@ from typing import Any, Callable, ClassVar
 import numpy as np
 
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command
+from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command, observation_layout
 from swarmnav.models.errors import ConfigError
 
 FIELD = "navigator.params.policy"
@@ -48,19 +48,29 @@ class PolicyNavigator:
     Args:
         policy: ``module:function``, a callable ``obs -> action``.
         action: ``"twist"`` (normalised v, omega) or ``"wheels"`` (rad/s), as in the environment.
-        path_waypoints: N > 0 adds the next N waypoints of the path planned at t = 0 as ``path``.
+        path_waypoints: P > 0 adds the next P waypoints of the path planned at t = 0 as ``path``.
+        obstacle_slots: N, the rows of ``obstacles`` (None: the scenario's moving obstacles, at least 1).
+        tracked_obstacles: with the ``rangefinder`` sensing model, also give the tracker's estimates as
+            ``obstacles`` (the ``detector`` model always does).
+
+    These three mean what the environment's options of the same names mean; a policy
+    trained with some values must be run with the same ones.
     """
 
     name: ClassVar[str] = "policy"
     policy: str = ""
     action: str = "twist"
     path_waypoints: int = 0
+    obstacle_slots: int | None = None
+    tracked_obstacles: bool = False
 
     def __post_init__(self) -> None:
         if self.action not in ACTION_MODES:
             raise ConfigError("navigator.params.action", f"expected one of {list(ACTION_MODES)}, got {self.action!r}")
         if self.path_waypoints < 0:
             raise ConfigError("navigator.params.path_waypoints", f"must be >= 0, got {self.path_waypoints}")
+        if self.obstacle_slots is not None and self.obstacle_slots < 1:
+            raise ConfigError("navigator.params.obstacle_slots", f"must be >= 1, got {self.obstacle_slots}")
         self._policy = load_policy(self.policy)
 
     def reset(self, setup: NavigationSetup) -> None:
@@ -69,8 +79,12 @@ class PolicyNavigator:
             raise TypeError("the policy navigator needs a controller with a drive geometry")
         self._geometry = geometry
         self._max_speed_m_s = setup.max_speed_m_s
+        if setup.scenario is None:
+            raise TypeError("the policy navigator needs the scenario in its NavigationSetup")
+        layout = observation_layout(setup.scenario, geometry, self.path_waypoints, self.obstacle_slots,
+                                    self.tracked_obstacles)
         goal = setup.goal
-        self._observer = PolicyObserver((goal.x_m, goal.y_m), setup.path.waypoints, self.path_waypoints)
+        self._observer = PolicyObserver(layout, (goal.x_m, goal.y_m), setup.path.waypoints)
 
     def step(self, observation: Observation) -> NavigationStep:
         action = np.asarray(self._policy(self._observer(observation)), dtype=float)

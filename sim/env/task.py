@@ -34,7 +34,7 @@ import numpy as np
 from dm_control import mujoco as dm_mujoco
 from dm_control.rl import control
 
-from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command
+from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command, observation_layout
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario, load_scenario
 from swarmnav.sim.episode import EpisodeSpec, plan_episode
@@ -54,7 +54,10 @@ class EnvOptions:
         action: ``"twist"`` (normalised v, omega in [-1, 1]^2) or ``"wheels"`` (rad/s).
         path_planner: a planner name; its path (planned at reset on the obstacles at
             t = 0) gives the ``path`` observation.  None: no ``path``.
-        path_waypoints: N, the waypoints in ``path``.
+        path_waypoints: P, the waypoints in ``path``.
+        obstacle_slots: N, the rows of ``obstacles`` (None: the scenario's moving obstacles, at least 1).
+        tracked_obstacles: with the ``rangefinder`` sensing model, also observe the tracker's estimates
+            as ``obstacles`` (the ``detector`` model always gives ``obstacles``).
         reward: the reward's weights.
         time_limit_s, stop_on_collision: override the scenario's.
         seed: the planner's seed (None: the scenario's).
@@ -66,6 +69,8 @@ class EnvOptions:
     action: str = "twist"
     path_planner: str | None = None
     path_waypoints: int = 5
+    obstacle_slots: int | None = None
+    tracked_obstacles: bool = False
     reward: RewardWeights = field(default_factory=RewardWeights)
     time_limit_s: float | None = None
     stop_on_collision: bool | None = None
@@ -78,6 +83,8 @@ class EnvOptions:
             raise ConfigError("env.action", f"expected one of {list(ACTION_MODES)}, got {self.action!r}")
         if self.path_waypoints < 1:
             raise ConfigError("env.path_waypoints", f"must be >= 1, got {self.path_waypoints}")
+        if self.obstacle_slots is not None and self.obstacle_slots < 1:
+            raise ConfigError("env.obstacle_slots", f"must be >= 1, got {self.obstacle_slots}")
         if self.time_limit_s is not None and not self.time_limit_s > 0:
             raise ConfigError("env.time_limit_s", f"must be > 0, got {self.time_limit_s}")
 
@@ -116,6 +123,9 @@ class NavigationTask(control.Task):
             scenario = scenario.with_world_seed(int(options.world_seed))
         self.simulation = Simulation(scenario, self.scene)
         self.seed = scenario.seed if options.seed is None else int(options.seed)
+        self.layout = observation_layout(scenario, self.scene.drive,
+                                         options.path_waypoints if options.path_planner else 0,
+                                         options.obstacle_slots, options.tracked_obstacles)
         self.episode = -1
         self.loop: StepLoop | None = None
         self.result: RunResult | None = None
@@ -156,7 +166,7 @@ class NavigationTask(control.Task):
         waypoints = planned.path.waypoints if planned is not None else None
         goal = scenario.goal
         self.goal = self.simulation.goal_checker()
-        self.observer = PolicyObserver((goal.x_m, goal.y_m), waypoints, options.path_waypoints)
+        self.observer = PolicyObserver(self.layout, (goal.x_m, goal.y_m), waypoints)
         self.stop_on_collision = (scenario.sim.stop_on_collision if options.stop_on_collision is None
                                   else options.stop_on_collision)
         recorder = self._open_recorder(planned)
@@ -207,8 +217,7 @@ class NavigationTask(control.Task):
         return action_spec(self.options.action, self.scene.drive)
 
     def observation_spec(self, physics: SwarmnavPhysics):
-        return observation_specs(len(self.scene.range_sensor_adr),
-                                 self.options.path_waypoints if self.options.path_planner else 0)
+        return observation_specs(self.layout)
 
     # --- the step's side information -------------------------------------------------------------
     def info(self) -> dict[str, Any]:
@@ -234,7 +243,7 @@ class NavigationTask(control.Task):
         self.observation = observation = loop.observe()
         self.outcome = loop.outcome(observation.pose, self.goal, self.stop_on_collision)
         self.obs = self.observer(observation)
-        self.distance_m = float(self.obs["goal"][0])
+        self.distance_m = self.observer.goal_distance_m(observation.pose.x_m, observation.pose.y_m)
         if self.outcome:
             loop.stop(observation, self.outcome)
             self.result = loop.result(self.outcome, time.perf_counter() - self._wall0)
