@@ -1,5 +1,6 @@
 """The dm_control task: the same model, the same steps as ``swarmnav run``, dm_env's contract."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -8,6 +9,7 @@ from absl.testing import absltest
 from dm_env import test_utils
 
 from swarmnav.models.scenario import load_scenario, parse_scenario
+from swarmnav.models.world import Pose2D
 from swarmnav.sim.env import RewardWeights, make_environment
 from swarmnav.sim.env.task import same_model
 from swarmnav.sim.episode import EpisodeSpec, run_episode
@@ -234,3 +236,51 @@ class DmEnvContractDetector(test_utils.EnvironmentTestMixin, absltest.TestCase):
 
     def make_object_under_test(self):
         return make_environment("dyn-head-on-3", time_limit_s=0.5, path_planner="astar")
+
+
+def _over_at_start(scenario, **options):
+    """reset and one step of an episode that ends before it starts."""
+    env = make_environment(scenario, action="wheels", **options)
+    first = env.reset()
+    return env, first, env.step(np.array([5.0, 5.0]))
+
+
+def test_a_start_at_the_goal_ends_on_the_first_step_with_discount_zero_and_no_movement():
+    base = load_scenario("restaurant-table-5")
+    scenario = dataclasses.replace(base, start=Pose2D(base.goal.x_m + 0.5 * base.goal_tolerance_m, base.goal.y_m, 0.3))
+    env, first, last = _over_at_start(scenario)
+    run = run_episode(EpisodeSpec(scenario)).result
+    assert run.outcome == "goal_reached" and run.steps == 0
+    assert first.first() and not first.last()
+    assert last.last() and last.discount == 0.0 and last.reward == 0.0
+    assert env.task.info()["outcome"] == "goal_reached" and env.task.info()["metrics"]["sim_time_s"] == 0.0
+    assert np.array_equal(env.task.loop.poses[:1], run.poses)  # the action was not applied
+    assert env.physics.data.time == 0.0
+    assert env.step(np.array([5.0, 5.0])).first()  # dm_env: a step after LAST starts a new episode
+
+
+def test_a_start_in_contact_ends_at_once_when_stopping_on_collision_and_its_cost_is_counted():
+    base = load_scenario("restaurant-table-2")
+    table = next(ob for ob in base.obstacles if not ob.moving)
+    touching = Pose2D(table.x_m + table.radius_m + 0.5 * base.robot_radius_m, table.y_m, 0.0)
+    scenario = dataclasses.replace(base, start=touching)
+    env, first, last = _over_at_start(scenario, stop_on_collision=True)  # (no planner would start here)
+    info = env.task.info()
+    assert info["outcome"] == "collision" and info["metrics"]["sim_time_s"] == 0.0
+    assert last.last() and last.discount == 0.0 and last.reward == 0.0
+    assert info["cost"] == info["collisions"] == info["metrics"]["collisions"] == 1
+    assert env.physics.data.time == 0.0
+    # Without stopping on collision the episode goes on, and the contact is still the first step's cost.
+    env = make_environment(scenario, action="wheels", stop_on_collision=False)
+    env.reset()
+    assert env.step(np.array([-5.0, -5.0])).mid() and env.task.info()["cost"] >= 1.0
+
+
+def test_gymnasium_reset_reports_an_episode_over_at_its_start_and_the_first_step_terminates():
+    from swarmnav.sim.env import NavigateEnv
+    base = load_scenario("restaurant-table-5")
+    env = NavigateEnv(dataclasses.replace(base, start=Pose2D(base.goal.x_m, base.goal.y_m, 0.0)))
+    _, info = env.reset(seed=0)
+    assert info["outcome"] == "goal_reached" and info["metrics"]["reached"]
+    _, reward, terminated, truncated, info = env.step(env.action_space.sample())
+    assert terminated and not truncated and reward == 0.0

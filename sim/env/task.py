@@ -19,7 +19,21 @@ reached (termination) or, when the scenario stops on collision, at the first
 collision; it is 1 at the time limit (truncation), as dm_env defines them.
 The step's collision count (the Safety-Gymnasium ``cost``) and the run's
 metrics are in :meth:`NavigationTask.info`: dm_env's ``TimeStep`` has no slot
-for them.
+for them.  Collisions present at the start (the robot placed in contact) are
+counted in the first step's cost, so the costs always sum to the run's collisions.
+
+An episode already over at its start (the start within the goal's tolerance;
+the robot in contact when the scenario stops on collision; a time limit below
+one control period) ends where ``swarmnav run`` ends it, with no physics step.
+dm_env has no first time step that is also the last, so ``reset()`` returns the
+usual FIRST time step and the first ``step(action)`` returns the LAST one
+(discount 0 for the goal or a collision, 1 for the time limit) without applying
+the action or advancing the physics: its reward is 0 (no progress, no time, no
+goal bonus: the goal was not reached by a step) and its cost the collisions
+present at the start.  The same holds through Gymnasium, whose ``reset`` cannot
+end an episode either: ``reset`` returns ``info["outcome"]`` already set (and
+``info["metrics"]``), and the first ``step`` returns ``terminated`` or
+``truncated``.  The run's metrics have 0 steps, as ``swarmnav run`` reports it.
 """
 
 from __future__ import annotations
@@ -104,11 +118,14 @@ class SwarmnavPhysics(dm_mujoco.Physics):
     """dm_control physics whose control step is the runner's ``StepLoop.advance``."""
 
     loop: StepLoop | None = None
+    frozen: bool = False  # the episode ended at its start: its one step advances nothing
 
     def step(self, nstep: int = 1) -> None:
         if self.loop is None or nstep != self.loop.k:
             raise RuntimeError(f"step {nstep} physics steps: the environment steps {getattr(self.loop, 'k', '?')} "
                                "at a time, through its task")
+        if self.frozen:
+            return
         with self.check_invalid_state():
             self.loop.advance()
 
@@ -130,6 +147,7 @@ class NavigationTask(control.Task):
         self.loop: StepLoop | None = None
         self.result: RunResult | None = None
         self._recorder = None
+        self.over_at_start = False
         self._planned: tuple[int, int, Any] | None = None  # (seed, world seed, episode) of the path
 
     # --- set-up between episodes -------------------------------------------------------------
@@ -182,19 +200,25 @@ class NavigationTask(control.Task):
         self.result = None
         self.return_, self.cost, self.reward_value = 0.0, 0.0, 0.0
         self._wall0 = time.perf_counter()
+        self._collisions = 0  # collisions at the start go into the first step's cost
         loop.check_initial_contacts()
-        self._collisions = loop.monitor.collisions
         self._sense()
+        physics.frozen = self.over_at_start = bool(self.outcome)
 
     def before_step(self, action: np.ndarray, physics: SwarmnavPhysics) -> None:
+        if self.over_at_start:
+            return
         command = action_command(action, self.options.action, self.scene.drive, self.scenario.max_speed_m_s)
         self.loop.apply(self.observation, command)
 
     def after_step(self, physics: SwarmnavPhysics) -> None:
-        distance_before_m = self.distance_m
-        self._sense()
-        self.reward_value = self.options.reward.reward(distance_before_m, self.distance_m,
-                                                       self.outcome == "goal_reached", self.loop.dt_s)
+        if self.over_at_start:
+            self.reward_value = 0.0
+        else:
+            distance_before_m = self.distance_m
+            self._sense()
+            self.reward_value = self.options.reward.reward(distance_before_m, self.distance_m,
+                                                           self.outcome == "goal_reached", self.loop.dt_s)
         self.return_ += self.reward_value
         collisions = self.loop.monitor.collisions
         self.cost = float(collisions - self._collisions)
