@@ -27,18 +27,35 @@ from swarmnav.sim.runner import Simulation
 SUITE_PREFIX = "dyn-"
 
 
-def default_navigators() -> list[str]:
-    """Every registered navigator that runs with its default parameters (``policy`` needs a callable)."""
+def default_navigators(settings: dict[str, dict[str, Any]] | None = None) -> list[str]:
+    """Every registered navigator that runs with its default parameters, or with its share of ``settings``
+    (``policy`` needs a callable: it joins when ``--navigator-set policy=module:function`` names one)."""
     from swarmnav.controllers.navigators import make_navigator
     from swarmnav.models.errors import ConfigError
     names = []
     for name in NAVIGATORS:
         try:
-            make_navigator(name)
+            make_navigator(name, (settings or {}).get(name))
         except ConfigError:
+            if name in (settings or {}):
+                raise  # asked for with a bad value: say so rather than leave it out
             continue
         names.append(name)
     return names
+
+
+def navigator_settings(pairs: dict[str, Any], navigators: list[str]) -> dict[str, dict[str, Any]]:
+    """``--navigator-set KEY=VALUE``: each navigator gets the keys it has as parameters; a key none has is an error."""
+    import dataclasses
+    from swarmnav.models.errors import ConfigError
+    out: dict[str, dict[str, Any]] = {}
+    for key, value in pairs.items():
+        takers = [n for n in navigators if key in {f.name for f in dataclasses.fields(NAVIGATORS[n]) if f.init}]
+        if not takers:
+            raise ConfigError("--navigator-set", f"no navigator of this benchmark has a parameter {key!r}")
+        for name in takers:
+            out.setdefault(name, {})[key] = value
+    return out
 
 
 def suite_names() -> list[str]:
@@ -47,9 +64,11 @@ def suite_names() -> list[str]:
 
 
 def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, scenarios: list[str] | None = None,
-                         progress: bool = False) -> list[dict[str, Any]]:
-    """One row per navigator (see the module docstring)."""
-    navigators = navigators or default_navigators()
+                         progress: bool = False, navigator_params: dict[str, dict[str, Any]] | None = None
+                         ) -> list[dict[str, Any]]:
+    """One row per navigator (see the module docstring); ``navigator_params``: per navigator name."""
+    navigator_params = navigator_params or {}
+    navigators = navigators or default_navigators(navigator_params)
     names = scenarios or suite_names()
     loaded = [load_scenario(n) for n in names]
     total = len(navigators) * len(loaded) * seeds
@@ -60,7 +79,8 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
             world = scenario.with_world_seed(k)
             simulation = Simulation(world)
             for nav in navigators:
-                episode = run_episode(EpisodeSpec(world, navigator=nav, seed=k, world_seed=k), simulation=simulation)
+                episode = run_episode(EpisodeSpec(world, navigator=nav, navigator_params=navigator_params.get(nav),
+                                                  seed=k, world_seed=k), simulation=simulation)
                 r = episode.result
                 runs[nav].append({"success": r.success, "collided": r.collisions > 0, "timeout": r.outcome == "timeout",
                                   "time_to_goal_s": r.sim_time_s if r.success else None, "spl": r.spl or 0.0,
@@ -102,6 +122,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seeds", type=int, default=5, help="world seeds per scenario (default 5)")
     parser.add_argument("--navigator", action="append", help="only these navigators (repeatable)")
     parser.add_argument("--scenario", action="append", help="only these scenarios (repeatable; default: the dyn-* suite)")
+    parser.add_argument("--navigator-set", action="append", metavar="KEY=VALUE",
+                        help="a parameter for every navigator that has it (repeatable), e.g. policy=module:function")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
 
 
@@ -112,8 +134,11 @@ def run(args: argparse.Namespace) -> int:
     for name in args.navigator or []:
         if name not in NAVIGATORS:
             raise ConfigError("--navigator", f"unknown navigator {name!r} (known: {', '.join(sorted(NAVIGATORS))})")
+    from swarmnav.sim.cli import parse_settings  # loaded already: the CLI is what calls this
+    settings = navigator_settings(parse_settings(args.navigator_set, "--navigator-set"),
+                                  args.navigator or list(NAVIGATORS))
     rows = benchmark_navigation(args.seeds, args.navigator, args.scenario,
-                                progress=not args.json and sys.stderr.isatty())
+                                progress=not args.json and sys.stderr.isatty(), navigator_params=settings)
     if args.json:
         print(json.dumps(rows))
         return 0
