@@ -204,7 +204,8 @@ class PolicyObserver:
             out["path"] = self.next_waypoints(x, y, heading)
         if self.layout.obstacle_slots:
             out["obstacles"], out["obstacle_mask"] = self.obstacle_rows(observation.detections, x, y, heading)
-        return {key: np.clip(value, self._bounds[key][1], self._bounds[key][2]).astype(OBSERVATION_DTYPE)
+        bounds = self._bounds
+        return {key: np.minimum(np.maximum(value, bounds[key][1]), bounds[key][2]).astype(OBSERVATION_DTYPE)
                 for key, value in out.items()}
 
     def goal_distance_m(self, x_m: float, y_m: float) -> float:

@@ -129,3 +129,19 @@ def test_an_episode_records_to_mcap_like_a_run(tmp_path):
     assert len(log.time_s) == steps + 1
     assert np.array_equal(log.position_m[:, :2], poses[:, :2])
     assert read_log(tmp_path / "ep1.mcap").outcome["outcome"] == "interrupted"
+
+
+def test_bench_env_quick_prints_the_three_rates_and_their_ratios_as_json():
+    out = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "bench", "env", "--quick", "--json"],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    figures = json.loads(out.stdout)
+    control_hz = load_scenario("dense-field-30").sim.control_hz
+    assert figures["control_steps_per_run"] == round(4.0 * control_hz) and figures["repeats"] == 2
+    for key in ("env", "runner", "bare_control", "env_replay"):
+        assert figures[f"{key}_steps_per_s"] > 0
+    assert figures["env_vs_runner"] == pytest.approx(figures["env_steps_per_s"] / figures["runner_steps_per_s"],
+                                                     rel=0.5)  # a median of ratios beside a ratio of medians
+    bad = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "bench", "env", "--repeats", "0"],
+                         capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and "--repeats" in bad.stderr and "Traceback" not in bad.stderr

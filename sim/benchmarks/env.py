@@ -7,6 +7,13 @@ timing), and ``mj_step`` with constant wheel commands on the same compiled
 model.  Rates are control steps per second (bare: physics steps per second
 divided by the physics steps per control step), so the ratios compare like
 with like.  Target: environment >= 0.7 x runner.
+
+Random actions and the ``follow`` loop drive different trajectories, and the
+physics costs more near obstacles (the step-by-step contact check), so a
+fourth figure compares like with like: the environment in ``wheels`` mode
+replaying the runner's own wheel commands (the same trajectory, bit for bit),
+``env_replay_vs_runner``: the environment's overhead alone.  ``--quick`` runs
+the same measurement over 4 simulated seconds twice (a smoke run; noisier).
 """
 
 from __future__ import annotations
@@ -20,6 +27,7 @@ import mujoco
 import numpy as np
 
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
+from swarmnav.sim.options import positive_float, positive_int
 from swarmnav.sim.runner import Simulation
 
 
@@ -33,9 +41,18 @@ def _env_steps_per_s(env, steps: int, rng: np.random.Generator) -> float:
     return steps / (time.perf_counter() - t0)
 
 
-def _runner_steps_per_s(simulation: Simulation, planned, duration_s: float) -> float:
+def _runner_steps_per_s(simulation: Simulation, planned, duration_s: float):
+    """The runner's rate and its wheel commands (for the replay)."""
     result = run_episode(planned.spec, simulation=simulation, planned=planned, time_limit_s=duration_s).result
-    return result.steps / result.wall_time_s
+    return result.steps / result.wall_time_s, result.wheel_command_rad_s[:-1]
+
+
+def _env_replay_steps_per_s(env, wheel_commands: np.ndarray) -> float:
+    env.reset(seed=0)
+    t0 = time.perf_counter()
+    for command in wheel_commands:
+        env.step(command)
+    return len(wheel_commands) / (time.perf_counter() - t0)
 
 
 def _bare_control_steps_per_s(simulation: Simulation, control_steps: int) -> float:
@@ -52,20 +69,24 @@ def benchmark_env(scenario_name: str = "dense-field-30", duration_s: float = 20.
     """Median control steps per second of the three, and the environment's ratios to the other two."""
     from swarmnav.sim.env import NavigateEnv  # dm_control and Gymnasium load only for this benchmark
     env = NavigateEnv(scenario_name)
+    replay_env = NavigateEnv(scenario_name, action="wheels")
     planned = plan_episode(EpisodeSpec(env.task.scenario))
     simulation = Simulation(planned.spec.scenario)
     control_steps = int(round(duration_s / simulation.control_dt_s))
     rng = np.random.default_rng(0)
-    envs, runners, bares, ratios = [], [], [], []
+    envs, runners, bares, ratios, replays, replay_ratios = [], [], [], [], [], []
     for _ in range(repeats):
         e = _env_steps_per_s(env, control_steps, rng)
-        r = _runner_steps_per_s(simulation, planned, duration_s)
+        r, commands = _runner_steps_per_s(simulation, planned, duration_s)
+        replays.append(_env_replay_steps_per_s(replay_env, commands))
+        replay_ratios.append(replays[-1] / r)
         b = _bare_control_steps_per_s(simulation, control_steps)
         envs.append(e)
         runners.append(r)
         bares.append(b)
         ratios.append(e / r)
     env.close()
+    replay_env.close()
     return {
         "scenario": scenario_name,
         "control_hz": round(1.0 / simulation.control_dt_s, 6),
@@ -77,19 +98,27 @@ def benchmark_env(scenario_name: str = "dense-field-30", duration_s: float = 20.
         "bare_control_steps_per_s": statistics.median(bares),
         "env_vs_runner": statistics.median(ratios),
         "env_vs_bare": statistics.median(envs) / statistics.median(bares),
+        "env_replay_steps_per_s": statistics.median(replays),
+        "env_replay_vs_runner": statistics.median(replay_ratios),
         "target_env_vs_runner": 0.7,
     }
 
 
+QUICK_DURATION_S, QUICK_REPEATS = 4.0, 2  # --quick: a smoke run of the same measurement (noisier figures)
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default="dense-field-30")
-    parser.add_argument("--duration", type=float, default=20.0, help="simulated seconds per measurement")
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--duration", type=positive_float, default=20.0, help="simulated seconds per measurement")
+    parser.add_argument("--repeats", type=positive_int, default=3)
+    parser.add_argument("--quick", action="store_true",
+                        help=f"{QUICK_DURATION_S:g} simulated s x {QUICK_REPEATS} repeats (overrides the two above)")
     parser.add_argument("--json", action="store_true")
 
 
 def run(args: argparse.Namespace) -> int:
-    figures = benchmark_env(args.scenario, duration_s=args.duration, repeats=args.repeats)
+    duration_s, repeats = (QUICK_DURATION_S, QUICK_REPEATS) if args.quick else (args.duration, args.repeats)
+    figures = benchmark_env(args.scenario, duration_s=duration_s, repeats=repeats)
     if args.json:
         print(json.dumps(figures))
     else:
