@@ -58,6 +58,7 @@ class PolicyNavigator:
     """
 
     name: ClassVar[str] = "policy"
+    uses_detections: ClassVar[bool] = True  # per run after reset: only when the observation has obstacles
     policy: str = ""
     action: str = "twist"
     path_waypoints: int = 0
@@ -85,6 +86,7 @@ class PolicyNavigator:
                                     self.tracked_obstacles)
         goal = setup.goal
         self._observer = PolicyObserver(layout, (goal.x_m, goal.y_m), setup.path.waypoints)
+        self.uses_detections = bool(layout.obstacle_slots)  # read by the runner after reset
 
     def step(self, observation: Observation) -> NavigationStep:
         action = np.asarray(self._policy(self._observer(observation)), dtype=float)

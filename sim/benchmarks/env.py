@@ -19,13 +19,13 @@ the same measurement over 4 simulated seconds twice (a smoke run; noisier).
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import time
 
 import mujoco
 import numpy as np
 
+from swarmnav.sim.benchmarks.figures import print_figures
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
 from swarmnav.sim.options import positive_float, positive_int
 from swarmnav.sim.runner import Simulation
@@ -118,10 +118,5 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     duration_s, repeats = (QUICK_DURATION_S, QUICK_REPEATS) if args.quick else (args.duration, args.repeats)
-    figures = benchmark_env(args.scenario, duration_s=duration_s, repeats=repeats)
-    if args.json:
-        print(json.dumps(figures))
-    else:
-        for key, value in figures.items():
-            print(f"{key:<28} {value:.4g}" if isinstance(value, float) else f"{key:<28} {value}")
+    print_figures(benchmark_env(args.scenario, duration_s=duration_s, repeats=repeats), args.json)
     return 0

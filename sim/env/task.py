@@ -191,6 +191,7 @@ class NavigationTask(control.Task):
         time_limit_s = scenario.time_limit_s if options.time_limit_s is None else options.time_limit_s
         self.loop = loop = StepLoop(self.simulation, recorder, time_limit_s, data=physics.data.ptr)
         physics.loop = loop
+        loop.sense_obstacles = bool(self.layout.obstacle_slots)  # the sensing model only when observed
         if recorder is not None:
             recorder.start(self.simulation.context(
                 options.path_planner or "none", {}, self.seed, NAVIGATOR_NAME,
