@@ -111,7 +111,7 @@ class BeeColonyPlanner(ContinuousPlanner):
         return float(self.limit)
 
     def init_swarm(self, state: ContinuousState, rng: np.random.Generator) -> None:
-        sources = self.random_solutions(state, self.population, rng)              # Eq. (6)
+        sources = self.initial_solutions(state, self.population, rng)              # Eq. (6)
         state.population = sources
         state.costs = self.evaluate(state, sources)
         state.data["failures"] = np.zeros(self.population, dtype=np.int64)

@@ -31,12 +31,34 @@ repair stage (:mod:`planners.swarm`), so its evaluations count against the same
 which ("population" or "fine_penalty").  If nothing passes it raises
 :class:`planners.errors.NoPathFound` (:class:`planners.errors.BudgetExceeded`
 when the budget ran out).
+
+Modes: the papers' algorithms and the robust options.  ``mode = "paper"`` runs the
+algorithm as its paper writes it (3 via-points, a uniform random first population, no
+polish).  ``mode = "robust"`` adds three named options, each of which can also be set on
+its own (an explicit value always wins over the mode's):
+
+* ``via_points``: chosen from the scene (:func:`planners.path_guess.via_points_for_guess`:
+  one per bend of an A* guess, plus two) and *grown* (doubled, up to
+  ``via_point_growth`` times, the search rerun on what is left of the budget) when no
+  candidate passes the exact check;
+* ``seed_fraction``: that share of the first population is placed on the least-squares
+  fit of the guess, perturbed (:mod:`planners.path_guess`), the rest uniformly at random
+  as in the paper (later random draws, e.g. ABC's scouts, stay the paper's);
+* ``polish_rounds``: a compass search from the chosen candidate (:mod:`planners.polish`);
+  its result is kept only if the returned path passes the exact check.
+
+``mode = "auto"`` (the default) is ``"paper"`` on the papers' own bundled instances
+(recognised by their geometry, :mod:`planners.paper_instances`) and ``"robust"`` everywhere
+else: a user reproducing a paper gets the paper's algorithm and parameters, and a user
+planning any other scene gets the version that finds it.  The mode a run used is in
+``stats.extra["mode"]`` (``swarmnav plan --json``), so the choice is never silent.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -44,10 +66,46 @@ import numpy as np
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound, check_parameters
+from swarmnav.planners.errors import BudgetExceeded
+from swarmnav.planners.paper_instances import paper_instance
 from swarmnav.planners.path_cost import PathObjective
-from swarmnav.planners.problem import Problem, check_supported
+from swarmnav.planners.path_guess import (MAX_AUTO_VIA_POINTS, fit_via_points, seeded_population,
+                                          grid_guesses, via_points_for_guess)
+from swarmnav.planners.polish import compass_polish
+from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 from swarmnav.planners.via_points import ENCODINGS, ViaPointCurve
+
+MODES = ("auto", "paper", "robust")
+#: Via-points of both papers (Kamil et al. 2020 Sect. 3; Abdulla & Hadi 2025).
+PAPER_VIA_POINTS = 3
+#: The robust mode's defaults of the options left unset.
+ROBUST_SEED_FRACTION = 0.5
+ROBUST_POLISH_ROUNDS = 40
+ROBUST_VIA_POINT_GROWTH = 2
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """What one run uses once the mode is resolved (:meth:`ContinuousPlanner.settings_for`).
+
+    Attributes:
+        mode: "paper" or "robust".
+        via_points: ``k`` of this attempt.
+        seed_fraction: share of the first population seeded from ``guess``.
+        polish_rounds: compass-search rounds on the chosen candidate.
+        growth: how many more times ``k`` may double when nothing passes.
+        guesses: the geometric guesses, (N, 2) waypoints each (empty: no seeding).
+        paper: the paper scenario recognised (for ``mode = "auto"``), or None.
+    """
+
+    mode: str = "paper"
+    via_points: int = PAPER_VIA_POINTS
+    seed_fraction: float = 0.0
+    polish_rounds: int = 0
+    growth: int = 0
+    guesses: tuple[np.ndarray, ...] = ()
+    paper: str | None = None
 
 
 #: Most curve points one evaluation batch may sample (population x samples): the
@@ -69,6 +127,7 @@ class ContinuousState(SwarmState):
         repair_step_m: the repair's current step size.
     """
 
+    settings: RunSettings = dataclasses.field(default_factory=RunSettings)
     objective: PathObjective | None = None
     lower: np.ndarray | None = None
     upper: np.ndarray | None = None
@@ -109,6 +168,15 @@ class ContinuousPlanner(SwarmPlanner):
         repair_rounds: batches of the fine-penalty repair (0: no such repair).
         waypoint_spacing_m: spacing of the returned waypoints along the spline; the
             polyline through them is what the exact check verifies.
+        mode: "paper", "robust" or "auto" (see the module docstring).
+        via_points: ``None`` (default): 3 in paper mode, chosen from the scene in robust mode.
+        seed_fraction: share of the first population seeded from the geometric guess
+            (``None``: 0 in paper mode, 0.5 in robust mode).
+        seed_spread_m: largest standard deviation of the seeds' perturbation.
+        guess_cell_m: cell of the A* guess's grid (``None``: the problem's).
+        polish_rounds: compass-search rounds on the result (``None``: 0 / 40).
+        polish_step_m: the compass search's first step.
+        via_point_growth: doublings of ``k`` when nothing passes (``None``: 0 / 2).
     """
 
     supports: ClassVar[frozenset[str]] = frozenset({"discs"})
@@ -116,7 +184,7 @@ class ContinuousPlanner(SwarmPlanner):
     population: int = 50
     iterations: int = 100
     max_evaluations: int | None = None
-    via_points: int = 3
+    via_points: int | None = None
     samples: int = 100
     encoding: str = "spline"
     length_weight: float = 1.0
@@ -125,6 +193,13 @@ class ContinuousPlanner(SwarmPlanner):
     penalty_margin_m: float = 0.02
     waypoint_spacing_m: float = 0.05
     repair_rounds: int = 10
+    mode: str = "auto"
+    seed_fraction: float | None = None
+    seed_spread_m: float = 0.2
+    guess_cell_m: float | None = None
+    polish_rounds: int | None = None
+    polish_step_m: float = 0.05
+    via_point_growth: int | None = None
 
     def __post_init__(self) -> None:
         checks = (
@@ -132,7 +207,7 @@ class ContinuousPlanner(SwarmPlanner):
             ("iterations", self.iterations >= 0, "must not be negative"),
             ("max_evaluations", self.max_evaluations is None or self.max_evaluations >= 0,
              "must not be negative"),
-            ("via_points", self.via_points >= 1, "must be at least 1"),
+            ("via_points", self.via_points is None or self.via_points >= 1, "must be at least 1"),
             ("samples", self.samples >= 2, "must be at least 2"),
             ("encoding", self.encoding in ENCODINGS, f"must be one of {', '.join(ENCODINGS)}"),
             ("length_weight", self.length_weight >= 0, "must not be negative"),
@@ -141,6 +216,15 @@ class ContinuousPlanner(SwarmPlanner):
             ("penalty_margin_m", self.penalty_margin_m >= 0, "must not be negative"),
             ("waypoint_spacing_m", self.waypoint_spacing_m > 0, "must be positive"),
             ("repair_rounds", self.repair_rounds >= 0, "must not be negative"),
+            ("mode", self.mode in MODES, f"must be one of {', '.join(MODES)}"),
+            ("seed_fraction", self.seed_fraction is None or 0.0 <= self.seed_fraction <= 1.0,
+             "must be between 0 and 1"),
+            ("seed_spread_m", self.seed_spread_m >= 0, "must not be negative"),
+            ("guess_cell_m", self.guess_cell_m is None or self.guess_cell_m > 0, "must be positive"),
+            ("polish_rounds", self.polish_rounds is None or self.polish_rounds >= 0, "must not be negative"),
+            ("polish_step_m", self.polish_step_m > 0, "must be positive"),
+            ("via_point_growth", self.via_point_growth is None or self.via_point_growth >= 0,
+             "must not be negative"),
         )
         check_parameters(self, checks)
         points = self.population * self.samples
@@ -152,9 +236,60 @@ class ContinuousPlanner(SwarmPlanner):
     # ----------------------------------------------------------------- set-up
     state_type = ContinuousState
 
-    def objective(self, problem: Problem) -> PathObjective:
-        """The cost function of ``problem`` for this planner's encoding and weights."""
-        curve = ViaPointCurve(self.encoding, self.via_points, problem.start.xy, problem.goal.xy,
+    def settings_for(self, problem: Problem) -> RunSettings:
+        """Resolve ``mode`` and the options left at ``None`` for ``problem`` (the robust mode
+        also computes the geometric guess here)."""
+        paper = paper_instance(problem) if self.mode == "auto" else None
+        mode = self.mode if self.mode != "auto" else ("paper" if paper else "robust")
+        if mode == "paper":
+            return RunSettings(mode="paper", via_points=self.via_points or PAPER_VIA_POINTS,
+                               seed_fraction=self.seed_fraction or 0.0, polish_rounds=self.polish_rounds or 0,
+                               growth=self.via_point_growth or 0, paper=paper,
+                               guesses=grid_guesses(problem, self.guess_cell_m) if self.seed_fraction else ())
+        fraction = ROBUST_SEED_FRACTION if self.seed_fraction is None else self.seed_fraction
+        guesses = grid_guesses(problem, self.guess_cell_m) if (fraction or self.via_points is None) else ()
+        via_points = self.via_points or max((via_points_for_guess(g) for g in guesses), default=PAPER_VIA_POINTS)
+        return RunSettings(
+            mode="robust", via_points=via_points, seed_fraction=fraction,
+            polish_rounds=ROBUST_POLISH_ROUNDS if self.polish_rounds is None else self.polish_rounds,
+            growth=ROBUST_VIA_POINT_GROWTH if self.via_point_growth is None else self.via_point_growth,
+            guesses=guesses, paper=paper)
+
+    def plan(self, problem: Problem, rng: np.random.Generator) -> Path:
+        """Resolve the mode, then run the search; in robust mode, rerun it with twice the
+        via-points (on what is left of the budget) while nothing passes the exact check."""
+        t0 = time.perf_counter()
+        check_endpoints(problem)
+        check_supported(self, problem)
+        settings = self.settings_for(problem)
+        spent = 0
+        for attempt in range(settings.growth + 1):
+            budget = None if not self.max_evaluations else self.max_evaluations - spent
+            state = self.state_type(max_evaluations=budget, settings=settings)
+            try:
+                path = self.run_search(problem, rng, state)
+                break
+            except BudgetExceeded:
+                raise
+            except NoPathFound:
+                spent += state.evaluations
+                if attempt == settings.growth or settings.via_points >= MAX_AUTO_VIA_POINTS * 2:
+                    raise
+                settings = dataclasses.replace(settings, via_points=2 * settings.via_points)
+        extra = dict(path.stats.extra, mode=settings.mode, via_point_count=settings.via_points,
+                     via_point_growths=attempt, guess_lengths_m=[
+                         float(np.sum(np.hypot(*np.diff(g, axis=0).T))) for g in settings.guesses])
+        if settings.paper:
+            extra["paper_instance"] = settings.paper
+        return Path.from_waypoints(path.waypoints, time.perf_counter() - t0, iterations=path.stats.iterations,
+                                   evaluations=spent + path.stats.evaluations,
+                                   cost_history=path.stats.cost_history, extra=extra)
+
+    def objective(self, problem: Problem, via_points: int | None = None) -> PathObjective:
+        """The cost function of ``problem`` for this planner's encoding and weights, with
+        ``via_points`` free via-points (default: the parameter, else the papers' 3)."""
+        k = via_points or self.via_points or PAPER_VIA_POINTS
+        curve = ViaPointCurve(self.encoding, k, problem.start.xy, problem.goal.xy,
                               self.samples)
         return PathObjective(curve=curve, centres_m=problem.disc_centres_m,
                              penalty_radii_m=problem.inflated_radii_m + self.penalty_margin_m,
@@ -162,9 +297,9 @@ class ContinuousPlanner(SwarmPlanner):
                              smoothness_weight=self.smoothness_weight,
                              penalty_weight=self.penalty_weight)
 
-    def search_bounds(self, problem: Problem) -> tuple[np.ndarray, np.ndarray]:
+    def search_bounds(self, problem: Problem, via_points: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(lower, upper), each (2k,): x of every via-point, then y, within the workspace."""
-        k = self.via_points
+        k = via_points or self.via_points or PAPER_VIA_POINTS
         b = problem.bounds
         lower = np.concatenate([np.full(k, b.x_min_m), np.full(k, b.y_min_m)])
         upper = np.concatenate([np.full(k, b.x_max_m), np.full(k, b.y_max_m)])
@@ -173,6 +308,20 @@ class ContinuousPlanner(SwarmPlanner):
     def random_solutions(self, state: ContinuousState, count: int, rng: np.random.Generator) -> np.ndarray:
         """``count`` uniform random decision vectors in the search box (Kamil et al. 2020 Eq. (6))."""
         return state.lower + rng.random((count, state.lower.size)) * (state.upper - state.lower)
+
+    def initial_solutions(self, state: ContinuousState, count: int, rng: np.random.Generator) -> np.ndarray:
+        """The first population: :meth:`random_solutions` (the papers'), except that with a
+        ``seed_fraction`` and guesses that share of it is seeded from the guesses (first,
+        split evenly between them)."""
+        settings = state.settings
+        seeded = int(round(settings.seed_fraction * count)) if settings.guesses else 0
+        if seeded == 0:
+            return self.random_solutions(state, count, rng)
+        shares = np.diff(np.linspace(0, seeded, len(settings.guesses) + 1).round().astype(int))
+        seeds = [seeded_population(np.clip(fit_via_points(state.objective.curve, guess), state.lower, state.upper),
+                                   int(share), self.seed_spread_m, state.lower, state.upper, rng)
+                 for guess, share in zip(settings.guesses, shares) if share]
+        return np.vstack(seeds + [self.random_solutions(state, count - seeded, rng)])
 
     def evaluate(self, state: ContinuousState, population: np.ndarray,
                  objective: PathObjective | None = None, offer: bool = True) -> np.ndarray:
@@ -204,8 +353,9 @@ class ContinuousPlanner(SwarmPlanner):
     # ------------------------------------------------------- the loop's hooks
     def init_state(self, state: ContinuousState, problem: Problem, rng: np.random.Generator) -> None:
         check_supported(self, problem)
-        state.objective = self.objective(problem)
-        state.lower, state.upper = self.search_bounds(problem)
+        k = state.settings.via_points
+        state.objective = self.objective(problem, k)
+        state.lower, state.upper = self.search_bounds(problem, k)
         self.init_swarm(state, rng)
 
     def init_swarm(self, state: ContinuousState, rng: np.random.Generator) -> None:
@@ -270,6 +420,13 @@ class ContinuousPlanner(SwarmPlanner):
                               f"(best clearance {state.best_gap_m:.4f} m), nor the fine-penalty repair; try "
                               f"more iterations or a larger penalty_weight")
         objective = state.objective
+        polished = 0
+        if state.settings.polish_rounds and not state.exhausted:
+            start_cost = float(objective(state.chosen[None, :])[0])
+            state.chosen, _, polished = compass_polish(
+                state.chosen, start_cost, lambda trial: self.evaluate(state, trial, offer=False),
+                lambda x: bool(problem.is_collision_free(self.dense_waypoints(objective, x))),
+                state.lower, state.upper, self.polish_step_m, state.settings.polish_rounds)
         waypoints = self.dense_waypoints(objective, state.chosen)
         return waypoints, {
             "repaired": state.repaired,
@@ -277,6 +434,7 @@ class ContinuousPlanner(SwarmPlanner):
             "objective_cost": float(objective(state.chosen[None, :])[0]),
             "clearance_m": problem.path_clearance_m(waypoints),
             "encoding": self.encoding,
+            "polish_rounds": polished,
         }
 
     def dense_waypoints(self, objective: PathObjective, solution: np.ndarray) -> np.ndarray:

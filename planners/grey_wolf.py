@@ -47,7 +47,7 @@ class GreyWolfPlanner(ContinuousPlanner):
     iterations: int = 100
 
     def init_swarm(self, state: ContinuousState, rng: np.random.Generator) -> None:
-        wolves = self.random_solutions(state, self.population, rng)
+        wolves = self.initial_solutions(state, self.population, rng)
         costs = self.evaluate(state, wolves)
         state.population = wolves
         state.costs = costs

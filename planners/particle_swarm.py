@@ -58,7 +58,7 @@ class ParticleSwarmPlanner(ContinuousPlanner):
                               f"must be positive, got {self.velocity_limit!r}")
 
     def init_swarm(self, state: ContinuousState, rng: np.random.Generator) -> None:
-        positions = self.random_solutions(state, self.population, rng)
+        positions = self.initial_solutions(state, self.population, rng)
         costs = self.evaluate(state, positions)
         width = state.upper - state.lower
         state.data["velocity_max"] = self.velocity_limit * width

@@ -137,10 +137,14 @@ class SwarmPlanner:
 
     # ----------------------------------------------------------------- loop
     def plan(self, problem: Problem, rng: np.random.Generator) -> Path:
+        return self.run_search(problem, rng, self.state_type(max_evaluations=self.max_evaluations or None))
+
+    def run_search(self, problem: Problem, rng: np.random.Generator, state: SwarmState) -> Path:
+        """The loop of :meth:`plan` on a state made by the caller (a subclass may put its run's
+        settings in it first)."""
         t0 = time.perf_counter()
         problem = self.prepare(problem)
         check_endpoints(problem)
-        state = self.state_type(max_evaluations=self.max_evaluations or None)
         self.init_state(state, problem, rng)
         history = [state.best_cost]
         done = 0
