@@ -31,6 +31,11 @@ from swarmnav.sim.study.grid import Cell
 from swarmnav.sim.versions import software_versions
 
 BEND_TOLERANCE_RAD = 1e-6  # a turn smaller than this between two segments is no bend
+# Quantities some planners report in ``stats.extra`` that a paper's table prints: given their own columns.
+EXTRA_COLUMNS = {"raw_length_m": "plan_raw_length_m",  # the tour before shortcutting (grid and ant planners)
+                 "gates_raised": "plan_gates_raised",  # IMMAS (Hasan et al. 2023), GateRaiseState
+                 "tunnels_closed": "plan_tunnels_closed",  # IMMAS, Algorithm 2 (tight tunnels)
+                 "total_arc_cost": "plan_arc_cost"}  # IMMAS, the arc cost of its tour
 
 
 class WallLimitExceeded(BaseException):
@@ -39,7 +44,7 @@ class WallLimitExceeded(BaseException):
 
 
 def bends(waypoints: np.ndarray) -> int:
-    """Interior waypoints where the heading changes (IACO, Li et al. 2023, Table 3 'bends')."""
+    """Interior waypoints where the heading changes (IACO, Gong et al. 2022, Table 3 'number of bends')."""
     if len(waypoints) < 3:
         return 0
     seg = np.diff(waypoints, axis=0)
@@ -155,6 +160,9 @@ def _add_metrics(row: dict[str, Any], episode) -> None:
                plan_bends=bends(episode.path.waypoints),
                plan_convergence_iteration=stats.extra.get("convergence_iteration"),
                plan_extra=json.dumps(_json_safe(stats.extra), sort_keys=True))
+    for key, column in EXTRA_COLUMNS.items():
+        value = stats.extra.get(key)
+        row[column] = None if value is None or not math.isfinite(float(value)) else value
     if episode.result is not None:
         run = episode.result.summary()
         row.update(reached=run["reached"], run_outcome=run["outcome"], collisions=run["collisions"],
