@@ -262,3 +262,58 @@ def test_a_copied_results_folder_reports_without_the_scenario_files(tmp_path):
     assert rows[rows.planner == "astar"].plan_gates_raised.isna().all()
     paper_header = next(line for line in report.splitlines() if line.startswith("| planner | runs | successes"))
     assert "gates" in paper_header and "tunnels" in paper_header
+
+
+def test_logs_keep_one_mcap_per_run_that_replays(tmp_path):
+    path = write(tmp_path, 'name = "logged"\nscenarios = ["restaurant-table-2", "gwo-scenario-1"]\n'
+                           'mode = "physics"\ntime_limit_s = 2.0\nseeds = [0]\n[[planners]]\nname = "astar"\n')
+    assert main(["study", str(path), "--out", str(tmp_path / "out"), "--workers", "2", "--logs", "--json"]) == 0
+    rows = pd.read_parquet(tmp_path / "out" / "runs.parquet")
+    assert len(rows) == 2 and rows.log.notna().all()
+    for row in rows.to_dict("records"):
+        assert Path(row["log"]).parent == (tmp_path / "out" / "logs").resolve()
+        assert main(["replay", row["log"], "--verify", "--json"]) == 0
+
+
+PLAN_ONLY = 'name = "bar"\nscenarios = ["gwo-scenario-1"]\nseeds = 2\n[[planners]]\nname = "astar"\n'
+
+
+def test_the_progress_bar_appears_only_on_a_terminal(tmp_path, capsys):
+    import pty
+    path = write(tmp_path, PLAN_ONLY)
+    assert main(["study", str(path), "--workers", "1", "--out", str(tmp_path / "piped")]) == 0
+    assert capsys.readouterr().err == ""  # stderr is not a terminal here
+    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--workers", "1"]
+    leader, follower = pty.openpty()
+    try:
+        on_terminal = subprocess.run(command + ["--out", str(tmp_path / "tty")], stdout=subprocess.PIPE,
+                                     stderr=follower, timeout=120)
+        os.close(follower)
+        err = b""
+        while True:
+            try:
+                chunk = os.read(leader, 4096)
+            except OSError:  # EIO once the child's end is closed and drained
+                break
+            if not chunk:
+                break
+            err += chunk
+    finally:
+        os.close(leader)
+    assert on_terminal.returncode == 0
+    text = err.decode()
+    assert "\r[" in text and "2/2" in text and "failed 0" in text
+
+
+def test_off_the_main_thread_the_wall_limit_is_checked_after_the_run():
+    import threading
+    from swarmnav.sim.study.cell import run_cell
+    from swarmnav.sim.study.spec import parse_study
+    cell = expand(parse_study(PLAN_ONLY.replace("seeds = 2\n", "seeds = 1\nwall_limit_s = 0.0001\n")))[0]
+    result = {}
+    thread = threading.Thread(target=lambda: result.update(row=run_cell(cell)[0]))
+    thread.start()
+    thread.join()
+    row = result["row"]
+    assert row["outcome"] == "timeout" and "checked after the run" in row["error"]
+    assert row["cell_wall_s"] > 0.0001 and row["plan_length_m"] > 0  # the run finished, then was judged

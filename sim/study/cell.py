@@ -73,7 +73,13 @@ def _json_safe(value: Any) -> Any:
 
 
 class _WallLimit:
-    """SIGALRM after ``limit_s`` when running on a main thread; elsewhere the limit is checked afterwards."""
+    """SIGALRM after ``limit_s`` when running on a main thread; elsewhere the limit is checked afterwards.
+
+    Both engines run cells on their worker's main thread (a spawned process's, and a Ray
+    task's: Ray executes a normal task on its worker process's main thread), so the
+    timer interrupts a long run there.  Only a caller running :func:`run_cell` on
+    another thread gets the after-the-run check (the run finishes, then becomes a
+    ``timeout`` row saying so)."""
 
     def __init__(self, limit_s: float):
         self.limit_s = limit_s
@@ -143,7 +149,8 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
         episode = None
     row["cell_wall_s"] = time.perf_counter() - started
     if episode is not None and row["cell_wall_s"] > cell.wall_limit_s:  # the limit could not be armed here
-        row.update(outcome="timeout", error=f"exceeded the wall limit of {cell.wall_limit_s:g} s")
+        row.update(outcome="timeout", error=f"exceeded the wall limit of {cell.wall_limit_s:g} s "
+                                            "(checked after the run: no timer off the main thread)")
     if episode is not None:
         _add_metrics(row, episode)
         progress = _progress_rows(cell, episode)

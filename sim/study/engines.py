@@ -90,6 +90,9 @@ def start_ray(address: str | None, workers: int | None) -> None:
     if address:
         ray.init(address=address, runtime_env=runtime_env, log_to_driver=False)
     else:
+        # A new local instance turns token authentication on by default and warns that it did unless
+        # RAY_AUTH_MODE is set; saying "token" explicitly keeps that default and drops the warning.
+        os.environ.setdefault("RAY_AUTH_MODE", "token")
         ray.init(num_cpus=workers, runtime_env=runtime_env, include_dashboard=False, log_to_driver=False)
 
 

@@ -62,6 +62,8 @@ def summarise(rows: list[dict[str, Any]], metric: str) -> MetricSummary | None:
     if v.size == 0:
         return None
     best = float(v.max() if not LOWER_IS_BETTER.get(metric, True) else v.min())
+    if np.ptp(v) <= 1e-12 * max(1.0, abs(float(v[0]))):  # identical runs up to rounding: no spread
+        return MetricSummary(int(v.size), float(v[0]), 0.0 if v.size > 1 else float("nan"), float(v[0]), best)
     return MetricSummary(int(v.size), float(v.mean()), float(v.std(ddof=1)) if v.size > 1 else float("nan"),
                          float(np.median(v)), best)
 
