@@ -192,6 +192,8 @@ BAD_STUDIES = {
                     "planners[0].params.iterations"),
     "sweep over a missing parameter": ('scenarios = ["gwo-scenario-1"]\n[[planners]]\nname = "astar"\n'
                                        'params = { wolves = [10, 20] }\n', "planners[0].params.wolves"),
+    "quick seeds beyond the seeds": ('scenarios = ["gwo-scenario-1"]\nseeds = 3\nquick_seeds = 4\n'
+                                     '[[planners]]\nname = "astar"\n', "quick_seeds"),
     "no scenario matches": ('scenarios = ["nothing-*"]\n[[planners]]\nname = "astar"\n', "scenarios[0]"),
 }
 
@@ -317,3 +319,13 @@ def test_off_the_main_thread_the_wall_limit_is_checked_after_the_run():
     row = result["row"]
     assert row["outcome"] == "timeout" and "checked after the run" in row["error"]
     assert row["cell_wall_s"] > 0.0001 and row["plan_length_m"] > 0  # the run finished, then was judged
+
+
+def test_a_quick_run_is_the_first_seeds_of_the_full_one():
+    full = load_study("iaco-vs-grid")
+    quick = full.quick()
+    assert quick.seeds == full.seeds[:full.quick_seeds] and len(quick.seeds) < len(full.seeds)
+    full_cells = {c.config_hash: c for c in expand(full)}
+    quick_cells = expand(quick)
+    assert len(quick_cells) * len(full.seeds) == len(full_cells) * len(quick.seeds)
+    assert all(c.config_hash in full_cells and c.seed in quick.seeds for c in quick_cells)
