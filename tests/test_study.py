@@ -150,7 +150,7 @@ def test_report_tables_and_wilcoxon_agree_with_the_rows(tiny, tmp_path):
     checked = 0
     for scenario, group in rows.groupby("scenario"):
         section = text.split(f"## Scenario {scenario}")[1].split("## Scenario")[0]
-        counts = {r[0]: r for r in _markdown_table(section, "planner | runs")}
+        counts = {r[0]: r for r in _markdown_table(section, "planner | runs | failed")}
         for label, runs in group.groupby("label"):
             assert int(counts[label][1]) == len(runs)
             assert int(counts[label][2]) == int((runs.outcome != "ok").sum())
@@ -164,9 +164,23 @@ def test_report_tables_and_wilcoxon_agree_with_the_rows(tiny, tmp_path):
             assert float(table[6]) == pytest.approx(lengths.min(), rel=1e-4)
             checked += 1
         ok = group[group.outcome == "ok"]
-        p = stats.ranksums(ok[ok.label == "astar"].plan_length_m, ok[ok.label == "gwo"].plan_length_m).pvalue
-        tests = _markdown_table(section, "against")
-        assert tests[0][0] == "gwo" and float(tests[0][3]) == pytest.approx(p, rel=1e-3)
+        tests = {r[1]: r for r in _markdown_table(section, "against | metric")}
+        for metric in ("plan_length_m", "plan_time_s", "path_length_m", "min_clearance_m"):
+            p = stats.ranksums(ok[ok.label == "astar"][metric], ok[ok.label == "gwo"][metric]).pvalue
+            assert tests[metric][0] == "gwo" and float(tests[metric][4]) == pytest.approx(p, rel=1e-3), metric
+        success = _markdown_table(section, "against | ref successes")[0]
+        counts_of = [(int(g.success.sum()), len(g)) for g in (group[group.label == "astar"], group[group.label == "gwo"])]
+        assert success[1:3] == [f"{s}/{n}" for s, n in counts_of]
+        (a_s, a_n), (g_s, g_n) = counts_of
+        assert float(success[3]) == pytest.approx(stats.fisher_exact([[a_s, a_n - a_s], [g_s, g_n - g_s]]).pvalue,
+                                                  rel=1e-3)
+        header = next(line for line in section.splitlines() if line.startswith("| planner | runs | successes"))
+        columns = [c.strip() for c in header.strip("|").split(" | ")]
+        paper = {r[0]: dict(zip(columns, r)) for r in _markdown_table(section, "planner | runs | successes")}
+        for label, runs in group.groupby("label"):
+            lengths = runs.loc[runs.outcome == "ok", "plan_length_m"].to_numpy()
+            assert float(paper[label]["optimal length"]) == pytest.approx(lengths.min(), rel=1e-4)
+            assert float(paper[label]["mean - optimal"]) == pytest.approx(lengths.mean() - lengths.min(), abs=1e-4)
     assert checked == 4 and metric_table
 
 
@@ -178,6 +192,8 @@ BAD_STUDIES = {
                     "planners[0].params.iterations"),
     "sweep over a missing parameter": ('scenarios = ["gwo-scenario-1"]\n[[planners]]\nname = "astar"\n'
                                        'params = { wolves = [10, 20] }\n', "planners[0].params.wolves"),
+    "quick seeds beyond the seeds": ('scenarios = ["gwo-scenario-1"]\nseeds = 3\nquick_seeds = 4\n'
+                                     '[[planners]]\nname = "astar"\n', "quick_seeds"),
     "no scenario matches": ('scenarios = ["nothing-*"]\n[[planners]]\nname = "astar"\n', "scenarios[0]"),
 }
 
@@ -209,3 +225,107 @@ def test_paper_values_are_flagged_where_impossible():
     assert impossible("plan_length_m", 14.25, rows) is None
     rows[1].update(outcome="no_path", plan_length_m=None)
     assert "no collision-free path" in impossible("plan_length_m", 14.25, rows)
+
+
+def test_a_copied_results_folder_reports_without_the_scenario_files(tmp_path):
+    """The path plot draws what study.json recorded at run time; the report opens no scenario file.
+    Also: the IMMAS quantities a paper prints are columns of their own, equal to the planner's stats."""
+    bundled = Path(load_scenario("immas-env1-scattered").source_path)
+    work = tmp_path / "work"
+    work.mkdir()
+    for name in (bundled.name, "immas-env1-scattered.map"):
+        source = bundled.parent / name if name.endswith(".toml") else bundled.parent.parent / "maps" / name
+        (work / name).write_bytes(source.read_bytes())
+    scenario = load_scenario(str(work / bundled.name))
+    (work / "study.toml").write_text('name = "copied"\nscenarios = ["immas-env1-scattered.toml"]\nseeds = 2\n'
+                                     '[[planners]]\nname = "immas"\n[[planners]]\nname = "astar"\n')
+    assert main(["study", str(work / "study.toml"), "--out", str(work / "out"), "--workers", "2", "--json"]) == 0
+    (tmp_path / "copy").mkdir()
+    os.rename(work / "out", tmp_path / "copy" / "out")
+    for path in work.iterdir():
+        path.unlink()
+    work.rmdir()
+    folder = tmp_path / "copy" / "out"
+    geometry = json.loads((folder / "study.json").read_text())["scenarios"]["immas-env1-scattered"]
+    assert geometry["arena_m"] == [scenario.arena_width_m, scenario.arena_height_m]
+    assert geometry["boxes"] == [[b.x_min_m, b.y_min_m, b.x_max_m, b.y_max_m] for b in scenario.boxes]
+    assert len(geometry["boxes"]) > 0 and geometry["goal"] == [scenario.goal.x_m, scenario.goal.y_m]
+    assert main(["report", str(folder)]) == 0
+    report = (folder / "report.md").read_text()
+    assert "immas-env1-scattered: the plan of one seed per planner" in report
+    rows = pd.read_parquet(folder / "runs.parquet")
+    immas = rows[rows.planner == "immas"]
+    assert len(immas) == 2 and (immas.outcome == "ok").all()
+    for row in immas.to_dict("records"):
+        extra = json.loads(row["plan_extra"])
+        assert (row["plan_gates_raised"], row["plan_tunnels_closed"]) == (extra["gates_raised"],
+                                                                          extra["tunnels_closed"])
+        assert row["plan_arc_cost"] == extra["total_arc_cost"]
+    assert rows[rows.planner == "astar"].plan_gates_raised.isna().all()
+    paper_header = next(line for line in report.splitlines() if line.startswith("| planner | runs | successes"))
+    assert "gates" in paper_header and "tunnels" in paper_header
+
+
+def test_logs_keep_one_mcap_per_run_that_replays(tmp_path):
+    path = write(tmp_path, 'name = "logged"\nscenarios = ["restaurant-table-2", "gwo-scenario-1"]\n'
+                           'mode = "physics"\ntime_limit_s = 2.0\nseeds = [0]\n[[planners]]\nname = "astar"\n')
+    assert main(["study", str(path), "--out", str(tmp_path / "out"), "--workers", "2", "--logs", "--json"]) == 0
+    rows = pd.read_parquet(tmp_path / "out" / "runs.parquet")
+    assert len(rows) == 2 and rows.log.notna().all()
+    for row in rows.to_dict("records"):
+        assert Path(row["log"]).parent == (tmp_path / "out" / "logs").resolve()
+        assert main(["replay", row["log"], "--verify", "--json"]) == 0
+
+
+PLAN_ONLY = 'name = "bar"\nscenarios = ["gwo-scenario-1"]\nseeds = 2\n[[planners]]\nname = "astar"\n'
+
+
+def test_the_progress_bar_appears_only_on_a_terminal(tmp_path, capsys):
+    import pty
+    path = write(tmp_path, PLAN_ONLY)
+    assert main(["study", str(path), "--workers", "1", "--out", str(tmp_path / "piped")]) == 0
+    assert capsys.readouterr().err == ""  # stderr is not a terminal here
+    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--workers", "1"]
+    leader, follower = pty.openpty()
+    try:
+        on_terminal = subprocess.run(command + ["--out", str(tmp_path / "tty")], stdout=subprocess.PIPE,
+                                     stderr=follower, timeout=120)
+        os.close(follower)
+        err = b""
+        while True:
+            try:
+                chunk = os.read(leader, 4096)
+            except OSError:  # EIO once the child's end is closed and drained
+                break
+            if not chunk:
+                break
+            err += chunk
+    finally:
+        os.close(leader)
+    assert on_terminal.returncode == 0
+    text = err.decode()
+    assert "\r[" in text and "2/2" in text and "failed 0" in text
+
+
+def test_off_the_main_thread_the_wall_limit_is_checked_after_the_run():
+    import threading
+    from swarmnav.sim.study.cell import run_cell
+    from swarmnav.sim.study.spec import parse_study
+    cell = expand(parse_study(PLAN_ONLY.replace("seeds = 2\n", "seeds = 1\nwall_limit_s = 0.0001\n")))[0]
+    result = {}
+    thread = threading.Thread(target=lambda: result.update(row=run_cell(cell)[0]))
+    thread.start()
+    thread.join()
+    row = result["row"]
+    assert row["outcome"] == "timeout" and "checked after the run" in row["error"]
+    assert row["cell_wall_s"] > 0.0001 and row["plan_length_m"] > 0  # the run finished, then was judged
+
+
+def test_a_quick_run_is_the_first_seeds_of_the_full_one():
+    full = load_study("iaco-vs-grid")
+    quick = full.quick()
+    assert quick.seeds == full.seeds[:full.quick_seeds] and len(quick.seeds) < len(full.seeds)
+    full_cells = {c.config_hash: c for c in expand(full)}
+    quick_cells = expand(quick)
+    assert len(quick_cells) * len(full.seeds) == len(full_cells) * len(quick.seeds)
+    assert all(c.config_hash in full_cells and c.seed in quick.seeds for c in quick_cells)

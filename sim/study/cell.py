@@ -31,6 +31,11 @@ from swarmnav.sim.study.grid import Cell
 from swarmnav.sim.versions import software_versions
 
 BEND_TOLERANCE_RAD = 1e-6  # a turn smaller than this between two segments is no bend
+# Quantities some planners report in ``stats.extra`` that a paper's table prints: given their own columns.
+EXTRA_COLUMNS = {"raw_length_m": "plan_raw_length_m",  # the tour before shortcutting (grid and ant planners)
+                 "gates_raised": "plan_gates_raised",  # IMMAS (Hasan et al. 2023), GateRaiseState
+                 "tunnels_closed": "plan_tunnels_closed",  # IMMAS, Algorithm 2 (tight tunnels)
+                 "total_arc_cost": "plan_arc_cost"}  # IMMAS, the arc cost of its tour
 
 
 class WallLimitExceeded(BaseException):
@@ -39,7 +44,7 @@ class WallLimitExceeded(BaseException):
 
 
 def bends(waypoints: np.ndarray) -> int:
-    """Interior waypoints where the heading changes (IACO, Li et al. 2023, Table 3 'bends')."""
+    """Interior waypoints where the heading changes (IACO, Gong et al. 2022, Table 3 'number of bends')."""
     if len(waypoints) < 3:
         return 0
     seg = np.diff(waypoints, axis=0)
@@ -68,7 +73,13 @@ def _json_safe(value: Any) -> Any:
 
 
 class _WallLimit:
-    """SIGALRM after ``limit_s`` when running on a main thread; elsewhere the limit is checked afterwards."""
+    """SIGALRM after ``limit_s`` when running on a main thread; elsewhere the limit is checked afterwards.
+
+    Both engines run cells on their worker's main thread (a spawned process's, and a Ray
+    task's: Ray executes a normal task on its worker process's main thread), so the
+    timer interrupts a long run there.  Only a caller running :func:`run_cell` on
+    another thread gets the after-the-run check (the run finishes, then becomes a
+    ``timeout`` row saying so)."""
 
     def __init__(self, limit_s: float):
         self.limit_s = limit_s
@@ -138,7 +149,8 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
         episode = None
     row["cell_wall_s"] = time.perf_counter() - started
     if episode is not None and row["cell_wall_s"] > cell.wall_limit_s:  # the limit could not be armed here
-        row.update(outcome="timeout", error=f"exceeded the wall limit of {cell.wall_limit_s:g} s")
+        row.update(outcome="timeout", error=f"exceeded the wall limit of {cell.wall_limit_s:g} s "
+                                            "(checked after the run: no timer off the main thread)")
     if episode is not None:
         _add_metrics(row, episode)
         progress = _progress_rows(cell, episode)
@@ -155,6 +167,9 @@ def _add_metrics(row: dict[str, Any], episode) -> None:
                plan_bends=bends(episode.path.waypoints),
                plan_convergence_iteration=stats.extra.get("convergence_iteration"),
                plan_extra=json.dumps(_json_safe(stats.extra), sort_keys=True))
+    for key, column in EXTRA_COLUMNS.items():
+        value = stats.extra.get(key)
+        row[column] = None if value is None or not math.isfinite(float(value)) else value
     if episode.result is not None:
         run = episode.result.summary()
         row.update(reached=run["reached"], run_outcome=run["outcome"], collisions=run["collisions"],

@@ -20,6 +20,8 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
                    help="local processes, or Ray tasks (needs the ray extra: pip install 'swarmnav[ray]')")
     p.add_argument("--address", help="with --engine ray: the cluster to join (default: a local instance)")
     p.add_argument("--logs", action="store_true", help="keep the MCAP log of every physics run in DIR/logs/")
+    p.add_argument("--quick", action="store_true",
+                   help="only the study's first quick_seeds seeds (a later full run into the same --out resumes)")
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
 
 
@@ -36,6 +38,8 @@ def run_study(args: argparse.Namespace) -> int:
         except ImportError:
             raise ConfigError("--engine", "ray is not installed (pip install 'swarmnav[ray]')") from None
     study = load_study(args.file)
+    if args.quick:
+        study = study.quick()
     from swarmnav.sim.study.execute import run_study as execute
     out = args.out or str(FilePath("studies") / study.name)
     summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,

@@ -10,6 +10,7 @@ before anything in them imports NumPy or MuJoCo.
 from __future__ import annotations
 
 import contextlib
+import logging
 import multiprocessing
 import os
 import threading
@@ -22,6 +23,7 @@ from swarmnav.sim.study.grid import Cell
 WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
                       "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
 PARENT_POLL_S = 0.5
+RAY_AUTH_LOGGER = "ray._private.authentication.authentication_token_setup"
 
 Result = tuple[dict[str, Any], list[dict[str, Any]]]
 
@@ -81,6 +83,11 @@ def run_local(cells: Sequence[Cell], workers: int, logs_dir: str | None = None) 
                 process.terminate()
 
 
+def _drop_token_notice(record: logging.LogRecord) -> bool:
+    """Logging filter: drop Ray's notice that a new local instance enabled token authentication."""
+    return not record.getMessage().startswith("Token authentication is enabled")
+
+
 def start_ray(address: str | None, workers: int | None) -> None:
     """Connect to the cluster at ``address``, or start a local instance with ``workers`` CPUs."""
     import ray
@@ -90,6 +97,9 @@ def start_ray(address: str | None, workers: int | None) -> None:
     if address:
         ray.init(address=address, runtime_env=runtime_env, log_to_driver=False)
     else:
+        # A new local instance turns token authentication on by default and logs a warning that it did;
+        # the default stays (setting RAY_AUTH_MODE after Ray's import would break its client), the notice goes.
+        logging.getLogger(RAY_AUTH_LOGGER).addFilter(_drop_token_notice)
         ray.init(num_cpus=workers, runtime_env=runtime_env, include_dashboard=False, log_to_driver=False)
 
 

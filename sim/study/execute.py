@@ -1,7 +1,9 @@
 """Run a study into a directory: expand, skip the cells already there, run the rest, write rows as they finish.
 
 ``DIR/study.json`` records the study's name, description, mode, reference
-planner and the paper's values (what the report needs beside the rows);
+planner, the paper's values and, per scenario, what the report draws under the
+paths (arena, start, goal, the obstacle footprints at t = 0): a report needs only
+the rows and this file, so it works on a copied results folder;
 ``DIR/runs.parquet`` and ``DIR/progress.parquet`` hold the rows (see ``rows``).
 """
 
@@ -16,6 +18,7 @@ from pathlib import Path as FilePath
 from typing import Any, Iterator, TextIO
 
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.study.engines import run_local, run_ray
 from swarmnav.sim.study.grid import Cell, expand
 from swarmnav.sim.study.rows import RowWriter, done_hashes
@@ -24,25 +27,44 @@ from swarmnav.sim.study.spec import Study
 METADATA = "study.json"
 
 
+def scenario_geometry(ref: str, world_seed: int | None = None) -> dict[str, Any]:
+    """What the report's path plot needs of one scenario: arena size, start, goal, and the obstacle
+    footprints at t = 0 (discs as [x, y, r], boxes as [x_min, y_min, x_max, y_max], in metres)."""
+    scenario = load_scenario(ref)
+    if world_seed is not None:
+        scenario = scenario.with_world_seed(world_seed)
+    return {"arena_m": [scenario.arena_width_m, scenario.arena_height_m],
+            "start": [scenario.start.x_m, scenario.start.y_m], "goal": [scenario.goal.x_m, scenario.goal.y_m],
+            "robot_radius_m": scenario.robot_radius_m,
+            "discs_t0": [[d.x_m, d.y_m, d.radius_m] for d in scenario.discs_at(0.0)],
+            "boxes": [[b.x_min_m, b.y_min_m, b.x_max_m, b.y_max_m] for b in scenario.boxes]}
+
+
 def study_metadata(study: Study) -> dict[str, Any]:
+    world_seed = study.world_seeds[0]
     return {"name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
             "reference": study.reference, "planners": [p.label for p in study.planners],
-            "paper": [dataclasses.asdict(p) for p in study.paper]}
+            "paper": [dataclasses.asdict(p) for p in study.paper],
+            "scenarios": {FilePath(s).stem: scenario_geometry(s, world_seed) for s in study.scenarios}}
 
 
 def _write_metadata(study: Study, out_dir: FilePath) -> None:
     path = out_dir / METADATA
+    metadata = study_metadata(study)
     if path.exists():
         try:
-            previous = json.loads(path.read_text(encoding="utf-8")).get("name")
+            old = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):
-            previous = None
+            old = {}
+        previous = old.get("name")
+        # rows of an earlier version of the study stay in the folder: keep the geometry of their scenarios
+        metadata["scenarios"] = {**old.get("scenarios", {}), **metadata["scenarios"]}
         if previous != study.name:
             raise ConfigError("--out", f"holds the rows of study {previous!r}, not {study.name!r} "
                                        "(choose another directory)", str(out_dir))
     out_dir.mkdir(parents=True, exist_ok=True)
     temporary = out_dir / f".{METADATA}.tmp"
-    temporary.write_text(json.dumps(study_metadata(study), indent=2) + "\n", encoding="utf-8")
+    temporary.write_text(json.dumps(metadata, indent=2) + "\n", encoding="utf-8")
     os.replace(temporary, path)
 
 

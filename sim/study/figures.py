@@ -56,6 +56,17 @@ def _carried(histories: list[np.ndarray], length: int) -> np.ndarray:
     return np.stack([np.concatenate([h, np.full(length - h.size, h[-1])]) for h in histories])
 
 
+def _quartiles(stack: np.ndarray) -> np.ndarray:
+    """25th, 50th and 75th percentiles of each column over the runs that have a finite best cost there
+    (before its first tour a colony's best cost is infinite); NaN where no run has one yet."""
+    finite = np.where(np.isfinite(stack), stack, np.nan)
+    out = np.full((3, stack.shape[1]), np.nan)
+    some = ~np.all(np.isnan(finite), axis=0)
+    if some.any():
+        out[:, some] = np.nanpercentile(finite[:, some], [25, 50, 75], axis=0)
+    return out
+
+
 def convergence(arms: dict[str, list[dict[str, Any]]], progress: dict[str, list[tuple[int, float, int]]]
                 ) -> bytes | None:
     """Median best cost with the interquartile band over runs, against iterations and against evaluations."""
@@ -72,14 +83,14 @@ def convergence(arms: dict[str, list[dict[str, Any]]], progress: dict[str, list[
         costs = [np.array([c for _, c, _ in run]) for run in runs]
         length = max(c.size for c in costs)
         stack = _carried(costs, length)
-        q1, med, q3 = np.percentile(stack, [25, 50, 75], axis=0)
+        q1, med, q3 = _quartiles(stack)
         line, = by_iter.plot(np.arange(length), med, label=name)
         by_iter.fill_between(np.arange(length), q1, q3, alpha=0.2, color=line.get_color())
         grid = np.linspace(0, max(run[-1][2] for run in runs), 200)
         on_grid = np.stack([np.array([c for _, c, _ in run])[
             np.clip(np.searchsorted([e for _, _, e in run], grid, side="right") - 1, 0, len(run) - 1)]
             for run in runs])
-        q1, med, q3 = np.percentile(on_grid, [25, 50, 75], axis=0)
+        q1, med, q3 = _quartiles(on_grid)
         by_eval.plot(grid, med, label=name, color=line.get_color())
         by_eval.fill_between(grid, q1, q3, alpha=0.2, color=line.get_color())
     by_iter.set_xlabel("iteration")
@@ -91,19 +102,21 @@ def convergence(arms: dict[str, list[dict[str, Any]]], progress: dict[str, list[
     return _png(fig)
 
 
-def paths(arms: dict[str, list[dict[str, Any]]], scenario) -> bytes | None:
-    """The plan of the lowest seed of each arm over the scenario's obstacles at t = 0 (if it loads)."""
+def paths(arms: dict[str, list[dict[str, Any]]], geometry: dict[str, Any] | None) -> bytes | None:
+    """The plan of the lowest seed of each arm over the scenario as ``study.json`` recorded it at run time
+    (arena, start, goal, obstacle footprints at t = 0); without it, the paths alone."""
     drawn = False
     fig, ax = plt.subplots(figsize=(5, 5))
-    if scenario is not None:
-        for disc in scenario.discs_at(0.0):
-            ax.add_patch(plt.Circle((disc.x_m, disc.y_m), disc.radius_m, color="0.6"))
-        ax.add_collection(PatchCollection([plt.Rectangle((b.x_min_m, b.y_min_m), b.x_max_m - b.x_min_m,
-                                                         b.y_max_m - b.y_min_m) for b in scenario.boxes],
-                                          color="0.6"))
-        bounds = scenario.bounds
-        ax.set_xlim(bounds.x_min_m, bounds.x_max_m)
-        ax.set_ylim(bounds.y_min_m, bounds.y_max_m)
+    if geometry:
+        for x, y, r in geometry.get("discs_t0", []):
+            ax.add_patch(plt.Circle((x, y), r, color="0.6"))
+        ax.add_collection(PatchCollection([plt.Rectangle((x0, y0), x1 - x0, y1 - y0)
+                                           for x0, y0, x1, y1 in geometry.get("boxes", [])], color="0.6"))
+        width_m, height_m = geometry["arena_m"]
+        ax.set_xlim(0.0, width_m)
+        ax.set_ylim(0.0, height_m)
+        ax.plot(*geometry["start"], "k^", markersize=7)
+        ax.plot(*geometry["goal"], "k*", markersize=9)
     for name, rows in arms.items():
         ok = sorted((r for r in rows if r.get("plan_waypoints")), key=lambda r: (r["seed"], str(r["world_seed"])))
         if ok:

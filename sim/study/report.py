@@ -1,8 +1,8 @@
 """``swarmnav report DIR``: a self-contained HTML report of a study's rows, and its Markdown twin.
 
 It reads only ``DIR/runs.parquet``, ``DIR/progress.parquet`` and ``DIR/study.json``
-(the reference planner and the paper's values); the only other file it opens is
-each scenario's, to draw the obstacles under the paths.  The HTML embeds its
+(the reference planner, the paper's values, and each scenario's arena and obstacles
+at t = 0 as recorded when the study ran), so a copied results folder reports alike.  The HTML embeds its
 images (base64 PNG); the Markdown links the same PNGs, written to
 ``<report>_files/`` beside it.
 """
@@ -18,13 +18,14 @@ from typing import Any
 
 from swarmnav.sim.study import figures
 from swarmnav.sim.study.rows import PROGRESS, RUNS, read_table
-from swarmnav.sim.study.statistics import (arm_counts, by_scenario, compare, friedman, impossible, summarise,
-                                           values)
+from swarmnav.sim.study.statistics import (arm_counts, by_scenario, compare, compare_success, friedman, impossible,
+                                           paper_table, summarise, values)
 
 PLAN_METRICS = ["plan_length_m", "plan_time_s", "plan_iterations", "plan_convergence_iteration", "plan_bends",
-                "plan_evaluations"]
+                "plan_evaluations", "plan_raw_length_m", "plan_gates_raised", "plan_tunnels_closed", "plan_arc_cost"]
 RUN_METRICS = ["path_length_m", "sim_time_s", "min_clearance_m", "collisions"]
-TEST_METRIC = "plan_length_m"  # the metric of the tests between planners (seed 003 Table 4 tests path lengths)
+# The metrics tested between planners, each where the runs have it (seed 003 Table 4 tests path lengths).
+TEST_METRICS = ["plan_length_m", "plan_time_s", "path_length_m", "sim_time_s", "min_clearance_m"]
 
 
 def _fmt(x: Any, digits: int = 4) -> str:
@@ -104,15 +105,6 @@ def _present(rows: list[dict[str, Any]], metrics: list[str]) -> list[str]:
     return [m for m in metrics if any(r.get(m) is not None for r in rows)]
 
 
-def _scenario(ref: str):
-    from swarmnav.models.errors import ConfigError
-    from swarmnav.models.scenario import load_scenario
-    try:
-        return load_scenario(ref)
-    except ConfigError:
-        return None
-
-
 def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePath:
     """Write the HTML report and its Markdown twin (``.md`` beside it); return the Markdown path."""
     directory, html_path = FilePath(directory), FilePath(html_path)
@@ -133,13 +125,18 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
         doc.paragraph(meta["description"])
     failed = sum(r["outcome"] != "ok" for r in runs)
     doc.paragraph(f"{len(runs)} runs, {failed} failed (no path, error or wall-limit timeout; counted, never "
-                  f"dropped). Mode: {meta.get('mode', '?')}. Statistics compare {TEST_METRIC} against the "
+                  f"dropped). Mode: {meta.get('mode', '?')}. Statistics compare each planner against the "
                   f"reference planner {meta.get('reference', '?')!r}.")
     for scenario, arms in by_scenario(runs).items():
         scenario_rows = [r for rows in arms.values() for r in rows]
         doc.heading(f"Scenario {scenario}")
         metrics = _present(scenario_rows, PLAN_METRICS + RUN_METRICS)
         doc.table(*count_rows(arms))
+        header, table = paper_table(arms)
+        doc.paragraph("One row per planner in the shape of Gong et al. (2022) Table 3, over the completed runs "
+                      "(std: sample; their 'standard deviation' column equals mean - optimal in every row, "
+                      "so that is given too).")
+        doc.table(header, [[_fmt(v) for v in line] for line in table])
         doc.table(*metric_rows(arms, metrics))
         errors = sorted({r["error"] for r in scenario_rows if r.get("error")})
         if errors:
@@ -151,7 +148,7 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
                   f"{scenario}: distributions over runs")
         doc.image(figures.success_bars(arms), f"{scenario}: success rate")
         doc.image(figures.convergence(arms, progress), f"{scenario}: median best cost with interquartile band")
-        doc.image(figures.paths(arms, _scenario(scenario_rows[0]["scenario_ref"])),
+        doc.image(figures.paths(arms, meta.get("scenarios", {}).get(scenario)),
                   f"{scenario}: the plan of one seed per planner")
     doc.html.append("</body></html>")
     html_path.parent.mkdir(parents=True, exist_ok=True)
@@ -165,20 +162,30 @@ def _statistics(doc: _Document, arms: dict[str, list[dict[str, Any]]], reference
         return
     reference = reference if reference in arms else next((a for a in arms if a.split("(")[0] == reference),
                                                         next(iter(arms)))
-    comparisons = compare(arms, reference, TEST_METRIC)
-    doc.paragraph(f"{TEST_METRIC}: {reference} against each planner. Wilcoxon rank-sum (scipy.stats.ranksums) "
-                  "with Cliff's delta (> 0: the reference's values are larger); Wilcoxon signed-rank on runs "
-                  "paired by seed and world seed, with the matched-pairs rank-biserial correlation; Holm-adjusted.")
-    doc.table(["against", "n ref", "n other", "rank-sum p", "Holm p", "Cliff's delta", "pairs", "signed-rank p",
-               "Holm p", "rank-biserial"],
-              [[c.other, str(c.n_ref), str(c.n_other), _fmt(c.ranksum_p), _fmt(c.ranksum_p_holm),
-                _fmt(c.cliffs_delta, 3), str(c.n_pairs), _fmt(c.signed_rank_p), _fmt(c.signed_rank_p_holm),
-                _fmt(c.rank_biserial, 3)] for c in comparisons])
-    result = friedman(arms, TEST_METRIC)
-    if result is not None:
-        doc.paragraph(f"Friedman test across all {len(arms)} planners on {result['blocks']} seeds every planner "
-                      f"completed: chi² = {_fmt(result['statistic'])}, p = {_fmt(result['p'])}, "
-                      f"Kendall's W = {_fmt(result['kendall_w'], 3)}.")
+    scenario_rows = [r for rows in arms.values() for r in rows]
+    doc.paragraph(f"{reference} against each planner, per metric. Wilcoxon rank-sum (scipy.stats.ranksums, as "
+                  "Gong et al. 2022 Table 4) with Cliff's delta (> 0: the reference's values are larger); Wilcoxon "
+                  "signed-rank on runs paired by seed and world seed, with the matched-pairs rank-biserial "
+                  "correlation; Holm-adjusted over the planners, per metric.")
+    rows = []
+    for metric in _present(scenario_rows, TEST_METRICS):
+        rows += [[c.other, metric, str(c.n_ref), str(c.n_other), _fmt(c.ranksum_p), _fmt(c.ranksum_p_holm),
+                  _fmt(c.cliffs_delta, 3), str(c.n_pairs), _fmt(c.signed_rank_p), _fmt(c.signed_rank_p_holm),
+                  _fmt(c.rank_biserial, 3)] for c in compare(arms, reference, metric)]
+    doc.table(["against", "metric", "n ref", "n other", "rank-sum p", "Holm p", "Cliff's delta", "pairs",
+               "signed-rank p", "Holm p", "rank-biserial"], rows)
+    success = compare_success(arms, reference)
+    doc.paragraph("Success rates: Fisher's exact test (two-sided, scipy.stats.fisher_exact) of successes and "
+                  f"failures, {reference} against each planner, Holm-adjusted.")
+    doc.table(["against", "ref successes", "other successes", "Fisher p", "Holm p"],
+              [[c.other, f"{c.ref_successes}/{c.ref_runs}", f"{c.other_successes}/{c.other_runs}",
+                _fmt(c.fisher_p), _fmt(c.fisher_p_holm)] for c in success])
+    for metric in _present(scenario_rows, TEST_METRICS[:1]):
+        result = friedman(arms, metric)
+        if result is not None:
+            doc.paragraph(f"Friedman test of {metric} across all {len(arms)} planners on {result['blocks']} seeds "
+                          f"every planner completed: chi² = {_fmt(result['statistic'])}, p = {_fmt(result['p'])}, "
+                          f"Kendall's W = {_fmt(result['kendall_w'], 3)}.")
 
 
 def _paper_values(doc: _Document, scenario: str, arms, scenario_rows, paper: list[dict[str, Any]]) -> None:

@@ -34,6 +34,8 @@ RUN_SCHEMA = pa.schema([
     ("plan_length_m", pa.float64()), ("plan_time_s", pa.float64()), ("plan_iterations", pa.int64()),
     ("plan_evaluations", pa.int64()), ("plan_collision_free", pa.bool_()), ("plan_waypoints", pa.string()),
     ("plan_bends", pa.int64()), ("plan_convergence_iteration", pa.int64()), ("plan_extra", pa.string()),
+    ("plan_raw_length_m", pa.float64()), ("plan_gates_raised", pa.int64()), ("plan_tunnels_closed", pa.int64()),
+    ("plan_arc_cost", pa.float64()),
     ("reached", pa.bool_()), ("run_outcome", pa.string()), ("collisions", pa.int64()),
     ("first_collision_s", pa.float64()), ("sim_time_s", pa.float64()), ("wall_time_s", pa.float64()),
     ("path_length_m", pa.float64()), ("min_clearance_m", pa.float64()), ("log", pa.string()),
@@ -52,10 +54,18 @@ def _part_names(directory: FilePath) -> list[FilePath]:
     return sorted(p for p in directory.glob("*.parquet") if not p.name.startswith((".", "_")))
 
 
+def _read_part(path: FilePath, schema: pa.Schema) -> pa.Table:
+    """One part in ``schema``: a column an older part lacks is null (rows written before it existed)."""
+    table = pq.read_table(path)
+    columns = [table.column(f.name).cast(f.type) if f.name in table.column_names
+               else pa.nulls(len(table), f.type) for f in schema]
+    return pa.Table.from_arrays(columns, schema=schema)
+
+
 def read_table(out_dir: str | os.PathLike, name: str = RUNS) -> pa.Table:
     """All parts of one table (an empty table with the schema when there is none)."""
     schema = RUN_SCHEMA if name == RUNS else PROGRESS_SCHEMA
-    parts = [pq.read_table(p, schema=schema) for p in _part_names(FilePath(out_dir) / name)]
+    parts = [_read_part(p, schema) for p in _part_names(FilePath(out_dir) / name)]
     return pa.concat_tables(parts) if parts else schema.empty_table()
 
 

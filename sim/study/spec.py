@@ -7,6 +7,7 @@ TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) o
     scenarios = ["gwo-scenario-*"]   # bundled names, paths, or glob patterns of either
     mode = "plan"                    # "plan" (plan only) or "physics" (plan, then simulate)
     seeds = 10                       # a count (0..N-1) or a list of planner seeds
+    quick_seeds = 3                  # optional: `swarmnav study --quick` runs only the first N seeds
     world_seeds = [0]                # optional: seeds of the random obstacle motions (default: the scenario's)
     wall_limit_s = 120               # per run; past it the run becomes an outcome "timeout" row
     reference = "gwo"                # the planner label (or one swept arm, "maco(p0=0.9)") the statistics
@@ -36,7 +37,7 @@ import fnmatch
 import glob
 import itertools
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path as FilePath
 from typing import Any
 
@@ -47,7 +48,7 @@ from swarmnav.planners import make_planner
 
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
-TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "world_seeds", "wall_limit_s",
+TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
             "time_limit_s", "reference", "planners", "navigators", "paper"}
 
 
@@ -91,6 +92,14 @@ class Study:
     planners: tuple[Component, ...]
     navigators: tuple[Component, ...]
     paper: tuple[PaperValue, ...]
+    quick_seeds: int | None = None  # the first N seeds make the quick run (None: the quick run is the full one)
+
+    def quick(self) -> "Study":
+        """The study on its first ``quick_seeds`` seeds (its rows are the full study's rows for those seeds,
+        so a later full run into the same folder resumes them)."""
+        if self.quick_seeds is None:
+            return self
+        return replace(self, seeds=self.seeds[:self.quick_seeds])
 
     @property
     def physics(self) -> bool:
@@ -104,7 +113,7 @@ def list_studies() -> list[str]:
 
 def resolve_study_path(name_or_path: str) -> FilePath:
     candidate = FilePath(name_or_path)
-    if candidate.suffix == ".toml" or candidate.exists() or "/" in name_or_path:
+    if candidate.suffix == ".toml" or candidate.is_file() or "/" in name_or_path:
         if not candidate.is_file():
             raise ConfigError("study", "file does not exist", str(candidate))
         return candidate
@@ -273,6 +282,11 @@ def parse_study(text: str, source: str = "<string>", default_name: str = "study"
     if mode not in MODES:
         _fail(source, "mode", f"unknown value {mode!r} (expected one of: {', '.join(MODES)})")
     seeds = _seeds(source, data, "seeds", 1)
+    quick_seeds = None
+    if "quick_seeds" in data:
+        quick_seeds = data["quick_seeds"]
+        if isinstance(quick_seeds, bool) or not isinstance(quick_seeds, int) or not 1 <= quick_seeds <= len(seeds):
+            _fail(source, "quick_seeds", f"expected a count from 1 to the {len(seeds)} seeds, got {quick_seeds!r}")
     world_seeds: tuple = _seeds(source, data, "world_seeds", [0]) if "world_seeds" in data else (None,)
     wall_limit_s = _number(source, data.get("wall_limit_s", 600.0), "wall_limit_s")
     if wall_limit_s <= 0:
@@ -293,4 +307,4 @@ def parse_study(text: str, source: str = "<string>", default_name: str = "study"
         _fail(source, "reference", f"{reference!r} is not a planner label of the study ({', '.join(labels)})")
     paper = _paper(source, data.get("paper", []), scenarios, labels)
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
-                 reference, planners, navigators, paper)
+                 reference, planners, navigators, paper, quick_seeds)

@@ -3,12 +3,18 @@
 * per arm (planner label, navigator label): runs, failures, success rate, and
   mean ± std (sample, ddof = 1), median and best of each metric over the runs
   that produced it;
-* between arms on one scenario: the Wilcoxon rank-sum test (``scipy.stats.ranksums``,
-  as Li et al. 2023, seed 003, Table 4 use it on path lengths) with Cliff's delta;
+* between arms on one scenario, for each metric (length, time, clearance, ...): the
+  Wilcoxon rank-sum test (``scipy.stats.ranksums``, as Gong et al. 2022, seed 003,
+  Table 4 use it on path lengths) with Cliff's delta;
   the Wilcoxon signed-rank test (``scipy.stats.wilcoxon``) on the runs that pair by
   (seed, world seed) with the matched-pairs rank-biserial correlation; Holm's
   step-down correction over the comparisons against the reference planner; and the
-  Friedman test across all arms on the seeds every arm completed, with Kendall's W.
+  Friedman test across all arms on the seeds every arm completed, with Kendall's W;
+* success rates: Fisher's exact test (``scipy.stats.fisher_exact``) of the reference
+  arm's successes and failures against each other arm's, Holm-corrected;
+* a one-row-per-arm table in the shape of Gong et al. (2022) Table 3: optimal (best)
+  and mean length, std, convergence iteration, bends and time, with the IMMAS
+  columns (Hasan et al. 2023: gates raised, tunnels closed, arc cost) where present.
 """
 
 from __future__ import annotations
@@ -56,6 +62,8 @@ def summarise(rows: list[dict[str, Any]], metric: str) -> MetricSummary | None:
     if v.size == 0:
         return None
     best = float(v.max() if not LOWER_IS_BETTER.get(metric, True) else v.min())
+    if np.ptp(v) <= 1e-12 * max(1.0, abs(float(v[0]))):  # identical runs up to rounding: no spread
+        return MetricSummary(int(v.size), float(v[0]), 0.0 if v.size > 1 else float("nan"), float(v[0]), best)
     return MetricSummary(int(v.size), float(v.mean()), float(v.std(ddof=1)) if v.size > 1 else float("nan"),
                          float(np.median(v)), best)
 
@@ -184,3 +192,64 @@ def impossible(metric: str, paper_value: float, scenario_rows: list[dict[str, An
     if optimum.size and paper_value < optimum.min() - 1e-6:
         return f"impossible: below the exact optimum ({optimum.min():.4f} m)"
     return None
+
+
+@dataclass
+class SuccessComparison:
+    other: str
+    ref_successes: int
+    ref_runs: int
+    other_successes: int
+    other_runs: int
+    fisher_p: float
+    fisher_p_holm: float = float("nan")
+
+
+def compare_success(arms: dict[str, list[dict[str, Any]]], reference: str) -> list[SuccessComparison]:
+    """Fisher's exact test (two-sided) of the 2 x 2 table successes/failures, reference against each arm."""
+    if reference not in arms:
+        return []
+    def counts(rows):
+        return sum(bool(r["success"]) for r in rows), len(rows)
+    ref_s, ref_n = counts(arms[reference])
+    out = []
+    for name, rows in arms.items():
+        if name == reference:
+            continue
+        s, n = counts(rows)
+        p = float(stats.fisher_exact([[ref_s, ref_n - ref_s], [s, n - s]]).pvalue) if ref_n and n else float("nan")
+        out.append(SuccessComparison(name, ref_s, ref_n, s, n, p))
+    for c, adjusted in zip(out, holm([c.fisher_p for c in out])):
+        c.fisher_p_holm = adjusted
+    return out
+
+
+# (header, metric, statistic) of the one-row-per-arm table; a column whose metric no run has is left out.
+PAPER_COLUMNS = (("optimal length", "plan_length_m", "best"), ("mean length", "plan_length_m", "mean"),
+                 ("std", "plan_length_m", "std"), ("mean - optimal", "plan_length_m", "spread"),
+                 ("convergence iteration", "plan_convergence_iteration", "mean"),
+                 ("bends", "plan_bends", "mean"), ("time (s)", "plan_time_s", "mean"),
+                 ("gates", "plan_gates_raised", "mean"), ("tunnels", "plan_tunnels_closed", "mean"),
+                 ("arc cost", "plan_arc_cost", "mean"), ("iterations", "plan_iterations", "mean"))
+
+
+def paper_table(arms: dict[str, list[dict[str, Any]]]) -> tuple[list[str], list[list[float | int | None]]]:
+    """Per arm: runs, successes, then each :data:`PAPER_COLUMNS` entry over the completed runs.
+    ``mean - optimal`` is there because Gong et al. (2022) Table 3's "standard deviation" column equals
+    the mean minus the optimal length in every one of its rows."""
+    all_rows = [r for rows in arms.values() for r in rows]
+    columns = [c for c in PAPER_COLUMNS if any(r.get(c[1]) is not None for r in all_rows)]
+    header = ["planner", "runs", "successes"] + [c[0] for c in columns]
+    table = []
+    for name, rows in arms.items():
+        line: list = [name, len(rows), sum(bool(r["success"]) for r in rows)]
+        for _, metric, statistic in columns:
+            summary = summarise(rows, metric)
+            if summary is None:
+                line.append(None)
+            elif statistic == "spread":
+                line.append(summary.mean - summary.best)
+            else:
+                line.append(getattr(summary, statistic))
+        table.append(line)
+    return header, table
