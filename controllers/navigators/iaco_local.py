@@ -32,8 +32,9 @@ Our choices where the paper is silent:
 * A crossing obstacle that is predicted to miss the robot, or a same-line
   obstacle moving away, is no conflict (type 0) and is not logged.
 * Replanning runs ``setup.planner`` when it is ``iaco``, else a default
-  :class:`~planners.improved_ant_colony.ImprovedAntColonyPlanner`, on the static
-  map (:func:`~controllers.navigators.cell_path.static_grid`) from the escape cell.
+  :class:`~planners.improved_ant_colony.ImprovedAntColonyPlanner`, on the known
+  static world (``setup.map_problem``: the map and the static discs,
+  :func:`~controllers.navigators.cell_path.static_grid`) from the escape cell.
 * Reach of an obstacle: its radius + the robot's inflation (radius and
   clearance) + ``margin_m``.
 """
@@ -99,7 +100,8 @@ class IacoLocalNavigator:
 
     def reset(self, setup: NavigationSetup) -> None:
         self.setup = setup
-        problem = setup.problem
+        problem = setup.map_problem  # static obstacles only: the moving ones are sensed
+        self.problem = problem
         self.grid = static_grid(problem)
         self.planner = setup.planner if isinstance(setup.planner, ImprovedAntColonyPlanner) \
             else ImprovedAntColonyPlanner()
@@ -111,7 +113,7 @@ class IacoLocalNavigator:
         self.goal_cell = goal
         free = ~self.grid.occupied
         self.labels, _ = ndimage.label(free, structure=np.ones((3, 3), dtype=bool))
-        replanned = not (setup.path.stats.extra.get("raw_cells") and not problem.obstacles
+        replanned = not (setup.path.stats.extra.get("raw_cells") and len(setup.problem.obstacles) == len(problem.obstacles)
                          and isinstance(setup.planner, ImprovedAntColonyPlanner))
         if replanned:  # Step 2: the IACO path on the static map (the first plan saw the moving obstacles at t = 0)
             cells = cells_of_path(self.planner.plan(grid_problem(problem, self.grid, start), setup.rng), self.grid)
@@ -262,7 +264,7 @@ class IacoLocalNavigator:
             cell = (here[0] + offset[0], here[1] + offset[1])
             tried += 1
             try:
-                path = self.planner.plan(grid_problem(self.setup.problem, self.grid, cell), self.setup.rng)
+                path = self.planner.plan(grid_problem(self.problem, self.grid, cell), self.setup.rng)
             except PlanningError:
                 continue
             moves = step_line(here, cell)
