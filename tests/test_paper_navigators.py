@@ -49,6 +49,16 @@ def test_obs1_head_on_odd_size_acts_now_with_two_escape_cells():
     assert x == pytest.approx(5) and timing(enc.kind, enc.ng, x, enc.step_scale) == ("act", 0)
 
 
+def test_an_escape_along_an_axis_costs_the_robot_its_moves():
+    """Heading along x, Eq. (14)'s cell two rows aside is two straight moves: Obs1's X is the paper's 5."""
+    from swarmnav.controllers.navigators.collision_types import escape_moves, precondition_x_of_moves
+    enc = _encounter(5, 0.6, 3 * V_ROB, -1)
+    (offset, _other) = escape_offsets(EAST, enc.grid_scale)
+    assert escape_moves(EAST, offset) == 2 and escape_moves((-1, 1), (2, 2)) == 2 and escape_moves((-1, 1), (1, 2)) == 1
+    x = precondition_x_of_moves(escape_moves(EAST, offset), enc.step_scale, enc.grid_scale)
+    assert x == pytest.approx(5) and timing(enc.kind, enc.ng, x, enc.step_scale) == ("act", 0)
+
+
 def test_obs2_head_on_even_size_has_six_escape_cells():
     enc = _encounter(3, 0.4, 2 * V_ROB, -1)                # seed 003 §5.4 Obs2
     assert (enc.kind, enc.ng, enc.grid_scale) == (HEAD_ON, 3, 2)
@@ -162,10 +172,26 @@ def test_immas_stepwise_never_steps_onto_an_occupied_cell_on_20_world_seeds():
     assert reached >= 18
 
 
-def test_iaco_local_avoids_obs1_and_obs2_where_wait_only_does_not():
+class _Events:
+    def __init__(self):
+        self.events = []
+
+    def start(self, context): pass
+    def path(self, time_s, waypoints_m): pass
+    def step(self, frame): pass
+    def finish(self, summary): pass
+
+    def event(self, time_s, kind, details):
+        self.events.append((kind, details))
+
+
+def test_iaco_local_avoids_obs1_to_obs3_where_wait_only_does_not():
     scenario = load_scenario("iaco-dynamic")
-    paper = run_episode(EpisodeSpec(scenario)).result
+    events = _Events()
+    paper = run_episode(EpisodeSpec(scenario), [events]).result
     assert paper.reached and paper.collisions == 0
+    kinds = [(d["type"], d["grid_scale"] % 2, d["action"]) for k, d in events.events if k == "collision_type"]
+    assert (2, 1, "escape") in kinds and (2, 0, "escape") in kinds and (3, 0, "escape") in kinds  # Obs1, 2, 3
     waiting = run_episode(EpisodeSpec(scenario, navigator_params={"strategy": "wait_only"}),
                           stop_on_collision=True).result
     assert waiting.collisions >= 1 or not waiting.reached

@@ -52,8 +52,9 @@ from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, Na
 from swarmnav.controllers.navigators.cell_path import (Cell, CellWalker, cells_of_path, grid_problem, heading_of,
                                                        static_grid, step_line)
 from swarmnav.controllers.navigators.collision_types import (CATCHING_UP, CROSSING, FROM_BEHIND, HEAD_ON,
-                                                             NO_CONFLICT, Encounter, classify, escape_offsets,
-                                                             first_band_index, precondition_x,
+                                                             NO_CONFLICT, Encounter, classify, escape_moves,
+                                                             escape_offsets, first_band_index,
+                                                             precondition_x_of_moves,
                                                              predicted_meeting_s, timing)
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
@@ -220,8 +221,10 @@ class IacoLocalNavigator:
             if enc.ng > rg:
                 return "go_on", {"rg": rg if math.isfinite(rg) else None}
             return self._escape(observation, det, enc, -math.inf)
-        offsets = escape_offsets(heading_of(self.walker.cells, index), enc.grid_scale)
-        xs = [precondition_x(math.hypot(*o), enc.step_scale, enc.grid_scale, self.lead_steps) for o in offsets]
+        heading = heading_of(self.walker.cells, index)
+        offsets = escape_offsets(heading, enc.grid_scale)
+        xs = [precondition_x_of_moves(escape_moves(heading, o), enc.step_scale, enc.grid_scale, self.lead_steps)
+              for o in offsets]
         usable = [x for o, x in zip(offsets, xs) if self._candidate_ok(observation, o, det)]
         if not usable:
             return "no_escape_cell", {}
@@ -258,8 +261,9 @@ class IacoLocalNavigator:
         best = None
         tried = 0
         for offset in escape_offsets(heading, enc.grid_scale):
-            x = precondition_x(math.hypot(*offset), enc.step_scale, enc.grid_scale, self.lead_steps)
-            if not self._candidate_ok(observation, offset, det) or (x > ng_limit and ng_limit != -math.inf):
+            x = precondition_x_of_moves(escape_moves(heading, offset), enc.step_scale, enc.grid_scale, self.lead_steps)
+            # Eq. (12), X <= ng, to within the noise of a sensed Step_scale (0.6 / 0.2 is not exactly 3).
+            if not self._candidate_ok(observation, offset, det) or (x > ng_limit + 1e-6 and ng_limit != -math.inf):
                 continue
             cell = (here[0] + offset[0], here[1] + offset[1])
             tried += 1
