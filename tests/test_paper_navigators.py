@@ -223,3 +223,12 @@ def test_static_discs_stay_in_the_navigators_map_and_moving_ones_do_not(name):
     grid = nav.grid
     assert grid.occupied[grid.cell_of(static.x_m, static.y_m)]
     assert not grid.occupied[grid.cell_of(moving.x_m, moving.y_m)]
+
+
+def test_turns_are_counted_on_the_driven_path():
+    from swarmnav.sim.benchmarks.paper_navigation import count_turns
+    t = np.linspace(0.0, 1.0, 200)[:, None]
+    straight = np.hstack([t * 4.0, 0.0 * t, 0.0 * t])
+    corner = np.vstack([straight, np.hstack([4.0 + 0.0 * t, t * 4.0, 0.0 * t])])
+    zigzag = np.vstack([corner, np.hstack([4.0 + t * 4.0, 4.0 + 0.0 * t, 0.0 * t])])
+    assert [count_turns(p, 0.4) for p in (straight, corner, zigzag)] == [0, 1, 2]
