@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from swarmnav.models.obstacle_motion import LinearMotion, RandomWalkMotion, Stationary, WaypointMotion
+from swarmnav.models.obstacle_motion import WALK_STEPS, LinearMotion, RandomWalkMotion, Stationary, WaypointMotion
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem
 
@@ -345,6 +345,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     static_radii_arr = np.array(static_radii, dtype=float)
 
     _check_motion_size(parsed, time_limit_s, sim, source)
+    box_array_m = np.array([[b.x_min_m, b.y_min_m, b.x_max_m, b.y_max_m] for b in boxes], dtype=float).reshape(-1, 4)
     obstacles = []
     for i, (t, x, y, radius, height, motion_raw) in enumerate(parsed):
         motion = None
@@ -354,14 +355,22 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
             # Centres stay inside the arena: seed 004 places obstacles on its edge.
             lower = (0.0, 0.0)
             upper = (width_m, height_m)
+            start_s = m.number("start_s", 0.0, non_negative=True)  # held at its start until then
             if kind == "linear":
                 motion = LinearMotion((x, y), m.number("speed_m_s", non_negative=True),
                                       math.radians(m.number("heading_deg")),
-                                      m.string("at_edge", choices=("reflect", "stop")), lower, upper)
+                                      m.string("at_edge", choices=("reflect", "stop")), lower, upper, start_s)
             elif kind == "random_walk":
+                # A walker's disc stays inside the walls and off the map's boxes; on a map it walks the
+                # paper's grid (seed 000) by default, elsewhere compass steps (obstacle_motion's docstring).
+                if walls:
+                    lower, upper = (radius, radius), (width_m - radius, height_m - radius)
                 motion = RandomWalkMotion(
                     (x, y), radius, m.number("step_m", positive=True), m.number("period_s", positive=True),
-                    time_limit_s, lower, upper, static_centres_arr, static_radii_arr, stream=i, world_seed=seed)
+                    time_limit_s, lower, upper, static_centres_arr, static_radii_arr, stream=i, world_seed=seed,
+                    static_boxes_m=box_array_m,
+                    steps=m.string("steps", "grid" if map_cell_m is not None else "compass", choices=WALK_STEPS),
+                    start_s=start_s)
             else:
                 points = m.raw("points")
                 if (not isinstance(points, list) or not points
@@ -375,7 +384,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
                 if len(outside):
                     m.fail(f"points[{outside[0]}]", f"({arr[outside[0], 0]:g}, {arr[outside[0], 1]:g}) must lie "
                                                     f"in the arena [0, {width_m:g}] x [0, {height_m:g}]")
-                motion = WaypointMotion(np.vstack([[x, y], arr]), m.number("speed_m_s", positive=True))
+                motion = WaypointMotion(np.vstack([[x, y], arr]), m.number("speed_m_s", positive=True), start_s)
             m.close()
         t.close()
         obstacles.append(Obstacle(x, y, radius, height, motion))

@@ -49,6 +49,16 @@ def test_obs1_head_on_odd_size_acts_now_with_two_escape_cells():
     assert x == pytest.approx(5) and timing(enc.kind, enc.ng, x, enc.step_scale) == ("act", 0)
 
 
+def test_an_escape_along_an_axis_costs_the_robot_its_moves():
+    """Heading along x, Eq. (14)'s cell two rows aside is two straight moves: Obs1's X is the paper's 5."""
+    from swarmnav.controllers.navigators.collision_types import escape_moves, precondition_x_of_moves
+    enc = _encounter(5, 0.6, 3 * V_ROB, -1)
+    (offset, _other) = escape_offsets(EAST, enc.grid_scale)
+    assert escape_moves(EAST, offset) == 2 and escape_moves((-1, 1), (2, 2)) == 2 and escape_moves((-1, 1), (1, 2)) == 1
+    x = precondition_x_of_moves(escape_moves(EAST, offset), enc.step_scale, enc.grid_scale)
+    assert x == pytest.approx(5) and timing(enc.kind, enc.ng, x, enc.step_scale) == ("act", 0)
+
+
 def test_obs2_head_on_even_size_has_six_escape_cells():
     enc = _encounter(3, 0.4, 2 * V_ROB, -1)                # seed 003 §5.4 Obs2
     assert (enc.kind, enc.ng, enc.grid_scale) == (HEAD_ON, 3, 2)
@@ -144,7 +154,7 @@ def test_immas_stepwise_never_steps_onto_an_occupied_cell_on_20_world_seeds():
     start = grid.cell_of(base.start.x_m, base.start.y_m)
     goal = grid.cell_of(base.goal.x_m, base.goal.y_m)
     walk = StepwiseWalk(analyse_environment(grid.occupied, start, goal), goal, 3.0, 1.0)
-    step_s = grid.cell_m / base.max_speed_m_s
+    step_s = base.obstacles[0].motion.period_s   # Algorithm 3's loop: one obstacle update per robot move
     reached = 0
     for world_seed in range(20):
         scenario = base.with_world_seed(world_seed)
@@ -162,10 +172,26 @@ def test_immas_stepwise_never_steps_onto_an_occupied_cell_on_20_world_seeds():
     assert reached >= 18
 
 
-def test_iaco_local_avoids_obs1_and_obs2_where_wait_only_does_not():
+class _Events:
+    def __init__(self):
+        self.events = []
+
+    def start(self, context): pass
+    def path(self, time_s, waypoints_m): pass
+    def step(self, frame): pass
+    def finish(self, summary): pass
+
+    def event(self, time_s, kind, details):
+        self.events.append((kind, details))
+
+
+def test_iaco_local_avoids_obs1_to_obs3_where_wait_only_does_not():
     scenario = load_scenario("iaco-dynamic")
-    paper = run_episode(EpisodeSpec(scenario)).result
+    events = _Events()
+    paper = run_episode(EpisodeSpec(scenario), [events]).result
     assert paper.reached and paper.collisions == 0
+    kinds = [(d["type"], d["grid_scale"] % 2, d["action"]) for k, d in events.events if k == "collision_type"]
+    assert (2, 1, "escape") in kinds and (2, 0, "escape") in kinds and (3, 0, "escape") in kinds  # Obs1, 2, 3
     waiting = run_episode(EpisodeSpec(scenario, navigator_params={"strategy": "wait_only"}),
                           stop_on_collision=True).result
     assert waiting.collisions >= 1 or not waiting.reached
@@ -173,6 +199,36 @@ def test_iaco_local_avoids_obs1_and_obs2_where_wait_only_does_not():
 
 def test_immas_stepwise_run_is_deterministic():
     scenario = load_scenario("immas-dynamic-10x10")
-    a = run_episode(EpisodeSpec(scenario, world_seed=0)).result
-    b = run_episode(EpisodeSpec(scenario, world_seed=0)).result
+    a = run_episode(EpisodeSpec(scenario, world_seed=1)).result
+    b = run_episode(EpisodeSpec(scenario, world_seed=1)).result
     assert a.reached and np.array_equal(a.poses, b.poses)
+
+
+@pytest.mark.parametrize("name", ["iaco_local", "immas_stepwise"])
+def test_static_discs_stay_in_the_navigators_map_and_moving_ones_do_not(name):
+    """A static disc blocks its cells for the whole run; a moving obstacle's t = 0 disc blocks nothing."""
+    from dataclasses import replace
+    from swarmnav.models.world import Disc
+    nav, problem = _setup(name)
+    static = Disc(problem.start.x_m + 6 * CELL, problem.start.y_m + 2 * CELL, 0.3)
+    moving = Disc(problem.start.x_m + 10 * CELL, problem.start.y_m, 0.3)
+    known = replace(problem, obstacles=(static,))
+    frozen = replace(problem, obstacles=(static, moving))
+    planner = make_planner("iaco" if name == "iaco_local" else "immas")
+    path = make_planner("iaco", {"ants": 5, "iterations": 5}).plan(known, np.random.default_rng(0))
+    setup = NavigationSetup(path, frozen, planner, np.random.default_rng(0),
+                            PointToPointController(DriveGeometry(0.035, 0.23, 12.0), max_speed_m_s=V_ROB),
+                            GoalChecker(problem.goal.x_m, problem.goal.y_m, 0.1), 0.02, V_ROB, known_problem=known)
+    nav.reset(setup)
+    grid = nav.grid
+    assert grid.occupied[grid.cell_of(static.x_m, static.y_m)]
+    assert not grid.occupied[grid.cell_of(moving.x_m, moving.y_m)]
+
+
+def test_turns_are_counted_on_the_driven_path():
+    from swarmnav.sim.benchmarks.paper_navigation import count_turns
+    t = np.linspace(0.0, 1.0, 200)[:, None]
+    straight = np.hstack([t * 4.0, 0.0 * t, 0.0 * t])
+    corner = np.vstack([straight, np.hstack([4.0 + 0.0 * t, t * 4.0, 0.0 * t])])
+    zigzag = np.vstack([corner, np.hstack([4.0 + t * 4.0, 4.0 + 0.0 * t, 0.0 * t])])
+    assert [count_turns(p, 0.4) for p in (straight, corner, zigzag)] == [0, 1, 2]

@@ -15,7 +15,7 @@ import numpy as np
 
 from swarmnav.controllers.controller import ControlCommand, Controller, Twist
 from swarmnav.models.grid_map import inflated_map_grid
-from swarmnav.models.world import OccupancyGrid, Pose2D
+from swarmnav.models.world import OccupancyGrid, Pose2D, rasterise
 from swarmnav.planners.problem import Path, Problem
 
 Cell = tuple[int, int]  # (row, col); rows grow with y
@@ -23,12 +23,13 @@ MOVES = ((-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (-1, 1), (1, -1), (1, 1))
 
 
 def static_grid(problem: Problem) -> OccupancyGrid:
-    """The static world on the problem's cells: its boxes (the map), inflated by the robot.
+    """The known static world on the problem's cells: its boxes (the map) and its discs, inflated by the robot.
 
-    The planning problem of a scenario freezes its moving obstacles at t = 0 as
-    discs; both papers plan on the static map and sense the moving obstacles, so
-    discs are left out here (ours: the papers' grids have no static discs; a
-    scenario with static discs beside moving ones is not their setting).
+    Pass the robot's known map, ``NavigationSetup.map_problem`` (static obstacles
+    only): both papers plan on the static map and sense the moving obstacles.  Map
+    cells are taken as the map has them (:func:`~models.grid_map.inflated_map_grid`,
+    so one-cell corridors stay open for a robot up to one cell wide); static discs
+    are rasterised with :func:`~models.world.rasterise`'s margin.
     """
     bounds = problem.bounds
     cell_m = problem.cell_m
@@ -41,12 +42,16 @@ def static_grid(problem: Problem) -> OccupancyGrid:
         inside_x = (xs > box.x_min_m) & (xs < box.x_max_m)
         inside_y = (ys > box.y_min_m) & (ys < box.y_max_m)
         occupied |= inside_y[:, None] & inside_x[None, :]
-    return inflated_map_grid(occupied, cell_m, problem.inflation_m, problem.boxes or None,
+    grid = inflated_map_grid(occupied, cell_m, problem.inflation_m, problem.boxes or None,
                              origin_m=(bounds.x_min_m, bounds.y_min_m))
+    if problem.obstacles:
+        discs = rasterise(bounds, problem.obstacles, (), problem.inflation_m, cell_m)
+        grid = OccupancyGrid(grid.occupied | discs.occupied, grid.cell_m, grid.origin_m)
+    return grid
 
 
 def grid_problem(problem: Problem, grid: OccupancyGrid, start_cell: Cell) -> Problem:
-    """The problem from a cell's centre to the goal on ``grid`` (no discs), for replanning."""
+    """The problem from a cell's centre to the goal on ``grid`` (its discs are in the grid), for replanning."""
     x, y = grid.centres_m(np.array([start_cell]))[0]
     return replace(problem, start=Pose2D(float(x), float(y), problem.start.heading_rad), obstacles=(),
                    grid_override=grid)

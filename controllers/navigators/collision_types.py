@@ -65,7 +65,25 @@ def precondition_x(ld_cells: float, step_scale: float, grid_scale: int, lead_ste
     ``lead_steps`` (ours, 0 in the paper) adds robot steps to the escape's, for the
     time a real robot needs to turn towards the escape cell.
     """
-    return (math.floor(ld_cells / math.sqrt(2.0) + 1e-9) + lead_steps) * step_scale - (grid_scale % 2)
+    return precondition_x_of_moves(math.floor(ld_cells / math.sqrt(2.0) + 1e-9), step_scale, grid_scale, lead_steps)
+
+
+def precondition_x_of_moves(moves: int, step_scale: float, grid_scale: int, lead_steps: int = 0) -> float:
+    """Eq. (12)'s left side for an escape of ``moves`` robot moves: ``(moves + lead_steps) * Step_scale - (Grid_scale mod 2)``."""
+    return (moves + lead_steps) * step_scale - (grid_scale % 2)
+
+
+def escape_moves(heading: Cell, offset: Cell) -> int:
+    """The robot moves an escape to ``offset`` costs in Eq. (12).
+
+    Diagonal heading (the paper's figures): ``floor(Ld / sqrt(2))``, Eq. (12) as read
+    above.  Heading along an axis (ours): the 8-neighbour moves to the cell,
+    ``max(|dr|, |dc|)``; reading ``floor(Ld / sqrt(2))`` there (as this module's first
+    version did) counted the two straight moves to ``2q`` as one.
+    """
+    if heading[0] and heading[1]:
+        return math.floor(math.hypot(*offset) / math.sqrt(2.0) + 1e-9)
+    return max(abs(offset[0]), abs(offset[1]))
 
 
 def escape_offsets(heading: Cell, grid_scale: int) -> list[Cell]:

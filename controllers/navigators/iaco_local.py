@@ -32,8 +32,9 @@ Our choices where the paper is silent:
 * A crossing obstacle that is predicted to miss the robot, or a same-line
   obstacle moving away, is no conflict (type 0) and is not logged.
 * Replanning runs ``setup.planner`` when it is ``iaco``, else a default
-  :class:`~planners.improved_ant_colony.ImprovedAntColonyPlanner`, on the static
-  map (:func:`~controllers.navigators.cell_path.static_grid`) from the escape cell.
+  :class:`~planners.improved_ant_colony.ImprovedAntColonyPlanner`, on the known
+  static world (``setup.map_problem``: the map and the static discs,
+  :func:`~controllers.navigators.cell_path.static_grid`) from the escape cell.
 * Reach of an obstacle: its radius + the robot's inflation (radius and
   clearance) + ``margin_m``.
 """
@@ -51,8 +52,9 @@ from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, Na
 from swarmnav.controllers.navigators.cell_path import (Cell, CellWalker, cells_of_path, grid_problem, heading_of,
                                                        static_grid, step_line)
 from swarmnav.controllers.navigators.collision_types import (CATCHING_UP, CROSSING, FROM_BEHIND, HEAD_ON,
-                                                             NO_CONFLICT, Encounter, classify, escape_offsets,
-                                                             first_band_index, precondition_x,
+                                                             NO_CONFLICT, Encounter, classify, escape_moves,
+                                                             escape_offsets, first_band_index,
+                                                             precondition_x_of_moves,
                                                              predicted_meeting_s, timing)
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
@@ -99,7 +101,8 @@ class IacoLocalNavigator:
 
     def reset(self, setup: NavigationSetup) -> None:
         self.setup = setup
-        problem = setup.problem
+        problem = setup.map_problem  # static obstacles only: the moving ones are sensed
+        self.problem = problem
         self.grid = static_grid(problem)
         self.planner = setup.planner if isinstance(setup.planner, ImprovedAntColonyPlanner) \
             else ImprovedAntColonyPlanner()
@@ -111,7 +114,7 @@ class IacoLocalNavigator:
         self.goal_cell = goal
         free = ~self.grid.occupied
         self.labels, _ = ndimage.label(free, structure=np.ones((3, 3), dtype=bool))
-        replanned = not (setup.path.stats.extra.get("raw_cells") and not problem.obstacles
+        replanned = not (setup.path.stats.extra.get("raw_cells") and len(setup.problem.obstacles) == len(problem.obstacles)
                          and isinstance(setup.planner, ImprovedAntColonyPlanner))
         if replanned:  # Step 2: the IACO path on the static map (the first plan saw the moving obstacles at t = 0)
             cells = cells_of_path(self.planner.plan(grid_problem(problem, self.grid, start), setup.rng), self.grid)
@@ -218,8 +221,10 @@ class IacoLocalNavigator:
             if enc.ng > rg:
                 return "go_on", {"rg": rg if math.isfinite(rg) else None}
             return self._escape(observation, det, enc, -math.inf)
-        offsets = escape_offsets(heading_of(self.walker.cells, index), enc.grid_scale)
-        xs = [precondition_x(math.hypot(*o), enc.step_scale, enc.grid_scale, self.lead_steps) for o in offsets]
+        heading = heading_of(self.walker.cells, index)
+        offsets = escape_offsets(heading, enc.grid_scale)
+        xs = [precondition_x_of_moves(escape_moves(heading, o), enc.step_scale, enc.grid_scale, self.lead_steps)
+              for o in offsets]
         usable = [x for o, x in zip(offsets, xs) if self._candidate_ok(observation, o, det)]
         if not usable:
             return "no_escape_cell", {}
@@ -256,13 +261,14 @@ class IacoLocalNavigator:
         best = None
         tried = 0
         for offset in escape_offsets(heading, enc.grid_scale):
-            x = precondition_x(math.hypot(*offset), enc.step_scale, enc.grid_scale, self.lead_steps)
-            if not self._candidate_ok(observation, offset, det) or (x > ng_limit and ng_limit != -math.inf):
+            x = precondition_x_of_moves(escape_moves(heading, offset), enc.step_scale, enc.grid_scale, self.lead_steps)
+            # Eq. (12), X <= ng, to within the noise of a sensed Step_scale (0.6 / 0.2 is not exactly 3).
+            if not self._candidate_ok(observation, offset, det) or (x > ng_limit + 1e-6 and ng_limit != -math.inf):
                 continue
             cell = (here[0] + offset[0], here[1] + offset[1])
             tried += 1
             try:
-                path = self.planner.plan(grid_problem(self.setup.problem, self.grid, cell), self.setup.rng)
+                path = self.planner.plan(grid_problem(self.problem, self.grid, cell), self.setup.rng)
             except PlanningError:
                 continue
             moves = step_line(here, cell)

@@ -125,6 +125,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--navigator-set", action="append", metavar="KEY=VALUE",
                         help="a parameter for every navigator that has it (repeatable), e.g. policy=module:function")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
+    parser.add_argument("--suite", choices=("dyn", "papers"), default="dyn",
+                        help="dyn: the dyn-* suite (default); papers: the papers' strategies beside replan + iaco "
+                             "and dstar_replan, one row per run (sim/benchmarks/paper_navigation.py)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -134,6 +137,12 @@ def run(args: argparse.Namespace) -> int:
     for name in args.navigator or []:
         if name not in NAVIGATORS:
             raise ConfigError("--navigator", f"unknown navigator {name!r} (known: {', '.join(sorted(NAVIGATORS))})")
+    if args.suite == "papers":
+        from swarmnav.sim.benchmarks.paper_navigation import (PAPER_SUITE, benchmark_paper_navigation,
+                                                              print_table)
+        paper_rows = benchmark_paper_navigation(args.seeds, tuple(args.scenario or PAPER_SUITE))
+        print(json.dumps(paper_rows)) if args.json else print_table(paper_rows)
+        return 0
     from swarmnav.sim.cli import parse_settings  # loaded already: the CLI is what calls this
     settings = navigator_settings(parse_settings(args.navigator_set, "--navigator-set"),
                                   args.navigator or list(NAVIGATORS))
