@@ -34,6 +34,23 @@ from swarmnav.sim.recording import Recorder, RecorderGroup
 from swarmnav.sim.runner import RunResult, Simulation
 from swarmnav.sim.scene import CompiledScene
 
+def json_safe(value: Any) -> Any:
+    """A planner's extra statistics as JSON values (NumPy scalars and arrays to numbers and lists)."""
+    if isinstance(value, dict):
+        return {str(k): json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return json_safe(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    if isinstance(value, (str, int, float, bool)) or value is None:
+        return value
+    return repr(value)
+
+
 NAVIGATOR_STREAM = 1  # spawn key of the navigator's generator under the run's seed
 
 
@@ -85,7 +102,8 @@ class Episode:
                 "waypoints": [[float(x), float(y)] for x, y in self.path.waypoints],
                 "length_m": stats.length_m, "plan_time_s": stats.plan_time_s,
                 "iterations": stats.iterations, "evaluations": stats.evaluations,
-                "collision_free": bool(self.problem.is_collision_free(self.path.waypoints))}
+                "collision_free": bool(self.problem.is_collision_free(self.path.waypoints)),
+                "details": json_safe(stats.extra)}
 
     def summary(self) -> dict[str, Any]:
         """The object ``swarmnav run --json`` prints (without the log and video paths)."""

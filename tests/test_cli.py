@@ -175,3 +175,12 @@ def test_out_naming_a_directory_is_one_line_and_leaves_it_alone(tmp_path, capsys
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "Is a directory" in err and str(tmp_path) in err
     assert sorted(tmp_path.iterdir()) == before
+
+
+def test_plan_json_says_which_mode_a_continuous_planner_used(capsys):
+    assert main(["plan", "gwo-scenario-1", "--planner", "gwo", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["details"]["mode"] == "paper"
+    assert main(["plan", "dense-field-30", "--planner", "gwo", "--set", "iterations=20", "--json"]) == 0
+    details = json.loads(capsys.readouterr().out)["details"]
+    assert details["mode"] == "robust"
+    json.dumps(details, allow_nan=False)

@@ -26,7 +26,7 @@ import numpy as np
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.planners.errors import PlanningError
-from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
+from swarmnav.sim.episode import EpisodeSpec, json_safe, plan_episode, run_episode
 from swarmnav.sim.study.grid import Cell
 from swarmnav.sim.versions import software_versions
 
@@ -56,20 +56,9 @@ def bends(waypoints: np.ndarray) -> int:
     return int(np.count_nonzero(turn > BEND_TOLERANCE_RAD))
 
 
-def _json_safe(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {str(k): _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _json_safe(value.tolist())
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, (str, int, float, bool)) or value is None:
-        return value
-    return repr(value)
+# The navigation metrics of ``run --json`` kept as columns of their own.
+NAVIGATION_METRICS = ("time_to_goal_s", "spl", "time_in_danger_s", "replans", "replan_wall_s", "stopped_s",
+                      "safety_triggers")
 
 
 class _WallLimit:
@@ -166,7 +155,7 @@ def _add_metrics(row: dict[str, Any], episode) -> None:
                plan_collision_free=plan["collision_free"], plan_waypoints=json.dumps(plan["waypoints"]),
                plan_bends=bends(episode.path.waypoints),
                plan_convergence_iteration=stats.extra.get("convergence_iteration"),
-               plan_extra=json.dumps(_json_safe(stats.extra), sort_keys=True))
+               plan_extra=json.dumps(json_safe(stats.extra), sort_keys=True))
     for key, column in EXTRA_COLUMNS.items():
         value = stats.extra.get(key)
         row[column] = None if value is None or not math.isfinite(float(value)) else value
@@ -176,6 +165,7 @@ def _add_metrics(row: dict[str, Any], episode) -> None:
                    first_collision_s=run["first_collision_s"], sim_time_s=run["sim_time_s"],
                    wall_time_s=run["wall_time_s"], path_length_m=run["path_length_m"],
                    min_clearance_m=run["min_clearance_m"])
+        row.update({key: run.get(key) for key in NAVIGATION_METRICS})
 
 
 def _progress_rows(cell: Cell, episode) -> list[dict[str, Any]]:
