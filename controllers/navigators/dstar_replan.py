@@ -52,7 +52,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from swarmnav.controllers.controller import ControlCommand
-from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.replan import check_positive, keep_outside
 from swarmnav.controllers.prediction import swept_discs
 from swarmnav.controllers.safety_filter import SafetyFilter
@@ -262,7 +262,7 @@ class DStarReplanNavigator:
             command, triggered = self.filter.apply(observation.pose, command, observation.detections)
             if triggered:
                 events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
-        return NavigationStep(command, new_path, tuple(events))
+        return NavigationStep(command, new_path, tuple(events), Belief(observation.detections, self.horizon_s))
 
 
 def _cells_length(cells: list[Cell]) -> float:

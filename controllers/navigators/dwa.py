@@ -44,7 +44,7 @@ import numpy as np
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import PathCarrot
 from swarmnav.controllers.kinematics import wheel_speeds
-from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.replan import check_positive
 from swarmnav.controllers.prediction import LocalObstacles
 from swarmnav.controllers.safety_filter import SafetyFilter
@@ -153,7 +153,7 @@ class DynamicWindowNavigator:
             command, triggered = self.filter.apply(pose, command, observation.detections)
             if triggered:
                 events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
-        return NavigationStep(command, None, tuple(events))
+        return NavigationStep(command, None, tuple(events), Belief(observation.detections, self.horizon_s))
 
     def _gaps(self, x0: float, y0: float, x: np.ndarray, y: np.ndarray, observation: Observation) -> np.ndarray:
         """(K, T) smallest gap between the robot's disc on each arc and every obstacle at that time."""

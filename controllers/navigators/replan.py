@@ -42,7 +42,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from swarmnav.controllers.controller import ControlCommand
-from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_discs
 from swarmnav.controllers.safety_filter import SafetyFilter
 from swarmnav.models.errors import ConfigError
@@ -216,4 +216,4 @@ class ReplanNavigator:
             command, triggered = self.filter.apply(observation.pose, command, observation.detections)
             if triggered:
                 events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
-        return NavigationStep(command, new_path, tuple(events))
+        return NavigationStep(command, new_path, tuple(events), Belief(observation.detections, self.horizon_s))

@@ -41,7 +41,7 @@ import numpy as np
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import PathCarrot
 from swarmnav.controllers.kinematics import wheel_speeds
-from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.replan import check_positive
 from swarmnav.controllers.prediction import LocalObstacles, time_to_collision_s
 from swarmnav.controllers.safety_filter import SafetyFilter
@@ -136,4 +136,4 @@ class VelocityObstacleNavigator:
             command, triggered = self.filter.apply(pose, command, observation.detections)
             if triggered:
                 events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
-        return NavigationStep(command, None, tuple(events))
+        return NavigationStep(command, None, tuple(events), Belief(observation.detections, self.time_horizon_s))
