@@ -46,7 +46,6 @@ from swarmnav.controllers.navigators.replan import check_positive
 from swarmnav.controllers.prediction import LocalObstacles, time_to_collision_s
 from swarmnav.controllers.safety_filter import SafetyFilter
 from swarmnav.models.geometry import segment_box_distances
-from swarmnav.models.world import wrap_angle_rad
 
 
 @dataclass
@@ -94,41 +93,49 @@ class VelocityObstacleNavigator:
                                    self.time_before_collision_s) if self.safety_filter else None
         speeds = np.linspace(self.max_speed / self.speed_samples, self.max_speed, self.speed_samples)
         offsets = np.linspace(-self.max_turn_rad, self.max_turn_rad, self.heading_samples)
-        self.speeds, self.offsets = (a.ravel() for a in np.meshgrid(speeds, offsets, indexing="ij"))
+        speed, offset = (a.ravel() for a in np.meshgrid(speeds, offsets, indexing="ij"))
+        # The candidates in the robot's frame (+x ahead), standing still last: fixed, so the
+        # obstacles are moved into this frame at each step rather than the candidates out of it.
+        self.speeds = np.append(speed, 0.0)                                              # (K,)
+        self.offsets = np.append(offset, 0.0)
+        self.candidates = np.column_stack([self.speeds * np.cos(self.offsets), self.speeds * np.sin(self.offsets)])
         self.reach = self.max_speed * self.time_horizon_s + 1.0
 
     def step(self, observation: Observation) -> NavigationStep:
         pose = observation.pose
-        p = np.array([pose.x_m, pose.y_m])
         target = self.carrot.update(pose)
-        to_target = target - p
-        remaining = float(np.hypot(*(self.goal - p)))
-        preferred_speed = min(self.max_speed, remaining)
-        preferred = preferred_speed * to_target / max(float(np.hypot(*to_target)), 1e-9)
-        directions = pose.heading_rad + self.offsets
-        candidates = np.column_stack([self.speeds * np.cos(directions), self.speeds * np.sin(directions)])
-        candidates = np.vstack([candidates, [[0.0, 0.0]]])                           # (K, 2), standing still last
+        c, s = math.cos(pose.heading_rad), math.sin(pose.heading_rad)
+        rx, ry = float(target[0]) - pose.x_m, float(target[1]) - pose.y_m
+        preferred_speed = min(self.max_speed, math.hypot(self.goal[0] - pose.x_m, self.goal[1] - pose.y_m))
+        scale = preferred_speed / max(math.hypot(rx, ry), 1e-9)
+        preferred = (scale * (c * rx + s * ry), scale * (-s * rx + c * ry))                # robot frame
+        candidates = self.candidates
+        cost = np.hypot(candidates[:, 0] - preferred[0], candidates[:, 1] - preferred[1])
         centres, velocities, radii, boxes = self.local.near(pose.x_m, pose.y_m, self.reach, observation.detections)
-        ttc = np.full(len(candidates), np.inf)
-        if len(centres):
-            ttc = time_to_collision_s(p, candidates, centres, velocities, radii + self.inflation).min(axis=1)
-        if len(boxes):
-            ends = p + candidates * self.time_horizon_s
-            d = segment_box_distances(np.repeat(p[None, :], len(ends), axis=0), ends, boxes).min(axis=1)
-            ttc = np.where(d < self.inflation, np.minimum(ttc, self.time_horizon_s * 0.5), ttc)
-        admissible = ttc >= self.time_horizon_s
-        cost = np.hypot(*(candidates - preferred).T)
-        if admissible.any():
-            k = int(np.argmin(np.where(admissible, cost, np.inf)))
+        if len(centres) or len(boxes):
+            rotate = np.array([[c, -s], [s, c]])                                           # row @ rotate: world -> robot
+            ttc = np.full(len(candidates), np.inf)
+            if len(centres):
+                local = (centres - (pose.x_m, pose.y_m)) @ rotate
+                ttc = time_to_collision_s(np.zeros(2), candidates, local, velocities @ rotate,
+                                          radii + self.inflation).min(axis=1)
+            if len(boxes):
+                p = np.array([pose.x_m, pose.y_m])
+                ends = p + (candidates * self.time_horizon_s) @ rotate.T
+                d = segment_box_distances(np.repeat(p[None, :], len(ends), axis=0), ends, boxes).min(axis=1)
+                ttc = np.where(d < self.inflation, np.minimum(ttc, self.time_horizon_s * 0.5), ttc)
+            admissible = ttc >= self.time_horizon_s
+            if admissible.any():
+                k = int(np.argmin(np.where(admissible, cost, np.inf)))
+            else:
+                k = int(np.argmax(ttc - 1e-6 * cost))
         else:
-            k = int(np.argmax(ttc - 1e-6 * cost))
-        chosen = candidates[k]
-        speed = float(np.hypot(*chosen))
+            k = int(np.argmin(cost))
+        speed, error = float(self.speeds[k]), float(self.offsets[k])
         if speed < 1e-9:
             v, omega = 0.0, 0.0
         else:
-            error = wrap_angle_rad(math.atan2(chosen[1], chosen[0]) - pose.heading_rad)
-            omega = float(np.clip(self.heading_gain * error, -self.max_angular_rad_s, self.max_angular_rad_s))
+            omega = min(max(self.heading_gain * error, -self.max_angular_rad_s), self.max_angular_rad_s)
             v = speed * math.cos(error) if abs(error) < self.turn_in_place_rad else 0.0
         command = ControlCommand(wheel_speeds(v, omega, self.geometry), v, omega, 0)
         events = []
