@@ -56,7 +56,10 @@ class VelocityObstacleNavigator:
         time_horizon_s: T_h, collisions later than this do not exclude a velocity.
         speed_samples, heading_samples: the candidate grid.
         max_turn_rad: candidate directions lie within this of the current heading.
-        margin_m: extra distance kept beyond the robot radius.
+        margin_m: extra distance kept beyond the robot radius.  0.15 m (ours): the rangefinder
+            tracker's centres are off by several centimetres, and a random walker that turns toward
+            the robot at 0.1 m/s closes 0.15 m in 1.5 s, time to turn and leave; at 0.05 m the robot
+            skirted obstacles it could not escape (bench navigation: 0.87 -> 0.97 success on the suite).
         lookahead_m: the carrot's distance along the global path.
         heading_gain, max_angular_rad_s, turn_in_place_rad: the (v, omega) conversion.
         safety_filter, time_before_collision_s: the optional Nav2-style filter.
@@ -68,7 +71,7 @@ class VelocityObstacleNavigator:
     speed_samples: int = 5
     heading_samples: int = 25
     max_turn_rad: float = math.pi
-    margin_m: float = 0.05
+    margin_m: float = 0.15
     lookahead_m: float = 1.0
     heading_gain: float = 2.5
     max_angular_rad_s: float = 1.2
