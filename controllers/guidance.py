@@ -9,6 +9,7 @@ does not send the carrot back.
 
 from __future__ import annotations
 
+import bisect
 import math
 
 import numpy as np
@@ -17,43 +18,56 @@ from swarmnav.models.world import Pose2D
 
 
 class PathCarrot:
-    """Projects the robot on a polyline and returns the point ``lookahead_m`` ahead of it."""
+    """Projects the robot on a polyline and returns the point ``lookahead_m`` ahead of it.
+
+    The polyline is kept as plain Python lists: the window searched each step holds
+    a handful of segments, for which a loop costs a few microseconds where NumPy's
+    per-call overhead cost a hundred or more.
+    """
 
     def __init__(self, waypoints: np.ndarray, lookahead_m: float):
         pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
         if len(pts) == 1:
             pts = np.vstack([pts, pts])
-        self.points = pts
-        self.seg = np.diff(pts, axis=0)
-        self.seg_len = np.hypot(self.seg[:, 0], self.seg[:, 1])
-        self.cum = np.concatenate([[0.0], np.cumsum(self.seg_len)])
+        self.points = pts.tolist()
+        self.seg = np.diff(pts, axis=0).tolist()
+        self.seg_len = [math.hypot(dx, dy) for dx, dy in self.seg]
+        self.cum = [0.0]
+        for length in self.seg_len:
+            self.cum.append(self.cum[-1] + length)
         self.lookahead_m = lookahead_m
         self.progress_m = 0.0
 
     @property
     def length_m(self) -> float:
-        return float(self.cum[-1])
+        return self.cum[-1]
+
+    def _segment(self, s_m: float) -> int:
+        """Index of the segment holding arc length ``s_m`` (clamped to the polyline)."""
+        return min(max(bisect.bisect_right(self.cum, s_m) - 1, 0), len(self.seg) - 1)
 
     def point_at(self, s_m: float) -> np.ndarray:
         s = min(max(s_m, 0.0), self.length_m)
-        i = int(min(np.searchsorted(self.cum, s, side="right") - 1, len(self.seg) - 1))
+        i = self._segment(s)
         frac = (s - self.cum[i]) / self.seg_len[i] if self.seg_len[i] > 0 else 0.0
-        return self.points[i] + frac * self.seg[i]
+        (ax, ay), (dx, dy) = self.points[i], self.seg[i]
+        return np.array([ax + frac * dx, ay + frac * dy])
 
     def update(self, pose: Pose2D, window_m: float = 2.0) -> np.ndarray:
         """Advance the progress to the robot's projection (within ``window_m`` ahead) and return the carrot."""
-        lo = int(min(max(np.searchsorted(self.cum, self.progress_m, side="right") - 1, 0), len(self.seg) - 1))
-        hi = int(min(np.searchsorted(self.cum, self.progress_m + window_m, side="right"), len(self.seg)))
-        hi = max(hi, lo + 1)
-        a = self.points[lo:hi]
-        d = self.seg[lo:hi]
-        l2 = np.maximum(self.seg_len[lo:hi] ** 2, 1e-12)
-        p = np.array([pose.x_m, pose.y_m])
-        t = np.clip(((p - a) * d).sum(axis=1) / l2, 0.0, 1.0)
-        near = a + t[:, None] * d
-        k = int(np.argmin(np.hypot(*(near - p).T)))
-        s = float(self.cum[lo + k] + t[k] * self.seg_len[lo + k])
-        self.progress_m = max(self.progress_m, s)
+        lo = self._segment(self.progress_m)
+        hi = max(min(bisect.bisect_right(self.cum, self.progress_m + window_m), len(self.seg)), lo + 1)
+        px, py = pose.x_m, pose.y_m
+        best_d2, best_s = math.inf, self.progress_m
+        for i in range(lo, hi):
+            (ax, ay), (dx, dy), length = self.points[i], self.seg[i], self.seg_len[i]
+            t = ((px - ax) * dx + (py - ay) * dy) / max(length * length, 1e-12)
+            t = min(max(t, 0.0), 1.0)
+            ex, ey = ax + t * dx - px, ay + t * dy - py
+            d2 = ex * ex + ey * ey
+            if d2 < best_d2:  # the first nearest, as argmin
+                best_d2, best_s = d2, self.cum[i] + t * length
+        self.progress_m = max(self.progress_m, best_s)
         return self.point_at(self.progress_m + self.lookahead_m)
 
     def remaining_m(self, pose: Pose2D) -> float:

@@ -111,6 +111,19 @@ class NavigationSetup:
 
 
 @dataclass(frozen=True, eq=False)
+class Belief:
+    """What a navigator acted on at one step, for the log's ``/navigator`` channel.
+
+    Attributes:
+        obstacles: the sensed obstacles it used (centres, radii, velocities).
+        horizon_s: how far it predicted them along their velocities (0: not at all).
+    """
+
+    obstacles: tuple[DetectedObstacle, ...] = ()
+    horizon_s: float = 0.0
+
+
+@dataclass(frozen=True, eq=False)
 class NavigationStep:
     """A navigator's answer for one control step.
 
@@ -118,11 +131,14 @@ class NavigationStep:
         command: the wheel command to apply now.
         new_path: a path that replaces the one being followed (logged and drawn), or None.
         events: ``(kind, details)`` pairs to log, e.g. ``("replan", {"reason": ...})``.
+        belief: what it acted on (logged on ``/navigator``); None for navigators that ignore
+            the sensed obstacles (``follow``), which then write no such channel.
     """
 
     command: ControlCommand
     new_path: Path | None = None
     events: tuple[tuple[str, dict[str, Any]], ...] = ()
+    belief: Belief | None = None
 
 
 class Navigator(Protocol):

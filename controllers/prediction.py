@@ -109,12 +109,16 @@ class LocalObstacles:
 
     def near(self, x_m: float, y_m: float, reach_m: float, detections: tuple[DetectedObstacle, ...]
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        keep = np.hypot(self.centres[:, 0] - x_m, self.centres[:, 1] - y_m) - self.radii <= reach_m
-        centres, radii = self.centres[keep], self.radii[keep]
-        velocities = np.zeros_like(centres)
-        if detections:
-            dc, dv, dr = detection_arrays(detections)
-            centres, velocities, radii = np.vstack([centres, dc]), np.vstack([velocities, dv]), np.concatenate([radii, dr])
+        if len(self.centres):
+            keep = np.hypot(self.centres[:, 0] - x_m, self.centres[:, 1] - y_m) - self.radii <= reach_m
+            centres, radii = self.centres[keep], self.radii[keep]
+            velocities = np.zeros_like(centres)
+            if detections:
+                dc, dv, dr = detection_arrays(detections)
+                centres, velocities = np.vstack([centres, dc]), np.vstack([velocities, dv])
+                radii = np.concatenate([radii, dr])
+        else:  # no disc on the map (the dynamic suite): only the sensed ones
+            centres, velocities, radii = detection_arrays(detections)
         boxes = self.boxes
         if len(boxes):
             gap_x = np.maximum(np.maximum(boxes[:, 0] - x_m, x_m - boxes[:, 2]), 0.0)

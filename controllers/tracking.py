@@ -13,13 +13,29 @@ tracker does only what the rays allow:
    apart.  With one hit the centre lies one radius beyond the hit along the
    ray; with two or more it lies on the perpendicular bisector of the widest
    chord, on the side away from the sensors, one radius from both ends.
-3. **Associates** clusters with tracks greedily by distance to each track's
-   position predicted to now, within ``gate_m``; what is left starts a track.
-4. **Estimates the velocity** of each track as the least-squares slope of its
-   centres over the last ``window_s`` (zero until two samples span ``min_span_s``).
-5. **Coasts** an unseen track (position predicted with its velocity) for
+3. **Associates** clusters with tracks greedily by the distance of the
+   cluster's hits from each track's rim (its disc predicted to now), within
+   ``gate_m``; what is left starts a track.
+4. **Updates with the prior**: one hit alone fixes only a point of the rim,
+   not where the centre lies around it.  Taking "one radius beyond the hit
+   along the ray" makes a disc the robot drives past appear to drive along
+   with it (the beam's hit slides over its surface); for a track, the centre
+   is instead the point one radius from the hit nearest the track's predicted
+   centre, on the side the ray came from (the least change that explains the hit).
+5. **Estimates the velocity** of each track as the least-squares slope of its
+   centres over the last ``window_s`` (zero until two samples span ``min_span_s``);
+   a centre more than ``jump_m`` from the predicted one restarts the window.
+6. **Coasts** an unseen track (position predicted with its velocity) for
    ``keep_s``, then forgets it: an obstacle that slips between two beams, or out
-   of range, is still reported for a moment.
+   of range, is still reported for a moment; but when the beams are given
+   (``beams``), a coasting track that a beam passes through, by more than
+   ``clear_m`` inside its rim, without a hit before it, is contradicted and
+   dropped at once (negative evidence).
+7. **Merges** two tracks whose centres come closer than half the sum of their
+   radii (one obstacle seen as two clusters): the older one stays.
+
+Radii: a circle fit must lie within ``max_radius_m``; the track's radius is the
+median of its fits (one stray fit no longer fixes it for good).
 
 This is a choice of ours (the papers only say the sensors detect obstacles,
 seed 004 §5.2); the tolerances the tests hold it to are stated there.
@@ -42,6 +58,7 @@ class _Track:
     centres_m: list[tuple[float, float]] = field(default_factory=list)
     radius_m: float = 0.0
     measured: bool = False  # the radius came from a circle fit (else a lower bound or the default)
+    fits_m: list[float] = field(default_factory=list)  # the radii of its circle fits
     velocity_m_s: tuple[float, float] = (0.0, 0.0)
 
     def predicted(self, time_s: float) -> tuple[float, float]:
@@ -62,17 +79,22 @@ class HitTracker:
         keep_s: how long an unseen track is still reported (coasting).
         max_speed_m_s: velocity estimates are clipped to this norm (a guard against fit noise).
         max_radius_m: circle fits larger than this are discarded (nearly collinear hits: a wall-like arc).
+        clear_m: how far inside a coasting track's rim a beam must pass unhindered to contradict it.
+        jump_m: a new centre this far from the predicted one restarts the velocity window.
     """
 
     default_radius_m: float = 0.3
-    gate_m: float = 0.5
+    gate_m: float = 0.25
     window_s: float = 1.0
     min_span_s: float = 0.3
     keep_s: float = 1.0
     max_speed_m_s: float = 0.5
     max_radius_m: float = 0.6
+    clear_m: float = 0.05
+    jump_m: float = 0.3
 
     def __post_init__(self) -> None:
+        self.reach_m = math.inf  # the beams' reach (set by the sensing); misses say nothing beyond it
         self.reset()
 
     def reset(self) -> None:
@@ -80,13 +102,22 @@ class HitTracker:
         self._next_id = 0
 
     # -- one step ------------------------------------------------------------
-    def update(self, time_s: float, hits_m: np.ndarray, origins_m: np.ndarray) -> tuple[DetectedObstacle, ...]:
-        """Feed this step's unknown hits (N, 2) and their sensors' positions (N, 2); return the tracks."""
+    def update(self, time_s: float, hits_m: np.ndarray, origins_m: np.ndarray,
+               beams: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> tuple[DetectedObstacle, ...]:
+        """Feed this step's unknown hits (N, 2) and their sensors' positions (N, 2); return the tracks.
+
+        ``beams``: every beam of this step as (origins (K, 2), unit directions (K, 2),
+        ranges (K,), ``inf`` where nothing was hit within reach, ranges capped at the reach
+        otherwise): the negative evidence of step 6.  Without it tracks only coast.
+        """
         hits = np.asarray(hits_m, dtype=float).reshape(-1, 2)
         origins = np.asarray(origins_m, dtype=float).reshape(-1, 2)
         clusters = [(hits[idx], origins[idx]) for idx in self._clusters(hits)]
-        self._associate(time_s, clusters)
+        seen = self._associate(time_s, clusters)
         self._tracks = [t for t in self._tracks if time_s - t.times_s[-1] <= self.keep_s]
+        if beams is not None:
+            self._tracks = [t for t in self._tracks if t.track_id in seen or not self._contradicted(t, time_s, beams)]
+        self._merge()
         out = []
         for t in self._tracks:
             x, y = t.predicted(time_s)
@@ -155,36 +186,101 @@ class HitTracker:
             return None
         return math.sqrt(r2)
 
-    def _associate(self, time_s: float, clusters: list[tuple[np.ndarray, np.ndarray]]) -> None:
-        discs = [self._fit(h, o)[:3] for h, o in clusters]
+    def _associate(self, time_s: float, clusters: list[tuple[np.ndarray, np.ndarray]]) -> set[int]:
+        """Update the tracks with this step's clusters; the ids of the tracks seen."""
         pairs = []
         for ti, track in enumerate(self._tracks):
             px, py = track.predicted(time_s)
-            for di, (x, y, _) in enumerate(discs):
-                gap = math.hypot(x - px, y - py)
+            for di, (hits, _) in enumerate(clusters):
+                # How far the hits lie from the predicted rim (the track's disc now).
+                gap = float(np.mean(np.abs(np.hypot(hits[:, 0] - px, hits[:, 1] - py) - track.radius_m)))
                 if gap <= self.gate_m:
                     pairs.append((gap, ti, di))
         pairs.sort()
         used_t, used_d = set(), set()
+        seen = set()
         for _, ti, di in pairs:
             if ti in used_t or di in used_d:
                 continue
             used_t.add(ti)
             used_d.add(di)
             track = self._tracks[ti]
-            self._observe(track, time_s, *self._fit(*clusters[di], track.radius_m))
-        for di, disc in enumerate(discs):
+            hits, origins = clusters[di]
+            if len(hits) == 1:
+                fit = self._fit_one(hits[0], origins[0], track.predicted(time_s), track.radius_m)
+            else:
+                fit = self._fit(hits, origins, track.radius_m)
+            self._observe(track, time_s, *fit)
+            seen.add(track.track_id)
+        for di in range(len(clusters)):
             if di not in used_d:
                 track = _Track(self._next_id)
                 self._next_id += 1
                 self._observe(track, time_s, *self._fit(*clusters[di]))
                 self._tracks.append(track)
+                seen.add(track.track_id)
+        return seen
+
+    @staticmethod
+    def _fit_one(hit: np.ndarray, origin: np.ndarray, prior: tuple[float, float], radius_m: float
+                 ) -> tuple[float, float, float, bool]:
+        """Step 4: the centre one radius from the hit nearest the prior centre, on the ray's far side."""
+        ray = hit - origin
+        ray = ray / max(float(np.hypot(*ray)), 1e-12)
+        toward = np.array(prior) - hit
+        norm = float(np.hypot(*toward))
+        u = toward / norm if norm > 1e-12 else ray
+        along = float(u @ ray)
+        if along < 0.0:  # the prior lies on the sensor's side of the hit: the rim point nearest it
+            u = u - along * ray
+            n = float(np.hypot(*u))
+            u = u / n if n > 1e-12 else ray
+        c = hit + radius_m * u
+        return float(c[0]), float(c[1]), radius_m, False
+
+    def _contradicted(self, track: _Track, time_s: float, beams: tuple[np.ndarray, np.ndarray, np.ndarray]) -> bool:
+        """A beam passes through the track's predicted disc (shrunk by ``clear_m``) with no hit before it."""
+        origins, directions, ranges = beams
+        if not len(origins):
+            return False
+        r = track.radius_m - self.clear_m
+        if r <= 0:
+            return False
+        px, py = track.predicted(time_s)
+        d = np.array([px, py]) - origins                       # (K, 2)
+        along = np.sum(d * directions, axis=1)
+        miss2 = np.sum(d * d, axis=1) - along ** 2
+        inside = miss2 < r * r
+        entry = along - np.sqrt(np.maximum(r * r - miss2, 0.0))
+        # Only beams whose reach covers the entry point say anything (a finite range or a miss = inf
+        # means nothing was hit before that range; the caller caps misses at the reach).
+        return bool(np.any(inside & (entry > 0.0) & (ranges > entry + self.clear_m) & (entry < self.reach_m)))
+
+    def _merge(self) -> None:
+        """Step 7: drop the younger of two tracks closer than half the sum of their radii."""
+        keep: list[_Track] = []
+        for track in sorted(self._tracks, key=lambda t: t.track_id):
+            x, y = track.centres_m[-1]
+            if all(math.hypot(x - k.centres_m[-1][0], y - k.centres_m[-1][1]) >= 0.5 * (track.radius_m + k.radius_m)
+                   for k in keep):
+                keep.append(track)
+        self._tracks = keep
 
     def _observe(self, track: _Track, time_s: float, x: float, y: float, r: float, measured: bool) -> None:
+        if track.times_s:
+            px, py = track.predicted(time_s)
+            if math.hypot(x - px, y - py) > self.jump_m:
+                # A jump (another part of the obstacle, or of another): the old centres say nothing
+                # about the motion any more.
+                track.times_s.clear()
+                track.centres_m.clear()
+                track.velocity_m_s = (0.0, 0.0)
         track.times_s.append(time_s)
         track.centres_m.append((x, y))
         if measured:
-            track.radius_m, track.measured = r, True
+            track.fits_m.append(r)
+            del track.fits_m[:-20]
+            track.radius_m, track.measured = float(np.median(track.fits_m)), True
         elif not track.measured:
             track.radius_m = max(track.radius_m, r)
         while track.times_s[0] < time_s - self.window_s:

@@ -84,6 +84,7 @@ class ObstacleSensing:
         self.angles_rad = angles_rad
         self.offset_m = offset_m
         self.tracker = HitTracker()
+        self.tracker.reach_m = scenario.sensor_range_m
         # Velocities by forward difference of the scripted track (backward at the last step).
         if track_m.shape[1] and len(track_m) > 1:
             diff = np.diff(track_m, axis=0) / dt_s
@@ -96,7 +97,11 @@ class ObstacleSensing:
             return self.detect(step, pose)
         hits, origins = hit_points(pose, ranges_m, self.angles_rad, self.offset_m)
         unknown = known_surface_gap_m(hits, self.scenario) > STATIC_HIT_TOLERANCE_M
-        return self.tracker.update(time_s, hits[unknown], origins[unknown])
+        world = pose.heading_rad + np.asarray(self.angles_rad)
+        directions = np.column_stack([np.cos(world), np.sin(world)])
+        beam_origins = np.array([pose.x_m, pose.y_m]) + self.offset_m * directions
+        beams = (beam_origins, directions, np.asarray(ranges_m, dtype=float))
+        return self.tracker.update(time_s, hits[unknown], origins[unknown], beams)
 
     def detect(self, step: int, pose: Pose2D) -> tuple[DetectedObstacle, ...]:
         """The ``detector`` model: the true moving obstacles whose surface is within range of the rim."""

@@ -18,6 +18,11 @@ Channels (Foxglove well-known protobuf schemas unless said otherwise):
 ``/wheels``             JSON ``swarmnav.WheelSpeeds``: commanded and measured rad/s
 ``/controller``         JSON ``swarmnav.ControllerState``: v, omega, active waypoint
 ``/events``             JSON ``swarmnav.Event``: goal_reached, collision_begin/end, timeout
+``/navigator``          SceneUpdate: what the navigator acted on (its sensed obstacles,
+                        their velocities and predicted sweeps); only in logs of navigators
+                        that use the sensing, from the first step they sensed something,
+                        then every step until they sense nothing (one update that only
+                        deletes).  Not in :data:`CHANNELS`: readers leave it alone.
 ======================  ===============================================================
 
 Time: ``log_time`` = ``publish_time`` = every message's own timestamp = simulation
@@ -82,6 +87,7 @@ CHANNELS: dict[str, tuple[str, str]] = {
     "/events": ("json", EVENT_SCHEMA["title"]),
 }
 TOPICS = tuple(CHANNELS)
+NAVIGATOR_TOPIC = "/navigator"  # a foxglove.SceneUpdate; optional (see the table above)
 
 
 def time_ns(time_s: float) -> int:

@@ -11,12 +11,19 @@ from typing import Any
 
 import foxglove
 from foxglove.messages import (
+    ArrowPrimitive,
     Color,
     CubePrimitive,
     CylinderPrimitive,
+    LinePrimitive,
+    LinePrimitiveLineType,
+    Point3,
     Pose,
     Quaternion,
     SceneEntity,
+    SceneEntityDeletion,
+    SceneEntityDeletionType,
+    SceneUpdate,
     Timestamp,
     Vector3,
 )
@@ -65,6 +72,52 @@ def obstacle_entity(info: ObstacleInfo, x_m: float, y_m: float, t_ns: int) -> Sc
     return SceneEntity(
         timestamp=stamp(t_ns), frame_id=WORLD_FRAME, id=info.entity_id, **{kind: [primitive]}
     )
+
+
+_SENSED_COLOUR = Color(r=0.2, g=0.45, b=0.95, a=0.55)
+_PREDICTED_COLOUR = Color(r=0.2, g=0.45, b=0.95, a=0.2)
+_SENSED_HEIGHT_M = 0.05
+_SENSED_Z_M = 0.35  # thin discs a little above the robot's rangefinders, through the true cylinders
+
+
+def belief_update(obstacles, horizon_s: float, t_ns: int) -> SceneUpdate:
+    """``/navigator``: delete what was drawn, then one entity per obstacle the navigator acted on.
+
+    Each entity (``sensed_<track id>``) is the estimated footprint (a thin disc),
+    the footprint predicted ``horizon_s`` ahead along the estimated velocity, the
+    two edges of the swept band between them, and an arrow along the velocity.
+    With no obstacles the update only deletes (what the robot believes now is nothing).
+    """
+    time_stamp = stamp(t_ns)
+    entities = []
+    for ob in obstacles:
+        x, y, r = float(ob.x_m), float(ob.y_m), float(ob.radius_m)
+        vx, vy = float(ob.vx_m_s), float(ob.vy_m_s)
+        ex, ey = x + vx * horizon_s, y + vy * horizon_s
+        size = Vector3(x=2 * r, y=2 * r, z=_SENSED_HEIGHT_M)
+        cylinders = [CylinderPrimitive(pose=Pose(position=Vector3(x=x, y=y, z=_SENSED_Z_M), orientation=Quaternion(w=1.0)),
+                                       size=size, bottom_scale=1.0, top_scale=1.0, color=_SENSED_COLOUR)]
+        lines, arrows = [], []
+        travel = math.hypot(ex - x, ey - y)
+        if travel > 1e-9:
+            cylinders.append(CylinderPrimitive(
+                pose=Pose(position=Vector3(x=ex, y=ey, z=_SENSED_Z_M), orientation=Quaternion(w=1.0)),
+                size=size, bottom_scale=1.0, top_scale=1.0, color=_PREDICTED_COLOUR))
+            nx, ny = -(ey - y) / travel * r, (ex - x) / travel * r
+            points = [Point3(x=x + nx, y=y + ny, z=_SENSED_Z_M), Point3(x=ex + nx, y=ey + ny, z=_SENSED_Z_M),
+                      Point3(x=x - nx, y=y - ny, z=_SENSED_Z_M), Point3(x=ex - nx, y=ey - ny, z=_SENSED_Z_M)]
+            lines.append(LinePrimitive(type=LinePrimitiveLineType.LineList, thickness=0.01, points=points,
+                                       color=_PREDICTED_COLOUR))
+            head = min(0.1, 0.5 * travel)
+            arrows.append(ArrowPrimitive(
+                pose=Pose(position=Vector3(x=x, y=y, z=_SENSED_Z_M + _SENSED_HEIGHT_M),
+                          orientation=yaw_quaternion(math.atan2(vy, vx))),
+                shaft_length=travel - head, shaft_diameter=0.02, head_length=head, head_diameter=0.06,
+                color=_SENSED_COLOUR))
+        entities.append(SceneEntity(timestamp=time_stamp, frame_id=WORLD_FRAME, id=f"sensed_{int(ob.track_id)}",
+                                    cylinders=cylinders, lines=lines, arrows=arrows))
+    return SceneUpdate(deletions=[SceneEntityDeletion(timestamp=time_stamp, type=SceneEntityDeletionType.All)],
+                       entities=entities)
 
 
 def yaw_quaternion(yaw_rad: float) -> Quaternion:

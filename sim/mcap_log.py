@@ -55,6 +55,7 @@ from swarmnav.sim.log_format import (
     EVENT_SCHEMA,
     LOG_PROFILE,
     MJCF_ATTACHMENT,
+    NAVIGATOR_TOPIC,
     TOPICS,
     WHEELS_SCHEMA,
     WORLD_FRAME,
@@ -65,6 +66,7 @@ from swarmnav.sim.log_format import (
     writer_versions,
 )
 from swarmnav.sim.log_messages import (
+    belief_update,
     controller_json,
     json_schema,
     obstacle_entity,
@@ -154,6 +156,8 @@ class McapRecorder:
         self._moving_infos: tuple[ObstacleInfo, ...] = ()
         self._static_entities: list[SceneEntity] = []
         self._json_channels: list[foxglove.Channel] = []
+        self._navigator: SceneUpdateChannel | None = None  # made at the first belief with obstacles
+        self._belief_drawn = False
 
     # -- Recorder protocol -------------------------------------------------
 
@@ -276,6 +280,7 @@ class McapRecorder:
         if "/planner/path" in late and self._last_path is not None:
             self._path.log(self._last_path, log_time=t_ns)
             written += 1
+        written += self._log_belief(frame.belief, t_ns)
         self._after_write(t_ns, written)
         if self._pacer is not None:
             self._pacer.step(frame)
@@ -368,6 +373,18 @@ class McapRecorder:
         for info, (x_m, y_m) in zip(self._moving_infos, np.asarray(moving_xy_m, dtype=float)):
             entities.append(obstacle_entity(info, float(x_m), float(y_m), t_ns))
         return SceneUpdate(entities=entities)
+
+    def _log_belief(self, belief: Any, t_ns: int) -> int:
+        """``/navigator`` while the navigator acts on sensed obstacles, and once more when it stops."""
+        obstacles = belief.obstacles if belief is not None else ()
+        if not obstacles and not self._belief_drawn:
+            return 0
+        if self._navigator is None:
+            self._navigator = SceneUpdateChannel(NAVIGATOR_TOPIC, context=self._fox)
+        self._navigator.log(belief_update(obstacles, belief.horizon_s if belief is not None else 0.0, t_ns),
+                            log_time=t_ns)
+        self._belief_drawn = bool(obstacles)
+        return 1
 
     def _after_write(self, t_ns: int, count: int) -> None:
         self.messages_written += count

@@ -72,6 +72,7 @@ class StepFrame:
         waypoint_index: index of the active waypoint.
         moving_obstacles_m: (M, 2) positions of the moving obstacles, in ObstacleInfo order
             (only those with ``moving=True``).
+        belief: what the navigator acted on (a :class:`~controllers.navigator.Belief`), or None.
     """
 
     time_s: float
@@ -85,6 +86,7 @@ class StepFrame:
     angular_rad_s: float
     waypoint_index: int
     moving_obstacles_m: np.ndarray
+    belief: Any = None
 
 
 class Recorder(Protocol):

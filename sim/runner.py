@@ -29,7 +29,7 @@ import numpy as np
 
 from swarmnav.controllers.controller import ControlCommand, Twist
 from swarmnav.controllers.goal import GoalChecker
-from swarmnav.controllers.navigator import NavigationSetup, Navigator, Observation
+from swarmnav.controllers.navigator import Belief, NavigationSetup, Navigator, Observation
 from swarmnav.models.scenario import Scenario
 from swarmnav.models.world import Pose2D
 from swarmnav.sim.clearance import ClearanceProbe
@@ -196,7 +196,7 @@ class Simulation:
                         recorder.path(observation.time_s, decision.new_path.waypoints)
                     for kind, details in decision.events:
                         recorder.event(observation.time_s, kind, details)
-                loop.apply(observation, decision.command)
+                loop.apply(observation, decision.command, decision.belief)
                 loop.advance()
             result = loop.result(outcome, time.perf_counter() - wall0)
             result.reference_length_m = reference_length_m
@@ -315,8 +315,8 @@ class StepLoop:
             return "timeout"
         return ""
 
-    def apply(self, observation: Observation, command: ControlCommand) -> None:
-        """Write the wheel command into ``data.ctrl`` and hand the step to the recorder."""
+    def apply(self, observation: Observation, command: ControlCommand, belief: Belief | None = None) -> None:
+        """Write the wheel command into ``data.ctrl`` and hand the step (and the navigator's belief) to the recorder."""
         left, right = command.wheels.left_rad_s, command.wheels.right_rad_s
         self.data.ctrl[0] = left
         self.data.ctrl[1] = right
@@ -325,7 +325,7 @@ class StepLoop:
         self.danger_steps += self.in_danger
         self.stopped_steps += left == 0.0 and right == 0.0
         if self.recorder is not None:
-            self.recorder.step(self._frame(observation, command))
+            self.recorder.step(self._frame(observation, command, belief))
 
     def advance(self) -> None:
         """``mj_step`` k times, checking for a collision after every physics step.
@@ -367,7 +367,7 @@ class StepLoop:
             time_in_danger_s=self.danger_steps * self.dt_s, stopped_s=self.stopped_steps * self.dt_s,
             replans=self.replans, safety_triggers=self.safety_triggers)
 
-    def _frame(self, observation: Observation, command: ControlCommand) -> StepFrame:
+    def _frame(self, observation: Observation, command: ControlCommand, belief: Belief | None = None) -> StepFrame:
         data, scene, adr = self.data, self.scene, self.qadr
         return StepFrame(
             time_s=observation.time_s, position_m=data.qpos[adr:adr + 3].copy(),
@@ -376,4 +376,5 @@ class StepLoop:
             wheel_command_rad_s=np.array([command.wheels.left_rad_s, command.wheels.right_rad_s]),
             wheel_measured_rad_s=np.array([data.qvel[scene.wheel_qvel_adr[0]], data.qvel[scene.wheel_qvel_adr[1]]]),
             linear_m_s=command.linear_m_s, angular_rad_s=command.angular_rad_s,
-            waypoint_index=command.waypoint_index, moving_obstacles_m=np.array(self.obstacle_track_m[self.step]))
+            waypoint_index=command.waypoint_index, moving_obstacles_m=np.array(self.obstacle_track_m[self.step]),
+            belief=belief)

@@ -5,18 +5,21 @@ import math
 import numpy as np
 import pytest
 
-from swarmnav.controllers.controller import ControlCommand
+from swarmnav.controllers.controller import ControlCommand, Twist
+from swarmnav.controllers.goal import GoalChecker
 from swarmnav.controllers.kinematics import DriveGeometry, WheelSpeeds
-from swarmnav.controllers.navigator import DetectedObstacle
+from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, Observation
+from swarmnav.controllers.navigators import make_navigator
+from swarmnav.controllers.point_to_point import PointToPointController
 from swarmnav.controllers.safety_filter import SafetyFilter
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.scenario_generator import GeneratorOptions, generate
 from swarmnav.models.world import Pose2D
 from swarmnav.sim.cli import main
-from swarmnav.sim.episode import EpisodeSpec, run_episode
+from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode, static_problem
 
-ONLINE = ("replan", "dwa", "velocity_obstacle")
+ONLINE = ("replan", "dstar_replan", "dwa", "velocity_obstacle")
 
 
 def short_case(kind: str, sensor_model: str = "rangefinder", **options) -> str:
@@ -41,6 +44,36 @@ def test_online_navigators_reach_the_goal_without_collision(navigator, kind, sen
     assert result.success and result.collisions == 0, summary
     assert summary["time_to_goal_s"] == pytest.approx(result.sim_time_s)
     assert 0.0 < summary["spl"] <= 1.0
+
+
+def test_dstar_replan_marks_a_sensed_sweep_on_its_cells_and_clears_it_when_the_obstacle_leaves():
+    scenario = parse_scenario(short_case("crossing"))
+    episode = plan_episode(EpisodeSpec(scenario, navigator="dstar_replan"))
+    goal = scenario.goal
+    setup = NavigationSetup(episode.path, episode.problem, None, np.random.default_rng(0),
+                            PointToPointController(GEOMETRY, max_speed_m_s=0.2), GoalChecker(goal.x_m, goal.y_m, 0.1),
+                            0.02, 0.2, known_problem=static_problem(scenario))
+    nav = make_navigator("dstar_replan")
+    nav.reset(setup)
+    start = scenario.start
+
+    def observe(t, detections):
+        return Observation(t, Pose2D(start.x_m, start.y_m, 0.0), Twist(0.0, 0.0), np.full(12, np.inf),
+                           np.zeros(12), 0.155, detections)
+
+    first = nav.step(observe(0.0, ()))
+    assert first.new_path is not None and not first.events  # the initial D* Lite path is not a replan
+    straight = first.new_path.waypoints
+    assert len(straight) == 2  # nothing in the way on this map
+    # A disc on the start-goal line ahead, still: its cells are blocked and the path bends around it.
+    ahead = DetectedObstacle(start.x_m + 1.0, start.y_m, 0.3, 0.0, 0.0, 0)
+    step = nav.step(observe(1.0, (ahead,)))
+    assert nav.current.sum() > nav.static.sum()
+    assert step.new_path is not None and [kind for kind, _ in step.events] == ["replan"]
+    assert len(step.new_path.waypoints) > 2
+    # It leaves: every marked cell is freed again, the cells are the known map's.
+    nav.step(observe(2.0, ()))
+    assert np.array_equal(nav.current, nav.static)
 
 
 def test_replan_replans_and_reports_it_in_the_metrics():
@@ -80,13 +113,14 @@ def test_safety_filter_stops_the_robot_before_an_obstacle_that_drives_straight_a
     assert moved < 0.01  # stood still for the half second before contact
 
 
-def test_same_scenario_seeds_and_navigator_give_the_same_trajectory_and_log_bytes(tmp_path):
+@pytest.mark.parametrize("navigator", ["replan", "dstar_replan"])
+def test_same_scenario_seeds_and_navigator_give_the_same_trajectory_and_log_bytes(tmp_path, navigator):
     from swarmnav.sim.mcap_log import McapRecorder
     scenario = parse_scenario(short_case("crossing"))
     logs, poses = [], []
     for k in range(2):
         path = tmp_path / f"run{k}.mcap"
-        result = run_episode(EpisodeSpec(scenario, navigator="replan"), [McapRecorder(path, overwrite=True)],
+        result = run_episode(EpisodeSpec(scenario, navigator=navigator), [McapRecorder(path, overwrite=True)],
                              time_limit_s=12.0).result
         logs.append(path.read_bytes())
         poses.append(result.poses)
@@ -109,6 +143,8 @@ def test_generator_is_a_function_of_kind_seed_and_options():
      "navigator.params.horizon_s"),
     (["run", "dyn-crossing-1", "--navigator", "dwa", "--navigator-set", "alpha=fast", "--no-log"],
      "navigator.params.alpha"),
+    (["run", "dyn-crossing-1", "--navigator", "dstar_replan", "--navigator-set", "cell_m=-0.1", "--no-log"],
+     "navigator.params.cell_m"),
     (["scenarios", "generate", "head_on", "--seed", "1", "--obstacles", "40"], "--obstacles"),
     (["scenarios", "generate", "sideways", "--seed", "1"], "KIND"),
 ])
@@ -135,3 +171,47 @@ def test_time_in_danger_counts_control_steps_below_danger_m():
     assert not result.success and result.spl == 0.0
     assert math.isclose(result.time_in_danger_s / (result.times_s[1] - result.times_s[0]),
                         round(result.time_in_danger_s / (result.times_s[1] - result.times_s[0])))
+
+
+def navigator_messages(path):
+    from mcap.reader import make_reader
+    from mcap_protobuf.decoder import DecoderFactory
+    with open(path, "rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        return {topic: [(m.log_time, d) for _, _, m, d in reader.iter_decoded_messages(topics=[topic])]
+                for topic in ("/navigator", "/obstacles")}
+
+
+def test_navigator_channel_draws_what_the_detector_reported_beside_the_true_obstacles(tmp_path):
+    """With the exact ``detector`` model the believed centres are the true ones at every logged step;
+    the update after the last sensed step only deletes; ``follow`` (which ignores sensing) writes none."""
+    from swarmnav.sim.mcap_log import McapRecorder
+    scenario = parse_scenario(short_case("head_on", "detector"))
+    logs = {}
+    for nav in ("dwa", "follow"):
+        logs[nav] = tmp_path / f"{nav}.mcap"
+        run_episode(EpisodeSpec(scenario, navigator=nav), [McapRecorder(logs[nav])], time_limit_s=15.0)
+    assert navigator_messages(logs["follow"])["/navigator"] == []
+    messages = navigator_messages(logs["dwa"])
+    belief, truth = messages["/navigator"], dict(messages["/obstacles"])
+    drawn = [(t, u) for t, u in belief if u.entities]
+    assert len(drawn) > 50
+    for t, update in drawn:
+        assert [d.type for d in update.deletions] == [1]  # ALL: the drawing is exactly this step's belief
+        (entity,) = update.entities
+        (true,) = [e for e in truth[t].entities if e.id == "obstacle_00"]  # the one (moving) obstacle
+        sensed, true_pos = entity.cylinders[0].pose.position, true.cylinders[0].pose.position
+        assert (sensed.x, sensed.y) == pytest.approx((true_pos.x, true_pos.y), abs=1e-9)
+        assert entity.arrows and entity.lines  # the obstacle drives at the robot: velocity and sweep drawn
+    cleared = [u for _, u in belief if not u.entities]
+    assert len(cleared) <= 1 and all(u.deletions for u in cleared)
+
+
+@pytest.mark.parametrize("navigator", ["replan", "dwa"])
+def test_replay_verify_reproduces_a_navigator_run_bit_for_bit(tmp_path, navigator, capsys):
+    from swarmnav.sim.mcap_log import McapRecorder
+    log = tmp_path / f"{navigator}.mcap"
+    run_episode(EpisodeSpec(parse_scenario(short_case("crossing")), navigator=navigator), [McapRecorder(log)])
+    assert navigator_messages(log)["/navigator"]  # the run sensed the obstacle and logged its belief
+    assert main(["replay", str(log), "--verify"]) == 0
+    assert "verify: bitwise equal" in capsys.readouterr().out

@@ -11,6 +11,7 @@ from swarmnav.controllers.navigators.follow import FollowNavigator
 from swarmnav.controllers.navigators.iaco_local import IacoLocalNavigator
 from swarmnav.controllers.navigators.immas_stepwise import ImmasStepwiseNavigator
 from swarmnav.controllers.navigators.policy import PolicyNavigator
+from swarmnav.controllers.navigators.dstar_replan import DStarReplanNavigator
 from swarmnav.controllers.navigators.dwa import DynamicWindowNavigator
 from swarmnav.controllers.navigators.replan import ReplanNavigator
 from swarmnav.controllers.navigators.velocity_obstacle import VelocityObstacleNavigator
@@ -24,7 +25,7 @@ def register(cls: type) -> type:
     return register_component(NAVIGATORS, "navigator", cls)
 
 
-for _cls in (FollowNavigator, ReplanNavigator, DynamicWindowNavigator, VelocityObstacleNavigator,
+for _cls in (FollowNavigator, ReplanNavigator, DStarReplanNavigator, DynamicWindowNavigator, VelocityObstacleNavigator,
              IacoLocalNavigator, ImmasStepwiseNavigator, PolicyNavigator):
     register(_cls)
 

@@ -20,7 +20,11 @@ Where we differ or the paper is silent (our choices):
 * **Guidance**: ``heading`` measures the alignment at the arc's end with the
   direction to a carrot point ``lookahead_m`` along the global path
   (:class:`~controllers.guidance.PathCarrot`), not to the goal: the global path
-  says how to get around the known map.
+  says how to get around the known map.  When the carrot (then the path's end)
+  is within the arcs' reach, the alignment is taken where each arc comes
+  closest to it, and an arc passing within the goal tolerance counts as
+  aligned: judged at the arc's end, an arc through the goal scored worse than
+  standing still facing it, and the robot stopped short of the goal.
 * **Moving obstacles**: the paper's obstacles are static points of the
   occupancy grid (and PythonRobotics' DWA treats them so).  Here every sensed
   obstacle moves along its estimated velocity at each simulated step of the
@@ -31,6 +35,13 @@ Where we differ or the paper is silent (our choices):
   and arcs are simulated for ``horizon_s`` in steps of ``sim_step_s``.
 * With no admissible pair the robot brakes at full deceleration and turns
   toward the carrot (nothing the window allows is safe).
+* **Sampling** (the paper searches a discretised velocity space): a fixed
+  lattice of ``v_samples`` speeds over [0, v_max] x ``omega_samples`` turn
+  rates over [-omega_max, omega_max], whose arcs are computed once, in the
+  robot's frame, at reset; each step takes the block of lattice pairs inside
+  the dynamic window (on an axis where the window holds no lattice value, the
+  value nearest the measured one) and moves the obstacles into the robot's
+  frame instead of the arcs into the world's.
 """
 
 from __future__ import annotations
@@ -44,7 +55,7 @@ import numpy as np
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import PathCarrot
 from swarmnav.controllers.kinematics import wheel_speeds
-from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.replan import check_positive
 from swarmnav.controllers.prediction import LocalObstacles
 from swarmnav.controllers.safety_filter import SafetyFilter
@@ -60,7 +71,7 @@ class DynamicWindowNavigator:
         accel_m_s2, angular_accel_rad_s2: the acceleration limits of the window.
         window_s: the time over which the window is open (the paper's cycle, 0.25 s).
         max_angular_rad_s: turn-rate limit.
-        v_samples, omega_samples: grid resolution over the window.
+        v_samples, omega_samples: the velocity lattice over [0, v_max] x [-omega_max, omega_max].
         horizon_s, sim_step_s: how far and how finely arcs are simulated.
         dist_cap_m: ``dist`` beyond this counts as free.
         margin_m: extra distance kept beyond the robot radius.
@@ -78,7 +89,7 @@ class DynamicWindowNavigator:
     window_s: float = 0.25
     max_angular_rad_s: float = 1.2
     v_samples: int = 7
-    omega_samples: int = 15
+    omega_samples: int = 25
     horizon_s: float = 3.0
     sim_step_s: float = 0.15
     dist_cap_m: float = 1.0
@@ -101,42 +112,66 @@ class DynamicWindowNavigator:
         self.local = LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m)
         self.carrot = PathCarrot(setup.path.waypoints, self.lookahead_m)
         self.goal = np.array([setup.goal.x_m, setup.goal.y_m])
+        self.goal_tolerance_m = setup.goal.tolerance_m
         self.times = np.arange(1, int(round(self.horizon_s / self.sim_step_s)) + 1) * self.sim_step_s  # (T,)
         self.filter = SafetyFilter(self.geometry, known.robot_radius_m,
                                    self.time_before_collision_s) if self.safety_filter else None
         self.reach = self.max_speed * self.horizon_s + 1.0
+        # The lattice V_s and its arcs in the robot's frame (start at the origin facing +x).
+        self.speeds = np.linspace(0.0, self.max_speed, self.v_samples) if self.v_samples > 1 \
+            else np.array([self.max_speed])                                                 # (V,)
+        self.turns = np.linspace(-self.max_angular_rad_s, self.max_angular_rad_s, self.omega_samples) \
+            if self.omega_samples > 1 else np.zeros(1)                                      # (W,)
+        v, w = np.meshgrid(self.speeds, self.turns, indexing="ij")
+        v, w, t = v[..., None], w[..., None], self.times
+        small = np.abs(w) < 1e-6
+        safe_w = np.where(small, 1.0, w)
+        self.arc_x = np.where(small, v * t, v / safe_w * np.sin(w * t))                     # (V, W, T)
+        self.arc_y = np.where(small, 0.0, v / safe_w * (1.0 - np.cos(w * t)))
+        # Per pair: v, omega, |omega|, the heading at the arc's end (robot frame).
+        self.pair = np.stack([v[..., 0], w[..., 0], np.abs(w[..., 0]), w[..., 0] * self.times[-1]], axis=-1)
 
     def step(self, observation: Observation) -> NavigationStep:
         pose, twist = observation.pose, observation.twist
         target = self.carrot.update(pose)
-        # Dynamic window (Eq. 13), clipped to the robot's limits V_s.
+        # Dynamic window (Eq. 13) on the lattice V_s.
         dv, dw = self.accel_m_s2 * self.window_s, self.angular_accel_rad_s2 * self.window_s
-        vs = np.linspace(max(0.0, twist.linear_m_s - dv), min(self.max_speed, twist.linear_m_s + dv), self.v_samples)
-        ws = np.linspace(max(-self.max_angular_rad_s, twist.angular_rad_s - dw),
-                         min(self.max_angular_rad_s, twist.angular_rad_s + dw), self.omega_samples)
-        v, w = (a.ravel() for a in np.meshgrid(vs, ws, indexing="ij"))           # (K,)
-        # Arcs, sampled at self.times (exact circular motion, straight when omega ~ 0).
-        t = self.times[None, :]
-        theta = pose.heading_rad + w[:, None] * t                                  # (K, T)
-        small = np.abs(w) < 1e-6
-        safe_w = np.where(small, 1.0, w)[:, None]
-        x = np.where(small[:, None], pose.x_m + v[:, None] * t * math.cos(pose.heading_rad),
-                     pose.x_m + v[:, None] / safe_w * (np.sin(theta) - math.sin(pose.heading_rad)))
-        y = np.where(small[:, None], pose.y_m + v[:, None] * t * math.sin(pose.heading_rad),
-                     pose.y_m - v[:, None] / safe_w * (np.cos(theta) - math.cos(pose.heading_rad)))
-        gap = self._gaps(pose.x_m, pose.y_m, x, y, observation)                    # (K, T)
-        hit = gap < 0.0
-        first = np.where(hit.any(axis=1), hit.argmax(axis=1), len(self.times))
-        t_free = np.where(first > 0, self.times[np.maximum(first - 1, 0)], 0.0)
-        free = first == len(self.times)
-        dist = np.where(free, self.dist_cap_m, np.minimum(np.abs(v) * t_free, self.dist_cap_m))  # arc before contact
-        admissible = (v <= np.sqrt(2.0 * dist * self.accel_m_s2) + 1e-9) & \
-                     (np.abs(w) <= np.sqrt(2.0 * dist * self.angular_accel_rad_s2) + 1e-9)
-        # The three terms of G, each normalised to [0, 1].
-        bearing = np.arctan2(target[1] - y[:, -1], target[0] - x[:, -1])
-        heading = 1.0 - np.abs(wrap_angle_rad(bearing - theta[:, -1])) / math.pi
+        vi = _window(self.speeds, twist.linear_m_s, dv)
+        wi = _window(self.turns, twist.angular_rad_s, dw)
+        n_t = len(self.times)
+        x = self.arc_x[vi, wi].reshape(-1, n_t)                                         # (K, T), robot frame
+        y = self.arc_y[vi, wi].reshape(-1, n_t)
+        v, w, w_abs, theta_end = self.pair[vi, wi].reshape(-1, 4).T                     # (K,) each
+        c, s = math.cos(pose.heading_rad), math.sin(pose.heading_rad)
+        gap = self._gaps(pose.x_m, pose.y_m, c, s, x, y, observation)                   # (K, T) or None
+        if gap is None:
+            dist = np.full(len(v), self.dist_cap_m)
+            admissible = (v <= math.sqrt(2.0 * self.dist_cap_m * self.accel_m_s2) + 1e-9) & \
+                         (w_abs <= math.sqrt(2.0 * self.dist_cap_m * self.angular_accel_rad_s2) + 1e-9)
+        else:
+            hit = gap < 0.0
+            first = np.where(hit.any(axis=1), hit.argmax(axis=1), n_t)
+            t_free = np.where(first > 0, self.times[np.maximum(first - 1, 0)], 0.0)
+            dist = np.where(first == n_t, self.dist_cap_m, np.minimum(v * t_free, self.dist_cap_m))  # before contact
+            admissible = (v <= np.sqrt(2.0 * dist * self.accel_m_s2) + 1e-9) & \
+                         (w_abs <= np.sqrt(2.0 * dist * self.angular_accel_rad_s2) + 1e-9)
+        # The three terms of G, each normalised to [0, 1]; the carrot in the robot's frame.
+        rx, ry = target[0] - pose.x_m, target[1] - pose.y_m
+        tx, ty = c * rx + s * ry, -s * rx + c * ry
+        if math.hypot(rx, ry) > self.reach - 1.0 + self.goal_tolerance_m:
+            bearing = np.arctan2(ty - y[:, -1], tx - x[:, -1])
+            heading = 1.0 - np.abs(wrap_angle_rad(bearing - theta_end)) / math.pi
+        else:
+            # The carrot is within the arcs' reach (the path's end): judge each arc where it comes
+            # closest to the carrot, and one that passes within the goal tolerance as aligned.
+            d2 = (tx - x) ** 2 + (ty - y) ** 2
+            j = d2.argmin(axis=1)
+            rows = np.arange(len(j))
+            bearing = np.arctan2(ty - y[rows, j], tx - x[rows, j])
+            heading = np.where(d2[rows, j] <= self.goal_tolerance_m ** 2, 1.0,
+                               1.0 - np.abs(wrap_angle_rad(bearing - w * self.times[j])) / math.pi)
         clearance = dist / self.dist_cap_m
-        remaining = float(np.hypot(*(self.goal - (pose.x_m, pose.y_m))))
+        remaining = math.hypot(self.goal[0] - pose.x_m, self.goal[1] - pose.y_m)
         v_top = min(self.max_speed, max(remaining, 0.05))  # no reward for overshooting the goal
         velocity = 1.0 - np.abs(v - v_top) / max(self.max_speed, 1e-9)
         score = self.alpha * _norm(heading) + self.beta * _norm(clearance) + self.gamma * _norm(velocity)
@@ -145,7 +180,7 @@ class DynamicWindowNavigator:
             v_cmd, w_cmd = float(v[k]), float(w[k])
         else:
             v_cmd = max(0.0, twist.linear_m_s - dv)
-            err = wrap_angle_rad(math.atan2(target[1] - pose.y_m, target[0] - pose.x_m) - pose.heading_rad)
+            err = wrap_angle_rad(math.atan2(ry, rx) - pose.heading_rad)
             w_cmd = float(np.clip(2.0 * err, -self.max_angular_rad_s, self.max_angular_rad_s))
         command = ControlCommand(wheel_speeds(v_cmd, w_cmd, self.geometry), v_cmd, w_cmd, 0)
         events = []
@@ -153,22 +188,46 @@ class DynamicWindowNavigator:
             command, triggered = self.filter.apply(pose, command, observation.detections)
             if triggered:
                 events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
-        return NavigationStep(command, None, tuple(events))
+        return NavigationStep(command, None, tuple(events), Belief(observation.detections, self.horizon_s))
 
-    def _gaps(self, x0: float, y0: float, x: np.ndarray, y: np.ndarray, observation: Observation) -> np.ndarray:
-        """(K, T) smallest gap between the robot's disc on each arc and every obstacle at that time."""
+    def _gaps(self, x0: float, y0: float, c: float, s: float, x: np.ndarray, y: np.ndarray,
+              observation: Observation) -> np.ndarray | None:
+        """(K, T) smallest gap between the robot's disc on each arc (robot frame: x, y) and every
+        obstacle at that time (None: nothing within reach)."""
         centres, velocities, radii, boxes = self.local.near(x0, y0, self.reach, observation.detections)
+        if not len(centres) and not len(boxes):
+            return None
         gap = np.full(x.shape, np.inf)
         if len(centres):
-            ox = centres[:, 0][None, :] + velocities[:, 0][None, :] * self.times[:, None]   # (T, N)
-            oy = centres[:, 1][None, :] + velocities[:, 1][None, :] * self.times[:, None]
-            d = np.hypot(x[:, :, None] - ox[None], y[:, :, None] - oy[None]) - radii - self.inflation
+            rel_x, rel_y = centres[:, 0] - x0, centres[:, 1] - y0
+            ox = c * rel_x + s * rel_y                                                   # (N,) robot frame
+            oy = -s * rel_x + c * rel_y
+            ovx = c * velocities[:, 0] + s * velocities[:, 1]
+            ovy = -s * velocities[:, 0] + c * velocities[:, 1]
+            ox_t = ox[None, :] + ovx[None, :] * self.times[:, None]                     # (T, N)
+            oy_t = oy[None, :] + ovy[None, :] * self.times[:, None]
+            d = np.hypot(x[:, :, None] - ox_t[None], y[:, :, None] - oy_t[None]) - (radii + self.inflation)
             gap = d.min(axis=2)
         if len(boxes):
-            dx = np.maximum(np.maximum(boxes[:, 0] - x[..., None], x[..., None] - boxes[:, 2]), 0.0)
-            dy = np.maximum(np.maximum(boxes[:, 1] - y[..., None], y[..., None] - boxes[:, 3]), 0.0)
+            wx, wy = x0 + c * x - s * y, y0 + s * x + c * y                               # boxes stay in the world
+            dx = np.maximum(np.maximum(boxes[:, 0] - wx[..., None], wx[..., None] - boxes[:, 2]), 0.0)
+            dy = np.maximum(np.maximum(boxes[:, 1] - wy[..., None], wy[..., None] - boxes[:, 3]), 0.0)
             gap = np.minimum(gap, (np.hypot(dx, dy) - self.inflation).min(axis=2))
         return gap
+
+
+def _window(lattice: np.ndarray, centre: float, half_width: float) -> slice:
+    """The slice of an evenly spaced lattice within ``centre +- half_width`` (the nearest point if none)."""
+    n = len(lattice)
+    if n == 1:
+        return slice(0, 1)
+    lo, step = float(lattice[0]), float(lattice[1] - lattice[0])
+    first = max(0, math.ceil((centre - half_width - lo) / step - 1e-9))
+    last = min(n - 1, math.floor((centre + half_width - lo) / step + 1e-9))
+    if first > last:
+        nearest = min(max(int(round((centre - lo) / step)), 0), n - 1)
+        return slice(nearest, nearest + 1)
+    return slice(first, last + 1)
 
 
 def _norm(values: np.ndarray) -> np.ndarray:

@@ -17,7 +17,11 @@ are used; our choices:
   static obstacles only: ``NavigationSetup.map_problem``) plus the swept discs
   of every sensed obstacle.  A swept disc that would contain the robot's
   current position (an obstacle already close) is shrunk to leave it outside,
-  or dropped; likewise for the goal.  A path the planner returns that is not
+  or dropped; likewise for the goal's future sweeps.  But while a sensed
+  obstacle's *current* footprint (grown by the inflation) covers the goal,
+  the replan fails and the robot waits (a random walker on the goal, or a
+  slower obstacle just ahead on it, will leave; driving on runs into it).
+  A path the planner returns that is not
   collision-free on that problem counts as a failure (swarm planners return
   their best attempt).
 * **Cooldown**: at least ``cooldown_s`` between two replans.
@@ -42,7 +46,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from swarmnav.controllers.controller import ControlCommand
-from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_discs
 from swarmnav.controllers.safety_filter import SafetyFilter
 from swarmnav.models.errors import ConfigError
@@ -185,7 +189,12 @@ class ReplanNavigator:
         self.next_replan_s = t + self.cooldown_s
         problem = sensed_problem(self.known, observation.pose, swept_discs(observation.detections, self.horizon_s))
         wall0 = time.perf_counter()
+        goal = self.setup.goal
+        on_goal = [d.track_id for d in observation.detections
+                   if math.hypot(d.x_m - goal.x_m, d.y_m - goal.y_m) < d.radius_m + self.known.inflation_m]
         try:
+            if on_goal:
+                raise PlanningError(f"the goal is inside sensed obstacle(s) {on_goal}: wait for it to leave")
             try:
                 path = self.setup.planner.plan(problem, self.setup.rng)
             except StartBlocked:
@@ -216,4 +225,4 @@ class ReplanNavigator:
             command, triggered = self.filter.apply(observation.pose, command, observation.detections)
             if triggered:
                 events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
-        return NavigationStep(command, new_path, tuple(events))
+        return NavigationStep(command, new_path, tuple(events), Belief(observation.detections, self.horizon_s))

@@ -9,7 +9,9 @@ averages the successful runs only.  ``navigator_us_per_step`` is the wall time
 measured around the navigator's ``step`` call per control step;
 ``realtime_factor`` is simulated over wall time of whole runs (physics, sensing,
 navigator).  Scenarios whose obstacles all move on fixed lines give the same run
-for every world seed; they are still counted once per seed.
+for every world seed; they are still counted once per seed.  ``--by-scenario``
+adds one row per navigator and scenario (the same columns plus ``scenario``), to
+see where the failures are.
 """
 
 from __future__ import annotations
@@ -64,9 +66,11 @@ def suite_names() -> list[str]:
 
 
 def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, scenarios: list[str] | None = None,
-                         progress: bool = False, navigator_params: dict[str, dict[str, Any]] | None = None
-                         ) -> list[dict[str, Any]]:
-    """One row per navigator (see the module docstring); ``navigator_params``: per navigator name."""
+                         progress: bool = False, navigator_params: dict[str, dict[str, Any]] | None = None,
+                         by_scenario: bool = False) -> list[dict[str, Any]]:
+    """One row per navigator (see the module docstring); ``navigator_params``: per navigator name.  With
+    ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key; the
+    overall rows have ``scenario`` None)."""
     navigator_params = navigator_params or {}
     navigators = navigators or default_navigators(navigator_params)
     names = scenarios or suite_names()
@@ -82,7 +86,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                 episode = run_episode(EpisodeSpec(world, navigator=nav, navigator_params=navigator_params.get(nav),
                                                   seed=k, world_seed=k), simulation=simulation)
                 r = episode.result
-                runs[nav].append({"success": r.success, "collided": r.collisions > 0, "timeout": r.outcome == "timeout",
+                runs[nav].append({"scenario": scenario.name, "success": r.success, "collided": r.collisions > 0, "timeout": r.outcome == "timeout",
                                   "time_to_goal_s": r.sim_time_s if r.success else None, "spl": r.spl or 0.0,
                                   "danger_s": r.time_in_danger_s, "replans": r.replans, "steps": r.steps,
                                   "navigator_s": r.navigator_wall_s, "sim_s": r.sim_time_s, "wall_s": r.wall_time_s})
@@ -93,7 +97,13 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                     sys.stderr.flush()
     if progress:
         sys.stderr.write("\n")
-    return [_row(nav, rows) for nav, rows in runs.items()]
+    table = [{"scenario": None, **_row(nav, rows)} for nav, rows in runs.items()]
+    if by_scenario:
+        for scenario in loaded:
+            for nav, rows in runs.items():
+                table.append({"scenario": scenario.name,
+                              **_row(nav, [r for r in rows if r["scenario"] == scenario.name])})
+    return table
 
 
 def _mean(values: list[float]) -> float | None:
@@ -124,6 +134,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", action="append", help="only these scenarios (repeatable; default: the dyn-* suite)")
     parser.add_argument("--navigator-set", action="append", metavar="KEY=VALUE",
                         help="a parameter for every navigator that has it (repeatable), e.g. policy=module:function")
+    parser.add_argument("--by-scenario", action="store_true",
+                        help="also one row per navigator and scenario, after the overall rows")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
     parser.add_argument("--suite", choices=("dyn", "papers"), default="dyn",
                         help="dyn: the dyn-* suite (default); papers: the papers' strategies beside replan + iaco "
@@ -147,10 +159,23 @@ def run(args: argparse.Namespace) -> int:
     settings = navigator_settings(parse_settings(args.navigator_set, "--navigator-set"),
                                   args.navigator or list(NAVIGATORS))
     rows = benchmark_navigation(args.seeds, args.navigator, args.scenario,
-                                progress=not args.json and sys.stderr.isatty(), navigator_params=settings)
+                                progress=not args.json and sys.stderr.isatty(), navigator_params=settings,
+                                by_scenario=args.by_scenario)
     if args.json:
         print(json.dumps(rows))
         return 0
+    overall = [r for r in rows if r["scenario"] is None]
+    _print_table(overall, "")
+    if args.by_scenario:
+        for name in dict.fromkeys(r["scenario"] for r in rows if r["scenario"] is not None):
+            print()
+            _print_table([r for r in rows if r["scenario"] == name], name)
+    return 0
+
+
+def _print_table(rows: list[dict[str, Any]], title: str) -> None:
+    if title:
+        print(title)
     header = (f"{'navigator':<18} {'runs':>4} {'success':>7} {'collide':>7} {'timeout':>7} {'t_goal_s':>8} "
               f"{'SPL':>5} {'danger_s':>8} {'replans':>7} {'us/step':>8} {'x_realtime':>10}")
     print(header)
@@ -159,4 +184,3 @@ def run(args: argparse.Namespace) -> int:
         print(f"{r['navigator']:<18} {r['runs']:>4} {r['success_rate']:>7.2f} {r['collision_rate']:>7.2f} "
               f"{r['timeout_rate']:>7.2f} {t_goal:>8} {r['mean_spl']:>5.2f} {r['mean_time_in_danger_s']:>8.2f} "
               f"{r['mean_replans']:>7.1f} {r['navigator_us_per_step']:>8.0f} {r['realtime_factor']:>10.1f}")
-    return 0

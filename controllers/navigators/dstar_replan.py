@@ -1,0 +1,270 @@
+"""``dstar_replan``: D* Lite (Koenig & Likhachev 2002) on the known map's cells, with the sensed
+obstacles' swept footprints marked on the cells and cleared when they leave; the classic grid
+replanning baseline.
+
+Koenig & Likhachev (2002) plan backwards from the goal so that, as the robot
+moves (``move_start``: the key modifier k_m grows by h(s_last, s_start), their
+Fig. 4, lines 31-32) and as cells change cost (``update_cells``: lines 33-37),
+only the part of the cost-to-goal field the changes reach is repaired.  The
+paper's robot senses the cells around it and treats what it has not seen as
+free; here the known map (static discs and boxes, inflated by the robot radius
+and the scenario's clearance, rasterised as every grid planner does) is marked
+at reset, and at every control step:
+
+1. **Marking** (ours; the paper's cells are static once seen), every
+   ``update_period_s`` (the paper senses once per cell moved): every sensed
+   obstacle (``Observation.detections``) is swept along its estimated velocity
+   over ``horizon_s`` (:func:`~controllers.prediction.swept_discs`), grown by
+   the inflation plus ``margin_m``, and rasterised; a swept disc that would
+   cover the robot's cell or the goal's is shrunk to leave them free (as
+   ``replan`` does).  The cells whose state differs from the last step's go to
+   ``update_cells``: newly covered ones are blocked, ones the sweeps have left
+   are freed.  Cells of the known map never change.
+2. **Start**: the robot's cell (``move_start``); if that cell is blocked (the
+   robot cut into an inflation) the nearest free cell within two cells stands in.
+3. **Replanning**: ``compute_shortest_path`` whenever cells changed or the
+   start moved off the path; the new cell path is adopted (a ``replan`` event,
+   a new ``/planner/path``) when the remainder of the current one crosses a
+   sweep grown by the bare inflation (without ``margin_m``), when the robot
+   left it, or when the new one is shorter by more than ``improvement_m``.
+   Both are hystereses of ours: D* Lite's paths hug the marked cells, and
+   without them a sweep growing by one cell would republish the path at
+   nearly every step.
+4. **Following**: the adopted cell path is shortened by line of sight on the
+   current cells (greedy string pulling) and handed to the scenario's
+   controller, from the robot's position to the exact goal.
+5. **No path** (the sweeps close every way): stop, and try again at every
+   step (the repair is incremental, so retrying is cheap); one
+   ``replan_failed`` event per blocked spell.
+
+``cell_m`` = 0 uses the scenario's ``sim.cell_m`` (a map scenario's own cells
+always).  The optional safety filter is the one every navigator shares.
+Planning wall time (``replan_wall_s``) counts the D* Lite repairs only.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from swarmnav.controllers.controller import ControlCommand
+from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigators.replan import check_positive, keep_outside
+from swarmnav.controllers.prediction import swept_discs
+from swarmnav.controllers.safety_filter import SafetyFilter
+from swarmnav.models.world import OccupancyGrid, rasterise
+from swarmnav.planners.dstar_lite import DStarLite
+from swarmnav.planners.errors import NoPathFound
+from swarmnav.planners.grid_graph import Cell, grid_line_of_sight, octile_cells
+from swarmnav.planners.problem import Path
+
+NO_CELL: Cell = (-1, -1)
+
+
+@dataclass
+class DStarReplanNavigator:
+    """D* Lite with sensed sweeps marked on its cells (see the module docstring).
+
+    Args:
+        horizon_s: how far sensed obstacles are swept along their estimated velocity.
+        margin_m: extra distance beyond the inflation (robot radius + clearance) around sensed obstacles.
+        cell_m: the grid's cell size; 0 = the scenario's.
+        improvement_m: a new path replaces a still-free one only when shorter by more than this.
+        update_period_s: the sweeps are marked (and D* Lite repaired) at most this often.
+        safety_filter, time_before_collision_s: the optional Nav2-style filter.
+    """
+
+    name: ClassVar[str] = "dstar_replan"
+
+    horizon_s: float = 3.0
+    margin_m: float = 0.1
+    cell_m: float = 0.0
+    improvement_m: float = 0.5
+    update_period_s: float = 0.2
+    safety_filter: bool = False
+    time_before_collision_s: float = 1.0
+
+    def __post_init__(self) -> None:
+        check_positive(self, ("horizon_s", "time_before_collision_s"),
+                       ("margin_m", "cell_m", "improvement_m", "update_period_s"))
+
+    def reset(self, setup: NavigationSetup) -> None:
+        known = setup.map_problem
+        self.known = known
+        self.controller = setup.controller
+        if known.grid_override is not None:
+            self.grid = known.grid_override
+        else:
+            self.grid = rasterise(known.bounds, known.obstacles, known.boxes, known.inflation_m,
+                                  self.cell_m or known.cell_m)
+        self.static = np.asarray(self.grid.occupied, dtype=bool)
+        self.current = self.static.copy()
+        self.inflation_m = known.inflation_m + self.margin_m
+        # Sweeps are kept this far from the robot and the goal, so their cells stay free.
+        self.room_m = self.inflation_m + 1.5 * self.grid.cell_m
+        self.goal_xy = (setup.goal.x_m, setup.goal.y_m)
+        self.goal_cell = self.grid.cell_of(*self.goal_xy)
+        start = self._free_cell_near(setup.problem.start.x_m, setup.problem.start.y_m)
+        self.dstar = DStarLite(self.static, start if start != NO_CELL else self.goal_cell, self.goal_cell)
+        self.cells: list[Cell] = []
+        self.at = 0  # index of the robot's cell in self.cells
+        self.adopted = False  # a path has been adopted at least once
+        self.blocked_spell = False
+        self.next_update_s = 0.0
+        self.sweeps: list = []
+        self.replan_wall_s = 0.0
+        self.filter = SafetyFilter(setup.controller.geometry, known.robot_radius_m,
+                                   self.time_before_collision_s) if self.safety_filter else None
+
+    # -- the step ------------------------------------------------------------
+    def step(self, observation: Observation) -> NavigationStep:
+        pose = observation.pose
+        events: list[tuple[str, dict[str, Any]]] = []
+        changed = False
+        if observation.time_s >= self.next_update_s - 1e-9 or not self.cells:
+            self.next_update_s = observation.time_s + self.update_period_s
+            changed = self._mark(observation)
+        start = self._free_cell_near(pose.x_m, pose.y_m)
+        on_path = self._locate(start)
+        new_path = None
+        if start == NO_CELL:
+            return self._finish(observation, self._stop(events, "the robot's cells are all blocked"), events, None)
+        if changed or not on_path or not self.cells:
+            wall0 = time.perf_counter()
+            if start != self.dstar.start:
+                self.dstar.move_start(start)
+            try:
+                cells = self.dstar.plan()
+            except NoPathFound:
+                cells = None
+            self.replan_wall_s += time.perf_counter() - wall0
+            if cells is None:
+                self.cells = []
+                return self._finish(observation, self._stop(events, "no path on the marked cells"), events, None)
+            self.blocked_spell = False
+            reason = self._reason(cells, on_path)
+            if reason:
+                new_path = self._adopt(cells, pose)
+                if reason != "initial":
+                    events.append(("replan", {"reason": reason, "tracks": [d.track_id for d in observation.detections],
+                                              "length_m": round(new_path.stats.length_m, 6)}))
+        command = self.controller.command(pose, observation.twist)
+        return self._finish(observation, command, events, new_path)
+
+    # -- cells ---------------------------------------------------------------
+    def _mark(self, observation: Observation) -> bool:
+        """Mark this step's sweeps; True when any cell changed (and D* Lite was told)."""
+        pose = observation.pose
+        occupied = self.static
+        self.sweeps = []
+        if observation.detections:
+            self.sweeps = keep_outside(swept_discs(observation.detections, self.horizon_s),
+                                       [(pose.x_m, pose.y_m), self.goal_xy], self.room_m)
+            marks = self._rasterise(self.inflation_m)
+            if marks is not None:
+                occupied = occupied | marks
+        flips = np.argwhere(occupied != self.current)
+        if not len(flips):
+            return False
+        self.current = occupied
+        self.dstar.update_cells({(int(r), int(c)): bool(occupied[r, c]) for r, c in flips})
+        return True
+
+    def _rasterise(self, inflation_m: float) -> np.ndarray | None:
+        """This step's sweeps on the grid's cells, grown by ``inflation_m`` (None with none)."""
+        if not self.sweeps:
+            return None
+        marks = rasterise(self.known.bounds, tuple(self.sweeps), (), inflation_m, self.grid.cell_m).occupied
+        return marks if marks.shape == self.static.shape else None
+
+    def _free_cell_near(self, x_m: float, y_m: float) -> Cell:
+        """The robot's cell, or the nearest free cell within two cells of it (NO_CELL if none)."""
+        r0, c0 = self.grid.cell_of(x_m, y_m)
+        if not self.current[r0, c0]:
+            return (r0, c0)
+        rows, cols = self.current.shape
+        best, best_d = NO_CELL, math.inf
+        for dr in range(-2, 3):
+            for dc in range(-2, 3):
+                r, c = r0 + dr, c0 + dc
+                if 0 <= r < rows and 0 <= c < cols and not self.current[r, c]:
+                    x, y = self.grid.centres_m(np.array([(r, c)]))[0]
+                    d = math.hypot(x - x_m, y - y_m)
+                    if d < best_d - 1e-12:
+                        best, best_d = (r, c), d
+        return best
+
+    def _locate(self, cell: Cell) -> bool:
+        """Advance ``self.at`` to the robot's cell on the current path; False if it is not on it."""
+        for i in range(self.at, min(self.at + 4, len(self.cells))):
+            if self.cells[i] == cell:
+                self.at = i
+                return True
+        # Beside the path (the controller cuts corners between shortened waypoints) counts as on it.
+        near = [i for i in range(self.at, min(self.at + 6, len(self.cells)))
+                if max(abs(self.cells[i][0] - cell[0]), abs(self.cells[i][1] - cell[1])) <= 1]
+        if near:
+            self.at = near[0]
+            return True
+        return False
+
+    def _reason(self, cells: list[Cell], on_path: bool) -> str:
+        """Why the new cell path replaces the current one ("" to keep the current one)."""
+        if not self.cells:
+            return "path found again" if self.adopted else "initial"
+        if not on_path:
+            return "left the path"
+        rest = self.cells[self.at:]
+        # Blocked: a sweep grown by the bare inflation (without margin_m) covers a cell still to come.
+        marks = self._rasterise(self.known.inflation_m)
+        if marks is not None and any(marks[r, c] for r, c in rest):
+            return "sensed obstacle on the path"
+        if _cells_length(rest) - _cells_length(cells) > self.improvement_m / self.grid.cell_m:
+            return "shorter path"
+        return ""
+
+    def _adopt(self, cells: list[Cell], pose) -> Path:
+        self.adopted = True
+        self.cells, self.at = cells, 0
+        corners = self._string_pull(cells)
+        middle = self.grid.centres_m(np.array(corners[1:-1])).reshape(-1, 2)
+        waypoints = np.vstack([[pose.x_m, pose.y_m], middle, [self.goal_xy]])
+        path = Path.from_waypoints(waypoints, 0.0)
+        self.controller.reset(path)
+        return path
+
+    def _string_pull(self, cells: list[Cell]) -> list[Cell]:
+        """The cells where the path must turn: greedy line of sight on the current cells."""
+        free = self.dstar.free
+        out = [cells[0]]
+        anchor = 0
+        while anchor < len(cells) - 1:
+            nxt = anchor + 1
+            while nxt + 1 < len(cells) and grid_line_of_sight(free, cells[anchor], cells[nxt + 1]):
+                nxt += 1
+            out.append(cells[nxt])
+            anchor = nxt
+        return out
+
+    def _stop(self, events: list, why: str) -> ControlCommand:
+        if not self.blocked_spell:
+            events.append(("replan_failed", {"reason": "sensed cells changed", "why": why}))
+            self.blocked_spell = True
+        return ControlCommand.stop(self.controller.waypoint_index)
+
+    def _finish(self, observation: Observation, command: ControlCommand, events: list,
+                new_path: Path | None) -> NavigationStep:
+        if self.filter is not None:
+            command, triggered = self.filter.apply(observation.pose, command, observation.detections)
+            if triggered:
+                events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
+        return NavigationStep(command, new_path, tuple(events), Belief(observation.detections, self.horizon_s))
+
+
+def _cells_length(cells: list[Cell]) -> float:
+    """Octile length of a cell path, in cells."""
+    return sum(octile_cells(b[0] - a[0], b[1] - a[1]) for a, b in zip(cells, cells[1:]))
