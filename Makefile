@@ -42,6 +42,7 @@ bench: $(STAMP)
 	$(BIN)/swarmnav bench grid
 	$(BIN)/swarmnav bench render
 	$(BIN)/swarmnav bench study
+	$(BIN)/swarmnav bench cli
 
 # Every bundled study into studies/<name>/ (rows resume if interrupted), with report.html and report.md.
 # Quick by default (each study's quick_seeds, about 10 min on 2 cores); `make studies STUDY_RUN=` runs them in full

@@ -176,6 +176,8 @@ class RandomWalkMotion:
 
     def positions_at(self, times_s: np.ndarray) -> np.ndarray:
         t = _held(times_s, self.start_s)
+        if not np.any(t > 0.0):  # the start alone: no need to draw the whole walk (scenario checks)
+            return np.repeat(np.asarray(self.start_m, dtype=float)[None, :], len(t), axis=0)
         nodes = self.nodes_m
         u = np.clip(t / self.period_s, 0.0, len(nodes) - 1.0)
         k = np.minimum(np.floor(u).astype(int), len(nodes) - 2)

@@ -19,17 +19,15 @@ import tomllib
 from pathlib import Path as FilePath
 from typing import Any, Callable
 
+# Building the parser imports only light modules (sim.commands): each subcommand imports
+# what it needs (MuJoCo, SciPy, the planners, the log formats) when it runs.
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
-from swarmnav.sim import log_commands, options, plot, replay
-from swarmnav.sim.benchmarks import env as bench_env
-from swarmnav.sim.benchmarks import grid as bench_grid
-from swarmnav.sim.benchmarks import navigation as bench_navigation
-from swarmnav.sim.benchmarks import planners as bench_planners
-from swarmnav.sim.benchmarks import render as bench_render
-from swarmnav.sim.benchmarks import sim as bench_sim
-from swarmnav.sim.benchmarks import study as bench_study
-from swarmnav.sim.study import cli as study_cli
+from swarmnav.sim import options
+from swarmnav.sim.commands import DEFAULT_FPS, MODULE_COMMANDS
+
+# As sim.render does, before any subcommand imports mujoco (which reads it once, on import).
+os.environ.setdefault("MUJOCO_GL", "egl")
 
 EXIT_OK, EXIT_BUG, EXIT_BAD_INPUT, EXIT_NO_PATH = 0, 1, 2, 3
 
@@ -205,26 +203,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-# Subcommands implemented in their own modules: (words, module, help); each module has
-# add_arguments(parser) and run(args) -> int (or add_<word>_arguments / run_<word>).
-MODULE_COMMANDS: list[tuple[tuple[str, ...], Any, str]] = [
-    (("bench", "sim"), bench_sim, "closed loop vs bare mj_step on the dense 30-cylinder scene"),
-    (("bench", "planners"), bench_planners, "continuous planners against the exact optimum and mealpy"),
-    (("bench", "grid"), bench_grid, "grid planners, Moving AI optima and the pathfinding peer"),
-    (("bench", "render"), bench_render, "offscreen rendering frames per second"),
-    (("bench", "env"), bench_env, "the Gymnasium environment vs the closed-loop runner and bare mj_step"),
-    (("bench", "navigation"), bench_navigation, "every navigator on the dynamic suite (dyn-*) x world seeds"),
-    (("log", "info"), log_commands, "what a log holds"),
-    (("log", "recover"), log_commands, "rewrite a truncated log as a complete one"),
-    (("replay",), replay, "re-render or re-simulate a log"),
-    (("plot",), plot, "plot a log to PNG"),
-    (("study",), study_cli, "run a study (scenarios x planners x navigators x seeds) into Parquet rows"),
-    (("studies",), study_cli, "list the bundled studies"),
-    (("report",), study_cli, "an HTML and Markdown report of a study's rows"),
-    (("bench", "study"), bench_study, "study harness: parallel efficiency, overhead per cell, Ray vs local"),
-]
-
-
 def _add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", help="bundled scenario name or path to a .toml file")
     p.add_argument("--planner", help="planner name (default: the scenario's)")
@@ -262,7 +240,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--camera", default="top", choices=("top", "chase"))
     p.add_argument("--width", type=int, default=640)
     p.add_argument("--height", type=int, default=480)
-    p.add_argument("--fps", type=float, default=30.0)
+    p.add_argument("--fps", type=float, default=DEFAULT_FPS)
     p.add_argument("--stop-on-collision", action="store_true", help="stop at the first collision")
     p.set_defaults(func=cmd_run)
 
@@ -272,13 +250,11 @@ def build_parser() -> argparse.ArgumentParser:
     log = sub.add_parser("log", help="inspect and repair MCAP logs")
     groups["log"] = log.add_subparsers(dest="log_command", required=True, metavar="LOGCMD")
 
-    for words, module, help_text in MODULE_COMMANDS:
+    for words, add_arguments, run, help_text in MODULE_COMMANDS:
         parent = groups[words[0]] if len(words) > 1 else sub
         p = parent.add_parser(words[-1], help=help_text)
-        adder = getattr(module, f"add_{words[-1]}_arguments", None) or module.add_arguments
-        runner = getattr(module, f"run_{words[-1]}", None) or module.run
-        adder(p)
-        p.set_defaults(func=runner)
+        add_arguments(p)
+        p.set_defaults(func=run)
     return parser
 
 

@@ -25,7 +25,7 @@ from swarmnav.controllers.navigator import NavigationSetup
 from swarmnav.controllers.navigators import make_navigator
 from swarmnav.controllers.point_to_point import PointToPointController
 from swarmnav.models.scenario import Scenario
-from swarmnav.planners import make_planner
+from swarmnav.planners.registry import make_planner
 from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.grid_search import ThetaStarPlanner

@@ -50,10 +50,6 @@ def describe(log: RunLog) -> list[str]:
     return lines
 
 
-def add_info_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("log", help="an .mcap run log")
-    parser.add_argument("--json", action="store_true", help="print the facts as JSON")
-
 
 def run_info(args: argparse.Namespace) -> int:
     log = read_log(args.log)
@@ -74,10 +70,6 @@ def run_info(args: argparse.Namespace) -> int:
     }, sort_keys=True))
     return 0
 
-
-def add_recover_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("source", metavar="IN", help="a (possibly truncated) .mcap file")
-    parser.add_argument("target", metavar="OUT", help="the complete, indexed .mcap file to write")
 
 
 def run_recover(args: argparse.Namespace) -> int:

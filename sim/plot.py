@@ -16,12 +16,12 @@ from pathlib import Path
 import numpy as np
 
 from swarmnav.models.errors import ConfigError
+from swarmnav.sim.commands import MAX_DPI, MIN_DPI
 from swarmnav.sim.log_reader import RunLog, outcome_text, read_log
 
 MAX_SWEEP_DISCS = 40
 MAX_SCANS = 400
-# The figure is 8 x 10.5 inches: 600 dpi is 4800 x 6300 pixels (about 120 MB of RGBA).
-MIN_DPI, MAX_DPI = 10, 600
+# The figure is 8 x 10.5 inches: MAX_DPI (sim.commands) is 4800 x 6300 pixels.
 # Formats Matplotlib writes on its own without a warning (pgf needs TeX; avif and webp depend on
 # Pillow's build; eps and ps warn that they drop transparency).
 SELF_CONTAINED_FORMATS = {"png", "jpg", "jpeg", "tif", "tiff", "svg", "svgz", "pdf"}
@@ -184,12 +184,6 @@ def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
     finally:
         plt.close(fig)
     return out
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("log", help="an .mcap run log")
-    parser.add_argument("-o", "--out", required=True, help="image to write (.png, .svg, .pdf)")
-    parser.add_argument("--dpi", type=int, default=120, help=f"dots per inch, {MIN_DPI}..{MAX_DPI}")
 
 
 def run(args: argparse.Namespace) -> int:

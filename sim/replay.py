@@ -24,13 +24,12 @@ from pathlib import Path
 import numpy as np
 
 from swarmnav.models.errors import ConfigError
+from swarmnav.sim.commands import DEFAULT_FPS
 from swarmnav.sim.log_format import ranges_from_scan
 from swarmnav.sim.log_reader import RunLog, read_log
 from swarmnav.sim.mcap_records import LogError
 from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
 from swarmnav.sim.verify_report import TrajectoryCapture, VerifyReport, compare_with_log
-
-DEFAULT_FPS = 30.0
 
 
 EXIT_DIFFERENT = 4  # replay --verify: the re-simulation differs from the log
@@ -155,20 +154,6 @@ def verify_log(log: RunLog) -> VerifyReport:
     episode = run_episode(spec, [capture], scene=index_scene(model, context.mjcf_xml), **options)
     path, result = episode.path, episode.result
     return compare_with_log(log, capture, np.asarray(path.waypoints, dtype=float)[:, :2], result.outcome)
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("log", help="an .mcap run log")
-    parser.add_argument("--video", metavar="OUT.mp4", help="render the run to an MP4 (offscreen EGL)")
-    parser.add_argument("--camera", choices=("top", "chase"), default="top")
-    parser.add_argument("--width", type=int, default=640)
-    parser.add_argument("--height", type=int, default=480)
-    parser.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second")
-    parser.add_argument("--no-trail", action="store_true", help="do not draw the driven trajectory")
-    parser.add_argument("--verify", action="store_true",
-                        help="re-simulate from the log and compare every pose and range scan "
-                             "(exit 1 if they differ)")
-    parser.add_argument("--json", action="store_true", help="print the results as JSON")
 
 
 def run(args: argparse.Namespace) -> int:

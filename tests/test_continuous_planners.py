@@ -10,7 +10,7 @@ import pytest
 from scipy.interpolate import CubicSpline
 
 from swarmnav.models.scenario import list_scenarios, load_scenario
-from swarmnav.planners import PLANNERS, make_planner
+from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.planners.bee_colony import adaptive_limit
 from swarmnav.planners.continuous import ContinuousPlanner
 from swarmnav.models.errors import ConfigError
@@ -200,9 +200,10 @@ def test_bad_parameters_are_config_errors():
 
 def test_bench_planners_rows_agree_with_their_runs():
     from swarmnav.sim.benchmarks import planners as bench_continuous
+    from swarmnav.sim.commands import add_bench_planners_arguments
 
     parser = argparse.ArgumentParser()
-    bench_continuous.add_arguments(parser)
+    add_bench_planners_arguments(parser)
     args = parser.parse_args(["--scenarios", "gwo-scenario-1", "adl-abc-path-1", "--planners", "gwo", "pso",
                               "--seeds", "2", "--population", "10", "--iterations", "5", "--peer-runs", "0"])
     result = bench_continuous.benchmark(args)

@@ -10,7 +10,7 @@ import pytest
 from swarmnav.models.scenario import list_scenarios, load_scenario, parse_scenario
 import json
 
-from swarmnav.planners import PLANNERS, make_planner
+from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.sim import cli
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound

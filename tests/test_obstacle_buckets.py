@@ -70,7 +70,7 @@ def test_the_shortcut_with_buckets_keeps_the_same_vertices():
     rng = np.random.default_rng(11)
     problem = replace(random_problem(rng, discs=400, boxes=0, radii_m=(0.1, 0.2)), cell_m=0.2)
     assert clearance_buckets(problem) is not None
-    from swarmnav.planners import make_planner
+    from swarmnav.planners.registry import make_planner
     path = make_planner("astar", {"shortcut": False}).plan(problem, rng)
     fast = exact_shortcut(problem, path.waypoints)
     assert problem.is_collision_free(fast)

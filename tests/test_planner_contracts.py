@@ -12,7 +12,7 @@ import pytest
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import list_scenarios, load_scenario
-from swarmnav.planners import PLANNERS, make_planner, register
+from swarmnav.planners.registry import PLANNERS, make_planner, register
 from swarmnav.planners.errors import BudgetExceeded, NoPathFound, PlanningError
 from swarmnav.planners.problem import scenario_problem
 from swarmnav.sim import cli

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from swarmnav.models.scenario import load_scenario
-from swarmnav.planners import make_planner
+from swarmnav.planners.registry import make_planner
 from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.path_guess import fit_via_points, resample_by_length
 from swarmnav.planners.polish import compass_polish

@@ -27,7 +27,7 @@ import numpy as np
 
 from swarmnav.sim.benchmarks.figures import print_figures
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
-from swarmnav.sim.options import positive_float, positive_int
+from swarmnav.sim.commands import BENCH_ENV_QUICK
 from swarmnav.sim.runner import Simulation
 
 
@@ -104,19 +104,7 @@ def benchmark_env(scenario_name: str = "dense-field-30", duration_s: float = 20.
     }
 
 
-QUICK_DURATION_S, QUICK_REPEATS = 4.0, 2  # --quick: a smoke run of the same measurement (noisier figures)
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--scenario", default="dense-field-30")
-    parser.add_argument("--duration", type=positive_float, default=20.0, help="simulated seconds per measurement")
-    parser.add_argument("--repeats", type=positive_int, default=3)
-    parser.add_argument("--quick", action="store_true",
-                        help=f"{QUICK_DURATION_S:g} simulated s x {QUICK_REPEATS} repeats (overrides the two above)")
-    parser.add_argument("--json", action="store_true")
-
-
 def run(args: argparse.Namespace) -> int:
-    duration_s, repeats = (QUICK_DURATION_S, QUICK_REPEATS) if args.quick else (args.duration, args.repeats)
+    duration_s, repeats = BENCH_ENV_QUICK if args.quick else (args.duration, args.repeats)
     print_figures(benchmark_env(args.scenario, duration_s=duration_s, repeats=repeats), args.json)
     return 0

@@ -36,17 +36,6 @@ GRID_PLANNERS = ("astar", "dijkstra", "theta_star", "dstar_lite", "immas", "iaco
 SEEDED = {"iaco"}
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--runs", type=int, default=5, help="runs (seeds) per map and planner")
-    parser.add_argument("--maps", nargs="*", help="map scenario names (default: every bundled [map] scenario)")
-    parser.add_argument("--all-pairs", action="store_true",
-                        help="plan every start/goal pair of each map's [map].pairs, not only the scenario's")
-    parser.add_argument("--swarm-sample", type=int, default=20,
-                        help="Moving AI instances per map on which immas and iaco report their ratio")
-    parser.add_argument("--quick", action="store_true",
-                        help="the two slowest maps, 2 runs, 50 Moving AI instances a map, 1 swarm sample (under a minute)")
-
 
 def _map_scenarios(names: list[str] | None):
     from swarmnav.models.scenario import list_scenarios, load_scenario
@@ -86,7 +75,7 @@ def _mean_clearance_m(problem, cells) -> float:
 
 
 def bench_maps(args: argparse.Namespace) -> list[dict[str, Any]]:
-    from swarmnav.planners import make_planner
+    from swarmnav.planners.registry import make_planner
 
     rows = []
     for scenario in _map_scenarios(args.maps):
@@ -128,7 +117,7 @@ def bench_maps(args: argparse.Namespace) -> list[dict[str, Any]]:
 def bench_restaurant(runs: int) -> list[dict[str, Any]]:
     """M-ACO on its home scenario, with the paper's node baselines' collisions."""
     from swarmnav.models.scenario import load_scenario
-    from swarmnav.planners import make_planner
+    from swarmnav.planners.registry import make_planner
 
     scenario = load_scenario("restaurant-table-2")
     problem = scenario_problem(scenario)
@@ -287,7 +276,8 @@ def run(args: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="swarmnav bench grid", description=__doc__.splitlines()[0])
-    add_arguments(parser)
+    from swarmnav.sim.commands import add_bench_grid_arguments
+    add_bench_grid_arguments(parser)
     return run(parser.parse_args(argv))
 
 

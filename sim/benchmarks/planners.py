@@ -46,18 +46,13 @@ from typing import Any
 
 import numpy as np
 
-from swarmnav.planners import make_planner
+from swarmnav.planners.registry import make_planner
 from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.path_cost import PathObjective
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.problem import scenario_problem
-from swarmnav.sim import options
 
-DEFAULT_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3",
-                     "adl-abc-path-1", "adl-abc-path-2", "adl-abc-path-3",
-                     "dense-field-30", "restaurant-table-2", "restaurant-table-5")
-DEFAULT_PLANNERS = ("abc", "adl_abc", "gwo", "pso")
 PEERS = (("gwo", "mealpy.OriginalGWO"), ("abc", "mealpy.OriginalABC"))
 
 # Lengths the papers report for their best path (Abdulla & Hadi 2025 Sects. 6.1-6.3; Kamil et al. 2020 Table 2).
@@ -69,25 +64,6 @@ PAPER_LENGTHS_M: dict[tuple[str, str], float] = {
     ("adl-abc-path-2", "abc"): 15.0817, ("adl-abc-path-2", "adl_abc"): 14.8163,
     ("adl-abc-path-3", "abc"): 10.3791, ("adl-abc-path-3", "adl_abc"): 10.3736,
 }
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Options of ``swarmnav bench planners``."""
-    parser.add_argument("--scenarios", nargs="+", default=list(DEFAULT_SCENARIOS), metavar="NAME")
-    parser.add_argument("--planners", nargs="+", default=list(DEFAULT_PLANNERS), metavar="NAME")
-    parser.add_argument("--seeds", type=options.positive_int, default=10, help="runs per planner and scenario (default 10)")
-    parser.add_argument("--population", type=options.positive_int, default=50)
-    parser.add_argument("--iterations", type=options.positive_int, default=100)
-    parser.add_argument("--clearance-m", type=options.non_negative_float, default=0.0,
-                        help="clearance beyond the robot radius (default 0, as in the papers)")
-    parser.add_argument("--peer-scenario", default="gwo-scenario-1")
-    parser.add_argument("--peer-runs", type=options.non_negative_int, default=3, help="mealpy runs per peer (0: none)")
-    parser.add_argument("--modes", nargs="+", default=["paper", "robust"], choices=["paper", "robust", "auto"])
-    parser.add_argument("--fields", type=options.non_negative_int, default=10,
-                        help="random disc fields of 10-40 discs (default 10; 0: none)")
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--quick", action="store_true",
-                        help="gwo-scenario-1 and dense-field-30, 3 seeds, 1 peer run, 2 random fields")
 
 
 #: Issue 14's speedups over mealpy: with the scipy objective a mealpy user writes, and with ours.
@@ -405,5 +381,6 @@ def run(args: argparse.Namespace) -> int:
 
 if __name__ == "__main__":
     _parser = argparse.ArgumentParser(prog="python -m planners.bench_continuous", description=__doc__.splitlines()[0])
-    add_arguments(_parser)
+    from swarmnav.sim.commands import add_bench_planners_arguments
+    add_bench_planners_arguments(_parser)
     raise SystemExit(run(_parser.parse_args()))

@@ -16,13 +16,13 @@ import time
 # Imported at the top on purpose: sim.render sets MUJOCO_GL=egl, which must happen before
 # anything imports mujoco, and the CLI imports this module before the runner's.
 from swarmnav.sim.benchmarks.figures import print_figures
+from swarmnav.sim.commands import BENCH_RENDER_QUICK_FRAMES
 from swarmnav.sim.render import ScenePoser, SceneRenderer, check_video_size
 
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 TARGET_FRAMES_PER_S = 60.0
-QUICK_FRAMES = 40
 
 # An MJCF with one light and one material and nothing set: MuJoCo fills in its defaults.
 _DEFAULTS_MJCF = '<mujoco><asset><material name="m"/></asset><worldbody><light/></worldbody></mujoco>'
@@ -80,18 +80,6 @@ def benchmark_render(
     }
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--scenario", default="dense-field-30")
-    parser.add_argument("--width", type=int, default=640)
-    parser.add_argument("--height", type=int, default=480)
-    parser.add_argument("--frames", type=int, default=150)
-    parser.add_argument("--camera", choices=("top", "chase"), default="top")
-    parser.add_argument("--compare-defaults", action="store_true",
-                        help="also time MuJoCo's default quality (multisampling, shadows, reflections)")
-    parser.add_argument("--quick", action="store_true", help=f"{QUICK_FRAMES} frames (a few seconds)")
-    parser.add_argument("--json", action="store_true")
-
-
 def run(args: argparse.Namespace) -> int:
     from swarmnav.models.errors import ConfigError
     from swarmnav.models.scenario import load_scenario
@@ -100,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
     check_video_size(args.width, args.height, 30.0)
     if args.frames < 1:
         raise ConfigError("--frames", f"must be at least 1, got {args.frames}")
-    frames = min(args.frames, QUICK_FRAMES) if args.quick else args.frames
+    frames = min(args.frames, BENCH_RENDER_QUICK_FRAMES) if args.quick else args.frames
     scenario = load_scenario(args.scenario)
     scene = compile_scene(scenario)
     grid_m = (scenario.arena_width_m, scenario.arena_height_m)  # as VideoRecorder draws it

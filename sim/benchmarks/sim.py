@@ -17,7 +17,7 @@ import mujoco
 from swarmnav.sim.benchmarks.figures import print_figures
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import MAX_CONTROL_STEPS, load_scenario
-from swarmnav.sim import options
+from swarmnav.sim.commands import BENCH_SIM_QUICK
 from swarmnav.sim.episode import Episode, EpisodeSpec, plan_episode, run_episode
 from swarmnav.sim.runner import Simulation
 
@@ -94,15 +94,7 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
     return figures
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--scenario", default="dense-field-30")
-    parser.add_argument("--duration", type=options.positive_float, default=20.0, help="simulated seconds per measurement")
-    parser.add_argument("--repeats", type=options.positive_int, default=3)
-    parser.add_argument("--quick", action="store_true", help="5 simulated seconds, 2 repeats (under a minute)")
-    parser.add_argument("--json", action="store_true")
-
-
 def run(args: argparse.Namespace) -> int:
-    duration_s, repeats = (5.0, 2) if args.quick else (args.duration, args.repeats)
+    duration_s, repeats = BENCH_SIM_QUICK if args.quick else (args.duration, args.repeats)
     print_figures(benchmark_sim(args.scenario, duration_s=duration_s, repeats=repeats), args.json)
     return 0

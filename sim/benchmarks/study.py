@@ -26,12 +26,6 @@ params = {{ iterations = {iterations} }}
 """
 
 
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--seeds", type=int, default=20, help="seeds per scenario (2 scenarios: 40 cells by default)")
-    p.add_argument("--iterations", type=int, default=60, help="GWO iterations per cell")
-    p.add_argument("--no-ray", action="store_true", help="skip the Ray comparison")
-    p.add_argument("--json", action="store_true")
-
 
 def _timed(results) -> tuple[float, int]:
     t0 = time.perf_counter()

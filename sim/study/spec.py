@@ -44,7 +44,7 @@ from typing import Any
 from swarmnav.controllers.navigators import make_navigator
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, resolve_scenario_path
-from swarmnav.planners import make_planner
+from swarmnav.planners.registry import make_planner
 
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")

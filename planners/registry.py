@@ -1,0 +1,60 @@
+"""The planner registry: ``PLANNERS`` is built explicitly here; registering a duplicate name is an error.
+
+Importing this module imports every planner (and SciPy with the ant colonies);
+``swarmnav.planners`` itself stays light and hands these names out on first use.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from swarmnav.planners.ant_system import AntSystemPlanner
+from swarmnav.planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
+from swarmnav.planners.dstar_lite import DStarLitePlanner
+from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, ThetaStarPlanner
+from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
+from swarmnav.planners.max_min_ant_system import MaxMinAntSystemPlanner
+from swarmnav.planners.waiter_ant_colony import WaiterAntColonyPlanner
+from swarmnav.planners.grey_wolf import GreyWolfPlanner
+from swarmnav.planners.optimal import OptimalPlanner
+from swarmnav.planners.particle_swarm import ParticleSwarmPlanner
+from swarmnav.planners.errors import BudgetExceeded, GoalBlocked, NoPathFound, PlanningError, StartBlocked
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.world import Box, Disc, Pose2D, Rect
+from swarmnav.planners.problem import Path, Planner, PlanStats, Problem
+from swarmnav.planners.straight import StraightPlanner
+from swarmnav.models.parameters import build_component, register_component
+
+PLANNERS: dict[str, type] = {}
+
+
+def register(cls: type) -> type:
+    """Add a planner class to :data:`PLANNERS`: it needs a free name and the obstacles it supports."""
+    supports = getattr(cls, "supports", None)
+    if not isinstance(supports, frozenset) or not supports or not supports <= {"discs", "boxes"}:
+        raise TypeError(f"{cls.__name__} must declare the obstacles it supports, a non-empty subset "
+                        "of {'discs', 'boxes'}")
+    return register_component(PLANNERS, "planner", cls)
+
+
+for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,
+             MaxMinAntSystemPlanner, ImprovedAntColonyPlanner, WaiterAntColonyPlanner, AntSystemPlanner,
+             OptimalPlanner, BeeColonyPlanner, AdaptiveLimitBeeColonyPlanner, GreyWolfPlanner,
+             ParticleSwarmPlanner):
+    register(_cls)
+
+
+def make_planner(name: str, params: dict[str, Any] | None = None, source: str | None = None) -> Any:
+    """Build a registered planner from its name and a parameter table.
+
+    Raises:
+        ConfigError: unknown planner, unknown parameter, or a value of the wrong type.
+    """
+    return build_component(PLANNERS, "planner", name, params, source)
+
+
+__all__ = [
+    "PLANNERS", "register", "make_planner",
+    "Problem", "Path", "PlanStats", "Planner", "Pose2D", "Disc", "Box", "Rect",
+    "PlanningError", "StartBlocked", "GoalBlocked", "NoPathFound", "BudgetExceeded", "ConfigError",
+]

@@ -1,0 +1,235 @@
+"""The subcommands implemented in their own modules: their options, and a run that imports the module.
+
+Building the parser must stay light (``swarmnav scenarios`` is a whole process
+of well under a second), so this module imports only argparse and the option
+types: each ``run_*`` below imports its module (MuJoCo, SciPy, the planners,
+the log formats) inside the function, when that subcommand is the one chosen.
+The options' defaults that the modules also use live here, once.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Callable
+
+from swarmnav.sim import options
+from swarmnav.sim.study import cli as study_cli
+
+Adder = Callable[[argparse.ArgumentParser], None]
+Runner = Callable[[argparse.Namespace], int]
+
+DEFAULT_FPS = 30.0  # frames per simulated second of a video (run --video, replay --video)
+MIN_DPI, MAX_DPI = 10, 600  # plot: 600 dpi is 4800 x 6300 pixels (about 120 MB of RGBA)
+BENCH_SIM_QUICK = (5.0, 2)  # bench sim --quick: simulated seconds, repeats (under a minute)
+BENCH_ENV_QUICK = (4.0, 2)  # bench env --quick: a smoke run of the same measurement (noisier figures)
+BENCH_RENDER_QUICK_FRAMES = 40
+BENCH_PLANNERS_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3",
+                            "adl-abc-path-1", "adl-abc-path-2", "adl-abc-path-3",
+                            "dense-field-30", "restaurant-table-2", "restaurant-table-5")
+BENCH_PLANNERS_PLANNERS = ("abc", "adl_abc", "gwo", "pso")
+
+
+def add_bench_sim_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenario", default="dense-field-30")
+    parser.add_argument("--duration", type=options.positive_float, default=20.0, help="simulated seconds per measurement")
+    parser.add_argument("--repeats", type=options.positive_int, default=3)
+    parser.add_argument("--quick", action="store_true",
+                        help="%g simulated seconds, %d repeats (under a minute)" % BENCH_SIM_QUICK)
+    parser.add_argument("--json", action="store_true")
+
+
+def run_bench_sim(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import sim
+    return sim.run(args)
+
+
+def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenarios", nargs="+", default=list(BENCH_PLANNERS_SCENARIOS), metavar="NAME")
+    parser.add_argument("--planners", nargs="+", default=list(BENCH_PLANNERS_PLANNERS), metavar="NAME")
+    parser.add_argument("--seeds", type=options.positive_int, default=10, help="runs per planner and scenario (default 10)")
+    parser.add_argument("--population", type=options.positive_int, default=50)
+    parser.add_argument("--iterations", type=options.positive_int, default=100)
+    parser.add_argument("--clearance-m", type=options.non_negative_float, default=0.0,
+                        help="clearance beyond the robot radius (default 0, as in the papers)")
+    parser.add_argument("--peer-scenario", default="gwo-scenario-1")
+    parser.add_argument("--peer-runs", type=options.non_negative_int, default=3, help="mealpy runs per peer (0: none)")
+    parser.add_argument("--modes", nargs="+", default=["paper", "robust"], choices=["paper", "robust", "auto"])
+    parser.add_argument("--fields", type=options.non_negative_int, default=10,
+                        help="random disc fields of 10-40 discs (default 10; 0: none)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--quick", action="store_true",
+                        help="gwo-scenario-1 and dense-field-30, 3 seeds, 1 peer run, 2 random fields")
+
+
+def run_bench_planners(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import planners
+    return planners.run(args)
+
+
+def add_bench_grid_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--runs", type=int, default=5, help="runs (seeds) per map and planner")
+    parser.add_argument("--maps", nargs="*", help="map scenario names (default: every bundled [map] scenario)")
+    parser.add_argument("--all-pairs", action="store_true",
+                        help="plan every start/goal pair of each map's [map].pairs, not only the scenario's")
+    parser.add_argument("--swarm-sample", type=int, default=20,
+                        help="Moving AI instances per map on which immas and iaco report their ratio")
+    parser.add_argument("--quick", action="store_true",
+                        help="the two slowest maps, 2 runs, 50 Moving AI instances a map, 1 swarm sample (under a minute)")
+
+
+def run_bench_grid(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import grid
+    return grid.run(args)
+
+
+def add_bench_render_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenario", default="dense-field-30")
+    parser.add_argument("--width", type=int, default=640)
+    parser.add_argument("--height", type=int, default=480)
+    parser.add_argument("--frames", type=int, default=150)
+    parser.add_argument("--camera", choices=("top", "chase"), default="top")
+    parser.add_argument("--compare-defaults", action="store_true",
+                        help="also time MuJoCo's default quality (multisampling, shadows, reflections)")
+    parser.add_argument("--quick", action="store_true", help=f"{BENCH_RENDER_QUICK_FRAMES} frames (a few seconds)")
+    parser.add_argument("--json", action="store_true")
+
+
+def run_bench_render(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import render
+    return render.run(args)
+
+
+def add_bench_env_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenario", default="dense-field-30")
+    parser.add_argument("--duration", type=options.positive_float, default=20.0, help="simulated seconds per measurement")
+    parser.add_argument("--repeats", type=options.positive_int, default=3)
+    parser.add_argument("--quick", action="store_true",
+                        help="%g simulated s x %d repeats (overrides the two above)" % BENCH_ENV_QUICK)
+    parser.add_argument("--json", action="store_true")
+
+
+def run_bench_env(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import env
+    return env.run(args)
+
+
+def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--seeds", type=int, default=5, help="world seeds per scenario (default 5)")
+    parser.add_argument("--navigator", action="append", help="only these navigators (repeatable)")
+    parser.add_argument("--scenario", action="append", help="only these scenarios (repeatable; default: the dyn-* suite)")
+    parser.add_argument("--navigator-set", action="append", metavar="KEY=VALUE",
+                        help="a parameter for every navigator that has it (repeatable), e.g. policy=module:function")
+    parser.add_argument("--by-scenario", action="store_true",
+                        help="also one row per navigator and scenario, after the overall rows")
+    parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
+    parser.add_argument("--suite", choices=("dyn", "papers"), default="dyn",
+                        help="dyn: the dyn-* suite (default); papers: the papers' strategies beside replan + iaco "
+                             "and dstar_replan, one row per run (sim/benchmarks/paper_navigation.py)")
+
+
+def run_bench_navigation(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import navigation
+    return navigation.run(args)
+
+
+def add_bench_study_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--seeds", type=int, default=20, help="seeds per scenario (2 scenarios: 40 cells by default)")
+    parser.add_argument("--iterations", type=int, default=60, help="GWO iterations per cell")
+    parser.add_argument("--no-ray", action="store_true", help="skip the Ray comparison")
+    parser.add_argument("--json", action="store_true")
+
+
+def run_bench_study(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import study
+    return study.run(args)
+
+
+def add_bench_cli_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--runs", type=options.positive_int, default=5, help="processes of each kind (default 5)")
+    parser.add_argument("--quick", action="store_true", help="3 processes of each kind")
+    parser.add_argument("--json", action="store_true")
+
+
+def run_bench_cli(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import cli_start
+    return cli_start.run(args)
+
+
+def add_log_info_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("log", help="an .mcap run log")
+    parser.add_argument("--json", action="store_true", help="print the facts as JSON")
+
+
+def run_log_info(args: argparse.Namespace) -> int:
+    from swarmnav.sim import log_commands
+    return log_commands.run_info(args)
+
+
+def add_log_recover_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("source", metavar="IN", help="a (possibly truncated) .mcap file")
+    parser.add_argument("target", metavar="OUT", help="the complete, indexed .mcap file to write")
+
+
+def run_log_recover(args: argparse.Namespace) -> int:
+    from swarmnav.sim import log_commands
+    return log_commands.run_recover(args)
+
+
+def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("log", help="an .mcap run log")
+    parser.add_argument("--video", metavar="OUT.mp4", help="render the run to an MP4 (offscreen EGL)")
+    parser.add_argument("--camera", choices=("top", "chase"), default="top")
+    parser.add_argument("--width", type=int, default=640)
+    parser.add_argument("--height", type=int, default=480)
+    parser.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second")
+    parser.add_argument("--no-trail", action="store_true", help="do not draw the driven trajectory")
+    parser.add_argument("--verify", action="store_true",
+                        help="re-simulate from the log and compare every pose and range scan "
+                             "(exit 1 if they differ)")
+    parser.add_argument("--json", action="store_true", help="print the results as JSON")
+
+
+def run_replay(args: argparse.Namespace) -> int:
+    from swarmnav.sim import replay
+    return replay.run(args)
+
+
+def add_plot_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("log", help="an .mcap run log")
+    parser.add_argument("-o", "--out", required=True, help="image to write (.png, .svg, .pdf)")
+    parser.add_argument("--dpi", type=int, default=120, help=f"dots per inch, {MIN_DPI}..{MAX_DPI}")
+
+
+def run_plot(args: argparse.Namespace) -> int:
+    from swarmnav.sim import plot
+    return plot.run(args)
+
+
+# (words, add the options, run, help): the CLI builds one subparser from each row.
+MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
+    (("bench", "sim"), add_bench_sim_arguments, run_bench_sim,
+     "closed loop vs bare mj_step on the dense 30-cylinder scene"),
+    (("bench", "planners"), add_bench_planners_arguments, run_bench_planners,
+     "continuous planners against the exact optimum and mealpy"),
+    (("bench", "grid"), add_bench_grid_arguments, run_bench_grid,
+     "grid planners, Moving AI optima and the pathfinding peer"),
+    (("bench", "render"), add_bench_render_arguments, run_bench_render, "offscreen rendering frames per second"),
+    (("bench", "env"), add_bench_env_arguments, run_bench_env,
+     "the Gymnasium environment vs the closed-loop runner and bare mj_step"),
+    (("bench", "navigation"), add_bench_navigation_arguments, run_bench_navigation,
+     "every navigator on the dynamic suite (dyn-*) x world seeds"),
+    (("bench", "cli"), add_bench_cli_arguments, run_bench_cli,
+     "start-up of `swarmnav scenarios` against a bare `python -c pass`"),
+    (("log", "info"), add_log_info_arguments, run_log_info, "what a log holds"),
+    (("log", "recover"), add_log_recover_arguments, run_log_recover, "rewrite a truncated log as a complete one"),
+    (("replay",), add_replay_arguments, run_replay, "re-render or re-simulate a log"),
+    (("plot",), add_plot_arguments, run_plot, "plot a log to PNG"),
+    (("study",), study_cli.add_study_arguments, study_cli.run_study,
+     "run a study (scenarios x planners x navigators x seeds) into Parquet rows"),
+    (("studies",), study_cli.add_studies_arguments, study_cli.run_studies, "list the bundled studies"),
+    (("report",), study_cli.add_report_arguments, study_cli.run_report,
+     "an HTML and Markdown report of a study's rows"),
+    (("bench", "study"), add_bench_study_arguments, run_bench_study,
+     "study harness: parallel efficiency, overhead per cell, Ray vs local"),
+]
