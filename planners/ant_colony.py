@@ -5,9 +5,10 @@ What the three papers have in common lives here, once:
 * :func:`roulette`: roulette-wheel choice of one option per ant, for all ants in one call;
 * :func:`evaporate` and :func:`deposit`: the pheromone update ``tau <- (1 - rho) tau + sum(delta)``;
 * :class:`GridGraph`: the 8-connected, no-corner-cutting cell graph of an occupancy grid;
-* :func:`walk_colony`: tour construction on a :class:`GridGraph`, vectorised over ants:
+* :func:`walk_colony_reference`: tour construction on a :class:`GridGraph`, vectorised over ants:
   every walking ant advances one cell per NumPy step, with masks for the ants that
-  reached the goal or got stuck (no unvisited neighbour left).
+  reached the goal or got stuck (no unvisited neighbour left); :func:`walk_colony`
+  is the same walk compiled (``planners/_colony_walk.c``), which the planners use.
 
 Each planner supplies only its desirability (how Eq. (1)/(3)/(6) of its paper
 weighs the neighbours, as a per-cell and a per-turn table) and its update rule, and runs through
@@ -20,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from swarmnav.planners._colony_walk import walk_block
 from swarmnav.planners.grid_graph import DIRECTIONS, STEP_COSTS, neighbour_table
 from swarmnav.models.world import OccupancyGrid
 
@@ -127,6 +129,49 @@ class ColonyWalk:
 def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights: np.ndarray,
                 turn_weights: np.ndarray | None, rng: np.random.Generator, max_steps: int,
                 backtrack: bool = True, max_length: float = np.inf) -> ColonyWalk:
+    """:func:`walk_colony_reference`, compiled (``planners/_colony_walk.c``): the same tours and draws.
+
+    The NumPy walk costs about 25 NumPy calls per step whatever the number of
+    ants, and an IACO ant walks ~180 steps on a 50 x 50 map (it backs out of dead
+    ends): ~0.6-0.8 s of call overhead per 50 x 100 plan (profiled, issue 14).
+    The C kernel does the same arithmetic per ant, in the same order, a block of
+    :data:`UNIFORM_BLOCK` steps per call; the block's uniforms are drawn here as
+    the reference draws them (one ``rng.random((UNIFORM_BLOCK, ants))`` per block
+    begun with an ant still walking), and the j-th ant still walking at a step,
+    in ant order, uses column j, as in the reference's compacted arrays.
+    """
+    n = graph.size
+    cw = np.ascontiguousarray(cell_weights, dtype=float)
+    turns = np.ones((1, 8)) if turn_weights is None else np.ascontiguousarray(turn_weights, dtype=float)
+    table = np.ascontiguousarray(graph.table, dtype=np.int64)
+    width = max_steps + 1
+    keys = np.empty(ants * width, dtype=np.int64)
+    keys[::width] = NO_DIRECTION * n + start
+    steps = np.zeros(ants, dtype=np.int64)
+    length = np.zeros(ants)
+    reached = np.full(ants, start == goal)
+    unvisited = np.ones(ants * (n + 1), dtype=bool)
+    unvisited[np.arange(ants) * (n + 1) + start] = False
+    walking = np.full(ants, start != goal)
+    key = np.full(ants, NO_DIRECTION * n + start, dtype=np.int64)
+    run = np.zeros(ants, dtype=np.int64)
+    walked = np.zeros(ants)
+    still = int(walking.sum())
+    for first in range(0, max_steps, UNIFORM_BLOCK):
+        if still == 0:
+            break
+        uniforms = rng.random((UNIFORM_BLOCK, ants))
+        still = walk_block(cw, turns, table, STEP_LENGTHS_9, uniforms, UNIFORM_BLOCK, first,
+                           min(first + UNIFORM_BLOCK, max_steps), n, goal, width, bool(backtrack),
+                           float(max_length), keys, unvisited, walking, key, run, walked, steps, length, reached)
+    steps[walking] = run[walking]
+    length[walking] = walked[walking]
+    return _colony_walk(keys, steps, length, reached, n, start)
+
+
+def walk_colony_reference(graph: GridGraph, start: int, goal: int, ants: int, cell_weights: np.ndarray,
+                          turn_weights: np.ndarray | None, rng: np.random.Generator, max_steps: int,
+                          backtrack: bool = True, max_length: float = np.inf) -> ColonyWalk:
     """Let ``ants`` ants walk from ``start`` until each reaches ``goal``, gets stuck, or runs out of steps.
 
     An ant at cell i that last moved in direction p picks direction d with
@@ -161,11 +206,7 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
     add_reduce, min_reduce, max_reduce = np.add.reduce, np.minimum.reduce, np.maximum.reduce
     or_reduce, and_reduce = np.logical_or.reduce, np.logical_and.reduce
     less_equal = np.less_equal
-    cw = np.asarray(cell_weights, dtype=float)
-    if turn_weights is None:
-        weights = np.tile(cw, (NO_DIRECTION + 1, 1))
-    else:
-        weights = (np.asarray(turn_weights, dtype=float)[:, None, :] * cw[None, :, :]).reshape(-1, 8)
+    weights = _key_weights(cell_weights, turn_weights)
     candidates = graph.key_table                              # (9 N, 8) cells, -1 where illegal
     key_back_lengths = -np.repeat(STEP_LENGTHS_9, n)           # (9 N,) length undone by stepping back
     width = max_steps + 1
@@ -239,8 +280,23 @@ def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights
     if ids.size:
         steps[ids] = run
         length[ids] = walked
+    return _colony_walk(keys, steps, length, reached, n, start)
+
+
+def _key_weights(cell_weights: np.ndarray, turn_weights: np.ndarray | None) -> np.ndarray:
+    """(9 N, 8) weight of each move by key ``direction * N + cell``: the turn factor times the cell's."""
+    cw = np.asarray(cell_weights, dtype=float)
+    if turn_weights is None:
+        return np.tile(cw, (NO_DIRECTION + 1, 1))
+    return (np.asarray(turn_weights, dtype=float)[:, None, :] * cw[None, :, :]).reshape(-1, 8)
+
+
+def _colony_walk(keys: np.ndarray, steps: np.ndarray, length: np.ndarray, reached: np.ndarray, n: int,
+                 start: int) -> ColonyWalk:
+    """The tours (cells, turns) from the walk's key stacks (ant-major, ``steps + 1`` valid keys each)."""
+    ants = steps.size
     used = int(steps.max()) + 1 if ants else 1
-    keys = keys.reshape(ants, width)[:, :used]
+    keys = keys.reshape(ants, -1)[:, :used]
     keys[:, 0] = NO_DIRECTION * n + start                      # an ant stuck at the start overwrote it
     moved = np.arange(used)[None, :] <= steps[:, None]
     paths = np.where(moved, keys % n, -1)
