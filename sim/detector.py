@@ -40,17 +40,26 @@ def hit_points(pose: Pose2D, ranges_m: np.ndarray, angles_rad: np.ndarray, offse
     return origins + np.asarray(ranges_m)[hit][:, None] * direction, origins
 
 
-def known_surface_gap_m(points_m: np.ndarray, scenario: Scenario) -> np.ndarray:
-    """(N,) distance from each point to the nearest known static surface (inf with none)."""
+def static_surfaces(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
+    """The known map's static discs (D, 3) as (x, y, radius) and boxes (B, 4), in metres."""
+    discs = np.array([(ob.x_m, ob.y_m, ob.radius_m) for ob in scenario.obstacles if not ob.moving],
+                     dtype=float).reshape(-1, 3)
+    boxes = np.array([[bx.x_min_m, bx.y_min_m, bx.x_max_m, bx.y_max_m] for bx in scenario.boxes],
+                     dtype=float).reshape(-1, 4)
+    return discs, boxes
+
+
+def known_surface_gap_m(points_m: np.ndarray, scenario: Scenario,
+                        surfaces: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+    """(N,) distance from each point to the nearest known static surface (inf with none);
+    ``surfaces``: :func:`static_surfaces` of the scenario, built once by a caller that asks every step."""
     pts = np.asarray(points_m, dtype=float).reshape(-1, 2)
     gap = np.full(len(pts), np.inf)
-    discs = [(ob.x_m, ob.y_m, ob.radius_m) for ob in scenario.obstacles if not ob.moving]
-    if discs:
-        d = np.array(discs)
+    d, b = static_surfaces(scenario) if surfaces is None else surfaces
+    if len(d):
         gap = np.minimum(gap, np.min(np.abs(np.hypot(pts[:, None, 0] - d[:, 0], pts[:, None, 1] - d[:, 1])
                                             - d[:, 2]), axis=1))
-    if scenario.boxes:
-        b = np.array([[bx.x_min_m, bx.y_min_m, bx.x_max_m, bx.y_max_m] for bx in scenario.boxes])
+    if len(b):
         dx = np.maximum(np.maximum(b[:, 0] - pts[:, None, 0], pts[:, None, 0] - b[:, 2]), 0.0)
         dy = np.maximum(np.maximum(b[:, 1] - pts[:, None, 1], pts[:, None, 1] - b[:, 3]), 0.0)
         gap = np.minimum(gap, np.min(np.hypot(dx, dy), axis=1))
@@ -85,6 +94,7 @@ class ObstacleSensing:
         self.offset_m = offset_m
         self.tracker = HitTracker()
         self.tracker.reach_m = scenario.sensor_range_m
+        self.surfaces = static_surfaces(scenario)  # the known map, once (asked about every step)
         # Velocities by forward difference of the scripted track (backward at the last step).
         if track_m.shape[1] and len(track_m) > 1:
             diff = np.diff(track_m, axis=0) / dt_s
@@ -96,7 +106,7 @@ class ObstacleSensing:
         if self.model == "detector":
             return self.detect(step, pose)
         hits, origins = hit_points(pose, ranges_m, self.angles_rad, self.offset_m)
-        unknown = known_surface_gap_m(hits, self.scenario) > STATIC_HIT_TOLERANCE_M
+        unknown = known_surface_gap_m(hits, self.scenario, self.surfaces) > STATIC_HIT_TOLERANCE_M
         world = pose.heading_rad + np.asarray(self.angles_rad)
         directions = np.column_stack([np.cos(world), np.sin(world)])
         beam_origins = np.array([pose.x_m, pose.y_m]) + self.offset_m * directions
