@@ -16,7 +16,7 @@ STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c
 
 .PHONY: demo test bench install clean studies
 
-$(STAMP): pyproject.toml planners/_colony_walk.c
+$(STAMP): pyproject.toml planners/_colony_walk.c planners/_grid_search.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test,bench]'

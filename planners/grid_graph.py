@@ -142,6 +142,26 @@ class _AdjacencyCache:
     def __init__(self, size: int = 16):
         self.size = size
         self.entries: OrderedDict[tuple, list[int]] = OrderedDict()
+        self.arrays: OrderedDict[tuple, np.ndarray] = OrderedDict()  # the same masks as uint8, for C
+
+    def clear(self) -> None:
+        self.entries.clear()
+        self.arrays.clear()
+
+    def get_array(self, occupied: np.ndarray) -> np.ndarray:
+        """The legal-move mask of every cell, as a (rows * cols,) uint8 array (read-only)."""
+        occ = np.ascontiguousarray(occupied, dtype=bool)
+        key = (occ.shape, occ.tobytes())
+        hit = self.arrays.get(key)
+        if hit is not None:
+            self.arrays.move_to_end(key)
+            return hit
+        masks = move_masks(occ)
+        masks.flags.writeable = False
+        self.arrays[key] = masks
+        if len(self.arrays) > self.size:
+            self.arrays.popitem(last=False)
+        return masks
 
     def get(self, occupied: np.ndarray) -> list[int]:
         """The legal-move mask of every cell, as a list."""

@@ -14,7 +14,7 @@ from typing import Callable
 
 import numpy as np
 
-from swarmnav.models.geometry import segment_box_distance
+from swarmnav.models.geometry import segment_box_distance, segment_box_pair_distances, segment_disc_distances
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.grid_graph import Cell, grid_line_of_sight, line_cells
 from swarmnav.planners.obstacle_buckets import ClearanceBuckets
@@ -36,6 +36,8 @@ def segments_clear(problem: Problem, a: np.ndarray, bs: np.ndarray, tolerance_m:
     ok = problem.in_bounds(bs, tolerance_m)
     if buckets is not None:
         ok &= buckets.segments_clear(a, bs, tolerance_m)
+    elif problem.boxes:
+        ok &= _fan_clear(problem, a, bs, tolerance_m)
     else:
         ok &= problem.segment_clearances_m(a, bs, cull_beyond_m=0.0) >= -tolerance_m
     if not problem.boxes and problem.grid_override is not None:
@@ -45,6 +47,34 @@ def segments_clear(problem: Problem, a: np.ndarray, bs: np.ndarray, tolerance_m:
         for k in np.flatnonzero(ok):
             ok[k] = grid_line_of_sight(free, ca, grid.cell_of(*bs[k]))
     return ok
+
+
+def _fan_clear(problem: Problem, a: np.ndarray, bs: np.ndarray, tolerance_m: float) -> np.ndarray:
+    """``problem.segment_clearances_m(a, bs, cull_beyond_m=0.0) >= -tolerance_m``, each box measured
+    only against the segments whose bounding box, grown by the inflation, it reaches.
+
+    The same decision: a box beyond that reach of a segment is farther than the inflation from it
+    (a positive gap, which cannot make the segment blocked), and the pairs that are measured get
+    the distances of :func:`~planners.geometry.segment_box_distances` (computed pair by pair,
+    bit for bit the same).  A fan of 32 segments meets a few of a map's boxes each, where the
+    segments' joint bounding box meets most of them (profiled: 13 such fans made ~2/3 of an
+    ``astar`` plan on a 50 x 50 map).
+    """
+    a_k, bs = np.broadcast_arrays(a, bs)
+    clear = np.ones(len(bs), dtype=bool)
+    if problem.obstacles:
+        d = segment_disc_distances(a_k, bs, problem.disc_centres_m)
+        clear = np.min(d - problem.inflated_radii_m[None, :], axis=1) >= -tolerance_m
+    boxes, reach_m = problem.box_array_m, problem.inflation_m
+    lo = np.minimum(a_k, bs) - reach_m
+    hi = np.maximum(a_k, bs) + reach_m
+    near = ((boxes[None, :, 0] <= hi[:, None, 0]) & (boxes[None, :, 2] >= lo[:, None, 0])
+            & (boxes[None, :, 1] <= hi[:, None, 1]) & (boxes[None, :, 3] >= lo[:, None, 1]))
+    seg, box = np.nonzero(near)
+    if seg.size:
+        gap = segment_box_pair_distances(a_k[seg], bs[seg], boxes[box]) - reach_m
+        clear[seg[gap < -tolerance_m]] = False
+    return clear
 
 
 #: Fewest obstacles for which :func:`exact_shortcut` files them in buckets: below it, measuring
