@@ -160,7 +160,9 @@ _CONTROLLER_JSON = '{"angular_rad_s": %r, "linear_m_s": %r, "waypoint_index": %d
 
 
 def _finite(*values: float) -> bool:
-    return all(-math.inf < v < math.inf for v in values)
+    # A non-finite value makes the sum inf or nan; finite values whose sum overflows take the
+    # ``dumps`` path too, which writes the same text for finite numbers.
+    return math.isfinite(sum(values))
 
 
 def wheels_json(command_rad_s: Any, measured_rad_s: Any) -> str:

@@ -61,7 +61,7 @@ from swarmnav.sim.log_format import (
     WORLD_FRAME,
     default_log_path,
     dumps,
-    scan_from_ranges,
+    scan_list_from_ranges,
     time_ns,
     writer_versions,
 )
@@ -265,13 +265,14 @@ class McapRecorder:
                 pose=self._scan_pose,
                 start_angle=self._scan_start_rad,
                 end_angle=self._scan_end_rad,  # inclusive
-                ranges=scan_from_ranges(frame.range_m, self._beam_offset_m).tolist(),
+                ranges=scan_list_from_ranges(frame.range_m, self._beam_offset_m),
             ),
             log_time=t_ns,
         )
-        self._wheels.log(wheels_json(frame.wheel_command_rad_s, frame.wheel_measured_rad_s), log_time=t_ns)
-        self._controller.log(controller_json(frame.linear_m_s, frame.angular_rad_s, frame.waypoint_index),
-                             log_time=t_ns)
+        # The JSON channels' own ``log`` only encodes text and calls its ``base``: called directly.
+        self._wheels.base.log(wheels_json(frame.wheel_command_rad_s, frame.wheel_measured_rad_s).encode(), t_ns, None)
+        self._controller.base.log(
+            controller_json(frame.linear_m_s, frame.angular_rad_s, frame.waypoint_index).encode(), t_ns, None)
         written = 5
         late = self._server.late_topics() if self._server is not None else ()
         if self._moving_infos or "/obstacles" in late:
