@@ -36,13 +36,17 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
+# Every benchmark; `make bench BENCH_FLAGS=--quick` runs each in under a minute.
+BENCH_FLAGS ?=
 bench: $(STAMP)
-	$(BIN)/swarmnav bench sim
-	$(BIN)/swarmnav bench planners
-	$(BIN)/swarmnav bench grid
-	$(BIN)/swarmnav bench render
-	$(BIN)/swarmnav bench study
-	$(BIN)/swarmnav bench cli
+	$(BIN)/swarmnav bench sim $(BENCH_FLAGS)
+	$(BIN)/swarmnav bench planners $(BENCH_FLAGS)
+	$(BIN)/swarmnav bench grid $(BENCH_FLAGS)
+	$(BIN)/swarmnav bench render $(BENCH_FLAGS)
+	$(BIN)/swarmnav bench env $(BENCH_FLAGS)
+	$(BIN)/swarmnav bench navigation $(BENCH_FLAGS)
+	$(BIN)/swarmnav bench study $(BENCH_FLAGS)
+	$(BIN)/swarmnav bench cli $(BENCH_FLAGS)
 
 # Every bundled study into studies/<name>/ (rows resume if interrupted), with report.html and report.md.
 # Quick by default (each study's quick_seeds, about 10 min on 2 cores); `make studies STUDY_RUN=` runs them in full

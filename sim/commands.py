@@ -27,6 +27,9 @@ BENCH_PLANNERS_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3"
                             "adl-abc-path-1", "adl-abc-path-2", "adl-abc-path-3",
                             "dense-field-30", "restaurant-table-2", "restaurant-table-5")
 BENCH_PLANNERS_PLANNERS = ("abc", "adl_abc", "gwo", "pso")
+# bench navigation --quick: one world seed on one scenario of each generated kind.
+BENCH_NAVIGATION_QUICK_SCENARIOS = ("dyn-crossing-1", "dyn-head-on-1", "dyn-overtake-1", "dyn-crowd-1")
+BENCH_STUDY_QUICK = (5, 20)  # bench study --quick: seeds per scenario, GWO iterations; no Ray
 
 
 def add_bench_sim_arguments(parser: argparse.ArgumentParser) -> None:
@@ -126,10 +129,14 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--suite", choices=("dyn", "papers"), default="dyn",
                         help="dyn: the dyn-* suite (default); papers: the papers' strategies beside replan + iaco "
                              "and dstar_replan, one row per run (sim/benchmarks/paper_navigation.py)")
+    parser.add_argument("--quick", action="store_true",
+                        help=f"1 world seed on {', '.join(BENCH_NAVIGATION_QUICK_SCENARIOS)} (under a minute)")
 
 
 def run_bench_navigation(args: argparse.Namespace) -> int:
     from swarmnav.sim.benchmarks import navigation
+    if args.quick:
+        args.seeds, args.scenario = 1, args.scenario or list(BENCH_NAVIGATION_QUICK_SCENARIOS)
     return navigation.run(args)
 
 
@@ -138,10 +145,14 @@ def add_bench_study_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--iterations", type=int, default=60, help="GWO iterations per cell")
     parser.add_argument("--no-ray", action="store_true", help="skip the Ray comparison")
     parser.add_argument("--json", action="store_true")
+    parser.add_argument("--quick", action="store_true",
+                        help="%d seeds per scenario, %d GWO iterations, no Ray (under a minute)" % BENCH_STUDY_QUICK)
 
 
 def run_bench_study(args: argparse.Namespace) -> int:
     from swarmnav.sim.benchmarks import study
+    if args.quick:
+        (args.seeds, args.iterations), args.no_ray = BENCH_STUDY_QUICK, True
     return study.run(args)
 
 
