@@ -154,9 +154,12 @@ def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     planner = log.metadata.get("planner", {}).get("name", "?")
-    seed = log.metadata.get("run", {}).get("seed", "?")
+    navigator = log.metadata.get("navigator", {}).get("name", "follow")
+    run = log.metadata.get("run", {})
+    seed, world_seed = run.get("seed", "?"), run.get("world_seed", run.get("seed", "?"))
     truncated = "" if log.complete else " (truncated log)"
-    ax.set_title(f"{log.scenario_name} / {planner} / seed {seed}: {outcome_text(log)}, "
+    ax.set_title(f"{log.scenario_name} / {planner} + {navigator} / seed {seed}, world seed {world_seed}: "
+                 f"{outcome_text(log)}, "
                  f"{log.duration_s:.1f} s{truncated}")
     ax.legend(loc="upper left", fontsize=8, framealpha=0.85)
 
