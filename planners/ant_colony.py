@@ -17,12 +17,18 @@ weighs the neighbours, as a per-cell and a per-turn table) and its update rule, 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from swarmnav.planners._colony_walk import walk_block
-from swarmnav.planners.grid_graph import DIRECTIONS, STEP_COSTS, neighbour_table
+from swarmnav.planners.errors import NoPathFound
+from swarmnav.planners.grid_graph import DIRECTIONS, STEP_COSTS, cells_to_waypoints, count_bends, neighbour_table
+from swarmnav.planners.grid_shortcut import exact_shortcut
+from swarmnav.planners.problem import Problem
+from swarmnav.planners.swarm import SwarmState
 from swarmnav.models.world import OccupancyGrid
 
 #: Index used for "no previous move" (an ant on its first step).
@@ -315,3 +321,29 @@ def cosine_table() -> np.ndarray:
     table = np.ones((9, 8))
     table[:8] = unit @ unit.T
     return table
+
+
+def best_tour_result(state: SwarmState, problem: Problem, shortcut: bool,
+                     name: str) -> tuple[np.ndarray, dict[str, Any]]:
+    """The shared end of a grid colony's run: the best tour as waypoints (shortcut or not) and the
+    statistics every colony reports (raw cells and length, the last iteration's tour lengths, bends).
+
+    Raises:
+        NoPathFound: no ant reached the goal.
+    """
+    data = state.data
+    if state.best_solution is None:
+        raise NoPathFound(f"{name}: no ant of {state.evaluations} reached the goal")
+    grid = problem.grid
+    cells = [tuple(int(v) for v in rc) for rc in data["graph"].cells(state.best_solution)]
+    raw = cells_to_waypoints(problem, grid, cells)
+    waypoints = exact_shortcut(problem, raw) if shortcut else raw
+    lengths_m = data["last_lengths"] * grid.cell_m
+    return waypoints, {
+        "raw_cells": [list(c) for c in cells],
+        "raw_length_m": state.best_cost,
+        "mean_length_m": float(np.mean(lengths_m)) if lengths_m.size else math.nan,
+        "std_length_m": float(np.std(lengths_m)) if lengths_m.size else math.nan,
+        "bends": count_bends(cells),
+        "successful_tours": int(data["successes"]),
+    }

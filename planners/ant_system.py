@@ -31,16 +31,14 @@ Readings for a start-goal grid problem (our choices, as the paper is about the T
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.planners.ant_colony import STEP_LENGTHS, GridGraph, deposit, evaporate, walk_colony
-from swarmnav.planners.errors import NoPathFound, check_parameters
-from swarmnav.planners.grid_graph import cells_to_waypoints, count_bends, grid_endpoints, grid_problem
-from swarmnav.planners.grid_shortcut import exact_shortcut
+from swarmnav.planners.ant_colony import STEP_LENGTHS, GridGraph, best_tour_result, deposit, evaporate, walk_colony
+from swarmnav.planners.errors import check_parameters
+from swarmnav.planners.grid_graph import grid_endpoints, grid_problem
 from swarmnav.planners.improved_ant_colony import MAX_ANTS, MAX_COLONY_CELLS
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
@@ -145,19 +143,4 @@ class AntSystemPlanner(SwarmPlanner):
 
     def finish(self, state: SwarmState, problem: Problem,
                rng: np.random.Generator) -> tuple[np.ndarray, dict[str, Any]]:
-        data = state.data
-        if state.best_solution is None:
-            raise NoPathFound(f"aco: no ant of {state.evaluations} reached the goal")
-        grid = problem.grid
-        cells = [tuple(int(v) for v in rc) for rc in data["graph"].cells(state.best_solution)]
-        raw = cells_to_waypoints(problem, grid, cells)
-        waypoints = exact_shortcut(problem, raw) if self.shortcut else raw
-        lengths_m = data["last_lengths"] * grid.cell_m
-        return waypoints, {
-            "raw_cells": [list(c) for c in cells],
-            "raw_length_m": state.best_cost,
-            "mean_length_m": float(np.mean(lengths_m)) if lengths_m.size else math.nan,
-            "std_length_m": float(np.std(lengths_m)) if lengths_m.size else math.nan,
-            "bends": count_bends(cells),
-            "successful_tours": int(data["successes"]),
-        }
+        return best_tour_result(state, problem, self.shortcut, "aco")

@@ -52,11 +52,10 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
-from swarmnav.planners.ant_colony import STEP_LENGTHS, GridGraph, cosine_table, deposit, evaporate, walk_colony
-from swarmnav.planners.errors import NoPathFound, check_parameters
-from swarmnav.planners.grid_graph import (Cell, cells_to_waypoints, count_bends, grid_endpoints, grid_line_of_sight,
-                                          grid_problem, line_cells)
-from swarmnav.planners.grid_shortcut import exact_shortcut
+from swarmnav.planners.ant_colony import (STEP_LENGTHS, GridGraph, best_tour_result, cosine_table, deposit, evaporate,
+                                          walk_colony)
+from swarmnav.planners.errors import check_parameters
+from swarmnav.planners.grid_graph import Cell, grid_endpoints, grid_line_of_sight, grid_problem, line_cells
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 
@@ -334,24 +333,12 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
 
     def finish(self, state: SwarmState, problem: Problem,
                rng: np.random.Generator) -> tuple[np.ndarray, dict[str, Any]]:
+        waypoints, extra = best_tour_result(state, problem, self.shortcut, "iaco")
         data = state.data
-        if state.best_solution is None:
-            raise NoPathFound(f"no ant of {state.evaluations} reached the goal")
-        grid = problem.grid
-        cells = [tuple(int(v) for v in rc) for rc in data["graph"].cells(state.best_solution)]
-        raw = cells_to_waypoints(problem, grid, cells)
-        waypoints = exact_shortcut(problem, raw) if self.shortcut else raw
-        lengths_m = data["last_lengths"] * grid.cell_m
         alpha, beta, rho = data["params"]
-        extra = {
-            "raw_cells": [list(c) for c in cells],
-            "raw_length_m": state.best_cost,
-            "mean_length_m": float(np.mean(lengths_m)) if lengths_m.size else math.nan,
-            "std_length_m": float(np.std(lengths_m)) if lengths_m.size else math.nan,
-            "bends": count_bends(cells),
-            "collar_length_m": data["collar_length"] * grid.cell_m,
+        extra.update({
+            "collar_length_m": data["collar_length"] * problem.grid.cell_m,
             "collar_points": [list(p) for p in data["collar_points"]],
-            "successful_tours": int(data["successes"]),
             "final_alpha": alpha, "final_beta": beta, "final_rho": rho,
-        }
+        })
         return waypoints, extra
