@@ -216,8 +216,6 @@ def inflated_map_grid(occupied: np.ndarray, cell_m: float, inflation_m: float,
     Args:
         occupied: (rows, cols) world grid (rows grow with y).
     """
-    from swarmnav.models.world import Rect, rasterise
-
     occ = np.asarray(occupied, dtype=bool)
     if inflation_m <= cell_m / 2.0 + 1e-12:
         return OccupancyGrid(occupied=occ.copy(), cell_m=float(cell_m), origin_m=origin_m)

@@ -19,7 +19,6 @@ from swarmnav.planners.errors import PlanningError
 from swarmnav.sim.cli import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
 from swarmnav.sim.study.grid import expand
-from swarmnav.sim.study.rows import TIMING_COLUMNS
 from swarmnav.sim.study.spec import list_studies, load_study
 
 TINY = """

@@ -56,7 +56,7 @@ from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationSt
 from swarmnav.controllers.navigators.replan import check_positive, keep_outside
 from swarmnav.controllers.prediction import swept_discs
 from swarmnav.controllers.safety_filter import SafetyFilter
-from swarmnav.models.world import OccupancyGrid, rasterise
+from swarmnav.models.world import rasterise
 from swarmnav.planners.dstar_lite import DStarLite
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.planners.grid_graph import Cell, grid_line_of_sight, octile_cells

@@ -51,9 +51,8 @@ from scipy import ndimage
 from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import (Cell, CellWalker, cells_of_path, grid_problem, heading_of,
                                                        static_grid, step_line)
-from swarmnav.controllers.navigators.collision_types import (CATCHING_UP, CROSSING, FROM_BEHIND, HEAD_ON,
-                                                             NO_CONFLICT, Encounter, classify, escape_moves,
-                                                             escape_offsets, first_band_index,
+from swarmnav.controllers.navigators.collision_types import (CATCHING_UP, CROSSING, NO_CONFLICT, Encounter, classify,
+                                                             escape_moves, escape_offsets, first_band_index,
                                                              precondition_x_of_moves,
                                                              predicted_meeting_s, timing)
 from swarmnav.models.errors import ConfigError
