@@ -88,6 +88,14 @@ def test_a_policy_returning_a_wrong_shape_names_the_field(policy_module, tmp_pat
                                 navigator_params={"policy": "bad_policy:act"}), time_limit_s=1.0)
 
 
+def test_a_policy_that_raises_is_reported_against_the_parameter(tmp_path, monkeypatch):
+    (tmp_path / "raising_policy.py").write_text("def act(obs):\n    return {}['missing']\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with pytest.raises(ConfigError, match="navigator.params.policy.*raised KeyError"):
+        run_episode(EpisodeSpec(load_scenario("restaurant-table-5"), navigator="policy",
+                                navigator_params={"policy": "raising_policy:act"}), time_limit_s=1.0)
+
+
 def test_bench_navigation_runs_the_policy_named_by_navigator_set(policy_module):
     out = swarmnav("bench", "navigation", "--seeds", "1", "--scenario", "dyn-crossing-3", "--navigator", "policy",
                    "--navigator", "follow", "--navigator-set", f"policy={policy_module}", "--json")

@@ -328,3 +328,17 @@ def test_a_quick_run_is_the_first_seeds_of_the_full_one():
     quick_cells = expand(quick)
     assert len(quick_cells) * len(full.seeds) == len(full_cells) * len(quick.seeds)
     assert all(c.config_hash in full_cells and c.seed in quick.seeds for c in quick_cells)
+
+
+def test_an_unreachable_ray_address_is_one_line_naming_the_option():
+    import socket
+
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.sim.study.engines import check_reachable
+
+    with socket.socket() as listener:  # a port that surely refuses: bound, never listening
+        listener.bind(("127.0.0.1", 0))
+        port = listener.getsockname()[1]
+        with pytest.raises(ConfigError) as info:
+            check_reachable(f"ray://127.0.0.1:{port}")
+    assert info.value.field == "--address" and str(port) in info.value.problem

@@ -89,7 +89,10 @@ class PolicyNavigator:
         self.uses_detections = bool(layout.obstacle_slots)  # read by the runner after reset
 
     def step(self, observation: Observation) -> NavigationStep:
-        action = np.asarray(self._policy(self._observer(observation)), dtype=float)
+        try:
+            action = np.asarray(self._policy(self._observer(observation)), dtype=float)
+        except Exception as exc:  # the user's code failed: their input, reported against the parameter
+            raise ConfigError(FIELD, f"{self.policy!r} raised {type(exc).__name__}: {exc}") from None
         if action.shape != (2,) or not np.all(np.isfinite(action)):
             raise ConfigError(FIELD, f"{self.policy!r} returned {action!r}; expected 2 finite numbers")
         return NavigationStep(action_command(action, self.action, self._geometry, self._max_speed_m_s))

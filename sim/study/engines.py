@@ -13,10 +13,12 @@ import contextlib
 import logging
 import multiprocessing
 import os
+import socket
 import threading
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Any, Iterator, Sequence
 
+from swarmnav.models.errors import ConfigError
 from swarmnav.sim.study.cell import run_cell
 from swarmnav.sim.study.grid import Cell
 
@@ -88,6 +90,18 @@ def _drop_token_notice(record: logging.LogRecord) -> bool:
     return not record.getMessage().startswith("Token authentication is enabled")
 
 
+def check_reachable(address: str, timeout_s: float = 5.0) -> None:
+    """Fail at once, naming ``--address``, when a ``host:port`` (or ``ray://host:port``) cluster address does not
+    answer a TCP connection (Ray itself would retry for minutes); other forms (``auto``) go to Ray as given."""
+    host, sep, port = address.removeprefix("ray://").rpartition(":")
+    if not sep or not port.isdigit():
+        return
+    try:
+        socket.create_connection((host, int(port)), timeout=timeout_s).close()
+    except OSError as exc:
+        raise ConfigError("--address", f"cannot reach {address} ({exc.strerror or exc})") from None
+
+
 def start_ray(address: str | None, workers: int | None) -> None:
     """Connect to the cluster at ``address``, or start a local instance with ``workers`` CPUs."""
     import ray
@@ -95,6 +109,7 @@ def start_ray(address: str | None, workers: int | None) -> None:
         return
     runtime_env = {"env_vars": worker_environment()}
     if address:
+        check_reachable(address)
         ray.init(address=address, runtime_env=runtime_env, log_to_driver=False)
     else:
         # A new local instance turns token authentication on by default and logs a warning that it did;
