@@ -120,6 +120,24 @@ class Scenario:
                           if isinstance(ob.motion, RandomWalkMotion) else ob for ob in self.obstacles)
         return replace(self, obstacles=obstacles, world_seed=int(world_seed))
 
+    def with_clearance(self, clearance_m: float, field_name: str = "clearance_m") -> "Scenario":
+        """This scenario with the planning clearance beyond the robot radius set to ``clearance_m``.
+
+        Raises:
+            ConfigError: negative, or the scenario plans on a map inflated when it was read (a map with
+                only moving obstacles): its clearance is part of that map.
+        """
+        clearance_m = float(clearance_m)
+        if not clearance_m >= 0.0:
+            raise ConfigError(field_name, f"must be a non-negative number, got {clearance_m:g}", self.source_path)
+        if clearance_m == self.clearance_m:
+            return self
+        if self.map_grid is not None:
+            raise ConfigError(field_name, f"cannot be changed for scenario {self.name!r}: it plans on a map "
+                                          "inflated by its own robot.clearance_m when it was read",
+                              self.source_path)
+        return replace(self, clearance_m=clearance_m)
+
     def discs_at(self, time_s: float = 0.0) -> tuple[Disc, ...]:
         """Every obstacle's footprint at a given time."""
         out = []

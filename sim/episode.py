@@ -58,7 +58,7 @@ NAVIGATOR_STREAM = 1  # spawn key of the navigator's generator under the run's s
 class EpisodeSpec:
     """What to run: a scenario, a planner and a navigator with their parameters, and two seeds.
 
-    ``None`` means "the scenario's": its planner, navigator, ``seed`` (for both seeds).
+    ``None`` means "the scenario's": its planner, navigator, ``seed`` (for both seeds), ``robot.clearance_m``.
     Parameters given here override the scenario's own for the same planner or navigator.
     """
 
@@ -69,6 +69,7 @@ class EpisodeSpec:
     navigator_params: dict[str, Any] | None = None
     seed: int | None = None
     world_seed: int | None = None
+    clearance_m: float | None = None  # the planning clearance beyond the robot radius; None = the scenario's
 
     def resolved(self) -> "EpisodeSpec":
         """Every field filled in; the scenario carries the world seed."""
@@ -83,7 +84,10 @@ class EpisodeSpec:
         world_seed = scenario.seed if self.world_seed is None else int(self.world_seed)
         if world_seed != scenario.world_seed:
             scenario = scenario.with_world_seed(world_seed)
-        return EpisodeSpec(scenario, planner, planner_params, navigator, navigator_params, seed, world_seed)
+        if self.clearance_m is not None:
+            scenario = scenario.with_clearance(self.clearance_m)
+        return EpisodeSpec(scenario, planner, planner_params, navigator, navigator_params, seed, world_seed,
+                           scenario.clearance_m)
 
 
 @dataclass(eq=False)

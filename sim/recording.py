@@ -54,6 +54,7 @@ class RunContext:
     navigator_name: str = "follow"
     navigator_params: dict[str, Any] = field(default_factory=dict)
     world_seed: int = 0
+    clearance_m: float | None = None  # the planning clearance the run used (None: the scenario file's)
 
 
 @dataclass

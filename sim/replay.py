@@ -63,6 +63,7 @@ def context_from_log(log: RunLog) -> RunContext:
         navigator_params=json.loads(navigator.get("params", "{}")),
         world_seed=int(log.metadata.get("run", {}).get("seed" if "world_seed" not in log.metadata.get("run", {})
                                                        else "world_seed", 0)),
+        clearance_m=log.run_value("clearance_m", None),
     )
 
 
@@ -141,7 +142,7 @@ def verify_log(log: RunLog) -> VerifyReport:
     context = context_from_log(log)
     scenario = parse_scenario(context.scenario_toml, f"{log.raw.path}[scenario]")
     spec = EpisodeSpec(scenario, context.planner_name, context.planner_params, context.navigator_name,
-                       context.navigator_params, context.seed, context.world_seed)
+                       context.navigator_params, context.seed, context.world_seed, context.clearance_m)
     model = mujoco.MjModel.from_xml_string(context.mjcf_xml)
     # Reproduce how the logged run stopped: a timeout at T means the limit was T.
     kinds = [kind for _, kind, _ in log.events]

@@ -194,6 +194,10 @@ BAD_STUDIES = {
     "quick seeds beyond the seeds": ('scenarios = ["gwo-scenario-1"]\nseeds = 3\nquick_seeds = 4\n'
                                      '[[planners]]\nname = "astar"\n', "quick_seeds"),
     "no scenario matches": ('scenarios = ["nothing-*"]\n[[planners]]\nname = "astar"\n', "scenarios[0]"),
+    "negative clearance": ('scenarios = ["gwo-scenario-1"]\nclearance_m = -0.1\n[[planners]]\nname = "astar"\n',
+                           "clearance_m"),
+    "clearance of a pre-inflated map": ('scenarios = ["immas-env1-dynamic"]\nclearance_m = 0.0\n'
+                                        '[[planners]]\nname = "astar"\n', "clearance_m"),
 }
 
 
@@ -274,6 +278,21 @@ def test_logs_keep_one_mcap_per_run_that_replays(tmp_path):
     for row in rows.to_dict("records"):
         assert Path(row["log"]).parent == (tmp_path / "out" / "logs").resolve()
         assert main(["replay", row["log"], "--verify", "--json"]) == 0
+
+
+def test_a_clearance_override_plans_and_simulates_with_it_and_replays(tmp_path):
+    """``clearance_m = 0`` (the papers' convention): the rows are the episodes with that clearance, the exact
+    optimum is shorter than with the scenario's own 0.05 m, and the logged run re-simulates bit for bit."""
+    path = write(tmp_path, 'name = "bare"\nscenarios = ["gwo-scenario-1"]\nmode = "physics"\ntime_limit_s = 2.0\n'
+                           'clearance_m = 0.0\nseeds = [0]\n[[planners]]\nname = "optimal"\n')
+    assert main(["study", str(path), "--out", str(tmp_path / "out"), "--workers", "1", "--logs", "--json"]) == 0
+    row = pd.read_parquet(tmp_path / "out" / "runs.parquet").to_dict("records")[0]
+    scenario = load_scenario("gwo-scenario-1")
+    bare = plan_episode(EpisodeSpec(scenario, "optimal", clearance_m=0.0))
+    own = plan_episode(EpisodeSpec(scenario, "optimal"))
+    assert row["clearance_m"] == 0.0 and bare.problem.clearance_m == 0.0
+    assert row["plan_length_m"] == bare.path.stats.length_m < own.path.stats.length_m
+    assert main(["replay", row["log"], "--verify", "--json"]) == 0
 
 
 PLAN_ONLY = 'name = "bar"\nscenarios = ["gwo-scenario-1"]\nseeds = 2\n[[planners]]\nname = "astar"\n'

@@ -54,7 +54,8 @@ def run(args: argparse.Namespace) -> int:
     bare, harness = [], []
     for cell in sample:
         spec = EpisodeSpec(load_scenario(cell.scenario), cell.planner, cell.planner_params, cell.navigator,
-                           cell.navigator_params, seed=cell.seed, world_seed=cell.world_seed)
+                           cell.navigator_params, seed=cell.seed, world_seed=cell.world_seed,
+                           clearance_m=cell.clearance_m)
         t0 = time.perf_counter()
         plan_episode(spec)
         bare.append(time.perf_counter() - t0)

@@ -116,7 +116,8 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
             row["straight_line_m"] = math.hypot(scenario.goal.x_m - scenario.start.x_m,
                                                 scenario.goal.y_m - scenario.start.y_m)
             spec = EpisodeSpec(scenario, cell.planner, cell.planner_params, cell.navigator, cell.navigator_params,
-                               seed=cell.seed, world_seed=cell.world_seed)
+                               seed=cell.seed, world_seed=cell.world_seed, clearance_m=cell.clearance_m)
+            row["clearance_m"] = spec.resolved().scenario.clearance_m
             episode = plan_episode(spec)
             if cell.physics:
                 recorders = []

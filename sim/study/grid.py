@@ -37,6 +37,7 @@ class Cell:
     time_limit_s: float | None
     wall_limit_s: float
     config_hash: str
+    clearance_m: float | None = None  # the study's planning clearance override (None: the scenario's)
 
     @property
     def physics(self) -> bool:
@@ -72,6 +73,8 @@ def expand(study: Study) -> list[Cell]:
                                           "navigator_params": navigator_params, "seed": seed,
                                           "world_seed": world_seed, "mode": study.mode,
                                           "time_limit_s": study.time_limit_s}
+                                if study.clearance_m is not None:  # absent otherwise: earlier hashes hold
+                                    config["clearance_m"] = study.clearance_m
                                 cells.append(Cell(
                                     study=study.name, scenario=scenario, scenario_name=FilePath(scenario).stem,
                                     planner=planner.name, label=_sweep_label(planner, planner_params),
@@ -79,5 +82,6 @@ def expand(study: Study) -> list[Cell]:
                                     navigator_label=_sweep_label(navigator, navigator_params),
                                     navigator_params=navigator_params, seed=seed, world_seed=world_seed,
                                     mode=study.mode, time_limit_s=study.time_limit_s,
-                                    wall_limit_s=study.wall_limit_s, config_hash=config_hash(config)))
+                                    wall_limit_s=study.wall_limit_s, config_hash=config_hash(config),
+                                    clearance_m=study.clearance_m))
     return cells

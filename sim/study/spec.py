@@ -10,6 +10,8 @@ TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) o
     quick_seeds = 3                  # optional: `swarmnav study --quick` runs only the first N seeds
     world_seeds = [0]                # optional: seeds of the random obstacle motions (default: the scenario's)
     wall_limit_s = 120               # per run; past it the run becomes an outcome "timeout" row
+    clearance_m = 0.0                # optional: the planning clearance beyond the robot radius for every
+                                     # scenario (default: each scenario's robot.clearance_m)
     reference = "gwo"                # the planner label (or one swept arm, "maco(p0=0.9)") the statistics
                                      # compare against (default: the first)
 
@@ -43,13 +45,13 @@ from typing import Any
 
 from swarmnav.controllers.navigators import make_navigator
 from swarmnav.models.errors import ConfigError
-from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, resolve_scenario_path
+from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, load_scenario, resolve_scenario_path
 from swarmnav.planners.registry import make_planner
 
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
 TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
-            "time_limit_s", "reference", "planners", "navigators", "paper"}
+            "time_limit_s", "reference", "planners", "navigators", "paper", "clearance_m"}
 
 
 @dataclass(frozen=True)
@@ -93,6 +95,7 @@ class Study:
     navigators: tuple[Component, ...]
     paper: tuple[PaperValue, ...]
     quick_seeds: int | None = None  # the first N seeds make the quick run (None: the quick run is the full one)
+    clearance_m: float | None = None  # planning clearance override for every scenario (None: each scenario's)
 
     def quick(self) -> "Study":
         """The study on its first ``quick_seeds`` seeds (its rows are the full study's rows for those seeds,
@@ -269,6 +272,25 @@ def parse_study(text: str, source: str = "<string>", default_name: str = "study"
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError("toml", f"malformed TOML ({exc})", source) from None
+    return study_from_tables(data, source, default_name)
+
+
+def _clearance(source: str, data: dict, scenarios: tuple[str, ...]) -> float | None:
+    if "clearance_m" not in data:
+        return None
+    clearance_m = _number(source, data["clearance_m"], "clearance_m")
+    if clearance_m < 0:
+        _fail(source, "clearance_m", f"must be non-negative, got {clearance_m:g}")
+    for ref in scenarios:
+        try:
+            load_scenario(ref).with_clearance(clearance_m)
+        except ConfigError as exc:
+            _fail(source, "clearance_m", exc.problem)
+    return clearance_m
+
+
+def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_name: str = "study") -> Study:
+    """Validate a study given as the tables its TOML file would hold (what a benchmark builds in code)."""
     for key in sorted(set(data) - TOP_KEYS):
         _fail(source, key, "unknown key")
     name = _string(source, data, "name", "name", default_name)
@@ -307,4 +329,4 @@ def parse_study(text: str, source: str = "<string>", default_name: str = "study"
         _fail(source, "reference", f"{reference!r} is not a planner label of the study ({', '.join(labels)})")
     paper = _paper(source, data.get("paper", []), scenarios, labels)
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
-                 reference, planners, navigators, paper, quick_seeds)
+                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios))
