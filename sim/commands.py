@@ -59,6 +59,11 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--modes", nargs="+", default=["paper", "robust"], choices=["paper", "robust", "auto"])
     parser.add_argument("--fields", type=options.non_negative_int, default=10,
                         help="random disc fields of 10-40 discs (default 10; 0: none)")
+    parser.add_argument("--out", metavar="DIR", help="keep the quality studies' rows in DIR/scenarios and DIR/fields "
+                        "(study folders: `swarmnav report DIR/scenarios`); a folder that holds them already resumes. "
+                        "Default: a temporary folder")
+    parser.add_argument("--workers", type=options.positive_int, default=1,
+                        help="processes running the quality studies (default 1: plan times measured alone)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--quick", action="store_true",
                         help="gwo-scenario-1 and dense-field-30, 3 seeds, 1 peer run, 2 random fields")

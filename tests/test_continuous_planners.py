@@ -198,31 +198,43 @@ def test_bad_parameters_are_config_errors():
         make_planner("adl_abc", {"limit": 0})
 
 
-def test_bench_planners_rows_agree_with_their_runs():
+def test_bench_planners_rows_agree_with_their_runs(tmp_path):
+    """The quality table is computed from the study rows it kept: checked against the Parquet rows
+    and against the exact optimum computed here."""
+    import pandas as pd
+
     from swarmnav.sim.benchmarks import planners as bench_continuous
     from swarmnav.sim.commands import add_bench_planners_arguments
 
     parser = argparse.ArgumentParser()
     add_bench_planners_arguments(parser)
     args = parser.parse_args(["--scenarios", "gwo-scenario-1", "adl-abc-path-1", "--planners", "gwo", "pso",
-                              "--seeds", "2", "--population", "10", "--iterations", "5", "--peer-runs", "0"])
+                              "--seeds", "2", "--population", "10", "--iterations", "5", "--peer-runs", "0",
+                              "--modes", "paper", "--fields", "0", "--out", str(tmp_path)])
     result = bench_continuous.benchmark(args)
     assert result["peers"] == []
     rows = {(r["scenario"], r["planner"]): r for r in result["rows"]}
     assert set(rows) == {(s, p) for s in ("gwo-scenario-1", "adl-abc-path-1") for p in ("gwo", "pso")}
     problem = scenario_problem(load_scenario("gwo-scenario-1"), clearance_m=0.0)
     optimum = OptimalPlanner().plan(problem, np.random.default_rng(0)).stats.extra["optimum_length_m"]
+    runs = pd.read_parquet(tmp_path / "scenarios" / "runs.parquet")
+    assert len(runs) == 2 * 3 * 2 and (runs.clearance_m == 0.0).all()  # 2 scenarios x (2 planners + optimal)
     for (scenario, planner), row in rows.items():
-        assert 0 <= row["feasible_runs"] <= row["runs"] == 2
+        arm = runs[(runs.scenario == scenario) & (runs.label == f"{planner}-paper")]
+        assert row["runs"] == len(arm) == 2 and row["feasible_runs"] == int(arm.success.sum())
         if scenario == "adl-abc-path-1":         # no path exists there: every run fails, the note says why
             assert row["optimum_length_m"] is None and row["feasible_runs"] == 0
+            assert set(arm.outcome) == {"no_path"}
             assert "no collision-free path" in row["note"] or row["paper_length_m"] is None
             continue
         assert row["optimum_length_m"] == pytest.approx(optimum)
         if row["median_length_m"] is not None:
+            assert row["median_length_m"] == pytest.approx(arm[arm.success].plan_length_m.median())
             assert row["best_length_m"] <= row["median_length_m"]
             assert row["ratio_to_optimum"] == pytest.approx(row["median_length_m"] / optimum)
             assert row["best_length_m"] >= optimum - 1e-9
         # A paper value below the exact optimum is flagged impossible, any other is not.
         paper = row["paper_length_m"]
         assert ("impossible" in row["note"]) == (paper is not None and paper < optimum)
+
+

@@ -1,18 +1,22 @@
 """``swarmnav bench planners``: the continuous planners against the exact optimum,
 the papers' reported lengths, and mealpy on the same objective.
 
-For every scenario the exact shortest path (:mod:`planners.optimal`) is the
-yardstick.  Every planner runs ``--seeds`` times (seeds 0, 1, ...); the table
-gives best, median and std of the lengths of the paths that were returned (every
-returned path has passed the exact check, and is checked again here), the median
-over the optimum, the mean plan time, the evaluations, the feasible runs, and
-the paper's reported length where a paper reports one, with a note where that
-value is shorter than the exact optimum (physically impossible).
+Quality (:mod:`swarmnav.sim.benchmarks.planner_quality`): a plan-only study on the
+scenarios (every planner in every mode of ``--modes``, default ``paper robust``: the
+paper's algorithm as written and the robust options of :mod:`planners.continuous`, side
+by side; and ``optimal``, the exact shortest path) and one on ``--fields`` random disc
+fields of 10-40 discs, both run by the study machinery into ``--out`` (a temporary
+folder by default).  The table gives, per scenario, planner and mode, best, median and
+std of the lengths of the collision-free plans, the median over the optimum, the mean
+plan time, the evaluations, the feasible runs, and the paper's reported length where a
+paper reports one, with a note where that value is shorter than the exact optimum
+(physically impossible).  As in the papers, the scenario problems use the robot radius
+only (``--clearance-m 0``); moving obstacles are frozen at t = 0.
 
-Peers: mealpy's ``OriginalGWO`` and ``OriginalABC`` with the same population and
-iterations, in this process, on the same objective values.  mealpy calls its
-objective one candidate at a time, so the objective is given to it in two forms,
-and both are timed:
+Peers (timing): mealpy's ``OriginalGWO`` and ``OriginalABC`` with the same population
+and iterations, in this process, on the same objective values.  mealpy calls its
+objective one candidate at a time, so the objective is given to it in two forms, and
+both are timed:
 
 * ``scipy``: the curve of each candidate fitted with
   ``scipy.interpolate.CubicSpline(bc_type="not-a-knot")`` and sampled, then the
@@ -21,18 +25,9 @@ and both are timed:
 * ``basis``: our precomputed-basis :class:`planners.path_cost.PathObjective`
   called with one candidate, which leaves only mealpy's own loop overhead.
 
-The two give the same cost to 1e-9 (checked on every run).  mealpy is the
-``bench`` extra; without it the peers are skipped with a note.
-
-As in the papers, the problems use the robot radius only (``--clearance-m 0``),
-and moving obstacles are frozen at t = 0.
-
-Modes: every planner runs in each of ``--modes`` (default ``paper robust``: the paper's
-algorithm as written, and the robust options of :mod:`planners.continuous`), side by side
-in the table; then both modes run on ``--fields`` random disc fields of 10-40 discs
-(:mod:`planners.random_fields`), reported as feasible runs, the median and worst of the
-per-field median length over the exact optimum, and the median plan time, against issue
-14's targets (100 % feasible, median <= 1.03 x the optimum).
+The two give the same cost to 1e-9 (checked on every run).  Ours is timed again right
+beside the peer, in this process.  mealpy is the ``bench`` extra; without it the peers
+are skipped with a note.
 """
 
 from __future__ import annotations
@@ -41,17 +36,18 @@ import argparse
 import json
 import math
 import statistics
+import tempfile
 import time
+from pathlib import Path as FilePath
 from typing import Any
 
 import numpy as np
 
 from swarmnav.planners.registry import make_planner
-from swarmnav.planners.errors import PlanningError
-from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.path_cost import PathObjective
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.problem import scenario_problem
+from swarmnav.sim.benchmarks.planner_quality import field_summary, scenario_rows, study_tables
 
 PEERS = (("gwo", "mealpy.OriginalGWO"), ("abc", "mealpy.OriginalABC"))
 
@@ -95,22 +91,13 @@ def load_problem(name: str, clearance_m: float) -> Problem:
     return scenario_problem(load_scenario(name), clearance_m=clearance_m)
 
 
-def optimum_length_m(problem: Problem) -> float | None:
-    """Exact shortest length, or None when no collision-free path exists."""
-    try:
-        return float(OptimalPlanner().plan(problem, np.random.default_rng(0)).stats.extra["optimum_length_m"])
-    except PlanningError:
-        return None
-
-
-def paper_note(paper_m: float | None, optimum_m: float | None, problem: Problem) -> str:
+def paper_note(paper_m: float | None, optimum_m: float | None, straight_m: float | None) -> str:
     """Why a paper's value cannot be right, or ''."""
     if paper_m is None:
         return ""
-    straight_m = float(np.hypot(*(problem.goal.xy - problem.start.xy)))
     if optimum_m is None:
         return "paper's path impossible: no collision-free path exists in this instance"
-    if paper_m < straight_m - 1e-9:
+    if straight_m is not None and paper_m < straight_m - 1e-9:
         return (f"paper's value impossible: shorter than the straight line "
                 f"({straight_m:.4f}) and the exact optimum")
     if paper_m < optimum_m - 1e-9:
@@ -118,23 +105,14 @@ def paper_note(paper_m: float | None, optimum_m: float | None, problem: Problem)
     return ""
 
 
-def run_planner(name: str, params: dict[str, Any], problem: Problem, seeds: int) -> dict[str, Any]:
-    """Run one planner ``seeds`` times; lengths of feasible runs, times and evaluations."""
-    lengths, times, evaluations, feasible = [], [], [], 0
-    for seed in range(seeds):
-        planner = make_planner(name, params)
-        t0 = time.perf_counter()
-        try:
-            path = planner.plan(problem, np.random.default_rng(seed))
-        except PlanningError:
-            times.append(time.perf_counter() - t0)
-            continue
+def time_planner(name: str, params: dict[str, Any], problem: Problem, runs: int) -> dict[str, list]:
+    """Plan times and evaluations of ``runs`` seeds in this process (the side of a side-by-side timing)."""
+    times, evaluations = [], []
+    for seed in range(runs):
+        path = make_planner(name, params).plan(problem, np.random.default_rng(seed))
         times.append(path.stats.plan_time_s)
         evaluations.append(path.stats.evaluations)
-        if problem.is_collision_free(path.waypoints):
-            feasible += 1
-            lengths.append(path.stats.length_m)
-    return {"lengths": lengths, "times": times, "evaluations": evaluations, "feasible": feasible}
+    return {"times": times, "evaluations": evaluations}
 
 
 def scipy_spline_cost(objective: PathObjective, solution: np.ndarray) -> float:
@@ -192,6 +170,40 @@ def _median(values: list[float]) -> float | None:
     return float(statistics.median(values)) if values else None
 
 
+def quality_rows(args: argparse.Namespace, out_dir: FilePath) -> tuple[list[dict], list[dict], list[str]]:
+    """Run the two quality studies into ``out_dir``; return the scenario rows, the field summary, notes."""
+    from swarmnav.models.disc_fields import disc_field_name, disc_field_toml
+    from swarmnav.sim.study.execute import run_study_tables
+
+    runs = run_study_tables(
+        study_tables("bench-planners", args.scenarios, args.planners, args.modes, args.seeds, args.population,
+                     args.iterations, clearance_m=args.clearance_m, paper_lengths_m=PAPER_LENGTHS_M),
+        out_dir / "scenarios", workers=args.workers)
+    rows = scenario_rows(runs, args.planners, args.modes)
+    notes = []
+    for row in rows:
+        paper = PAPER_LENGTHS_M.get((row["scenario"], row["planner"])) if row["mode"] == "paper" else None
+        row.update(paper_length_m=paper, note=paper_note(paper, row["optimum_length_m"], row["straight_line_m"]))
+    for scenario in dict.fromkeys(r["scenario"] for r in rows if r["optimum_length_m"] is None):
+        notes.append(f"{scenario}: no collision-free path exists (the exact planner proves it); "
+                     f"every planner must fail there")
+    fields: list[dict] = []
+    if args.fields:
+        folder = out_dir / "field-scenarios"
+        folder.mkdir(parents=True, exist_ok=True)
+        paths = []
+        for f in range(args.fields):
+            count = 10 + (30 * f) // max(args.fields - 1, 1)
+            path = folder / f"{disc_field_name(count, f)}.toml"
+            path.write_text(disc_field_toml(count, f), encoding="utf-8")
+            paths.append(str(path))
+        field_runs = run_study_tables(study_tables("bench-planners-fields", paths, args.planners, args.modes,
+                                                   args.seeds, args.population, args.iterations),
+                                      out_dir / "fields", workers=args.workers)
+        fields = field_summary(field_runs, args.planners, args.modes)
+    return rows, fields, notes
+
+
 def benchmark(args: argparse.Namespace) -> dict[str, Any]:
     """All figures of the benchmark as one JSON-ready object."""
     if getattr(args, "quick", False):
@@ -199,33 +211,12 @@ def benchmark(args: argparse.Namespace) -> dict[str, Any]:
                                                       min(args.peer_runs, 1))
         args.fields = min(args.fields, 2)
     params = {"population": args.population, "iterations": args.iterations}
-    rows, notes, ours_by_key = [], [], {}
-    for scenario in args.scenarios:
-        problem = load_problem(scenario, args.clearance_m)
-        optimum = optimum_length_m(problem)
-        if optimum is None:
-            notes.append(f"{scenario}: no collision-free path exists (the exact planner proves it); "
-                         f"every planner must fail there")
-        for name, mode in ((n, m) for n in args.planners for m in args.modes):
-            result = run_planner(name, dict(params, mode=mode), problem, args.seeds)
-            if mode == "paper":
-                ours_by_key[(scenario, name)] = result
-            lengths = result["lengths"]
-            median = _median(lengths)
-            paper = PAPER_LENGTHS_M.get((scenario, name))
-            rows.append({
-                "scenario": scenario, "planner": name, "mode": mode, "runs": args.seeds,
-                "feasible_runs": result["feasible"],
-                "best_length_m": min(lengths) if lengths else None,
-                "median_length_m": median,
-                "std_length_m": float(np.std(lengths)) if lengths else None,
-                "optimum_length_m": optimum,
-                "ratio_to_optimum": (median / optimum) if (median is not None and optimum) else None,
-                "mean_plan_time_s": float(np.mean(result["times"])) if result["times"] else None,
-                "evaluations": int(round(np.mean(result["evaluations"]))) if result["evaluations"] else None,
-                "paper_length_m": paper,
-                "note": paper_note(paper, optimum, problem),
-            })
+    if args.out is None:
+        with tempfile.TemporaryDirectory(prefix="swarmnav-bench-planners-") as folder:
+            rows, fields, notes = quality_rows(args, FilePath(folder))
+    else:
+        rows, fields, notes = quality_rows(args, FilePath(args.out))
+    ours_by_key = {(r["scenario"], r["planner"]): r for r in rows if r["mode"] == "paper"}
 
     peers = []
     if args.peer_runs > 0:
@@ -237,10 +228,9 @@ def benchmark(args: argparse.Namespace) -> dict[str, Any]:
             problem = load_problem(args.peer_scenario, args.clearance_m)
             paper = dict(params, mode="paper")
             for name, peer in PEERS:
-                ours = ours_by_key.get((args.peer_scenario, name)) or run_planner(
-                    name, paper, problem, args.seeds)
-                # Time ours again right beside the peers: the machine's load drifts.
-                beside = run_planner(name, paper, problem, max(args.peer_runs, 3))
+                ours = ours_by_key.get((args.peer_scenario, name), {})
+                # Time ours right beside the peers, in this process: the machine's load drifts.
+                beside = time_planner(name, paper, problem, max(args.peer_runs, 3))
                 theirs = peer_runs(name, peer, problem, args.population, args.iterations,
                                    args.peer_runs, "scipy")
                 basis = peer_runs(name, peer, problem, args.population, args.iterations,
@@ -250,51 +240,22 @@ def benchmark(args: argparse.Namespace) -> dict[str, Any]:
                 basis_time = float(np.mean(basis["times"]))
                 peers.append({
                     "planner": name, "peer": peer, "scenario": args.peer_scenario,
-                    "evaluations": int(round(np.mean(ours["evaluations"]))) if ours["evaluations"] else None,
+                    "evaluations": int(round(np.mean(beside["evaluations"]))),
                     "peer_evaluations": int(round(np.mean(theirs["evaluations"]))),
                     "our_time_s": our_time, "peer_time_s": peer_time,
                     "speedup": peer_time / our_time if our_time > 0 else math.inf,
-                    "our_median_length_m": _median(ours["lengths"]),
+                    "our_median_length_m": ours.get("median_length_m"),
                     "peer_median_length_m": _median(theirs["lengths"]),
-                    "our_runs": args.seeds, "peer_runs": args.peer_runs,
+                    "our_runs": ours.get("runs", 0), "peer_runs": args.peer_runs,
                     "peer_feasible_runs": len(theirs["lengths"]),
                     "peer_objective": "scipy CubicSpline per candidate",
                     "peer_time_basis_objective_s": basis_time,
                     "speedup_basis_objective": basis_time / our_time if our_time > 0 else math.inf,
                 })
     speed = warm_median_times(load_problem(args.peer_scenario, args.clearance_m), 50, 100)
-    fields = field_rows(args, params) if args.fields else []
     return {"population": args.population, "iterations": args.iterations,
             "clearance_m": args.clearance_m, "rows": rows, "peers": peers, "notes": notes,
-            "warm_median_plan_time_s": speed, "fields": fields}
-
-
-def field_rows(args: argparse.Namespace, params: dict[str, Any]) -> list[dict[str, Any]]:
-    """Each planner and mode on ``args.fields`` random disc fields of 10-40 discs (field ``f``
-    has ``10 + 30 f / (fields - 1)`` discs and is drawn with seed ``f``), ``args.seeds`` runs each."""
-    from swarmnav.planners.random_fields import random_disc_field
-
-    problems = []
-    for f in range(args.fields):
-        problem = random_disc_field(10 + (30 * f) // max(args.fields - 1, 1), f)
-        optimum = optimum_length_m(problem)
-        if optimum is not None:
-            problems.append((problem, optimum))
-    out = []
-    for name, mode in ((n, m) for n in args.planners for m in args.modes):
-        ratios, times, feasible, runs = [], [], 0, 0
-        for problem, optimum in problems:
-            result = run_planner(name, dict(params, mode=mode), problem, args.seeds)
-            runs += args.seeds
-            feasible += result["feasible"]
-            times += result["times"]
-            ratios.append(statistics.median(result["lengths"]) / optimum if result["lengths"] else math.inf)
-        out.append({"planner": name, "mode": mode, "fields": len(problems), "runs": runs, "feasible_runs": feasible,
-                    "median_ratio": float(statistics.median(ratios)) if ratios else None,
-                    "worst_median_ratio": float(max(ratios)) if ratios else None,
-                    "fields_within_1_03": sum(r <= 1.03 for r in ratios),
-                    "median_plan_time_s": float(statistics.median(times)) if times else None})
-    return out
+            "warm_median_plan_time_s": speed, "fields": fields, "out": args.out}
 
 
 def _fmt(value: Any, spec: str = ".4f") -> str:
@@ -367,6 +328,8 @@ def print_table(result: dict[str, Any]) -> None:
                   f"{r['feasible_runs']}/{r['runs']} feasible ({'met' if ok else 'NOT met'})")
     for note in result["notes"]:
         print(f"note: {note}")
+    if result.get("out"):
+        print(f"rows: {result['out']}/scenarios and {result['out']}/fields (swarmnav report DIR)")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -127,3 +127,15 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
     return {"study": study.name, "out": str(out_dir), "cells": total, "skipped": total - len(todo), "ran": ran,
             "failed": ran - counts.get("ok", 0), "outcomes": counts, "engine": engine, "workers": workers,
             "wall_s": round(time.perf_counter() - started, 3)}
+
+
+def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, workers: int = 1,
+                     source: str = "<benchmark>") -> list[dict[str, Any]]:
+    """Validate a study built in code (the tables its TOML file would hold), run it into ``out_dir`` on the
+    local engine, and return every run row of the folder (what the benchmarks tabulate)."""
+    from swarmnav.sim.study.rows import read_table
+    from swarmnav.sim.study.spec import study_from_tables
+
+    study = study_from_tables(tables, source, str(tables.get("name", "study")))
+    run_study(study, out_dir, engine="local", workers=workers)
+    return read_table(out_dir).to_pylist()
