@@ -63,7 +63,8 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
                         "(study folders: `swarmnav report DIR/scenarios`); a folder that holds them already resumes. "
                         "Default: a temporary folder")
     parser.add_argument("--workers", type=options.positive_int, default=1,
-                        help="processes running the quality studies (default 1: plan times measured alone)")
+                        help="processes running the quality studies (default 1: in this process, plan times "
+                        "measured alone and warm)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--quick", action="store_true",
                         help="gwo-scenario-1 and dense-field-30, 3 seeds, 1 peer run, 2 random fields")
@@ -76,12 +77,14 @@ def run_bench_planners(args: argparse.Namespace) -> int:
 
 def add_bench_grid_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--runs", type=int, default=5, help="runs (seeds) per map and planner")
+    parser.add_argument("--runs", type=options.positive_int, default=5, help="runs (seeds) per map and planner")
     parser.add_argument("--maps", nargs="*", help="map scenario names (default: every bundled [map] scenario)")
     parser.add_argument("--all-pairs", action="store_true",
                         help="plan every start/goal pair of each map's [map].pairs, not only the scenario's")
-    parser.add_argument("--swarm-sample", type=int, default=20,
+    parser.add_argument("--swarm-sample", type=options.positive_int, default=20,
                         help="Moving AI instances per map on which immas and iaco report their ratio")
+    parser.add_argument("--out", metavar="DIR", help="keep the quality studies' rows in DIR/maps, DIR/restaurant and "
+                        "DIR/movingai (study folders: `swarmnav report DIR/maps`); default: a temporary folder")
     parser.add_argument("--quick", action="store_true",
                         help="the two slowest maps, 2 runs, 50 Moving AI instances a map, 1 swarm sample (under a minute)")
 

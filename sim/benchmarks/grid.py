@@ -2,14 +2,15 @@
 
 Prints (or, with ``--json``, emits one object with):
 
-* ``rows``: per map and planner, ``runs``, ``median_length_m`` (the executed path,
+* ``rows`` (from the quality studies of :mod:`swarmnav.sim.benchmarks.grid_quality`, kept in
+  ``--out``): per map and planner, ``runs``, ``feasible_runs``, ``median_length_m`` (the executed path,
   shortcut on, as each planner returns it), ``astar_length_m`` (A*'s, the same way),
   ``ratio_to_astar``, ``mean_plan_time_s``; also the raw (cell path) lengths and
   their ratio to the A* optimum, and the mean cell clearance of the raw path;
 * ``movingai``: ``scenarios``, ``mismatches``, ``max_abs_error`` of A* and Dijkstra against
   every optimal length in the Moving AI benchmark folder (``SWARMNAV_MOVINGAI_DIR``
   or ``<repo>/../shared/benchmarks/movingai``), plus the swarm planners' length
-  ratios to those optima on a sample;
+  ratios to those optima on a sample (a study of scenario files, one per instance);
 * ``peers``: our A* against the PyPI ``pathfinding`` A* (``DiagonalMovement.only_when_no_obstacle``)
   on the same grids in this process, ``speedup`` = their time / ours;
 * ``targets``: the issue's targets and whether they were met on this machine.
@@ -21,97 +22,22 @@ from __future__ import annotations
 
 import argparse
 import json
-import statistics
 import sys
+import tempfile
 import time
+from pathlib import Path as FilePath
 from typing import Any
 
 import numpy as np
+
+from swarmnav.models.scenario import load_scenario
 from swarmnav.planners.problem import scenario_problem
-from scipy import ndimage
+from swarmnav.sim.benchmarks.grid_quality import (GRID_PLANNERS, map_scenarios, maps_study, movingai_study,
+                                                  restaurant_study)
 
 #: Issue 14's targets (astar < 3 ms, iaco < 0.3 s on the worst bundled map), and the earlier ones.
 TARGETS = {"astar_movingai_speedup": 10.0, "astar_plan_s": 0.003, "immas_plan_s": 0.050, "iaco_plan_s": 0.3, "iaco_median_ratio": 1.05}
-GRID_PLANNERS = ("astar", "dijkstra", "theta_star", "dstar_lite", "immas", "iaco")
-SEEDED = {"iaco"}
 
-
-
-def _map_scenarios(names: list[str] | None):
-    from swarmnav.models.scenario import list_scenarios, load_scenario
-
-    out = []
-    for name in names or list_scenarios():
-        scenario = load_scenario(name)
-        if scenario.boxes and (names or name.startswith(("immas-", "iaco-"))):
-            out.append(scenario)
-    return out
-
-
-def _problems(scenario, all_pairs: bool):
-    """(label, Problem) for the scenario's own start/goal, or for each of its [map].pairs."""
-    from dataclasses import replace
-
-    from swarmnav.models.world import Pose2D
-
-    problem = scenario_problem(scenario)
-    if not all_pairs:
-        return [(scenario.name, problem)]
-    pairs = scenario.map_pairs
-    cell = scenario.cell_m
-    out = []
-    for x0, y0, x1, y1 in pairs:
-        out.append((f"{scenario.name}:{x0},{y0}->{x1},{y1}",
-                    replace(problem, start=Pose2D((x0 + 0.5) * cell, (y0 + 0.5) * cell),
-                            goal=Pose2D((x1 + 0.5) * cell, (y1 + 0.5) * cell))))
-    return out
-
-
-def _mean_clearance_m(problem, cells) -> float:
-    grid = problem.grid
-    clearance = ndimage.distance_transform_edt(~grid.occupied) * grid.cell_m
-    idx = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
-    return float(np.mean(clearance[idx[:, 0], idx[:, 1]]))
-
-
-def bench_maps(args: argparse.Namespace) -> list[dict[str, Any]]:
-    from swarmnav.planners.registry import make_planner
-
-    rows = []
-    for scenario in _map_scenarios(args.maps):
-        for label, problem in _problems(scenario, args.all_pairs):
-            astar = make_planner("astar").plan(problem, np.random.default_rng(0))
-            astar_len = astar.stats.length_m
-            astar_raw = astar.stats.extra["raw_length_m"]
-            for name in GRID_PLANNERS:
-                params = dict(scenario.planner_params) if name == scenario.planner_name else {}
-                planner = make_planner(name, params)
-                lengths, raws, times, clearances, extras = [], [], [], [], []
-                for run in range(args.runs):
-                    path = planner.plan(problem, np.random.default_rng(run))
-                    lengths.append(path.stats.length_m)
-                    raws.append(path.stats.extra["raw_length_m"])
-                    times.append(path.stats.plan_time_s)
-                    clearances.append(_mean_clearance_m(problem, path.stats.extra["raw_cells"]))
-                    extras.append(path.stats.extra)
-                    if not problem.is_collision_free(path.waypoints):
-                        raise AssertionError(f"{name} returned a colliding path on {label}")
-                median = statistics.median(lengths)
-                row = {"map": label, "planner": name, "runs": args.runs, "median_length_m": median,
-                       "astar_length_m": astar_len, "ratio_to_astar": median / astar_len,
-                       "mean_plan_time_s": statistics.fmean(times),
-                       "median_raw_length_m": statistics.median(raws), "astar_raw_length_m": astar_raw,
-                       "raw_ratio_to_astar": statistics.median(raws) / astar_raw,
-                       "mean_cell_clearance_m": statistics.fmean(clearances)}
-                if name == "immas":
-                    row.update(gates_raised=extras[0]["gates_raised"], tunnels_closed=extras[0]["tunnels_closed"],
-                               moves=extras[0]["moves"], total_arc_cost=extras[0]["total_arc_cost"])
-                if name == "iaco":
-                    row.update(convergence_iteration=statistics.median(e["convergence_iteration"] for e in extras),
-                               bends=statistics.median(e["bends"] for e in extras),
-                               std_length_m=statistics.pstdev(raws))
-                rows.append(row)
-    return rows
 
 
 def warm_up(names: list[str] | None) -> dict[str, float]:
@@ -119,7 +45,7 @@ def warm_up(names: list[str] | None) -> dict[str, float]:
     warm figures; returned: each first plan's wall time (caches, first imports)."""
     from swarmnav.planners.registry import make_planner
 
-    problem = scenario_problem(_map_scenarios(names)[0])
+    problem = scenario_problem(load_scenario(map_scenarios(names)[0]))
     out = {}
     for name in GRID_PLANNERS:
         t0 = time.perf_counter()
@@ -128,34 +54,10 @@ def warm_up(names: list[str] | None) -> dict[str, float]:
     return out
 
 
-def bench_restaurant(runs: int) -> list[dict[str, Any]]:
-    """M-ACO on its home scenario, with the paper's node baselines' collisions."""
-    from swarmnav.models.scenario import load_scenario
-    from swarmnav.planners.registry import make_planner
-
-    scenario = load_scenario("restaurant-table-2")
-    problem = scenario_problem(scenario)
-    astar = make_planner("astar").plan(problem, np.random.default_rng(0))
-    planner = make_planner("maco", scenario.planner_params)
-    lengths, times, crashes = [], [], 0
-    for run in range(runs):
-        path = planner.plan(problem, np.random.default_rng(run))
-        lengths.append(path.stats.length_m)
-        times.append(path.stats.plan_time_s)
-        crashes += bool(path.stats.extra.get("dijkstra_colliding_links"))
-    median = statistics.median(lengths)
-    return [{"map": scenario.name, "planner": "maco", "runs": runs, "median_length_m": median,
-             "astar_length_m": astar.stats.length_m, "ratio_to_astar": median / astar.stats.length_m,
-             "mean_plan_time_s": statistics.fmean(times), "node_baseline_runs_colliding": crashes}]
-
-
-def bench_movingai(sample: int, limit: int | None = None) -> dict[str, Any]:
-    from swarmnav.planners.errors import PlanningError
+def bench_movingai(limit: int | None = None) -> dict[str, Any]:
+    """A* and Dijkstra (the searches alone) against every published optimum of the Moving AI sets."""
     from swarmnav.planners.grid_search import astar_cells, dijkstra_cells
-    from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
-    from swarmnav.planners.max_min_ant_system import MaxMinAntSystemPlanner
     from swarmnav.models.grid_map import benchmark_sets, benchmarks_dir, read_map, read_scenarios
-    from swarmnav.planners.problem import map_problem
 
     sets = benchmark_sets()
     if not sets:
@@ -164,8 +66,6 @@ def bench_movingai(sample: int, limit: int | None = None) -> dict[str, Any]:
     count = mismatches = 0
     worst = 0.0
     per_map = {}
-    swarm: dict[str, list[float]] = {"immas": [], "iaco": []}
-    failures: dict[str, int] = {"immas": 0, "iaco": 0}
     t0 = time.perf_counter()
     for map_path, scen_path in sets:
         occupied = read_map(map_path)
@@ -178,27 +78,8 @@ def bench_movingai(sample: int, limit: int | None = None) -> dict[str, Any]:
                 mismatches += err > 1e-4
                 count += 1
         per_map[map_path.name] = len(scenarios)
-        # The swarm planners on the same instances (world grid: flip rows), raw cell lengths.
-        world = occupied[::-1]
-        height = occupied.shape[0]
-        step = max(1, len(scenarios) // max(1, sample))
-        for s in scenarios[::step][:sample]:
-            if s.optimal_length == 0:
-                continue
-            problem = map_problem(world, 1.0, (height - 1 - s.start_row, s.start_col),
-                                  (height - 1 - s.goal_row, s.goal_col))
-            for name, planner in (("immas", MaxMinAntSystemPlanner()), ("iaco", ImprovedAntColonyPlanner())):
-                try:
-                    path = planner.plan(problem, np.random.default_rng(0))
-                except PlanningError:
-                    failures[name] += 1
-                    continue
-                swarm[name].append(path.stats.extra["raw_length_m"] / s.optimal_length)
     return {"scenarios": count // 2, "checks": count, "mismatches": mismatches, "max_abs_error": worst,
-            "maps": per_map, "seconds": time.perf_counter() - t0,
-            "swarm_ratio_to_optimum": {name: {"instances": len(v), "failures": failures[name],
-                                              "median": statistics.median(v) if v else None,
-                                              "max": max(v) if v else None} for name, v in swarm.items()}}
+            "maps": per_map, "seconds": time.perf_counter() - t0}
 
 
 def bench_peers(names: list[str] | None, repeats: int = 20) -> list[dict[str, Any]] | dict[str, str]:
@@ -214,8 +95,8 @@ def bench_peers(names: list[str] | None, repeats: int = 20) -> list[dict[str, An
     ours_s = theirs_s = ours_cold_s = 0.0
     plans = 0
     disagreements = 0
-    for scenario in _map_scenarios(names):
-        problem = scenario_problem(scenario)
+    for name in map_scenarios(names):
+        problem = scenario_problem(load_scenario(name))
         occ = problem.grid.occupied
         start = problem.grid.cell_of(problem.start.x_m, problem.start.y_m)
         goal = problem.grid.cell_of(problem.goal.x_m, problem.goal.y_m)
@@ -290,9 +171,17 @@ def bench_movingai_peer(per_map: int = 20) -> dict[str, Any]:
             "met": theirs_s / ours_s >= TARGETS["astar_movingai_speedup"]}
 
 
+def quality_rows(args: argparse.Namespace, limit: int | None, out_dir: FilePath):
+    """The map, restaurant and Moving AI quality studies (:mod:`swarmnav.sim.benchmarks.grid_quality`)."""
+    rows = maps_study(args, out_dir) + restaurant_study(args.runs, out_dir)
+    return rows, movingai_study(args.swarm_sample, limit, out_dir)
+
+
 def _targets(rows: list[dict[str, Any]]) -> dict[str, Any]:
     def worst(planner: str, key: str) -> float | None:
-        values = [r[key] for r in rows if r["planner"] == planner]
+        values = [r.get(key) for r in rows if r["planner"] == planner]
+        if any(v is None for v in values):  # a planner that failed everywhere on a map
+            return None
         return max(values) if values else None
 
     out = {}
@@ -313,8 +202,12 @@ def run(args: argparse.Namespace) -> int:
         args.maps = args.maps or ["iaco-baffle", "immas-env6-rows"]
         args.runs, args.swarm_sample, limit = min(args.runs, 2), min(args.swarm_sample, 1), 50
     first_plan = warm_up(args.maps)
-    rows = bench_maps(args) + bench_restaurant(args.runs)
-    movingai = bench_movingai(args.swarm_sample, limit)
+    if args.out is None:
+        with tempfile.TemporaryDirectory(prefix="swarmnav-bench-grid-") as folder:
+            rows, swarm = quality_rows(args, limit, FilePath(folder))
+    else:
+        rows, swarm = quality_rows(args, limit, FilePath(args.out))
+    movingai = dict(bench_movingai(limit), swarm_ratio_to_optimum=swarm)
     peers = bench_peers(args.maps)
     movingai_peer = bench_movingai_peer(5 if getattr(args, "quick", False) else 20)
     result = {"rows": rows, "movingai": movingai, "peers": peers, "movingai_peer": movingai_peer,
@@ -322,12 +215,17 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(result))
         return 0
-    print(f"{'map':<26} {'planner':<11} {'runs':>4} {'median_m':>9} {'astar_m':>8} {'ratio':>6} "
+    print(f"{'map':<26} {'planner':<11} {'ok/runs':>5} {'median_m':>9} {'astar_m':>8} {'ratio':>6} "
           f"{'raw_ratio':>9} {'clear_m':>7} {'plan_ms':>8}")
+    def number(row: dict[str, Any], key: str, width: int, scale: float = 1.0) -> str:
+        value = row.get(key)
+        return f"{scale * value:>{width}.3f}" if value is not None else f"{'-':>{width}}"
+
     for r in rows:
-        print(f"{r['map']:<26} {r['planner']:<11} {r['runs']:>4} {r['median_length_m']:>9.3f} "
-              f"{r['astar_length_m']:>8.3f} {r['ratio_to_astar']:>6.3f} {r.get('raw_ratio_to_astar', float('nan')):>9.3f} "
-              f"{r.get('mean_cell_clearance_m', float('nan')):>7.3f} {1e3 * r['mean_plan_time_s']:>8.2f}")
+        print(f"{r['map']:<26} {r['planner']:<11} {r['feasible_runs']:>2}/{r['runs']:<2} "
+              f"{number(r, 'median_length_m', 9)} {number(r, 'astar_length_m', 8)} {number(r, 'ratio_to_astar', 6)} "
+              f"{number(r, 'raw_ratio_to_astar', 9)} {number(r, 'mean_cell_clearance_m', 7)} "
+              f"{number(r, 'mean_plan_time_s', 8, 1e3)}")
     print("first plan in this process (untimed in the rows):", json.dumps(first_plan))
     print("movingai:", json.dumps(movingai))
     print("peers:", json.dumps(peers))

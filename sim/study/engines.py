@@ -1,4 +1,4 @@
-"""Engines that run study cells: separate local processes, or Ray tasks.
+"""Engines that run study cells: separate local processes, or Ray tasks (or, for the benchmarks, this process).
 
 Both call the same :func:`swarmnav.sim.study.cell.run_cell` and yield each
 cell's ``(row, progress)`` as it finishes (in finishing order).  Workers run with
@@ -83,6 +83,13 @@ def run_local(cells: Sequence[Cell], workers: int, logs_dir: str | None = None) 
             executor.shutdown(wait=False, cancel_futures=True)
             for process in set(multiprocessing.active_children()) - before:
                 process.terminate()
+
+
+def run_inline(cells: Sequence[Cell], logs_dir: str | None = None) -> Iterator[Result]:
+    """Run the cells one after another in this process (the benchmarks' engine: plan times are measured
+    alone and warm, as their own timing loops measure them; no worker start-up)."""
+    for cell in cells:
+        yield run_cell(cell, logs_dir)
 
 
 def _drop_token_notice(record: logging.LogRecord) -> bool:

@@ -19,7 +19,7 @@ from typing import Any, Iterator, TextIO
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.study.engines import run_local, run_ray
+from swarmnav.sim.study.engines import run_inline, run_local, run_ray
 from swarmnav.sim.study.grid import Cell, expand
 from swarmnav.sim.study.rows import RowWriter, done_hashes
 from swarmnav.sim.study.spec import Study
@@ -105,8 +105,12 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
     todo, total = pending_cells(study, out_dir)
     workers = workers or os.cpu_count() or 1
     logs_dir = str((out_dir / "logs").resolve()) if logs else None
-    results: Iterator = (run_ray(todo, address, None if address else workers, logs_dir) if engine == "ray"
-                         else run_local(todo, workers, logs_dir))
+    if engine == "ray":
+        results: Iterator = run_ray(todo, address, None if address else workers, logs_dir)
+    elif engine == "inline":
+        results = run_inline(todo, logs_dir)
+    else:
+        results = run_local(todo, workers, logs_dir)
     writer = RowWriter(out_dir)
     bar = ProgressBar(len(todo), sys.stderr) if show_progress and todo else None
     counts: dict[str, int] = {}
@@ -131,11 +135,12 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
 
 def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, workers: int = 1,
                      source: str = "<benchmark>") -> list[dict[str, Any]]:
-    """Validate a study built in code (the tables its TOML file would hold), run it into ``out_dir`` on the
-    local engine, and return every run row of the folder (what the benchmarks tabulate)."""
+    """Validate a study built in code (the tables its TOML file would hold), run it into ``out_dir`` (in this
+    process with ``workers=1``, else on that many local processes), and return every run row of the folder
+    (what the benchmarks tabulate)."""
     from swarmnav.sim.study.rows import read_table
     from swarmnav.sim.study.spec import study_from_tables
 
     study = study_from_tables(tables, source, str(tables.get("name", "study")))
-    run_study(study, out_dir, engine="local", workers=workers)
+    run_study(study, out_dir, engine="inline" if workers == 1 else "local", workers=workers)
     return read_table(out_dir).to_pylist()
