@@ -126,13 +126,15 @@ def run_bench_env(args: argparse.Namespace) -> int:
 
 
 def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--seeds", type=int, default=5, help="world seeds per scenario (default 5)")
+    parser.add_argument("--seeds", type=options.positive_int, default=5, help="world seeds per scenario (default 5)")
     parser.add_argument("--navigator", action="append", help="only these navigators (repeatable)")
     parser.add_argument("--scenario", action="append", help="only these scenarios (repeatable; default: the dyn-* suite)")
     parser.add_argument("--navigator-set", action="append", metavar="KEY=VALUE",
                         help="a parameter for every navigator that has it (repeatable), e.g. policy=module:function")
     parser.add_argument("--by-scenario", action="store_true",
                         help="also one row per navigator and scenario, after the overall rows")
+    parser.add_argument("--out", metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
+                        "default: a temporary folder")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
     parser.add_argument("--suite", choices=("dyn", "papers"), default="dyn",
                         help="dyn: the dyn-* suite (default); papers: the papers' strategies beside replan + iaco "

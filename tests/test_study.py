@@ -194,6 +194,8 @@ BAD_STUDIES = {
     "quick seeds beyond the seeds": ('scenarios = ["gwo-scenario-1"]\nseeds = 3\nquick_seeds = 4\n'
                                      '[[planners]]\nname = "astar"\n', "quick_seeds"),
     "no scenario matches": ('scenarios = ["nothing-*"]\n[[planners]]\nname = "astar"\n', "scenarios[0]"),
+    "paired seeds of different counts": ('scenarios = ["gwo-scenario-1"]\nseeds = 3\nworld_seeds = [0, 1]\n'
+                                         'paired_seeds = true\n[[planners]]\nname = "astar"\n', "paired_seeds"),
     "negative clearance": ('scenarios = ["gwo-scenario-1"]\nclearance_m = -0.1\n[[planners]]\nname = "astar"\n',
                            "clearance_m"),
     "clearance of a pre-inflated map": ('scenarios = ["immas-env1-dynamic"]\nclearance_m = 0.0\n'
@@ -278,6 +280,17 @@ def test_logs_keep_one_mcap_per_run_that_replays(tmp_path):
     for row in rows.to_dict("records"):
         assert Path(row["log"]).parent == (tmp_path / "out" / "logs").resolve()
         assert main(["replay", row["log"], "--verify", "--json"]) == 0
+
+
+def test_paired_seeds_run_the_kth_seed_with_the_kth_world_seed(tmp_path):
+    from swarmnav.sim.study.spec import parse_study
+    text = 'scenarios = ["gwo-scenario-2"]\nseeds = [3, 4, 5]\nworld_seeds = [7, 8, 9]\n{}[[planners]]\nname = "astar"\n'
+    paired = expand(parse_study(text.format("paired_seeds = true\n")))
+    crossed = expand(parse_study(text.format("")))
+    assert [(c.seed, c.world_seed) for c in paired] == [(3, 7), (4, 8), (5, 9)]
+    assert len(crossed) == 9 and {c.config_hash for c in paired} <= {c.config_hash for c in crossed}
+    quick = parse_study(text.format("paired_seeds = true\nquick_seeds = 2\n")).quick()
+    assert [(c.seed, c.world_seed) for c in expand(quick)] == [(3, 7), (4, 8)]
 
 
 def test_a_clearance_override_plans_and_simulates_with_it_and_replays(tmp_path):

@@ -3,7 +3,8 @@ benchmarks report it (BARN, Nav2, CrowdNav): success, collisions, timeouts, SPL,
 
 Every navigator x every scenario of the suite (the bundled ``dyn-*`` files,
 made by ``swarmnav scenarios generate``) x N world seeds (run k uses world
-seed k and planner seed k).  One row per navigator; every run counts in every
+seed k and planner seed k), run as a physics study (the study machinery, in this
+process; ``--out DIR`` keeps its rows for ``swarmnav report``).  One row per navigator; every run counts in every
 rate (failures are never dropped from the denominators).  ``mean_time_to_goal_s``
 averages the successful runs only.  ``navigator_us_per_step`` is the wall time
 measured around the navigator's ``step`` call per control step;
@@ -19,12 +20,11 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import tempfile
 from typing import Any
 
 from swarmnav.controllers.navigators import NAVIGATORS
 from swarmnav.models.scenario import list_scenarios, load_scenario
-from swarmnav.sim.episode import EpisodeSpec, run_episode
-from swarmnav.sim.runner import Simulation
 
 SUITE_PREFIX = "dyn-"
 
@@ -65,44 +65,40 @@ def suite_names() -> list[str]:
     return [name for name in list_scenarios() if name.startswith(SUITE_PREFIX)]
 
 
+def navigation_study(seeds: int, navigators: list[str], scenarios: list[str],
+                     navigator_params: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """The benchmark as a physics study: each scenario with its own planner, every navigator, run ``k`` with
+    world seed ``k`` and planner seed ``k`` (paired)."""
+    planners = list(dict.fromkeys(load_scenario(name).planner_name for name in scenarios))
+    return {"name": "bench-navigation", "scenarios": scenarios, "mode": "physics", "seeds": seeds,
+            "world_seeds": list(range(seeds)), "paired_seeds": True,
+            "planners": [{"name": p} for p in planners],
+            "navigators": [{"name": n, "params": navigator_params.get(n, {})} for n in navigators]}
+
+
 def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, scenarios: list[str] | None = None,
                          progress: bool = False, navigator_params: dict[str, dict[str, Any]] | None = None,
-                         by_scenario: bool = False) -> list[dict[str, Any]]:
+                         by_scenario: bool = False, out_dir: str | None = None) -> list[dict[str, Any]]:
     """One row per navigator (see the module docstring); ``navigator_params``: per navigator name.  With
     ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key; the
-    overall rows have ``scenario`` None)."""
+    overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given."""
+    from swarmnav.sim.study.execute import run_study_tables
+
     navigator_params = navigator_params or {}
     navigators = navigators or default_navigators(navigator_params)
     names = scenarios or suite_names()
-    loaded = [load_scenario(n) for n in names]
-    total = len(navigators) * len(loaded) * seeds
-    done = 0
-    runs: dict[str, list[dict[str, Any]]] = {n: [] for n in navigators}
-    for scenario in loaded:
-        for k in range(seeds):
-            world = scenario.with_world_seed(k)
-            simulation = Simulation(world)
-            for nav in navigators:
-                episode = run_episode(EpisodeSpec(world, navigator=nav, navigator_params=navigator_params.get(nav),
-                                                  seed=k, world_seed=k), simulation=simulation)
-                r = episode.result
-                runs[nav].append({"scenario": scenario.name, "success": r.success, "collided": r.collisions > 0, "timeout": r.outcome == "timeout",
-                                  "time_to_goal_s": r.sim_time_s if r.success else None, "spl": r.spl or 0.0,
-                                  "danger_s": r.time_in_danger_s, "replans": r.replans, "steps": r.steps,
-                                  "navigator_s": r.navigator_wall_s, "sim_s": r.sim_time_s, "wall_s": r.wall_time_s})
-                done += 1
-                if progress:
-                    sys.stderr.write(f"\rbench navigation: {done}/{total} runs ({scenario.name}, seed {k}, {nav})"
-                                     + " " * 10)
-                    sys.stderr.flush()
-    if progress:
-        sys.stderr.write("\n")
-    table = [{"scenario": None, **_row(nav, rows)} for nav, rows in runs.items()]
+    tables = navigation_study(seeds, navigators, names, navigator_params)
+    if out_dir is None:
+        with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
+            rows = run_study_tables(tables, folder, show_progress=progress)
+    else:
+        rows = run_study_tables(tables, out_dir, show_progress=progress)
+    runs = {n: [r for r in rows if r["navigator"] == n] for n in navigators}
+    table = [{"scenario": None, **_row(nav, arm)} for nav, arm in runs.items()]
     if by_scenario:
-        for scenario in loaded:
-            for nav, rows in runs.items():
-                table.append({"scenario": scenario.name,
-                              **_row(nav, [r for r in rows if r["scenario"] == scenario.name])})
+        for name in names:
+            for nav, arm in runs.items():
+                table.append({"scenario": name, **_row(nav, [r for r in arm if r["scenario"] == name])})
     return table
 
 
@@ -111,22 +107,24 @@ def _mean(values: list[float]) -> float | None:
 
 
 def _row(navigator: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """Rates over every run (a run that raised, or found no path, counts as a failure in each rate's
+    denominator); means over the runs that drove."""
     n = len(rows)
+    drove = [r for r in rows if r["outcome"] == "ok"]
     reached = [r["time_to_goal_s"] for r in rows if r["success"]]
-    steps = sum(r["steps"] for r in rows)
+    steps = sum(r["control_steps"] for r in drove)
     return {
-        "navigator": navigator, "runs": n,
-        "success_rate": sum(r["success"] for r in rows) / n,
-        "collision_rate": sum(r["collided"] for r in rows) / n,
-        "timeout_rate": sum(r["timeout"] for r in rows) / n,
+        "navigator": navigator, "runs": n, "failed_runs": n - len(drove),
+        "success_rate": sum(bool(r["success"]) for r in rows) / n,
+        "collision_rate": sum(bool(r["collisions"]) for r in drove) / n,
+        "timeout_rate": sum(r["run_outcome"] == "timeout" for r in drove) / n,
         "mean_time_to_goal_s": _mean(reached),
-        "mean_spl": _mean([r["spl"] for r in rows]),
-        "mean_time_in_danger_s": _mean([r["danger_s"] for r in rows]),
-        "mean_replans": _mean([r["replans"] for r in rows]),
-        "navigator_us_per_step": 1e6 * sum(r["navigator_s"] for r in rows) / max(steps, 1),
-        "realtime_factor": sum(r["sim_s"] for r in rows) / max(sum(r["wall_s"] for r in rows), 1e-9),
+        "mean_spl": _mean([r["spl"] or 0.0 for r in drove]),
+        "mean_time_in_danger_s": _mean([r["time_in_danger_s"] for r in drove]),
+        "mean_replans": _mean([r["replans"] for r in drove]),
+        "navigator_us_per_step": 1e6 * sum(r["navigator_wall_s"] for r in drove) / max(steps, 1),
+        "realtime_factor": sum(r["sim_time_s"] for r in drove) / max(sum(r["wall_time_s"] for r in drove), 1e-9),
     }
-
 
 
 def run(args: argparse.Namespace) -> int:
@@ -147,7 +145,7 @@ def run(args: argparse.Namespace) -> int:
                                   args.navigator or list(NAVIGATORS))
     rows = benchmark_navigation(args.seeds, args.navigator, args.scenario,
                                 progress=not args.json and sys.stderr.isatty(), navigator_params=settings,
-                                by_scenario=args.by_scenario)
+                                by_scenario=args.by_scenario, out_dir=args.out)
     if args.json:
         print(json.dumps(rows))
         return 0

@@ -165,7 +165,8 @@ def _add_metrics(row: dict[str, Any], episode) -> None:
         row.update(reached=run["reached"], run_outcome=run["outcome"], collisions=run["collisions"],
                    first_collision_s=run["first_collision_s"], sim_time_s=run["sim_time_s"],
                    wall_time_s=run["wall_time_s"], path_length_m=run["path_length_m"],
-                   min_clearance_m=run["min_clearance_m"])
+                   min_clearance_m=run["min_clearance_m"], control_steps=episode.result.steps,
+                   navigator_wall_s=episode.result.navigator_wall_s)
         row.update({key: run.get(key) for key in NAVIGATION_METRICS})
 
 

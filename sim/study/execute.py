@@ -134,7 +134,7 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
 
 
 def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, workers: int = 1,
-                     source: str = "<benchmark>") -> list[dict[str, Any]]:
+                     source: str = "<benchmark>", show_progress: bool = False) -> list[dict[str, Any]]:
     """Validate a study built in code (the tables its TOML file would hold), run it into ``out_dir`` (in this
     process with ``workers=1``, else on that many local processes), and return every run row of the folder
     (what the benchmarks tabulate)."""
@@ -142,5 +142,6 @@ def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, work
     from swarmnav.sim.study.spec import study_from_tables
 
     study = study_from_tables(tables, source, str(tables.get("name", "study")))
-    run_study(study, out_dir, engine="inline" if workers == 1 else "local", workers=workers)
+    run_study(study, out_dir, engine="inline" if workers == 1 else "local", workers=workers,
+              show_progress=show_progress)
     return read_table(out_dir).to_pylist()

@@ -56,32 +56,36 @@ def config_hash(config: dict[str, Any]) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def expand(study: Study) -> list[Cell]:
-    """Every cell of the study, in a fixed order (scenario, planner, setting, navigator, world seed, seed)."""
-    cells: list[Cell] = []
-    scenario_digest = {s: hashlib.sha256(resolve_scenario_path(s).read_bytes()).hexdigest() for s in study.scenarios}
+def _settings(study: Study):
+    """(scenario, planner, planner setting, navigator, navigator setting) in the grid's order."""
     for scenario in study.scenarios:
         for planner in study.planners:
             for planner_params in planner.settings():
                 for navigator in study.navigators:
                     for navigator_params in navigator.settings():
-                        for world_seed in study.world_seeds:
-                            for seed in study.seeds:
-                                config = {"scenario_sha256": scenario_digest[scenario], "planner": planner.name,
-                                          "label": planner.label, "navigator_label": navigator.label,
-                                          "planner_params": planner_params, "navigator": navigator.name,
-                                          "navigator_params": navigator_params, "seed": seed,
-                                          "world_seed": world_seed, "mode": study.mode,
-                                          "time_limit_s": study.time_limit_s}
-                                if study.clearance_m is not None:  # absent otherwise: earlier hashes hold
-                                    config["clearance_m"] = study.clearance_m
-                                cells.append(Cell(
-                                    study=study.name, scenario=scenario, scenario_name=FilePath(scenario).stem,
-                                    planner=planner.name, label=_sweep_label(planner, planner_params),
-                                    planner_params=planner_params, navigator=navigator.name,
-                                    navigator_label=_sweep_label(navigator, navigator_params),
-                                    navigator_params=navigator_params, seed=seed, world_seed=world_seed,
-                                    mode=study.mode, time_limit_s=study.time_limit_s,
-                                    wall_limit_s=study.wall_limit_s, config_hash=config_hash(config),
-                                    clearance_m=study.clearance_m))
+                        yield scenario, planner, planner_params, navigator, navigator_params
+
+
+def expand(study: Study) -> list[Cell]:
+    """Every cell of the study, in a fixed order (scenario, planner, setting, navigator, world seed, seed)."""
+    cells: list[Cell] = []
+    scenario_digest = {s: hashlib.sha256(resolve_scenario_path(s).read_bytes()).hexdigest() for s in study.scenarios}
+    for scenario, planner, planner_params, navigator, navigator_params in _settings(study):
+        for world_seed, seed in study.seed_pairs():
+            config = {"scenario_sha256": scenario_digest[scenario], "planner": planner.name,
+                      "label": planner.label, "navigator_label": navigator.label,
+                      "planner_params": planner_params, "navigator": navigator.name,
+                      "navigator_params": navigator_params, "seed": seed,
+                      "world_seed": world_seed, "mode": study.mode, "time_limit_s": study.time_limit_s}
+            if study.clearance_m is not None:  # absent otherwise: earlier hashes hold
+                config["clearance_m"] = study.clearance_m
+            cells.append(Cell(
+                study=study.name, scenario=scenario, scenario_name=FilePath(scenario).stem,
+                planner=planner.name, label=_sweep_label(planner, planner_params),
+                planner_params=planner_params, navigator=navigator.name,
+                navigator_label=_sweep_label(navigator, navigator_params),
+                navigator_params=navigator_params, seed=seed, world_seed=world_seed,
+                mode=study.mode, time_limit_s=study.time_limit_s,
+                wall_limit_s=study.wall_limit_s, config_hash=config_hash(config),
+                clearance_m=study.clearance_m))
     return cells

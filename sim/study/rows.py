@@ -41,14 +41,14 @@ RUN_SCHEMA = pa.schema([
     ("path_length_m", pa.float64()), ("min_clearance_m", pa.float64()), ("log", pa.string()),
     ("time_to_goal_s", pa.float64()), ("spl", pa.float64()), ("time_in_danger_s", pa.float64()),
     ("replans", pa.int64()), ("replan_wall_s", pa.float64()), ("stopped_s", pa.float64()),
-    ("safety_triggers", pa.int64()),
+    ("safety_triggers", pa.int64()), ("control_steps", pa.int64()), ("navigator_wall_s", pa.float64()),
 ])
 PROGRESS_SCHEMA = pa.schema([
     ("config_hash", pa.string()), ("iteration", pa.int64()), ("best_cost", pa.float64()),
     ("evaluations", pa.int64()), ("evaluations_estimated", pa.bool_()),
 ])
 # Columns that measure time on the wall clock: they differ between two runs of the same cell.
-TIMING_COLUMNS = ("cell_wall_s", "plan_time_s", "wall_time_s", "replan_wall_s")
+TIMING_COLUMNS = ("cell_wall_s", "plan_time_s", "wall_time_s", "replan_wall_s", "navigator_wall_s")
 
 
 def _part_names(directory: FilePath) -> list[FilePath]:

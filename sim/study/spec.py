@@ -9,6 +9,8 @@ TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) o
     seeds = 10                       # a count (0..N-1) or a list of planner seeds
     quick_seeds = 3                  # optional: `swarmnav study --quick` runs only the first N seeds
     world_seeds = [0]                # optional: seeds of the random obstacle motions (default: the scenario's)
+    paired_seeds = false             # optional: true runs the k-th seed with the k-th world seed only (same
+                                     # count), instead of every seed with every world seed
     wall_limit_s = 120               # per run; past it the run becomes an outcome "timeout" row
     clearance_m = 0.0                # optional: the planning clearance beyond the robot radius for every
                                      # scenario (default: each scenario's robot.clearance_m)
@@ -51,7 +53,8 @@ from swarmnav.planners.registry import make_planner
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
 TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
-            "time_limit_s", "reference", "planners", "navigators", "paper", "clearance_m"}
+            "time_limit_s", "reference", "planners", "navigators", "paper", "clearance_m",
+            "paired_seeds"}
 
 
 @dataclass(frozen=True)
@@ -96,12 +99,21 @@ class Study:
     paper: tuple[PaperValue, ...]
     quick_seeds: int | None = None  # the first N seeds make the quick run (None: the quick run is the full one)
     clearance_m: float | None = None  # planning clearance override for every scenario (None: each scenario's)
+    paired_seeds: bool = False  # the k-th seed runs with the k-th world seed only
+
+    def seed_pairs(self) -> list[tuple[int | None, int]]:
+        """(world seed, seed) of every run of one setting, in the grid's order."""
+        if self.paired_seeds:
+            return list(zip(self.world_seeds, self.seeds))
+        return [(w, s) for w in self.world_seeds for s in self.seeds]
 
     def quick(self) -> "Study":
         """The study on its first ``quick_seeds`` seeds (its rows are the full study's rows for those seeds,
         so a later full run into the same folder resumes them)."""
         if self.quick_seeds is None:
             return self
+        if self.paired_seeds:
+            return replace(self, seeds=self.seeds[:self.quick_seeds], world_seeds=self.world_seeds[:self.quick_seeds])
         return replace(self, seeds=self.seeds[:self.quick_seeds])
 
     @property
@@ -328,5 +340,11 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
     if reference not in labels and not any(reference.startswith(f"{label}(") for label in labels):
         _fail(source, "reference", f"{reference!r} is not a planner label of the study ({', '.join(labels)})")
     paper = _paper(source, data.get("paper", []), scenarios, labels)
+    paired = data.get("paired_seeds", False)
+    if not isinstance(paired, bool):
+        _fail(source, "paired_seeds", f"expected true or false, got {paired!r}")
+    if paired and len(world_seeds) != len(seeds):
+        _fail(source, "paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
+                                      f"{len(world_seeds) if 'world_seeds' in data else 'no'} world seeds")
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
-                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios))
+                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired)
