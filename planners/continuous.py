@@ -283,7 +283,11 @@ class ContinuousPlanner(SwarmPlanner):
             extra["paper_instance"] = settings.paper
         return Path.from_waypoints(path.waypoints, time.perf_counter() - t0, iterations=path.stats.iterations,
                                    evaluations=spent + path.stats.evaluations,
-                                   cost_history=path.stats.cost_history, extra=extra)
+                                   cost_history=path.stats.cost_history,
+                                   # The last search's histories (a failed search raised, and its best costs
+                                   # had fewer via-points); its evaluation counts start after the failed ones'.
+                                   evaluation_history=tuple(spent + e for e in path.stats.evaluation_history),
+                                   extra=extra)
 
     def objective(self, problem: Problem, via_points: int | None = None) -> PathObjective:
         """The cost function of ``problem`` for this planner's encoding and weights, with

@@ -150,13 +150,23 @@ class Problem:
 
 @dataclass(frozen=True, eq=False)
 class PlanStats:
-    """What a planner measured about its own run."""
+    """What a planner measured about its own run.
+
+    ``cost_history`` is the best cost after the initialisation and after each
+    iteration (``iterations + 1`` entries, empty for a planner without iterations);
+    ``evaluation_history`` has the same length and holds the objective evaluations
+    (what ``evaluations`` counts for that planner) spent by then, cumulatively.  Its
+    last entry is the end of the search: evaluations spent after it (the swarm loop's
+    repair rounds, the continuous robust mode's final polish) are
+    ``evaluations - evaluation_history[-1]``.
+    """
 
     length_m: float
     plan_time_s: float
     iterations: int = 0
     evaluations: int = 0
     cost_history: tuple[float, ...] = ()
+    evaluation_history: tuple[int, ...] = ()
     extra: dict[str, Any] = field(default_factory=dict)
 
 
@@ -178,7 +188,8 @@ class Path:
         return (np.array_equal(self.waypoints, other.waypoints)
                 and self.stats.iterations == other.stats.iterations
                 and self.stats.evaluations == other.stats.evaluations
-                and self.stats.cost_history == other.stats.cost_history)
+                and self.stats.cost_history == other.stats.cost_history
+                and self.stats.evaluation_history == other.stats.evaluation_history)
 
 
 @runtime_checkable

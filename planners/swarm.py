@@ -17,7 +17,8 @@ and a *repair* stage, ``needs_repair(state, problem)`` and
 at most ``repair_limit()`` rounds while the best is not collision-free.
 
 The loop owns everything else: timing, the iteration budget, the best-cost
-history, and the **evaluation budget**, which holds everywhere.
+history with the evaluations spent by each of its entries, and the
+**evaluation budget**, which holds everywhere.
 ``max_evaluations`` (0 or None: none) is carried by the state; a step evaluates
 at most :attr:`SwarmState.evaluations_left` candidates (the continuous planners
 evaluate the first ones of a batch and give the rest an infinite cost, the ant
@@ -147,6 +148,7 @@ class SwarmPlanner:
         check_endpoints(problem)
         self.init_state(state, problem, rng)
         history = [state.best_cost]
+        spent = [state.evaluations]  # cumulative evaluations at each entry of ``history``
         done = 0
         converged_at = 0
         for iteration in range(self.iteration_limit(problem)):
@@ -156,6 +158,7 @@ class SwarmPlanner:
             if state.best_cost < history[-1]:
                 converged_at = iteration + 1
             history.append(state.best_cost)
+            spent.append(state.evaluations)
             done = iteration + 1
         repairs = 0
         while repairs < self.repair_limit() and not state.exhausted and self.needs_repair(state, problem):
@@ -173,4 +176,5 @@ class SwarmPlanner:
             extra.setdefault("repair_rounds", repairs)
         return Path.from_waypoints(waypoints, time.perf_counter() - t0, iterations=done,
                                    evaluations=state.evaluations,
-                                   cost_history=tuple(float(c) for c in history), extra=extra)
+                                   cost_history=tuple(float(c) for c in history),
+                                   evaluation_history=tuple(int(e) for e in spent), extra=extra)

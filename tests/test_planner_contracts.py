@@ -181,3 +181,81 @@ def test_oversized_or_bad_numbers_are_config_errors_naming_the_field(planner_nam
     assert code == 2
     assert field in err and needed in err
     assert len(err.strip().splitlines()) == 1
+
+
+# -- evaluation histories: what each recorded iteration had spent ---------------------
+
+@pytest.mark.parametrize("planner_name", sorted(PLANNERS))
+def test_evaluation_history_is_cumulative_and_matches_the_cost_history(planner_name, problems):
+    """Same length as the best-cost history, non-decreasing, never past the run's total; it ends at the
+    total unless evaluations came after the search (repair rounds, the robust mode's polish)."""
+    problem = problems["restaurant-table-2" if "discs" in PLANNERS[planner_name].supports else "iaco-complex"]
+    params = small_budget(planner_name)
+    if "polish_rounds" in fields_of(planner_name):
+        params.update(polish_rounds=0, repair_rounds=0)
+    try:
+        path = make_planner(planner_name, params).plan(problem, np.random.default_rng(3))
+    except PlanningError:
+        pytest.skip(f"{planner_name} found no path here")
+    stats = path.stats
+    history = np.array(stats.evaluation_history)
+    assert len(history) == len(stats.cost_history)
+    if not stats.cost_history:
+        return
+    assert len(history) == stats.iterations + 1
+    assert np.all(np.diff(history) >= 0) and history[-1] > history[0]
+    assert history[-1] == stats.evaluations
+
+
+def test_the_repair_and_polish_come_after_the_last_recorded_iteration():
+    problem = scenario_problem(load_scenario("restaurant-table-2"))
+    params = {"population": 20, "iterations": 20}
+    bare = make_planner("gwo", dict(params, polish_rounds=0)).plan(problem, np.random.default_rng(3))
+    polished = make_planner("gwo", params).plan(problem, np.random.default_rng(3))
+    assert polished.stats.extra["polish_rounds"] > 0
+    # The search is the same; only the polish after it differs.
+    assert polished.stats.evaluation_history == bare.stats.evaluation_history
+    assert polished.stats.evaluations > polished.stats.evaluation_history[-1] == bare.stats.evaluations
+
+
+def test_bee_colony_history_counts_employed_onlookers_and_scouts():
+    """Karaboga's ABC: SN to score the first sources, then 2 SN a cycle plus one per scout, so cycles
+    differ (an even spread of the total would not)."""
+    problem = scenario_problem(load_scenario("restaurant-table-2"))
+    sources = 20
+    path = make_planner("abc", {"population": sources, "iterations": 20, "limit": 2}).plan(
+        problem, np.random.default_rng(3))
+    history = np.array(path.stats.evaluation_history)
+    steps = np.diff(history)
+    assert history[0] == sources
+    assert np.all(steps >= 2 * sources) and np.all(steps <= 3 * sources)
+    assert len(set(steps.tolist())) > 1
+
+
+def test_pso_spends_one_swarm_an_iteration():
+    problem = scenario_problem(load_scenario("restaurant-table-2"))
+    path = make_planner("pso", {"population": 12, "iterations": 8}).plan(problem, np.random.default_rng(3))
+    assert np.array_equal(np.diff(path.stats.evaluation_history), np.full(8, 12))
+
+
+def test_a_via_point_growth_keeps_the_last_search_after_the_failed_ones():
+    """Robust mode reran the search with twice the via-points: the histories are the last search's, and its
+    evaluation counts start after what the failed search spent, so they still end at the total."""
+    problem = scenario_problem(load_scenario("restaurant-table-5"))
+    population, iterations = 10, 5
+    params = dict(population=population, iterations=iterations, via_points=1, seed_fraction=0.0, polish_rounds=0,
+                  repair_rounds=0)
+    grown = None
+    for seed in range(10):
+        try:
+            path = make_planner("pso", params).plan(problem, np.random.default_rng(seed))
+        except PlanningError:
+            continue
+        if path.stats.extra["via_point_growths"]:
+            grown = path
+            break
+    assert grown is not None, "no seed needed a second search"
+    stats = grown.stats
+    assert len(stats.evaluation_history) == len(stats.cost_history) == iterations + 1
+    assert stats.evaluation_history[-1] == stats.evaluations
+    assert stats.evaluation_history[0] == stats.evaluations - iterations * population > population

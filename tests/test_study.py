@@ -374,3 +374,50 @@ def test_an_unreachable_ray_address_is_one_line_naming_the_option():
         with pytest.raises(ConfigError) as info:
             check_reachable(f"ray://127.0.0.1:{port}")
     assert info.value.field == "--address" and str(port) in info.value.problem
+
+
+ABC_PLAN_ONLY = ('name = "abc-progress"\nscenarios = ["restaurant-table-2"]\nseeds = 2\n'
+                 '[[planners]]\nname = "abc"\nparams = { population = 10, iterations = 12, limit = 2 }\n')
+
+
+def test_progress_rows_are_the_planners_own_evaluation_history():
+    """A study's progress rows for a cell equal the history the planner records for the same seed, and
+    ABC's evaluations per iteration differ (scouts), so they are no even spread."""
+    from swarmnav.sim.study.cell import run_cell
+    from swarmnav.sim.study.spec import parse_study
+    for cell in expand(parse_study(ABC_PLAN_ONLY)):
+        row, progress = run_cell(cell)
+        assert row["outcome"] == "ok", row.get("error")
+        stats = plan_episode(EpisodeSpec(load_scenario(cell.scenario), cell.planner, cell.planner_params,
+                                         seed=cell.seed)).path.stats
+        assert [p["iteration"] for p in progress] == list(range(len(stats.cost_history)))
+        assert [p["best_cost"] for p in progress] == list(stats.cost_history)
+        assert [p["evaluations"] for p in progress] == list(stats.evaluation_history)
+        assert not any(p["evaluations_estimated"] for p in progress)
+        assert len(set(np.diff([p["evaluations"] for p in progress]).tolist())) > 1
+
+
+def test_a_planner_without_an_evaluation_history_gets_an_even_spread_marked_estimated():
+    import dataclasses
+
+    from swarmnav.planners.problem import Path as PlannedPath
+    from swarmnav.sim.study.cell import _progress_rows
+    from swarmnav.sim.study.spec import parse_study
+    cell = expand(parse_study(ABC_PLAN_ONLY))[0]
+    episode = plan_episode(EpisodeSpec(load_scenario(cell.scenario), cell.planner, cell.planner_params,
+                                       seed=cell.seed))
+    stats = dataclasses.replace(episode.path.stats, evaluation_history=())
+    episode.path = PlannedPath(episode.path.waypoints, stats)
+    progress = _progress_rows(cell, episode)
+    assert all(p["evaluations_estimated"] for p in progress)
+    evaluations = [p["evaluations"] for p in progress]
+    assert evaluations[0] == 0 and evaluations[-1] == stats.evaluations
+    assert np.ptp(np.diff(evaluations)) <= 1  # even, up to rounding
+
+
+def test_the_convergence_curve_by_evaluations_is_the_recorded_step_function():
+    from swarmnav.sim.study.figures import _on_evaluation_grid
+    run = [(0, 9.0, 20, False), (1, 7.0, 61, False), (2, 7.0, 101, False), (3, 4.0, 150, False)]
+    costs = _on_evaluation_grid(run, np.array([0, 19, 20, 60, 61, 149, 150, 400]))
+    assert np.isnan(costs[:2]).all()  # nothing was scored before the first population
+    assert costs[2:].tolist() == [9.0, 9.0, 7.0, 7.0, 4.0, 4.0]

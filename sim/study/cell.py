@@ -171,17 +171,22 @@ def _add_metrics(row: dict[str, Any], episode) -> None:
 
 
 def _progress_rows(cell: Cell, episode) -> list[dict[str, Any]]:
-    """Best cost per iteration.  The planners record a best-cost history but not the evaluations spent per
-    iteration, so ``evaluations`` is the run's total spread evenly over its iterations and
-    ``evaluations_estimated`` says so."""
+    """Best cost per iteration with the evaluations spent by then, as the planner recorded them
+    (``stats.evaluation_history``).  A planner that records a best-cost history but no evaluation
+    history gets its total spread evenly over its iterations, and ``evaluations_estimated`` says so."""
     stats = episode.path.stats
     history = stats.cost_history
     if not history:
         return []
-    steps = max(len(history) - 1, 1)
+    recorded = len(stats.evaluation_history) == len(history)
+    if recorded:
+        evaluations = [int(e) for e in stats.evaluation_history]
+    else:
+        steps = max(len(history) - 1, 1)
+        evaluations = [int(round(stats.evaluations * i / steps)) for i in range(len(history))]
     return [{"config_hash": cell.config_hash, "iteration": i, "best_cost": float(cost),
-             "evaluations": int(round(stats.evaluations * i / steps)), "evaluations_estimated": True}
-            for i, cost in enumerate(history)]
+             "evaluations": spent, "evaluations_estimated": not recorded}
+            for i, (cost, spent) in enumerate(zip(history, evaluations))]
 
 
 def _success(row: dict[str, Any]) -> bool:

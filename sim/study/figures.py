@@ -67,9 +67,20 @@ def _quartiles(stack: np.ndarray) -> np.ndarray:
     return out
 
 
-def convergence(arms: dict[str, list[dict[str, Any]]], progress: dict[str, list[tuple[int, float, int]]]
-                ) -> bytes | None:
-    """Median best cost with the interquartile band over runs, against iterations and against evaluations."""
+def _on_evaluation_grid(run: list[tuple], grid: np.ndarray) -> np.ndarray:
+    """A run's best cost after each number of evaluations in ``grid``: the latest entry recorded at or below
+    it (a step function); NaN before the run's first entry (a population is scored before it exists)."""
+    index = np.searchsorted([e for _, _, e, *_ in run], grid, side="right") - 1
+    costs = np.array([c for _, c, *_ in run] + [np.nan])
+    return costs[np.where(index >= 0, index, -1)]
+
+
+def convergence(arms: dict[str, list[dict[str, Any]]], progress: dict[str, list[tuple]]) -> bytes | None:
+    """Median best cost with the interquartile band over runs, against iterations and against evaluations.
+
+    ``progress`` maps a run's ``config_hash`` to its ``(iteration, best_cost, evaluations[, estimated])``
+    entries; ``estimated`` (True where the planner recorded no evaluation history and the total was spread
+    evenly over its iterations) is named on the evaluations axis."""
     curves = {}
     for name, rows in arms.items():
         runs = [sorted(progress[r["config_hash"]]) for r in rows if progress.get(r["config_hash"])]
@@ -79,22 +90,23 @@ def convergence(arms: dict[str, list[dict[str, Any]]], progress: dict[str, list[
     if not curves:
         return None
     fig, (by_iter, by_eval) = plt.subplots(1, 2, figsize=(10, 3.6))
+    estimated = set()
     for name, runs in curves.items():
-        costs = [np.array([c for _, c, _ in run]) for run in runs]
+        costs = [np.array([c for _, c, *_ in run]) for run in runs]
         length = max(c.size for c in costs)
         stack = _carried(costs, length)
         q1, med, q3 = _quartiles(stack)
         line, = by_iter.plot(np.arange(length), med, label=name)
         by_iter.fill_between(np.arange(length), q1, q3, alpha=0.2, color=line.get_color())
         grid = np.linspace(0, max(run[-1][2] for run in runs), 200)
-        on_grid = np.stack([np.array([c for _, c, _ in run])[
-            np.clip(np.searchsorted([e for _, _, e in run], grid, side="right") - 1, 0, len(run) - 1)]
-            for run in runs])
-        q1, med, q3 = _quartiles(on_grid)
+        q1, med, q3 = _quartiles(np.stack([_on_evaluation_grid(run, grid) for run in runs]))
         by_eval.plot(grid, med, label=name, color=line.get_color())
         by_eval.fill_between(grid, q1, q3, alpha=0.2, color=line.get_color())
+        if any(len(entry) > 3 and entry[3] for run in runs for entry in run):
+            estimated.add(name)
     by_iter.set_xlabel("iteration")
-    by_eval.set_xlabel("evaluations (spread evenly over iterations)")
+    by_eval.set_xlabel("evaluations" + (f" (spread evenly over iterations for {', '.join(sorted(estimated))})"
+                                        if estimated else ""))
     for ax in (by_iter, by_eval):
         ax.set_ylabel("best cost")
         ax.grid(alpha=0.3)

@@ -109,13 +109,14 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
     """Write the HTML report and its Markdown twin (``.md`` beside it); return the Markdown path."""
     directory, html_path = FilePath(directory), FilePath(html_path)
     runs = read_table(directory, RUNS).to_pylist()
-    progress: dict[str, list[tuple[int, float, int]]] = {}
+    progress: dict[str, list[tuple[int, float, int, bool]]] = {}
     seen = set()
     for p in read_table(directory, PROGRESS).to_pylist():
         key = (p["config_hash"], p["iteration"])
         if key not in seen:  # a part may repeat after a resumed crash; the values are the same
             seen.add(key)
-            progress.setdefault(p["config_hash"], []).append((p["iteration"], p["best_cost"], p["evaluations"]))
+            progress.setdefault(p["config_hash"], []).append((p["iteration"], p["best_cost"], p["evaluations"],
+                                                              bool(p.get("evaluations_estimated"))))
     meta_path = directory / "study.json"
     meta = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
     title = f"Study {meta.get('name', directory.name)}"
