@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -226,9 +227,26 @@ def test_static_discs_stay_in_the_navigators_map_and_moving_ones_do_not(name):
 
 
 def test_turns_are_counted_on_the_driven_path():
-    from swarmnav.sim.benchmarks.paper_navigation import count_turns
+    from swarmnav.sim.trajectory_metrics import count_turns
     t = np.linspace(0.0, 1.0, 200)[:, None]
     straight = np.hstack([t * 4.0, 0.0 * t, 0.0 * t])
     corner = np.vstack([straight, np.hstack([4.0 + 0.0 * t, t * 4.0, 0.0 * t])])
     zigzag = np.vstack([corner, np.hstack([4.0 + t * 4.0, 4.0 + 0.0 * t, 0.0 * t])])
     assert [count_turns(p, 0.4) for p in (straight, corner, zigzag)] == [0, 1, 2]
+
+
+def test_paper_navigation_rows_are_study_rows_with_the_walks_events(tmp_path):
+    """bench navigation --suite papers reads its figures from the study rows: IMMAS's moves are the count of
+    its move events, and every contender's run is a row of the kept study folder."""
+    import pandas as pd
+
+    from swarmnav.sim.benchmarks.paper_navigation import benchmark_paper_navigation
+
+    rows = benchmark_paper_navigation(1, ("immas-dynamic-10x10",), str(tmp_path))
+    runs = pd.read_parquet(tmp_path / "runs.parquet")
+    assert len(rows) == len(runs) >= 2
+    walk = runs[runs.navigator == "immas_stepwise"].iloc[0]
+    events = json.loads(walk.run_events)
+    paper = next(r for r in rows if r["strategy"] == "paper")
+    assert paper["moves"] == events["counts"]["immas_move"] == events["last"]["immas_move"]["moves"] > 0
+    assert paper["turns"] == walk.driven_turns and paper["collisions"] == walk.collisions

@@ -137,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
     if args.suite == "papers":
         from swarmnav.sim.benchmarks.paper_navigation import (PAPER_SUITE, benchmark_paper_navigation,
                                                               print_table)
-        paper_rows = benchmark_paper_navigation(args.seeds, tuple(args.scenario or PAPER_SUITE))
+        paper_rows = benchmark_paper_navigation(args.seeds, tuple(args.scenario or PAPER_SUITE), args.out)
         print(json.dumps(paper_rows)) if args.json else print_table(paper_rows)
         return 0
     from swarmnav.sim.cli import parse_settings  # loaded already: the CLI is what calls this

@@ -8,6 +8,10 @@ is registered; one row per run: path length, turns, time, collisions, replans,
 and for ``immas_stepwise`` the paper's figures of the walk (moves = its
 "iterations", and the total arc cost).
 
+Each contender runs as a physics study on each scenario (the study machinery, in this
+process; ``--out DIR`` keeps the rows for ``swarmnav report DIR``): the scenario's
+planner seed, world seeds 0..N-1.  A run that raised is a row with its outcome.
+
 Turns are counted on the driven trajectory: resampled every ``cell_m`` of arc
 length, a turn is a heading change of more than 22.5 degrees between successive
 pieces (the papers count the inflection points of their cell paths).
@@ -15,14 +19,12 @@ pieces (the papers count the inflection points of their cell paths).
 
 from __future__ import annotations
 
-import math
+import json
+import tempfile
 from typing import Any
-
-import numpy as np
 
 from swarmnav.controllers.navigators import NAVIGATORS
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.episode import EpisodeSpec, run_episode
 
 # (label, navigator, navigator params, planner or None for the scenario's)
 CONTENDERS: tuple[tuple[str, str, dict[str, Any], str | None], ...] = (
@@ -42,43 +44,28 @@ PAPER_FIGURES = {
 }
 
 
-def count_turns(poses: np.ndarray, spacing_m: float, threshold_rad: float = math.radians(22.5)) -> int:
-    """Heading changes above ``threshold_rad`` along the driven path, resampled every ``spacing_m``."""
-    xy = np.asarray(poses, dtype=float)[:, :2]
-    seg = np.linalg.norm(np.diff(xy, axis=0), axis=1)
-    arc = np.concatenate([[0.0], np.cumsum(seg)])
-    if arc[-1] < 2 * spacing_m:
-        return 0
-    s = np.arange(0.0, arc[-1], spacing_m)
-    pts = np.column_stack([np.interp(s, arc, xy[:, 0]), np.interp(s, arc, xy[:, 1])])
-    d = np.diff(pts, axis=0)
-    heading = np.arctan2(d[:, 1], d[:, 0])
-    change = np.abs((np.diff(heading) + math.pi) % (2 * math.pi) - math.pi)
-    return int(np.count_nonzero(change > threshold_rad))
+def _slug(label: str) -> str:
+    return "".join(c if c.isalnum() else "-" for c in label).strip("-")
 
 
-class _WalkFigures:
-    """Keeps immas_stepwise's last move event (moves, total arc cost) and counts escapes/waits."""
-
-    def __init__(self) -> None:
-        self.moves = None
-        self.arc_cost = None
-        self.escapes = 0
-
-    def start(self, context) -> None: ...
-    def path(self, time_s, waypoints_m) -> None: ...
-    def step(self, frame) -> None: ...
-    def finish(self, summary) -> None: ...
-
-    def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
-        if kind == "immas_move":
-            self.moves, self.arc_cost = details["moves"], details["total_arc_cost"]
-        elif kind == "collision_type" and details.get("action") == "escape":
-            self.escapes += 1
+def contender_tables(base, label: str, navigator: str, params: dict[str, Any], planner: str | None,
+                     seeds: int) -> dict[str, Any]:
+    """One contender on one scenario as a physics study: the scenario's planner seed, world seeds 0..N-1."""
+    return {"name": "bench-paper-navigation", "scenarios": [base.name], "mode": "physics", "seeds": [base.seed],
+            "world_seeds": list(range(seeds)),
+            "planners": [{"name": planner or base.planner_name}],
+            "navigators": [{"name": navigator, "label": _slug(label), "params": params}]}
 
 
-def benchmark_paper_navigation(seeds: int = 1, scenarios: tuple[str, ...] = PAPER_SUITE) -> list[dict[str, Any]]:
-    """One row per scenario x contender x world seed (see the module docstring)."""
+def benchmark_paper_navigation(seeds: int = 1, scenarios: tuple[str, ...] = PAPER_SUITE,
+                               out_dir: str | None = None) -> list[dict[str, Any]]:
+    """One row per scenario x contender x world seed (see the module docstring), from the rows of one
+    physics study per scenario and contender, all kept in ``out_dir`` when given."""
+    if out_dir is None:
+        with tempfile.TemporaryDirectory(prefix="swarmnav-bench-paper-navigation-") as folder:
+            return benchmark_paper_navigation(seeds, scenarios, folder)
+    from swarmnav.sim.study.execute import run_study_tables
+
     rows = []
     for name in scenarios:
         base = load_scenario(name)
@@ -87,28 +74,36 @@ def benchmark_paper_navigation(seeds: int = 1, scenarios: tuple[str, ...] = PAPE
             if navigator not in NAVIGATORS or (navigator == "iaco_local" and base.navigator_name != "iaco_local"
                                                and label != "paper"):
                 continue
-            for k in range(seeds):
-                figures = _WalkFigures()
-                spec = EpisodeSpec(base, planner=planner, navigator=navigator,
-                                   navigator_params=params or None, world_seed=k)
-                r = run_episode(spec, [figures]).result
-                rows.append({
-                    "scenario": name, "strategy": label, "navigator": navigator,
-                    "planner": planner or base.planner_name, "world_seed": k, "reached": r.reached,
-                    "collisions": r.collisions, "time_s": round(r.sim_time_s, 2),
-                    "path_length_m": round(r.path_length_m, 3),
-                    "turns": count_turns(r.poses, base.cell_m), "replans": r.replans + figures.escapes,
-                    "moves": figures.moves, "total_arc_cost": figures.arc_cost})
+            runs = run_study_tables(contender_tables(base, label, navigator, params, planner, seeds), out_dir)
+            mine = sorted((r for r in runs if r["scenario"] == name and r["navigator_label"] == _slug(label)
+                           and r["planner"] == (planner or base.planner_name)), key=lambda r: r["world_seed"])
+            rows += [_paper_row(name, label, r) for r in mine]
     return rows
+
+
+def _paper_row(scenario: str, label: str, run: dict[str, Any]) -> dict[str, Any]:
+    events = json.loads(run["run_events"]) if run.get("run_events") else {"counts": {}, "last": {}}
+    walk = events["last"].get("immas_move", {})
+    escapes = events["counts"].get("collision_type.escape", 0)
+    drove = run["outcome"] == "ok"
+    return {"scenario": scenario, "strategy": label, "navigator": run["navigator"], "planner": run["planner"],
+            "world_seed": run["world_seed"], "outcome": run["outcome"], "reached": bool(run["reached"]),
+            "collisions": run["collisions"], "time_s": round(run["sim_time_s"], 2) if drove else None,
+            "path_length_m": round(run["path_length_m"], 3) if drove else None,
+            "turns": run["driven_turns"], "replans": run["replans"] + escapes if drove else None,
+            "moves": walk.get("moves"), "total_arc_cost": walk.get("total_arc_cost")}
 
 
 def print_table(rows: list[dict[str, Any]]) -> None:
     print(f"{'scenario':<20} {'strategy':<22} {'seed':>4} {'reached':>7} {'collide':>7} {'time_s':>7} "
           f"{'length_m':>8} {'turns':>5} {'replans':>7} {'moves':>5} {'arc_cost':>8}")
+    def cell(value: Any, width: int, spec: str = "") -> str:
+        return f"{'-' if value is None else format(value, spec):>{width}}"
+
     for r in rows:
         print(f"{r['scenario']:<20} {r['strategy']:<22} {r['world_seed']:>4} {str(r['reached']):>7} "
-              f"{r['collisions']:>7} {r['time_s']:>7.1f} {r['path_length_m']:>8.2f} {r['turns']:>5} "
-              f"{r['replans']:>7} {'-' if r['moves'] is None else r['moves']:>5} "
-              f"{'-' if r['total_arc_cost'] is None else r['total_arc_cost']:>8}")
+              f"{cell(r['collisions'], 7)} {cell(r['time_s'], 7, '.1f')} {cell(r['path_length_m'], 8, '.2f')} "
+              f"{cell(r['turns'], 5)} {cell(r['replans'], 7)} {cell(r['moves'], 5)} {cell(r['total_arc_cost'], 8)}"
+              + ("" if r["outcome"] == "ok" else f"  ({r['outcome']})"))
     for name, text in PAPER_FIGURES.items():
         print(f"paper, {name}: {text}")

@@ -22,15 +22,13 @@ import time
 from pathlib import Path as FilePath
 from typing import Any
 
-import numpy as np
-
 from swarmnav.models.scenario import load_scenario
 from swarmnav.planners.errors import PlanningError
 from swarmnav.sim.episode import EpisodeSpec, json_safe, plan_episode, run_episode
 from swarmnav.sim.study.grid import Cell
+from swarmnav.sim.trajectory_metrics import bends, count_turns
 from swarmnav.sim.versions import software_versions
 
-BEND_TOLERANCE_RAD = 1e-6  # a turn smaller than this between two segments is no bend
 # Quantities some planners report in ``stats.extra`` that a paper's table prints: given their own columns.
 EXTRA_COLUMNS = {"raw_length_m": "plan_raw_length_m",  # the tour before shortcutting (grid and ant planners)
                  "gates_raised": "plan_gates_raised",  # IMMAS (Hasan et al. 2023), GateRaiseState
@@ -38,22 +36,33 @@ EXTRA_COLUMNS = {"raw_length_m": "plan_raw_length_m",  # the tour before shortcu
                  "total_arc_cost": "plan_arc_cost"}  # IMMAS, the arc cost of its tour
 
 
+class EventTally:
+    """A recorder that counts the navigator's events by kind (``collision_type`` also by its ``action``) and
+    keeps each kind's last details: the row's ``run_events`` (JSON), e.g. IMMAS's moves and arc cost from its
+    last ``immas_move``, the escapes of IACO's collision-type strategies."""
+
+    def __init__(self) -> None:
+        self.counts: dict[str, int] = {}
+        self.last: dict[str, Any] = {}
+
+    def start(self, context) -> None: ...
+    def path(self, time_s, waypoints_m) -> None: ...
+    def step(self, frame) -> None: ...
+    def finish(self, summary) -> None: ...
+
+    def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
+        keys = [kind] + ([f"{kind}.{details['action']}"] if "action" in details else [])
+        for key in keys:
+            self.counts[key] = self.counts.get(key, 0) + 1
+        self.last[kind] = details
+
+    def as_json(self) -> str:
+        return json.dumps(json_safe({"counts": self.counts, "last": self.last}), sort_keys=True)
+
+
 class WallLimitExceeded(BaseException):
     """Raised in the cell by SIGALRM at the wall limit (a BaseException, so planners' ``except Exception``
     cannot swallow it)."""
-
-
-def bends(waypoints: np.ndarray) -> int:
-    """Interior waypoints where the heading changes (IACO, Gong et al. 2022, Table 3 'number of bends')."""
-    if len(waypoints) < 3:
-        return 0
-    seg = np.diff(waypoints, axis=0)
-    seg = seg[np.hypot(seg[:, 0], seg[:, 1]) > 0]
-    if len(seg) < 2:
-        return 0
-    heading = np.arctan2(seg[:, 1], seg[:, 0])
-    turn = np.abs((np.diff(heading) + np.pi) % (2 * np.pi) - np.pi)
-    return int(np.count_nonzero(turn > BEND_TOLERANCE_RAD))
 
 
 # The navigation metrics of ``run --json`` kept as columns of their own.
@@ -120,13 +129,15 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
             row["clearance_m"] = spec.resolved().scenario.clearance_m
             episode = plan_episode(spec)
             if cell.physics:
-                recorders = []
+                tally = EventTally()
+                recorders = [tally]
                 if logs_dir is not None:
                     from swarmnav.sim.mcap_log import McapRecorder
                     log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
                     recorders.append(McapRecorder(log_path, overwrite=True))
                     row["log"] = str(log_path)
                 episode = run_episode(spec, recorders, planned=episode, time_limit_s=cell.time_limit_s)
+                row["run_events"] = tally.as_json()
         row["outcome"] = "ok"
     except WallLimitExceeded:
         row.update(outcome="timeout", error=f"exceeded the wall limit of {cell.wall_limit_s:g} s")
@@ -166,7 +177,8 @@ def _add_metrics(row: dict[str, Any], episode) -> None:
                    first_collision_s=run["first_collision_s"], sim_time_s=run["sim_time_s"],
                    wall_time_s=run["wall_time_s"], path_length_m=run["path_length_m"],
                    min_clearance_m=run["min_clearance_m"], control_steps=episode.result.steps,
-                   navigator_wall_s=episode.result.navigator_wall_s)
+                   navigator_wall_s=episode.result.navigator_wall_s,
+                   driven_turns=count_turns(episode.result.poses, episode.spec.scenario.cell_m))
         row.update({key: run.get(key) for key in NAVIGATION_METRICS})
 
 

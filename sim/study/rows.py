@@ -42,6 +42,7 @@ RUN_SCHEMA = pa.schema([
     ("time_to_goal_s", pa.float64()), ("spl", pa.float64()), ("time_in_danger_s", pa.float64()),
     ("replans", pa.int64()), ("replan_wall_s", pa.float64()), ("stopped_s", pa.float64()),
     ("safety_triggers", pa.int64()), ("control_steps", pa.int64()), ("navigator_wall_s", pa.float64()),
+    ("driven_turns", pa.int64()), ("run_events", pa.string()),
 ])
 PROGRESS_SCHEMA = pa.schema([
     ("config_hash", pa.string()), ("iteration", pa.int64()), ("best_cost", pa.float64()),
