@@ -362,7 +362,7 @@ def test_a_quick_run_is_the_first_seeds_of_the_full_one():
     assert all(c.config_hash in full_cells and c.seed in quick.seeds for c in quick_cells)
 
 
-def test_an_unreachable_ray_address_is_one_line_naming_the_option():
+def test_an_unreachable_ray_address_is_one_line_naming_the_option(tmp_path):
     import socket
 
     from swarmnav.models.errors import ConfigError
@@ -373,7 +373,11 @@ def test_an_unreachable_ray_address_is_one_line_naming_the_option():
         port = listener.getsockname()[1]
         with pytest.raises(ConfigError) as info:
             check_reachable(f"ray://127.0.0.1:{port}")
-    assert info.value.field == "--address" and str(port) in info.value.problem
+        assert info.value.field == "--address" and str(port) in info.value.problem
+        study = write(tmp_path, PLAN_ONLY)
+        assert main(["study", str(study), "--out", str(tmp_path / "out"), "--engine", "ray",
+                     "--address", f"127.0.0.1:{port}"]) == 2
+    assert not (tmp_path / "out").exists()  # refused before anything was written
 
 
 ABC_PLAN_ONLY = ('name = "abc-progress"\nscenarios = ["restaurant-table-2"]\nseeds = 2\n'

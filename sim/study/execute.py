@@ -19,7 +19,7 @@ from typing import Any, Iterator, TextIO
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.study.engines import run_inline, run_local, run_ray
+from swarmnav.sim.study.engines import check_reachable, run_inline, run_local, run_ray
 from swarmnav.sim.study.grid import Cell, expand
 from swarmnav.sim.study.rows import RowWriter, done_hashes
 from swarmnav.sim.study.spec import Study
@@ -101,6 +101,8 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
               address: str | None = None, logs: bool = False, show_progress: bool = False) -> dict[str, Any]:
     """Run every cell of ``study`` that ``out_dir`` does not hold yet; return a summary of this invocation."""
     out_dir = FilePath(out_dir)
+    if engine == "ray" and address:
+        check_reachable(address)  # before anything is written
     _write_metadata(study, out_dir)
     todo, total = pending_cells(study, out_dir)
     workers = workers or os.cpu_count() or 1
