@@ -238,3 +238,33 @@ def test_bench_planners_rows_agree_with_their_runs(tmp_path):
         assert ("impossible" in row["note"]) == (paper is not None and paper < optimum)
 
 
+
+
+def test_bench_planners_random_fields_are_a_study_of_scenario_files(tmp_path):
+    """The random fields run as scenario files; the summary's ratios are the rows' per-field medians over
+    the exact optimum found in the same rows."""
+    import pandas as pd
+
+    from swarmnav.planners.random_fields import random_disc_field
+    from swarmnav.sim.benchmarks import planners as bench_continuous
+    from swarmnav.sim.commands import add_bench_planners_arguments
+
+    parser = argparse.ArgumentParser()
+    add_bench_planners_arguments(parser)
+    args = parser.parse_args(["--scenarios", "gwo-scenario-1", "--planners", "gwo", "--modes", "robust",
+                              "--seeds", "2", "--population", "10", "--iterations", "5", "--peer-runs", "0",
+                              "--fields", "2", "--out", str(tmp_path)])
+    (summary,) = bench_continuous.benchmark(args)["fields"]
+    runs = pd.read_parquet(tmp_path / "fields" / "runs.parquet")
+    assert summary["runs"] == 4 and summary["fields"] + summary["fields_without_path"] == 2
+    ratios = []
+    for scenario, rows in runs.groupby("scenario"):
+        optimum = rows[rows.label == "optimal"].plan_length_m.iloc[0]
+        count = int(scenario.split("-")[2])
+        direct = OptimalPlanner().plan(random_disc_field(count, int(scenario.split("-")[-1])),
+                                       np.random.default_rng(0)).stats.length_m
+        assert optimum == pytest.approx(direct)
+        ours = rows[(rows.label == "gwo-robust") & rows.success].plan_length_m
+        ratios.append(ours.median() / optimum if len(ours) else math.inf)
+    assert summary["worst_median_ratio"] == pytest.approx(max(ratios))
+    assert summary["feasible_runs"] == int(runs[runs.label == "gwo-robust"].success.sum())
