@@ -7,24 +7,11 @@ from pathlib import Path
 
 import pytest
 
+from probe_scenario import PROBE_SCENARIO
+
 from swarmnav.sim.cli import main
 
-BASE = """
-name = "probe"
-seed = 0
-time_limit_s = 60.0
-arena = { width_m = 5.0, height_m = 5.0, walls = false }
-robot = { radius_m = 0.15, max_speed_m_s = 0.2 }
-start = { x = 0.5, y = 0.5, heading_deg = 45.0 }
-goal = { x = 4.5, y = 4.5, tolerance_m = 0.1 }
-sensors = { count = 12, range_m = 0.4 }
-planner = { name = "astar", params = {} }
-
-[[obstacles]]
-x = 2.5
-y = 2.5
-radius_m = 0.5
-"""
+BASE = PROBE_SCENARIO.replace("time_limit_s = 30.0", "time_limit_s = 60.0")  # tests/probe_scenario.py
 
 PLAN_KEYS = {"scenario", "planner", "seed", "waypoints", "length_m", "plan_time_s", "iterations",
              "evaluations", "collision_free"}
