@@ -138,6 +138,32 @@ def _markdown_table(text: str, first_header: str) -> list[list[str]]:
     return out
 
 
+def test_the_report_is_in_the_study_order_whatever_order_the_rows_finished_in(tiny, tmp_path):
+    """The same rows give the same report: written from the rows reversed, the Markdown is identical, and the
+    scenarios and planners appear in the study file's order."""
+    import shutil
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    _, out = tiny
+    copy = tmp_path / "copy"
+    (copy / "runs.parquet").mkdir(parents=True)
+    shutil.copytree(out / "progress.parquet", copy / "progress.parquet")
+    shutil.copy(out / "study.json", copy / "study.json")
+    table = pq.read_table(out / "runs.parquet")
+    pq.write_table(table.take(pa.array(range(table.num_rows - 1, -1, -1))), copy / "runs.parquet" / "part-0.parquet")
+    texts = []
+    for folder in (out, copy):
+        html = tmp_path / folder.name / "r.html"
+        assert main(["report", str(folder), "--out", str(html)]) == 0
+        texts.append(html.with_suffix(".md").read_text())
+    assert texts[0] == texts[1]
+    assert texts[0].index("## Scenario gwo-scenario-1") < texts[0].index("## Scenario restaurant-table-2")
+    counts = texts[0].split("## Scenario gwo-scenario-1")[1]
+    assert counts.index("| astar |") < counts.index("| gwo |")
+
+
 def test_report_tables_and_wilcoxon_agree_with_the_rows(tiny, tmp_path):
     _, out = tiny
     html = tmp_path / "r.html"

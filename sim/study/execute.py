@@ -44,6 +44,7 @@ def study_metadata(study: Study) -> dict[str, Any]:
     world_seed = study.world_seeds[0]
     return {"name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
             "reference": study.reference, "planners": [p.label for p in study.planners],
+            "navigators": [n.label for n in study.navigators],
             "paper": [dataclasses.asdict(p) for p in study.paper],
             "scenarios": {FilePath(s).stem: scenario_geometry(s, world_seed) for s in study.scenarios}}
 

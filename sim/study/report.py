@@ -13,6 +13,7 @@ import base64
 import html
 import json
 import math
+import re
 from pathlib import Path as FilePath
 from typing import Any
 
@@ -105,6 +106,32 @@ def _present(rows: list[dict[str, Any]], metrics: list[str]) -> list[str]:
     return [m for m in metrics if any(r.get(m) is not None for r in rows)]
 
 
+def _natural(text: str) -> tuple:
+    """A sort key that orders the numbers inside a label by value ("iterations=9" before "iterations=10")."""
+    return tuple((0, float(part), "") if part.replace(".", "", 1).isdigit() else (1, 0.0, part)
+                 for part in re.split(r"(\d+(?:\.\d+)?)", text) if part)
+
+
+def ordered_runs(runs: list[dict[str, Any]], meta: dict[str, Any]) -> list[dict[str, Any]]:
+    """The rows in the study's own order (scenario, planner, its sweep, navigator, world seed, seed), not the
+    order in which they finished, so the same rows always give the same report.  Scenarios, planners and
+    navigators the metadata does not list come after the listed ones, by name."""
+    def rank(names: list[str], name: str) -> tuple:
+        return (names.index(name), "") if name in names else (len(names), name)
+
+    scenarios, planners = list(meta.get("scenarios", {})), meta.get("planners", [])
+    navigators = meta.get("navigators", [])
+
+    def key(row: dict[str, Any]) -> tuple:
+        label = row["label"]
+        base = label.split("(", 1)[0]
+        return (rank(scenarios, row["scenario"]), rank(planners, label if label in planners else base),
+                _natural(label), rank(navigators, (row.get("navigator_label") or "follow").split("(", 1)[0]),
+                _natural(row.get("navigator_label") or ""), -1 if row["world_seed"] is None else row["world_seed"],
+                row["seed"])
+    return sorted(runs, key=key)
+
+
 def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePath:
     """Write the HTML report and its Markdown twin (``.md`` beside it); return the Markdown path."""
     directory, html_path = FilePath(directory), FilePath(html_path)
@@ -119,6 +146,7 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
                                                               bool(p.get("evaluations_estimated"))))
     meta_path = directory / "study.json"
     meta = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
+    runs = ordered_runs(runs, meta)
     title = f"Study {meta.get('name', directory.name)}"
     markdown_path = html_path.with_suffix(".md")
     doc = _Document(title, html_path.parent / f"{html_path.stem}_files")
