@@ -164,7 +164,9 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
         header, table = paper_table(arms)
         doc.paragraph("One row per planner in the shape of Gong et al. (2022) Table 3, over the completed runs "
                       "(std: sample; their 'standard deviation' column equals mean - optimal in every row, "
-                      "so that is given too).")
+                      "so that is given too). Bends: heading changes between consecutive waypoints, as the paper "
+                      "counts them on grid paths; a continuous planner's path is its spline sampled densely, so "
+                      "there every sample counts and the figure says little.")
         doc.table(header, [[_fmt(v) for v in line] for line in table])
         doc.table(*metric_rows(arms, metrics))
         errors = sorted({r["error"] for r in scenario_rows if r.get("error")})
