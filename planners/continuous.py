@@ -37,15 +37,34 @@ algorithm as its paper writes it (3 via-points, a uniform random first populatio
 polish).  ``mode = "robust"`` adds three named options, each of which can also be set on
 its own (an explicit value always wins over the mode's):
 
-* ``via_points``: chosen from the scene (:func:`planners.path_guess.via_points_for_guess`:
-  one per bend of an A* guess, plus two) and *grown* (doubled, up to
-  ``via_point_growth`` times, the search rerun on what is left of the budget) when no
-  candidate passes the exact check;
+* ``guess``: the geometric guess the other options start from: ``"tangent"`` (robust default),
+  the shortest route of the tangent graph around the inflated discs grown by
+  ``guess_margin_m`` (default ``penalty_margin_m``; :mod:`planners.tangent_guess`), or
+  ``"grid"``, a line-of-sight-shortcut A* path on the problem's grid (``guess_cell_m``);
+* ``via_points``: chosen from the scene (:func:`planners.path_guess.via_points_for_turns`:
+  two per turn of the tangent route plus three; for the grid guess
+  :func:`planners.path_guess.via_points_for_guess`, one per bend plus two) and *grown*
+  (doubled, up to ``via_point_growth`` times, the search rerun on what is left of the
+  budget) when no candidate passes the exact check;
 * ``seed_fraction``: that share of the first population is placed on the least-squares
   fit of the guess, perturbed (:mod:`planners.path_guess`), the rest uniformly at random
   as in the paper (later random draws, e.g. ABC's scouts, stay the paper's);
+* ``fit_push_rounds``: rounds of :func:`planners.path_guess.pushed_fit_via_points`, which
+  moves the fit's curve out of the penalty's discs (a plain least-squares fit cuts the
+  corners of a route that hugs them; 0: the plain fit);
 * ``polish_rounds``: a compass search from the chosen candidate (:mod:`planners.polish`);
   its result is kept only if the returned path passes the exact check.
+* ``stall_evaluations``: the search stops early once that many evaluations in a row have
+  not lowered the best cost by more than ``stall_tolerance`` (relative).  Started from a
+  seeded population, the swarm mostly refines the guess's fit, and on the random fields
+  the best stops improving within a few iterations (the default stops only a seeded
+  search: from a uniform random start a swarm may stall for a while and then find a
+  feasible basin).  A stop on lack of improvement is the
+  "improvement-based" criterion of Zielinski & Laur (2008, "Stopping criteria for
+  differential evolution in constrained single-objective optimization", in Chakraborty
+  (ed.), Advances in Differential Evolution, Springer, Sect. 3.1); counting evaluations
+  rather than iterations makes it the same for the algorithms that evaluate once an
+  iteration (GWO, PSO) and those that evaluate two or three times (ABC, ADL-ABC).
 
 ``mode = "auto"`` (the default) is ``"paper"`` on the papers' own bundled instances
 (recognised by their geometry, :mod:`planners.paper_instances`) and ``"robust"`` everywhere
@@ -70,19 +89,24 @@ from swarmnav.planners.errors import BudgetExceeded
 from swarmnav.planners.paper_instances import paper_instance
 from swarmnav.planners.path_cost import PathObjective
 from swarmnav.planners.path_guess import (MAX_AUTO_VIA_POINTS, fit_via_points, seeded_population,
-                                          grid_guesses, via_points_for_guess)
+                                          pushed_fit_via_points, scene_guesses)
 from swarmnav.planners.polish import compass_polish
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 from swarmnav.planners.via_points import ENCODINGS, ViaPointCurve
 
 MODES = ("auto", "paper", "robust")
+GUESSES = ("grid", "tangent")
 #: Via-points of both papers (Kamil et al. 2020 Sect. 3; Abdulla & Hadi 2025).
 PAPER_VIA_POINTS = 3
 #: The robust mode's defaults of the options left unset.
 ROBUST_SEED_FRACTION = 0.5
 ROBUST_POLISH_ROUNDS = 40
 ROBUST_VIA_POINT_GROWTH = 2
+ROBUST_FIT_PUSH_ROUNDS = 10
+ROBUST_GUESS = "tangent"
+#: The robust mode's ``stall_evaluations``, in populations.
+ROBUST_STALL_POPULATIONS = 10
 
 
 @dataclass(frozen=True)
@@ -97,6 +121,8 @@ class RunSettings:
         growth: how many more times ``k`` may double when nothing passes.
         guesses: the geometric guesses, (N, 2) waypoints each (empty: no seeding).
         paper: the paper scenario recognised (for ``mode = "auto"``), or None.
+        push_rounds: rounds that push the seeds' fit out of the discs.
+        stall_evaluations: evaluations without improvement that end the search (0: never).
     """
 
     mode: str = "paper"
@@ -106,6 +132,8 @@ class RunSettings:
     growth: int = 0
     guesses: tuple[np.ndarray, ...] = ()
     paper: str | None = None
+    push_rounds: int = 0
+    stall_evaluations: int = 0
 
 
 #: Most curve points one evaluation batch may sample (population x samples): the
@@ -125,6 +153,8 @@ class ContinuousState(SwarmState):
         fine: the repair's finer objective (ten times the samples), once the repair starts.
         repair_solution, repair_cost: the repair's incumbent and its fine cost.
         repair_step_m: the repair's current step size.
+        improved_at, reference_cost: the evaluation count when the best last improved by
+            more than ``stall_tolerance``, and the best cost then (for ``stall_evaluations``).
     """
 
     settings: RunSettings = dataclasses.field(default_factory=RunSettings)
@@ -139,6 +169,8 @@ class ContinuousState(SwarmState):
     repair_solution: np.ndarray | None = None
     repair_cost: float = math.inf
     repair_step_m: float = 0.0
+    improved_at: int = 0
+    reference_cost: float = math.inf
 
 
 @dataclass
@@ -177,6 +209,16 @@ class ContinuousPlanner(SwarmPlanner):
         polish_rounds: compass-search rounds on the result (``None``: 0 / 40).
         polish_step_m: the compass search's first step.
         via_point_growth: doublings of ``k`` when nothing passes (``None``: 0 / 2).
+        guess: ``"tangent"`` or ``"grid"``: the geometric guess of the seeds and of ``k``
+            (``None``: "grid" in paper mode, where it seeds only with an explicit
+            ``seed_fraction``, "tangent" in robust mode).
+        guess_margin_m: how much the tangent guess grows the inflated discs (``None``:
+            ``penalty_margin_m``, so that the guess clears the discs the penalty sees).
+        fit_push_rounds: rounds that push the seeds' fit out of the discs (``None``: 0 / 10).
+        stall_evaluations: end the search once this many evaluations in a row have not
+            improved the best (``None``: never in paper mode; in robust mode 10 x
+            ``population`` when the first population is seeded, never otherwise; 0: never).
+        stall_tolerance: the relative drop of the best cost that counts as an improvement.
     """
 
     supports: ClassVar[frozenset[str]] = frozenset({"discs"})
@@ -200,6 +242,11 @@ class ContinuousPlanner(SwarmPlanner):
     polish_rounds: int | None = None
     polish_step_m: float = 0.05
     via_point_growth: int | None = None
+    guess: str | None = None
+    guess_margin_m: float | None = None
+    fit_push_rounds: int | None = None
+    stall_evaluations: int | None = None
+    stall_tolerance: float = 1e-4
 
     def __post_init__(self) -> None:
         checks = (
@@ -225,6 +272,12 @@ class ContinuousPlanner(SwarmPlanner):
             ("polish_step_m", self.polish_step_m > 0, "must be positive"),
             ("via_point_growth", self.via_point_growth is None or self.via_point_growth >= 0,
              "must not be negative"),
+            ("guess", self.guess is None or self.guess in GUESSES, f"must be one of {', '.join(GUESSES)}"),
+            ("guess_margin_m", self.guess_margin_m is None or self.guess_margin_m >= 0, "must not be negative"),
+            ("fit_push_rounds", self.fit_push_rounds is None or self.fit_push_rounds >= 0, "must not be negative"),
+            ("stall_evaluations", self.stall_evaluations is None or self.stall_evaluations >= 0,
+             "must not be negative"),
+            ("stall_tolerance", self.stall_tolerance >= 0, "must not be negative"),
         )
         check_parameters(self, checks)
         points = self.population * self.samples
@@ -244,16 +297,27 @@ class ContinuousPlanner(SwarmPlanner):
         if mode == "paper":
             return RunSettings(mode="paper", via_points=self.via_points or PAPER_VIA_POINTS,
                                seed_fraction=self.seed_fraction or 0.0, polish_rounds=self.polish_rounds or 0,
-                               growth=self.via_point_growth or 0, paper=paper,
-                               guesses=grid_guesses(problem, self.guess_cell_m) if self.seed_fraction else ())
+                               growth=self.via_point_growth or 0, paper=paper, push_rounds=self.fit_push_rounds or 0,
+                               stall_evaluations=self.stall_evaluations or 0,
+                               guesses=scene_guesses(problem, self.guess or "grid", self.guess_cell_m,
+                                                     self.resolved_guess_margin_m())[0] if self.seed_fraction else ())
         fraction = ROBUST_SEED_FRACTION if self.seed_fraction is None else self.seed_fraction
-        guesses = grid_guesses(problem, self.guess_cell_m) if (fraction or self.via_points is None) else ()
-        via_points = self.via_points or max((via_points_for_guess(g) for g in guesses), default=PAPER_VIA_POINTS)
+        guesses, chosen_k = (scene_guesses(problem, self.guess or ROBUST_GUESS, self.guess_cell_m,
+                                           self.resolved_guess_margin_m())
+                             if (fraction or self.via_points is None) else ((), PAPER_VIA_POINTS))
+        via_points = self.via_points or chosen_k
         return RunSettings(
             mode="robust", via_points=via_points, seed_fraction=fraction,
             polish_rounds=ROBUST_POLISH_ROUNDS if self.polish_rounds is None else self.polish_rounds,
             growth=ROBUST_VIA_POINT_GROWTH if self.via_point_growth is None else self.via_point_growth,
-            guesses=guesses, paper=paper)
+            guesses=guesses, paper=paper,
+            push_rounds=ROBUST_FIT_PUSH_ROUNDS if self.fit_push_rounds is None else self.fit_push_rounds,
+            stall_evaluations=(self.stall_evaluations if self.stall_evaluations is not None
+                               else ROBUST_STALL_POPULATIONS * self.population if (fraction and guesses) else 0))
+
+    def resolved_guess_margin_m(self) -> float:
+        """``guess_margin_m``, or by default the penalty's own margin ``penalty_margin_m``."""
+        return self.penalty_margin_m if self.guess_margin_m is None else self.guess_margin_m
 
     def plan(self, problem: Problem, rng: np.random.Generator) -> Path:
         """Resolve the mode, then run the search; in robust mode, rerun it with twice the
@@ -322,7 +386,11 @@ class ContinuousPlanner(SwarmPlanner):
         if seeded == 0:
             return self.random_solutions(state, count, rng)
         shares = np.diff(np.linspace(0, seeded, len(settings.guesses) + 1).round().astype(int))
-        seeds = [seeded_population(np.clip(fit_via_points(state.objective.curve, guess), state.lower, state.upper),
+        objective = state.objective
+        seeds = [seeded_population(np.clip(pushed_fit_via_points(objective.curve, guess, objective.centres_m,
+                                                                 objective.penalty_radii_m, settings.push_rounds)
+                                           if settings.push_rounds else fit_via_points(objective.curve, guess),
+                                           state.lower, state.upper),
                                    int(share), self.seed_spread_m, state.lower, state.upper, rng)
                  for guess, share in zip(settings.guesses, shares) if share]
         return np.vstack(seeds + [self.random_solutions(state, count - seeded, rng)])
@@ -352,7 +420,18 @@ class ContinuousPlanner(SwarmPlanner):
         state.evaluations += count
         if offer:
             state.offer(population, costs)
+            self.note_stall(state)
         return costs
+
+    def note_stall(self, state: ContinuousState) -> None:
+        """Track the last improvement of the best by more than ``stall_tolerance`` and end
+        the search (``state.done``) once ``stall_evaluations`` have passed without one."""
+        if state.best_cost < state.reference_cost * (1.0 - self.stall_tolerance) or not math.isfinite(
+                state.reference_cost):
+            state.reference_cost, state.improved_at = state.best_cost, state.evaluations
+        limit = state.settings.stall_evaluations
+        if limit and state.evaluations - state.improved_at >= limit:
+            state.done = True
 
     # ------------------------------------------------------- the loop's hooks
     def init_state(self, state: ContinuousState, problem: Problem, rng: np.random.Generator) -> None:
@@ -439,6 +518,7 @@ class ContinuousPlanner(SwarmPlanner):
             "clearance_m": problem.path_clearance_m(waypoints),
             "encoding": self.encoding,
             "polish_rounds": polished,
+            "stopped_on_stall": bool(state.done),
         }
 
     def dense_waypoints(self, objective: PathObjective, solution: np.ndarray) -> np.ndarray:

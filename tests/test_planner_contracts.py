@@ -112,7 +112,9 @@ def test_max_evaluations_holds_repair_included(planner_name, scenario_name, caps
 def test_the_repair_counts_against_the_budget():
     """Without a budget the repair would spend its own evaluations; with one it stops at it."""
     problem = scenario_problem(load_scenario("dense-field-30"))
-    unlimited = make_planner("abc", {"population": 10, "iterations": 5})
+    # the robust mode's grid guess and plain fit (its tangent guess needs no repair here)
+    params = {"population": 10, "iterations": 5, "guess": "grid", "fit_push_rounds": 0}
+    unlimited = make_planner("abc", params)
     repaired = None
     for seed in range(20):
         try:
@@ -127,7 +129,7 @@ def test_the_repair_counts_against_the_budget():
     search_only = spent - path.stats.extra["repair_rounds"] * 10 - 1
     assert search_only > 0
     budget = search_only + 3          # room for the repair's first evaluation and a part of one batch
-    limited = make_planner("abc", {"population": 10, "iterations": 5, "max_evaluations": budget})
+    limited = make_planner("abc", dict(params, max_evaluations=budget))
     try:
         path = limited.plan(problem, np.random.default_rng(seed))
     except BudgetExceeded:
@@ -137,8 +139,9 @@ def test_the_repair_counts_against_the_budget():
 
 def test_budget_spent_without_a_path_is_budget_exceeded():
     problem = scenario_problem(load_scenario("dense-field-30"))
-    with pytest.raises(BudgetExceeded):
-        make_planner("gwo", {"max_evaluations": 60}).plan(problem, np.random.default_rng(1))
+    with pytest.raises(BudgetExceeded):   # the robust mode's grid guess, plain fit (the tangent one finds it)
+        make_planner("gwo", {"max_evaluations": 60, "guess": "grid", "fit_push_rounds": 0}).plan(
+            problem, np.random.default_rng(1))
     # Without a budget the same failure is NoPathFound (the paper's gwo: the robust mode's
     # seeded start would find a path even with four wolves and one iteration).
     with pytest.raises(NoPathFound) as err:
