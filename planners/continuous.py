@@ -54,6 +54,10 @@ its own (an explicit value always wins over the mode's):
   corners of a route that hugs them; 0: the plain fit);
 * ``polish_rounds``: a compass search from the chosen candidate (:mod:`planners.polish`);
   its result is kept only if the returned path passes the exact check.
+* ``gap_margins``: the penalty's margin (``penalty_margin_m``) shrinks, disc by disc, to
+  less than half of every narrower gap between two footprints (and less than a wall gap),
+  so that the cost does not close a gap the robot fits through
+  (:func:`planners.path_guess.gap_margins_m`; our choice);
 * ``stall_evaluations``: the search stops early once that many evaluations in a row have
   not lowered the best cost by more than ``stall_tolerance`` (relative).  Started from a
   seeded population, the swarm mostly refines the guess's fit, and on the random fields
@@ -88,10 +92,11 @@ from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.errors import BudgetExceeded
 from swarmnav.planners.paper_instances import paper_instance
 from swarmnav.planners.path_cost import PathObjective
-from swarmnav.planners.path_guess import (MAX_AUTO_VIA_POINTS, fit_via_points, seeded_population,
-                                          pushed_fit_via_points, scene_guesses)
+from swarmnav.planners.path_guess import (MAX_AUTO_VIA_POINTS, fit_via_points, gap_margins_m,
+                                          pushed_fit_via_points, scene_guesses, seeded_population)
 from swarmnav.planners.polish import compass_polish
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
+from swarmnav.planners.segment_gaps import polyline_gap_m
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 from swarmnav.planners.via_points import ENCODINGS, ViaPointCurve
 
@@ -103,10 +108,11 @@ PAPER_VIA_POINTS = 3
 ROBUST_SEED_FRACTION = 0.5
 ROBUST_POLISH_ROUNDS = 40
 ROBUST_VIA_POINT_GROWTH = 2
-ROBUST_FIT_PUSH_ROUNDS = 10
+ROBUST_FIT_PUSH_ROUNDS = 40
 ROBUST_GUESS = "tangent"
 #: The robust mode's ``stall_evaluations``, in populations.
 ROBUST_STALL_POPULATIONS = 10
+ROBUST_GAP_MARGINS = True
 
 
 @dataclass(frozen=True)
@@ -123,6 +129,7 @@ class RunSettings:
         paper: the paper scenario recognised (for ``mode = "auto"``), or None.
         push_rounds: rounds that push the seeds' fit out of the discs.
         stall_evaluations: evaluations without improvement that end the search (0: never).
+        margins_m: (n,) the penalty margin of each disc (None: ``penalty_margin_m`` for all).
     """
 
     mode: str = "paper"
@@ -134,7 +141,12 @@ class RunSettings:
     paper: str | None = None
     push_rounds: int = 0
     stall_evaluations: int = 0
+    margins_m: np.ndarray | None = None
 
+
+#: A fast gap below minus this rejects a candidate without the exact check (whose own
+#: tolerance is 1e-6 m; the two computations differ by rounding only).
+PRECHECK_SLACK_M = 1e-5
 
 #: Most curve points one evaluation batch may sample (population x samples): the
 #: cost's temporaries grow with it.
@@ -214,11 +226,15 @@ class ContinuousPlanner(SwarmPlanner):
             ``seed_fraction``, "tangent" in robust mode).
         guess_margin_m: how much the tangent guess grows the inflated discs (``None``:
             ``penalty_margin_m``, so that the guess clears the discs the penalty sees).
-        fit_push_rounds: rounds that push the seeds' fit out of the discs (``None``: 0 / 10).
+        fit_push_rounds: rounds that push the seeds' fit out of the discs (``None``: 0 / 40; it stops
+            early once the fit is clear).
         stall_evaluations: end the search once this many evaluations in a row have not
             improved the best (``None``: never in paper mode; in robust mode 10 x
             ``population`` when the first population is seeded, never otherwise; 0: never).
         stall_tolerance: the relative drop of the best cost that counts as an improvement.
+        gap_margins: whether each disc's penalty margin shrinks to keep narrow gaps open
+            (:func:`planners.path_guess.gap_margins_m`; ``None``: no / yes).  The tangent
+            guess then grows each disc by its own margin (unless ``guess_margin_m`` is set).
     """
 
     supports: ClassVar[frozenset[str]] = frozenset({"discs"})
@@ -247,6 +263,7 @@ class ContinuousPlanner(SwarmPlanner):
     fit_push_rounds: int | None = None
     stall_evaluations: int | None = None
     stall_tolerance: float = 1e-4
+    gap_margins: bool | None = None
 
     def __post_init__(self) -> None:
         checks = (
@@ -302,8 +319,11 @@ class ContinuousPlanner(SwarmPlanner):
                                guesses=scene_guesses(problem, self.guess or "grid", self.guess_cell_m,
                                                      self.resolved_guess_margin_m())[0] if self.seed_fraction else ())
         fraction = ROBUST_SEED_FRACTION if self.seed_fraction is None else self.seed_fraction
-        guesses, chosen_k = (scene_guesses(problem, self.guess or ROBUST_GUESS, self.guess_cell_m,
-                                           self.resolved_guess_margin_m())
+        gap_margins = ROBUST_GAP_MARGINS if self.gap_margins is None else self.gap_margins
+        margins = gap_margins_m(problem, self.penalty_margin_m) if gap_margins else None
+        guess_margin = self.guess_margin_m if self.guess_margin_m is not None else (
+            margins if margins is not None else self.penalty_margin_m)
+        guesses, chosen_k = (scene_guesses(problem, self.guess or ROBUST_GUESS, self.guess_cell_m, guess_margin)
                              if (fraction or self.via_points is None) else ((), PAPER_VIA_POINTS))
         via_points = self.via_points or chosen_k
         return RunSettings(
@@ -312,6 +332,7 @@ class ContinuousPlanner(SwarmPlanner):
             growth=ROBUST_VIA_POINT_GROWTH if self.via_point_growth is None else self.via_point_growth,
             guesses=guesses, paper=paper,
             push_rounds=ROBUST_FIT_PUSH_ROUNDS if self.fit_push_rounds is None else self.fit_push_rounds,
+            margins_m=margins,
             stall_evaluations=(self.stall_evaluations if self.stall_evaluations is not None
                                else ROBUST_STALL_POPULATIONS * self.population if (fraction and guesses) else 0))
 
@@ -353,14 +374,17 @@ class ContinuousPlanner(SwarmPlanner):
                                    evaluation_history=tuple(spent + e for e in path.stats.evaluation_history),
                                    extra=extra)
 
-    def objective(self, problem: Problem, via_points: int | None = None) -> PathObjective:
+    def objective(self, problem: Problem, via_points: int | None = None,
+                  margins_m: np.ndarray | None = None) -> PathObjective:
         """The cost function of ``problem`` for this planner's encoding and weights, with
-        ``via_points`` free via-points (default: the parameter, else the papers' 3)."""
+        ``via_points`` free via-points (default: the parameter, else the papers' 3) and the
+        penalty margins ``margins_m`` (one per disc; default ``penalty_margin_m`` for all)."""
         k = via_points or self.via_points or PAPER_VIA_POINTS
         curve = ViaPointCurve(self.encoding, k, problem.start.xy, problem.goal.xy,
                               self.samples)
         return PathObjective(curve=curve, centres_m=problem.disc_centres_m,
-                             penalty_radii_m=problem.inflated_radii_m + self.penalty_margin_m,
+                             penalty_radii_m=problem.inflated_radii_m + (
+                                 self.penalty_margin_m if margins_m is None else margins_m),
                              bounds=problem.bounds, length_weight=self.length_weight,
                              smoothness_weight=self.smoothness_weight,
                              penalty_weight=self.penalty_weight)
@@ -437,7 +461,7 @@ class ContinuousPlanner(SwarmPlanner):
     def init_state(self, state: ContinuousState, problem: Problem, rng: np.random.Generator) -> None:
         check_supported(self, problem)
         k = state.settings.via_points
-        state.objective = self.objective(problem, k)
+        state.objective = self.objective(problem, k, state.settings.margins_m)
         state.lower, state.upper = self.search_bounds(problem, k)
         self.init_swarm(state, rng)
 
@@ -459,9 +483,7 @@ class ContinuousPlanner(SwarmPlanner):
                 candidates.extend(np.asarray(state.population[i], dtype=float) for i in order
                                   if math.isfinite(state.costs[i]))
             for rank, solution in enumerate(candidates):
-                waypoints = self.dense_waypoints(state.objective, solution)
-                state.best_gap_m = max(state.best_gap_m, problem.path_clearance_m(waypoints))
-                if problem.is_collision_free(waypoints):
+                if self.passes_exact_check(problem, self.dense_waypoints(state.objective, solution), state):
                     state.chosen, state.repaired = solution, ("population" if rank > 0 else None)
                     break
         return state.chosen is None and state.best_solution is not None
@@ -485,7 +507,7 @@ class ContinuousPlanner(SwarmPlanner):
         i = int(np.argmin(costs))
         if costs[i] < state.repair_cost:
             state.repair_solution, state.repair_cost = trial[i], float(costs[i])
-            if problem.is_collision_free(self.dense_waypoints(state.objective, trial[i])):
+            if self.passes_exact_check(problem, self.dense_waypoints(state.objective, trial[i]), state):
                 state.chosen, state.repaired = trial[i], "fine_penalty"
         state.repair_step_m *= 0.6
 
@@ -508,7 +530,7 @@ class ContinuousPlanner(SwarmPlanner):
             start_cost = float(objective(state.chosen[None, :])[0])
             state.chosen, _, polished = compass_polish(
                 state.chosen, start_cost, lambda trial: self.evaluate(state, trial, offer=False),
-                lambda x: bool(problem.is_collision_free(self.dense_waypoints(objective, x))),
+                lambda x: self.passes_exact_check(problem, self.dense_waypoints(objective, x), state),
                 state.lower, state.upper, self.polish_step_m, state.settings.polish_rounds)
         waypoints = self.dense_waypoints(objective, state.chosen)
         return waypoints, {
@@ -520,6 +542,16 @@ class ContinuousPlanner(SwarmPlanner):
             "polish_rounds": polished,
             "stopped_on_stall": bool(state.done),
         }
+
+    @staticmethod
+    def passes_exact_check(problem: Problem, waypoints: np.ndarray, state: ContinuousState) -> bool:
+        """``problem.is_collision_free(waypoints)``, the exact check, run only when the fast
+        gap (:func:`planners.segment_gaps.polyline_gap_m`, the same distances without
+        temporaries) does not already show a cut deeper than :data:`PRECHECK_SLACK_M`;
+        keeps the best gap seen in ``state.best_gap_m`` (for the error message)."""
+        gap_m = polyline_gap_m(waypoints, problem.disc_centres_m, problem.inflated_radii_m)
+        state.best_gap_m = max(state.best_gap_m, gap_m)
+        return gap_m >= -PRECHECK_SLACK_M and bool(problem.is_collision_free(waypoints))
 
     def dense_waypoints(self, objective: PathObjective, solution: np.ndarray) -> np.ndarray:
         """The returned polyline: the spline every ``waypoint_spacing_m``, projected onto the

@@ -43,6 +43,8 @@ from swarmnav.planners.via_points import ViaPointCurve
 MAX_AUTO_VIA_POINTS = 16
 #: Via-points beyond two per turn of a tangent route (:func:`via_points_for_turns`).
 TURN_EXTRA_VIA_POINTS = 3
+#: Share of an open gap between two footprints a penalty margin may take (:func:`gap_margins_m`).
+GAP_SHARE = 0.4
 #: How far :func:`pushed_fit_via_points` moves a target per unit depth of its sample.
 PUSH_GAIN = 2.0
 
@@ -58,7 +60,32 @@ def grid_guesses(problem: Problem, cell_m: float | None = None) -> tuple[np.ndar
         return ()
 
 
-def tangent_guesses(problem: Problem, margin_m: float = 0.0) -> tuple[np.ndarray, ...]:
+def gap_margins_m(problem: Problem, margin_m: float, share: float = GAP_SHARE) -> np.ndarray:
+    """(n,) each disc's penalty margin: ``margin_m``, but at most ``share`` of every open gap
+    between its inflated footprint and another's, and ``2 share`` of the gap to each
+    arena wall, so that a margin never closes a gap the robot fits through (gaps already
+    closed, overlapping footprints, are left alone).
+
+    The penalty's margin keeps a curve sampled at ``samples`` points from cutting a disc
+    between two samples; a uniform 2 cm margin also closes every gap narrower than 4 cm, and
+    on 4 of 60 further random fields the optimum threads such a gap (the robust mode's
+    result was then 1.03-1.16 x the optimum in the next homotopy class)."""
+    centres, radii = problem.disc_centres_m, problem.inflated_radii_m
+    n = radii.size
+    margins = np.full(n, float(margin_m))
+    if n == 0:
+        return margins
+    gaps = np.hypot(*(centres[:, None, :] - centres[None, :, :]).transpose(2, 0, 1)) - radii[:, None] - radii[None, :]
+    gaps[np.arange(n), np.arange(n)] = np.inf
+    gaps[gaps <= 0.0] = np.inf
+    b = problem.bounds
+    walls = np.column_stack([centres[:, 0] - b.x_min_m, b.x_max_m - centres[:, 0],
+                             centres[:, 1] - b.y_min_m, b.y_max_m - centres[:, 1]]) - radii[:, None]
+    walls[walls <= 0.0] = np.inf
+    return np.minimum(margins, np.minimum(share * gaps.min(axis=1), 2.0 * share * walls.min(axis=1)))
+
+
+def tangent_guesses(problem: Problem, margin_m: float | np.ndarray = 0.0) -> tuple[np.ndarray, ...]:
     """The (N, 2) waypoints of the shortest route of the tangent graph
     (:func:`planners.tangent_guess.tangent_route`) around the inflated discs grown by
     ``margin_m`` (never so far that a grown disc would reach the start or the goal), as a
@@ -67,9 +94,10 @@ def tangent_guesses(problem: Problem, margin_m: float = 0.0) -> tuple[np.ndarray
     return () if route is None else (route.waypoints,)
 
 
-def tangent_route_for(problem: Problem, margin_m: float = 0.0) -> TangentRoute | None:
+def tangent_route_for(problem: Problem, margin_m: float | np.ndarray = 0.0) -> TangentRoute | None:
     """:func:`planners.tangent_guess.tangent_route` of ``problem``'s inflated discs grown by
-    ``margin_m`` (capped a micrometre short of the start and the goal)."""
+    ``margin_m`` (one for all, or one per disc; capped a micrometre short of the start and
+    the goal)."""
     centres, radii = problem.disc_centres_m, problem.inflated_radii_m
     reach = np.minimum(np.hypot(*(centres - problem.start.xy).T), np.hypot(*(centres - problem.goal.xy).T))
     grown = np.maximum(np.minimum(radii + margin_m, reach - 1e-6), radii)
@@ -77,7 +105,7 @@ def tangent_route_for(problem: Problem, margin_m: float = 0.0) -> TangentRoute |
 
 
 def scene_guesses(problem: Problem, kind: str, cell_m: float | None = None,
-                  margin_m: float = 0.0) -> tuple[tuple[np.ndarray, ...], int]:
+                  margin_m: float | np.ndarray = 0.0) -> tuple[tuple[np.ndarray, ...], int]:
     """The guesses of ``kind`` ("grid": :func:`grid_guesses`, "tangent": :func:`tangent_guesses`)
     and the via-points a curve needs to follow them (:func:`via_points_for_guess`,
     :func:`via_points_for_turns`; the papers' 3 when there is no guess)."""

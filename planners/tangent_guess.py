@@ -36,6 +36,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from swarmnav.models.world import Rect
+from swarmnav.planners.segment_gaps import segments_clear
 
 TOLERANCE_M = 1e-9
 
@@ -107,7 +108,7 @@ def tangent_route(start: np.ndarray, goal: np.ndarray, centres: np.ndarray, radi
     centres = np.asarray(centres, dtype=float).reshape(-1, 2)
     radii = np.asarray(radii, dtype=float).reshape(-1)
     n = centres.shape[0]
-    direct = n == 0 or bool(_segments_clear(start[None], goal[None], centres,
+    direct = n == 0 or bool(segments_clear(start[None], goal[None], centres,
                                             np.maximum(radii - TOLERANCE_M, 0.0) ** 2)[0])
     if direct:
         return TangentRoute(np.vstack([start, goal]), float(np.hypot(*(goal - start))), 0, np.empty((0, 2)))
@@ -129,7 +130,7 @@ def tangent_route(start: np.ndarray, goal: np.ndarray, centres: np.ndarray, radi
     node_ok &= ~_inside_any(points, centres, inner_sq)
     keep = node_ok[ends_a] & node_ok[ends_b]
     ends_a, ends_b = ends_a[keep], ends_b[keep]
-    clear = _segments_clear(points[ends_a], points[ends_b], centres, inner_sq)
+    clear = segments_clear(points[ends_a], points[ends_b], centres, inner_sq)
     ends_a, ends_b = ends_a[clear], ends_b[clear]
     seg_len = np.hypot(*(points[ends_b] - points[ends_a]).T)
 
@@ -184,25 +185,6 @@ def _inside_any(points: np.ndarray, centres: np.ndarray, radii_sq: np.ndarray) -
     dy *= dy
     dx += dy
     return np.any(dx < radii_sq, axis=1)
-
-
-def _segments_clear(a: np.ndarray, b: np.ndarray, centres: np.ndarray, radii_sq: np.ndarray) -> np.ndarray:
-    """(S,) whether each segment ``a -> b`` stays out of every disc: the squared distance
-    from the segment to each centre (the nearest point at the clipped projection) against
-    the squared radius (the exact test of :func:`models.geometry.segment_disc_distances`,
-    without its roots and its (S, n, 2) temporaries)."""
-    ab = b - a
-    length_sq = np.maximum(ab[:, 0] * ab[:, 0] + ab[:, 1] * ab[:, 1], 1e-300)[:, None]
-    ox = centres[None, :, 0] - a[:, 0, None]                  # (S, n) from a to each centre
-    oy = centres[None, :, 1] - a[:, 1, None]
-    t = (ox * ab[:, 0, None] + oy * ab[:, 1, None]) / length_sq
-    np.clip(t, 0.0, 1.0, out=t)
-    ox -= t * ab[:, 0, None]
-    oy -= t * ab[:, 1, None]
-    ox *= ox
-    oy *= oy
-    ox += oy
-    return ~np.any(ox < radii_sq[None, :], axis=1)
 
 
 def _arcs_clear(centres: np.ndarray, radii: np.ndarray, arc_disc: np.ndarray, arc_from: np.ndarray,

@@ -155,3 +155,43 @@ def test_the_robust_search_stops_on_stall_and_the_paper_runs_every_iteration(pla
     paper = make_planner(planner, dict(SMALL, mode="paper")).plan(
         scenario_problem(load_scenario("gwo-scenario-1"), clearance_m=0.0), np.random.default_rng(3))
     assert paper.stats.iterations == SMALL["iterations"] and not paper.stats.extra["stopped_on_stall"]
+
+
+def test_gap_margins_keep_a_narrow_gap_open_and_the_robust_mode_threads_it():
+    """Field (25, 142): the optimum passes a gap narrower than twice the penalty's 2 cm
+    margin; a uniform margin closed it (1.16 x the optimum), the gap margins keep it."""
+    from swarmnav.planners.path_guess import gap_margins_m
+
+    problem = random_disc_field(25, 142)
+    margins = gap_margins_m(problem, 0.02)
+    centres, radii = problem.disc_centres_m, problem.inflated_radii_m
+    gaps = np.hypot(*(centres[:, None, :] - centres[None, :, :]).transpose(2, 0, 1)) - radii[:, None] - radii
+    np.fill_diagonal(gaps, np.inf)
+    open_pairs = gaps > 0
+    assert np.any(open_pairs & (gaps < 0.04))
+    assert np.all((margins[:, None] + margins[None, :] < gaps) | ~open_pairs)
+    assert np.all(margins <= 0.02) and np.any(margins == 0.02)
+    optimum = _optimum(problem)
+    lengths = [make_planner("gwo", {"mode": "robust"}).plan(problem, np.random.default_rng(seed)).stats.length_m
+               for seed in range(3)]
+    uniform = make_planner("gwo", {"mode": "robust", "gap_margins": False}).plan(problem, np.random.default_rng(0))
+    assert np.median(lengths) <= 1.03 * optimum < uniform.stats.length_m
+
+
+def test_fast_gap_matches_the_exact_clearance():
+    from swarmnav.planners.segment_gaps import polyline_gap_m
+
+    problem = random_disc_field(30, 5)
+    rng = np.random.default_rng(0)
+    for _ in range(50):
+        points = rng.uniform(0.0, 10.0, (rng.integers(1, 40), 2))
+        exact = problem.path_clearance_m(points)
+        fast = polyline_gap_m(points, problem.disc_centres_m, problem.inflated_radii_m)
+        assert abs(fast - exact) < 1e-9
+    # a segment of zero length, and one ending exactly on an inflated edge
+    centre, radius = problem.disc_centres_m[0], problem.inflated_radii_m[0]
+    on_edge = np.array([centre + [radius, 0.0], centre + [radius + 1.0, 0.0]])
+    assert abs(polyline_gap_m(on_edge, problem.disc_centres_m[:1], problem.inflated_radii_m[:1])) < 1e-12
+    point = np.array([[5.0, 5.0]])
+    assert abs(polyline_gap_m(point, problem.disc_centres_m, problem.inflated_radii_m)
+               - problem.path_clearance_m(point)) < 1e-9
