@@ -167,6 +167,8 @@ class ContinuousState(SwarmState):
         repair_step_m: the repair's current step size.
         improved_at, reference_cost: the evaluation count when the best last improved by
             more than ``stall_tolerance``, and the best cost then (for ``stall_evaluations``).
+        seed_fits: the fits of the guesses the first population was seeded from (the scan's
+            last candidates).
     """
 
     settings: RunSettings = dataclasses.field(default_factory=RunSettings)
@@ -183,6 +185,7 @@ class ContinuousState(SwarmState):
     repair_step_m: float = 0.0
     improved_at: int = 0
     reference_cost: float = math.inf
+    seed_fits: list[np.ndarray] = dataclasses.field(default_factory=list)
 
 
 @dataclass
@@ -411,12 +414,13 @@ class ContinuousPlanner(SwarmPlanner):
             return self.random_solutions(state, count, rng)
         shares = np.diff(np.linspace(0, seeded, len(settings.guesses) + 1).round().astype(int))
         objective = state.objective
-        seeds = [seeded_population(np.clip(pushed_fit_via_points(objective.curve, guess, objective.centres_m,
-                                                                 objective.penalty_radii_m, settings.push_rounds)
-                                           if settings.push_rounds else fit_via_points(objective.curve, guess),
-                                           state.lower, state.upper),
-                                   int(share), self.seed_spread_m, state.lower, state.upper, rng)
-                 for guess, share in zip(settings.guesses, shares) if share]
+        state.seed_fits = [np.clip(pushed_fit_via_points(objective.curve, guess, objective.centres_m,
+                                                         objective.penalty_radii_m, settings.push_rounds)
+                                   if settings.push_rounds else fit_via_points(objective.curve, guess),
+                                   state.lower, state.upper)
+                           for guess, share in zip(settings.guesses, shares) if share]
+        seeds = [seeded_population(fit, int(share), self.seed_spread_m, state.lower, state.upper, rng)
+                 for fit, share in zip(state.seed_fits, [share for share in shares if share])]
         return np.vstack(seeds + [self.random_solutions(state, count - seeded, rng)])
 
     def evaluate(self, state: ContinuousState, population: np.ndarray,
@@ -473,8 +477,8 @@ class ContinuousPlanner(SwarmPlanner):
         return self.repair_rounds
 
     def needs_repair(self, state: ContinuousState, problem: Problem) -> bool:
-        """Scan the best and then the final population (cheapest first) once for a
-        candidate that passes the exact check; repair while there is none."""
+        """Scan the best, then the final population (cheapest first), then the seeds' fits
+        once for a candidate that passes the exact check; repair while there is none."""
         if not state.scanned:
             state.scanned = True
             candidates = [] if state.best_solution is None else [np.asarray(state.best_solution, dtype=float)]
@@ -482,6 +486,7 @@ class ContinuousPlanner(SwarmPlanner):
                 order = np.argsort(state.costs, kind="stable")
                 candidates.extend(np.asarray(state.population[i], dtype=float) for i in order
                                   if math.isfinite(state.costs[i]))
+            candidates.extend(state.seed_fits)    # a swarm that moves every member may have lost them
             for rank, solution in enumerate(candidates):
                 if self.passes_exact_check(problem, self.dense_waypoints(state.objective, solution), state):
                     state.chosen, state.repaired = solution, ("population" if rank > 0 else None)
