@@ -39,7 +39,7 @@ its own (an explicit value always wins over the mode's):
 
 * ``guess``: the geometric guess the other options start from: ``"tangent"`` (robust default),
   the shortest route of the tangent graph around the inflated discs grown by
-  ``guess_margin_m`` (default ``penalty_margin_m``; :mod:`planners.tangent_guess`), or
+  ``guess_margin_m`` (default: each disc's penalty margin; :mod:`planners.tangent_guess`), or
   ``"grid"``, a line-of-sight-shortcut A* path on the problem's grid (``guess_cell_m``);
 * ``via_points``: chosen from the scene (:func:`planners.path_guess.via_points_for_turns`:
   two per turn of the tangent route plus three; for the grid guess
@@ -227,8 +227,8 @@ class ContinuousPlanner(SwarmPlanner):
         guess: ``"tangent"`` or ``"grid"``: the geometric guess of the seeds and of ``k``
             (``None``: "grid" in paper mode, where it seeds only with an explicit
             ``seed_fraction``, "tangent" in robust mode).
-        guess_margin_m: how much the tangent guess grows the inflated discs (``None``:
-            ``penalty_margin_m``, so that the guess clears the discs the penalty sees).
+        guess_margin_m: how much the tangent guess grows the inflated discs (``None``: each
+            disc's penalty margin, so that the guess clears the discs the penalty sees).
         fit_push_rounds: rounds that push the seeds' fit out of the discs (``None``: 0 / 40; it stops
             early once the fit is clear).
         stall_evaluations: end the search once this many evaluations in a row have not
@@ -340,7 +340,8 @@ class ContinuousPlanner(SwarmPlanner):
                                else ROBUST_STALL_POPULATIONS * self.population if (fraction and guesses) else 0))
 
     def resolved_guess_margin_m(self) -> float:
-        """``guess_margin_m``, or by default the penalty's own margin ``penalty_margin_m``."""
+        """``guess_margin_m``, or by default the penalty's own margin ``penalty_margin_m`` (the
+        robust mode's gap margins replace it by each disc's own)."""
         return self.penalty_margin_m if self.guess_margin_m is None else self.guess_margin_m
 
     def plan(self, problem: Problem, rng: np.random.Generator) -> Path:
@@ -454,8 +455,8 @@ class ContinuousPlanner(SwarmPlanner):
     def note_stall(self, state: ContinuousState) -> None:
         """Track the last improvement of the best by more than ``stall_tolerance`` and end
         the search (``state.done``) once ``stall_evaluations`` have passed without one."""
-        if state.best_cost < state.reference_cost * (1.0 - self.stall_tolerance) or not math.isfinite(
-                state.reference_cost):
+        improved = state.best_cost < state.reference_cost * (1.0 - self.stall_tolerance)
+        if improved or not math.isfinite(state.reference_cost):
             state.reference_cost, state.improved_at = state.best_cost, state.evaluations
         limit = state.settings.stall_evaluations
         if limit and state.evaluations - state.improved_at >= limit:
