@@ -42,7 +42,7 @@ its own (an explicit value always wins over the mode's):
   ``guess_margin_m`` (default: each disc's penalty margin; :mod:`planners.tangent_guess`), or
   ``"grid"``, a line-of-sight-shortcut A* path on the problem's grid (``guess_cell_m``);
 * ``via_points``: chosen from the scene (:func:`planners.path_guess.via_points_for_turns`:
-  two per turn of the tangent route plus three; for the grid guess
+  two per turn of the tangent route plus seven; for the grid guess
   :func:`planners.path_guess.via_points_for_guess`, one per bend plus two) and *grown*
   (doubled, up to ``via_point_growth`` times, the search rerun on what is left of the
   budget) when no candidate passes the exact check;
