@@ -37,7 +37,8 @@ algorithm as its paper writes it (3 via-points, a uniform random first populatio
 polish).  ``mode = "robust"`` adds three named options, each of which can also be set on
 its own (an explicit value always wins over the mode's):
 
-* ``guess``: the geometric guess the other options start from: ``"tangent"`` (robust default),
+* ``guess``: the geometric guess the other options start from: ``"tangent"`` (robust default
+  up to 100 discs),
   the shortest route of the tangent graph around the inflated discs grown by
   ``guess_margin_m`` (default: each disc's penalty margin; :mod:`planners.tangent_guess`), or
   ``"grid"``, a line-of-sight-shortcut A* path on the problem's grid (``guess_cell_m``);
@@ -92,7 +93,7 @@ from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.errors import BudgetExceeded
 from swarmnav.planners.paper_instances import paper_instance
 from swarmnav.planners.path_cost import PathObjective
-from swarmnav.planners.path_guess import (MAX_AUTO_VIA_POINTS, fit_via_points, gap_margins_m,
+from swarmnav.planners.path_guess import (MAX_AUTO_VIA_POINTS, MAX_TANGENT_DISCS, fit_via_points, gap_margins_m,
                                           pushed_fit_via_points, scene_guesses, seeded_population)
 from swarmnav.planners.polish import compass_polish
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
@@ -130,6 +131,7 @@ class RunSettings:
         push_rounds: rounds that push the seeds' fit out of the discs.
         stall_evaluations: evaluations without improvement that end the search (0: never).
         margins_m: (n,) the penalty margin of each disc (None: ``penalty_margin_m`` for all).
+        guess: the kind of the guesses ("tangent" or "grid"; None: none computed).
     """
 
     mode: str = "paper"
@@ -142,6 +144,7 @@ class RunSettings:
     push_rounds: int = 0
     stall_evaluations: int = 0
     margins_m: np.ndarray | None = None
+    guess: str | None = None
 
 
 #: A fast gap below minus this rejects a candidate without the exact check (whose own
@@ -226,7 +229,8 @@ class ContinuousPlanner(SwarmPlanner):
         via_point_growth: doublings of ``k`` when nothing passes (``None``: 0 / 2).
         guess: ``"tangent"`` or ``"grid"``: the geometric guess of the seeds and of ``k``
             (``None``: "grid" in paper mode, where it seeds only with an explicit
-            ``seed_fraction``, "tangent" in robust mode).
+            ``seed_fraction``; in robust mode "tangent" up to
+            :data:`planners.path_guess.MAX_TANGENT_DISCS` discs, "grid" above).
         guess_margin_m: how much the tangent guess grows the inflated discs (``None``: each
             disc's penalty margin, so that the guess clears the discs the penalty sees).
         fit_push_rounds: rounds that push the seeds' fit out of the discs (``None``: 0 / 40; it stops
@@ -320,13 +324,15 @@ class ContinuousPlanner(SwarmPlanner):
                                growth=self.via_point_growth or 0, paper=paper, push_rounds=self.fit_push_rounds or 0,
                                stall_evaluations=self.stall_evaluations or 0,
                                guesses=scene_guesses(problem, self.guess or "grid", self.guess_cell_m,
-                                                     self.resolved_guess_margin_m())[0] if self.seed_fraction else ())
+                                                     self.resolved_guess_margin_m())[0] if self.seed_fraction else (),
+                               guess=(self.guess or "grid") if self.seed_fraction else None)
         fraction = ROBUST_SEED_FRACTION if self.seed_fraction is None else self.seed_fraction
         gap_margins = ROBUST_GAP_MARGINS if self.gap_margins is None else self.gap_margins
         margins = gap_margins_m(problem, self.penalty_margin_m) if gap_margins else None
         guess_margin = self.guess_margin_m if self.guess_margin_m is not None else (
             margins if margins is not None else self.penalty_margin_m)
-        guesses, chosen_k = (scene_guesses(problem, self.guess or ROBUST_GUESS, self.guess_cell_m, guess_margin)
+        kind = self.guess or (ROBUST_GUESS if problem.disc_centres_m.shape[0] <= MAX_TANGENT_DISCS else "grid")
+        guesses, chosen_k = (scene_guesses(problem, kind, self.guess_cell_m, guess_margin)
                              if (fraction or self.via_points is None) else ((), PAPER_VIA_POINTS))
         via_points = self.via_points or chosen_k
         return RunSettings(
@@ -335,7 +341,7 @@ class ContinuousPlanner(SwarmPlanner):
             growth=ROBUST_VIA_POINT_GROWTH if self.via_point_growth is None else self.via_point_growth,
             guesses=guesses, paper=paper,
             push_rounds=ROBUST_FIT_PUSH_ROUNDS if self.fit_push_rounds is None else self.fit_push_rounds,
-            margins_m=margins,
+            margins_m=margins, guess=kind if (fraction or self.via_points is None) else None,
             stall_evaluations=(self.stall_evaluations if self.stall_evaluations is not None
                                else ROBUST_STALL_POPULATIONS * self.population if (fraction and guesses) else 0))
 
@@ -365,7 +371,7 @@ class ContinuousPlanner(SwarmPlanner):
                 if attempt == settings.growth or settings.via_points >= MAX_AUTO_VIA_POINTS * 2:
                     raise
                 settings = dataclasses.replace(settings, via_points=2 * settings.via_points)
-        extra = dict(path.stats.extra, mode=settings.mode, via_point_count=settings.via_points,
+        extra = dict(path.stats.extra, mode=settings.mode, via_point_count=settings.via_points, guess=settings.guess,
                      via_point_growths=attempt, guess_lengths_m=[
                          float(np.sum(np.hypot(*np.diff(g, axis=0).T))) for g in settings.guesses])
         if settings.paper:

@@ -36,7 +36,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from swarmnav.models.world import Rect
-from swarmnav.planners.segment_gaps import segments_clear
+from swarmnav.planners.segment_gaps import row_blocks, segments_clear
 
 TOLERANCE_M = 1e-9
 
@@ -179,19 +179,28 @@ def tangent_route(start: np.ndarray, goal: np.ndarray, centres: np.ndarray, radi
 
 def _inside_any(points: np.ndarray, centres: np.ndarray, radii_sq: np.ndarray) -> np.ndarray:
     """(N,) whether each point is strictly inside one of the discs (squared radii given)."""
-    dx = points[:, 0, None] - centres[None, :, 0]
-    dy = points[:, 1, None] - centres[None, :, 1]
-    dx *= dx
-    dy *= dy
-    dx += dy
-    return np.any(dx < radii_sq, axis=1)
+    inside = np.zeros(points.shape[0], dtype=bool)
+    for block in row_blocks(points.shape[0], centres.shape[0]):
+        dx = points[block, 0, None] - centres[None, :, 0]
+        dy = points[block, 1, None] - centres[None, :, 1]
+        dx *= dx
+        dy *= dy
+        dx += dy
+        inside[block] = np.any(dx < radii_sq, axis=1)
+    return inside
 
 
 def _arcs_clear(centres: np.ndarray, radii: np.ndarray, arc_disc: np.ndarray, arc_from: np.ndarray,
                 sweep: np.ndarray, bounds: Rect) -> np.ndarray:
     """Whether each counter-clockwise arc stays out of the other discs and inside the bounds."""
-    if arc_disc.size == 0:
-        return np.zeros(0, dtype=bool)
+    ok = np.zeros(arc_disc.size, dtype=bool)
+    for block in row_blocks(arc_disc.size, centres.shape[0]):
+        ok[block] = _arc_block_clear(centres, radii, arc_disc[block], arc_from[block], sweep[block], bounds)
+    return ok
+
+
+def _arc_block_clear(centres: np.ndarray, radii: np.ndarray, arc_disc: np.ndarray, arc_from: np.ndarray,
+                     sweep: np.ndarray, bounds: Rect) -> np.ndarray:
     c, r = centres[arc_disc], radii[arc_disc]
     offset = centres[None, :, :] - c[:, None, :]                      # (A, n, 2)
     d = np.hypot(offset[..., 0], offset[..., 1])

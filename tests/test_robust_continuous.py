@@ -183,11 +183,21 @@ def test_fast_gap_matches_the_exact_clearance():
 
     problem = random_disc_field(30, 5)
     rng = np.random.default_rng(0)
-    for _ in range(50):
-        points = rng.uniform(0.0, 10.0, (rng.integers(1, 40), 2))
+    cuts = 0
+    for _ in range(200):
+        start = rng.uniform(0.0, 10.0, 2)
+        points = start + np.cumsum(rng.normal(0.0, 0.3, (rng.integers(1, 200), 2)), axis=0)
         exact = problem.path_clearance_m(points)
-        fast = polyline_gap_m(points, problem.disc_centres_m, problem.inflated_radii_m)
-        assert abs(fast - exact) < 1e-9
+        fast = polyline_gap_m(points, problem.disc_centres_m, problem.inflated_radii_m, chunk=8)
+        assert fast >= exact - 1e-9
+        if exact < 0:
+            cuts += 1
+            assert abs(fast - exact) < 1e-9
+    assert 20 < cuts < 190
+    # all discs measured (one chunk whose box covers the arena): the same gap
+    corners = np.array([[0.0, 0.0], [10.0, 10.0], [0.0, 10.0], [10.0, 0.0]])
+    assert abs(polyline_gap_m(corners, problem.disc_centres_m, problem.inflated_radii_m)
+               - problem.path_clearance_m(corners)) < 1e-9
     # a segment of zero length, and one ending exactly on an inflated edge
     centre, radius = problem.disc_centres_m[0], problem.inflated_radii_m[0]
     on_edge = np.array([centre + [radius, 0.0], centre + [radius + 1.0, 0.0]])
@@ -195,3 +205,23 @@ def test_fast_gap_matches_the_exact_clearance():
     point = np.array([[5.0, 5.0]])
     assert abs(polyline_gap_m(point, problem.disc_centres_m, problem.inflated_radii_m)
                - problem.path_clearance_m(point)) < 1e-9
+
+
+def test_robust_guess_is_the_tangent_graph_up_to_its_disc_limit_then_the_grid():
+    from swarmnav.models.world import Disc, Pose2D, Rect
+    from swarmnav.planners.path_guess import MAX_TANGENT_DISCS
+    from swarmnav.planners.problem import Problem
+
+    def lattice(count):
+        side = int(np.ceil(np.sqrt(count)))
+        discs = tuple(Disc(1.5 + 1.0 * (i % side), 1.5 + 1.0 * (i // side), 0.15) for i in range(count))
+        arena = 2.0 + side
+        return Problem(Pose2D(0.5, 0.5, 0.0), Pose2D(arena - 0.5, arena - 0.5, 0.0), Rect(0.0, 0.0, arena, arena),
+                       discs, robot_radius_m=0.15, clearance_m=0.05)
+
+    small = make_planner("gwo", dict(SMALL, mode="robust")).plan(lattice(16), np.random.default_rng(0))
+    large = make_planner("gwo", dict(SMALL, mode="robust")).plan(lattice(MAX_TANGENT_DISCS + 1),
+                                                                np.random.default_rng(0))
+    assert small.stats.extra["guess"] == "tangent" and large.stats.extra["guess"] == "grid"
+    paper = make_planner("gwo", dict(SMALL, mode="paper")).plan(lattice(16), np.random.default_rng(0))
+    assert paper.stats.extra["guess"] is None
