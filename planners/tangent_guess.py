@@ -32,9 +32,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import dijkstra
-
 from swarmnav.models.world import Rect
 from swarmnav.planners.segment_gaps import row_blocks, segments_clear
 
@@ -108,6 +105,9 @@ def tangent_route(start: np.ndarray, goal: np.ndarray, centres: np.ndarray, radi
     centres = np.asarray(centres, dtype=float).reshape(-1, 2)
     radii = np.asarray(radii, dtype=float).reshape(-1)
     n = centres.shape[0]
+    from scipy.sparse import coo_matrix          # here: 7 ms of import a cold `swarmnav` need not pay
+    from scipy.sparse.csgraph import dijkstra
+
     direct = n == 0 or bool(segments_clear(start[None], goal[None], centres,
                                             np.maximum(radii - TOLERANCE_M, 0.0) ** 2)[0])
     if direct:
