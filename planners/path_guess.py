@@ -131,13 +131,15 @@ def scene_guesses(problem: Problem, kind: str, cell_m: float | None = None,
 
 def via_points_for_turns(turns: int) -> int:
     """Via-points for a curve that follows a tangent route of ``turns`` arcs: ``2 turns +``
-    :data:`TURN_EXTRA_VIA_POINTS`, clamped to [3, :data:`MAX_TURN_VIA_POINTS`] (on the ten
-    random fields of ``bench planners``, the pushed fit with one via-point per turn plus one
-    to three still cuts discs by up to 5 cm, with two per turn plus three it is clear of
-    them, at most 1.01 x the optimum; on fields whose route makes 7-9 turns a cap of 16
+    :data:`TURN_EXTRA_VIA_POINTS`, clamped to [3, :data:`MAX_TURN_VIA_POINTS`], and 3 for a
+    straight route (on the ten random fields of ``bench planners``, the pushed fit with one
+    via-point per turn plus one to three still cuts discs by up to 5 cm, with two per turn
+    plus three it is clear of them, at most 1.01 x the optimum; on fields whose route makes 7-9 turns a cap of 16
     left the fit cutting by up to 3 mm, where 17-21 via-points clear it; and a short route
     with one turn, restaurant-table-5's, needs more: 5 via-points end at 1.0094 x the
     optimum, 7 at 1.0054, 9 at 1.0037, its grown route's own 1.0031, hence plus seven)."""
+    if turns == 0:
+        return 3                  # a straight route: the papers' count draws it exactly
     return int(min(max(2 * turns + TURN_EXTRA_VIA_POINTS, 3), MAX_TURN_VIA_POINTS))
 
 
