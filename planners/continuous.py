@@ -334,6 +334,9 @@ class ContinuousPlanner(SwarmPlanner):
         kind = self.guess or (ROBUST_GUESS if problem.disc_centres_m.shape[0] <= MAX_TANGENT_DISCS else "grid")
         guesses, chosen_k = (scene_guesses(problem, kind, self.guess_cell_m, guess_margin)
                              if (fraction or self.via_points is None) else ((), PAPER_VIA_POINTS))
+        if kind == "tangent" and not guesses and (fraction or self.via_points is None):
+            raise NoPathFound(f"{self.name}: no collision-free path exists: the tangent graph of the inflated "
+                              f"discs (exact, as the optimal planner's) joins no route from start to goal")
         via_points = self.via_points or chosen_k
         return RunSettings(
             mode="robust", via_points=via_points, seed_fraction=fraction,

@@ -117,13 +117,17 @@ def tangent_route_for(problem: Problem, margin_m: float | np.ndarray = 0.0) -> T
 
 def scene_guesses(problem: Problem, kind: str, cell_m: float | None = None,
                   margin_m: float | np.ndarray = 0.0) -> tuple[tuple[np.ndarray, ...], int]:
-    """The guesses of ``kind`` ("grid": :func:`grid_guesses`, "tangent": :func:`tangent_guesses`)
-    and the via-points a curve needs to follow them (:func:`via_points_for_guess`,
-    :func:`via_points_for_turns`; the papers' 3 when there is no guess)."""
+    """The guesses of ``kind`` ("grid": :func:`grid_guesses`, "tangent": the route of
+    :func:`tangent_route_for` with ``margin_m``, or without margins when they close every
+    way) and the via-points a curve needs to follow them (:func:`via_points_for_guess`,
+    :func:`via_points_for_turns`; the papers' 3 when there is no guess).  No tangent guess
+    means that no collision-free path exists (the tangent graph without margins is exact)."""
     if kind == "tangent":
         route = tangent_route_for(problem, margin_m)
+        if route is None and np.any(np.asarray(margin_m) > 0):
+            route = tangent_route_for(problem, 0.0)   # the margins closed the only way through
         if route is None:
-            return (), 3
+            return (), 3                              # the exact graph has no route: no path exists
         return (route.waypoints,), via_points_for_turns(route.turns)
     guesses = grid_guesses(problem, cell_m)
     return guesses, max((via_points_for_guess(g) for g in guesses), default=3)

@@ -225,3 +225,18 @@ def test_robust_guess_is_the_tangent_graph_up_to_its_disc_limit_then_the_grid():
     assert small.stats.extra["guess"] == "tangent" and large.stats.extra["guess"] == "grid"
     paper = make_planner("gwo", dict(SMALL, mode="paper")).plan(lattice(16), np.random.default_rng(0))
     assert paper.stats.extra["guess"] is None
+
+
+@pytest.mark.parametrize("scenario", ["adl-abc-path-1", "adl-abc-path-2"])
+def test_robust_mode_fails_at_once_where_the_exact_planner_proves_no_path(scenario):
+    from swarmnav.planners.errors import NoPathFound
+
+    problem = scenario_problem(load_scenario(scenario), clearance_m=0.0)
+    with pytest.raises(NoPathFound):
+        OptimalPlanner().plan(problem, np.random.default_rng(0))
+    with pytest.raises(NoPathFound, match="tangent graph"):
+        make_planner("gwo", {"mode": "robust"}).plan(problem, np.random.default_rng(0))
+    # the paper's algorithm searches (and fails) as written
+    with pytest.raises(NoPathFound) as paper:
+        make_planner("gwo", dict(SMALL, mode="paper")).plan(problem, np.random.default_rng(0))
+    assert "tangent graph" not in str(paper.value)
