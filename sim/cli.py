@@ -24,10 +24,12 @@ from typing import Any, Callable
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
 from swarmnav.sim import options
-from swarmnav.sim.commands import DEFAULT_FPS, MODULE_COMMANDS
+from swarmnav.sim.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT
 
 # As sim.render does, before any subcommand imports mujoco (which reads it once, on import).
 os.environ.setdefault("MUJOCO_GL", "egl")
+for _name, _value in SINGLE_THREAD_ENVIRONMENT.items():  # before any subcommand imports NumPy
+    os.environ.setdefault(_name, _value)
 
 EXIT_OK, EXIT_BUG, EXIT_BAD_INPUT, EXIT_NO_PATH = 0, 1, 2, 3
 

@@ -6,6 +6,7 @@ prints the start-up time itself.
 """
 
 import json
+import os
 import subprocess
 import sys
 
@@ -71,3 +72,16 @@ def test_bench_cli_prints_its_figures(capsys):
     assert figures["runs"] == 1
     assert figures["scenarios_over_bare_s"] == figures["scenarios_s"] - figures["bare_python_s"]
     assert figures["meets_target"] == (figures["scenarios_s"] < figures["target_scenarios_s"])
+
+
+def test_the_cli_runs_blas_on_one_thread_unless_the_environment_says_otherwise():
+    """Set before NumPy loads (the planners' small matrices, multithreaded on a busy machine, ran up to 10x
+    slower); a value the user exported wins."""
+    code = ("import os, sys; import swarmnav.sim.cli; assert 'numpy' not in sys.modules; import numpy; "
+            "print(os.environ['OPENBLAS_NUM_THREADS'], os.environ['OMP_NUM_THREADS'])")
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")}
+    plain = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert plain.stdout.split() == ["1", "1"]
+    mine = subprocess.run([sys.executable, "-c", code], env={**env, "OPENBLAS_NUM_THREADS": "2"},
+                          capture_output=True, text=True, check=True)
+    assert mine.stdout.split() == ["2", "1"]

@@ -19,11 +19,11 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Any, Iterator, Sequence
 
 from swarmnav.models.errors import ConfigError
+from swarmnav.sim.commands import SINGLE_THREAD_ENVIRONMENT
 from swarmnav.sim.study.cell import run_cell
 from swarmnav.sim.study.grid import Cell
 
-WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
-                      "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
+WORKER_ENVIRONMENT = SINGLE_THREAD_ENVIRONMENT  # the CLI's own setting, also for Ray tasks on other hosts
 PARENT_POLL_S = 0.5
 RAY_AUTH_LOGGER = "ray._private.authentication.authentication_token_setup"
 
