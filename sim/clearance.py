@@ -5,6 +5,14 @@ the nearest obstacle; ``mj_geomDistance`` then measures the exact gap between
 it and the robot: the chassis, and every other robot collision geom (wheel,
 caster) that reaches beyond the chassis footprint, so a wheel that sticks out
 of a small chassis is not forgotten, while the usual robot costs one call.
+
+:meth:`ClearanceProbe.lower_bound_m` bounds the clearance from below without MuJoCo, from the last :meth:`~ClearanceProbe.measure`: footprint
+distances are 1-Lipschitz in the point they are measured from, a geom's plan
+view lies within its bounding sphere, and a 3-D distance is at least the
+distance between plan views, so the nearest footprint distance then, less how
+far the robot's geoms and the obstacles have moved since, less the geoms'
+bounding radii, is a lower bound on what ``measure`` would return now.  The
+runner asks it first and measures only when the answer could matter.
 """
 
 from __future__ import annotations
@@ -17,6 +25,8 @@ import numpy as np
 from swarmnav.sim.scene import CompiledScene
 
 CLEARANCE_HORIZON_M = 2.0  # mj_geomDistance search radius: clearances are reported up to this value
+# lower_bound_m keeps this much to spare, far above mj_geomDistance's numerical error.
+BOUND_MARGIN_M = 1e-4
 
 
 def outer_robot_geoms(scene: CompiledScene) -> list[int]:
@@ -37,9 +47,13 @@ def outer_robot_geoms(scene: CompiledScene) -> list[int]:
 
 
 class ClearanceProbe:
-    """Measures the gap between the robot and its nearest obstacle (``inf`` with no obstacle)."""
+    """Measures the gap between the robot and its nearest obstacle (``inf`` with no obstacle).
 
-    def __init__(self, scene: CompiledScene):
+    ``data``, when given, is the ``MjData`` that :meth:`lower_bound_m` reads (the
+    runner's); :meth:`measure` takes its ``data`` per call.
+    """
+
+    def __init__(self, scene: CompiledScene, data: mujoco.MjData | None = None):
         model = scene.model
         self.model = model
         self.robot_geom_ids = outer_robot_geoms(scene)
@@ -51,14 +65,50 @@ class ClearanceProbe:
         self.half_m = np.where(is_box[:, None], size, 0.0)
         self.radius_m = np.where(is_box, 0.0, size[:, 0])
         self._fromto = np.zeros(6)
+        # For lower_bound_m: each outer robot geom's centre (a view into data) and bounding radius.
+        self._robot_xy = [] if data is None else [(data.geom_xpos[g], float(model.geom_rbound[g]))
+                                                  for g in self.robot_geom_ids]
+        self._bound_valid = bool(self._robot_xy) and len(self.obstacle_ids) > 0 and \
+            _upright_footprints(model, self.obstacle_ids, is_box)
+        self._reference: tuple[float, float, float] | None = None  # (x, y, nearest footprint distance)
 
     def measure(self, data: mujoco.MjData, x_m: float, y_m: float) -> float:
         if not len(self.obstacle_ids):
             return math.inf
         d = np.maximum(np.abs(data.geom_xpos[self.obstacle_ids, :2] - (x_m, y_m)) - self.half_m, 0.0)
-        nearest = int(self.obstacle_ids[np.argmin(np.sqrt(np.einsum("ij,ij->i", d, d)) - self.radius_m)])
+        footprint_m = np.sqrt(np.einsum("ij,ij->i", d, d)) - self.radius_m
+        i = int(np.argmin(footprint_m))
+        self._reference = (x_m, y_m, float(footprint_m[i]))
+        nearest = int(self.obstacle_ids[i])
         model, fromto = self.model, self._fromto
         gap = math.inf
         for g in self.robot_geom_ids:
             gap = min(gap, mujoco.mj_geomDistance(model, data, g, nearest, CLEARANCE_HORIZON_M, fromto))
         return gap
+
+    def lower_bound_m(self, obstacle_shift_m: float) -> float:
+        """A value that :meth:`measure` on the bound ``data`` would now certainly exceed.
+
+        From the last :meth:`measure`, with ``obstacle_shift_m`` bounding how far any
+        obstacle has moved since; ``BOUND_MARGIN_M`` below the geometric bound.
+        ``-inf`` when there is none (before any measure, or an obstacle whose plan view is
+        not its footprint).  Above ``CLEARANCE_HORIZON_M``, ``measure`` returns exactly
+        the horizon.
+        """
+        reference = self._reference
+        if reference is None or not self._bound_valid:
+            return -math.inf
+        x0, y0, footprint_m = reference
+        reach_m = max(math.hypot(xpos[0] - x0, xpos[1] - y0) + rbound_m for xpos, rbound_m in self._robot_xy)
+        return footprint_m - obstacle_shift_m - reach_m - BOUND_MARGIN_M
+
+
+def _upright_footprints(model: mujoco.MjModel, geom_ids: np.ndarray, is_box: np.ndarray) -> bool:
+    """Whether every obstacle's plan view is its footprint: upright cylinders, axis-aligned boxes."""
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    xmat = data.geom_xmat[geom_ids].reshape(-1, 3, 3)
+    upright = np.all(np.abs(xmat[:, :, 2] - (0.0, 0.0, 1.0)) < 1e-12, axis=1)
+    aligned = np.all(np.abs(xmat - np.eye(3)) < 1e-12, axis=(1, 2))
+    cylinder = model.geom_type[geom_ids] == mujoco.mjtGeom.mjGEOM_CYLINDER
+    return bool(np.all(np.where(is_box, aligned, cylinder & upright)))

@@ -32,7 +32,7 @@ from swarmnav.controllers.goal import GoalChecker
 from swarmnav.controllers.navigator import Belief, NavigationSetup, Navigator, Observation
 from swarmnav.models.scenario import Scenario
 from swarmnav.models.world import Pose2D
-from swarmnav.sim.clearance import ClearanceProbe
+from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
 from swarmnav.sim.contact import ContactMonitor
 from swarmnav.sim.detector import ObstacleSensing
 from swarmnav.sim.recording import ObstacleInfo, Recorder, RunContext, StepFrame
@@ -239,16 +239,31 @@ class StepLoop:
         # Contacts that are not collisions (wheels and casters on the floor), counted at the
         # start: a substep with no more contacts than these and no ongoing collision is skipped.
         self.resting_contacts = self.data.ncon - self.monitor.robot_obstacle_contacts(self.data)
-        self.clearance = ClearanceProbe(scene)
+        self.clearance = ClearanceProbe(scene, self.data)
         # Farther than this from every obstacle, no contact can begin within one control period:
         # twice the distance the base covers at full wheel speed, plus a centimetre.
         top_speed_m_s = scene.drive.max_wheel_speed_rad_s * scene.drive.wheel_radius_m
         self.contact_free_gap_m = 2.0 * top_speed_m_s * self.dt_s + 0.01
-        self.qadr = scene.free_qpos_adr
+        self.qadr = qadr = scene.free_qpos_adr
+        # Views into data, made once: the base's position and quaternion, its velocity, the rangefinders.
+        self._base_qpos = self.data.qpos[qadr:qadr + 7]
+        self._base_qvel = self.data.qvel[scene.free_qvel_adr:scene.free_qvel_adr + 6]
+        adr = np.asarray(scene.range_sensor_adr)
+        contiguous = len(adr) > 0 and np.array_equal(adr, np.arange(adr[0], adr[0] + len(adr)))
+        self._range_raw = self.data.sensordata[adr[0]:adr[0] + len(adr)] if contiguous else None
+        # How far the moving obstacles can have moved: obstacle_shift_m[j] - obstacle_shift_m[i]
+        # bounds every obstacle's displacement between control steps i and j (for clearance skips).
+        track = self.obstacle_track_m
+        hops = np.hypot(*np.moveaxis(np.diff(track, axis=0), 2, 0)).max(axis=1) if track.shape[1] else \
+            np.zeros(max(len(track) - 1, 0))
+        self.obstacle_shift_m = np.concatenate([[0.0], np.cumsum(hops)]).tolist()
+        self._shift_at_measure_m = 0.0
+        self._observed_step = -1
         self.poses = np.zeros((self.n_max + 1, 3))
         self.wheel_cmd = np.zeros((self.n_max + 1, 2))
         self.min_clearance_m = math.inf
-        self.clearance_m = math.inf  # at the last observation
+        self._clearance_m: float | None = math.inf  # at the last observation; None: not measured (see clearance_m)
+        self._contact_free = True  # the last observation's clearance rules out a contact (none yet: inf, as ever)
         self.length_m = 0.0
         self.waypoint_index = 0  # of the last command, recorded with the final step
         self.in_danger = False
@@ -275,22 +290,59 @@ class StepLoop:
         if len(self.mocap_index):
             self.data.mocap_pos[self.mocap_index, :2] = self.obstacle_track_m[self.step]
 
+    @property
+    def clearance_m(self) -> float:
+        """The clearance at the last observation (measured on demand if :meth:`observe` could skip it)."""
+        if self._clearance_m is None:
+            if self._observed_step != self.step:
+                raise RuntimeError("the clearance of an observation is only available until the next advance()")
+            x, y = self.poses[self.step, :2].tolist()
+            self._clearance_m = self.clearance.measure(self.data, x, y)
+            self._shift_at_measure_m = self.obstacle_shift_m[max(self.step - 1, 0)]
+        return self._clearance_m
+
+    def clearance_bound_m(self) -> float:
+        """A value the clearance now certainly exceeds (:meth:`ClearanceProbe.lower_bound_m`)."""
+        return self.clearance.lower_bound_m(self.obstacle_shift_m[self.step] - self._shift_at_measure_m)
+
     def observe(self) -> Observation:
-        """Pose, twist and ranges now; also tracks the driven length and the clearance."""
-        data, scene, qadr, step = self.data, self.scene, self.qadr, self.step
-        qpos = data.qpos
-        x, y = float(qpos[qadr]), float(qpos[qadr + 1])
-        heading = yaw_from_quaternion(qpos[qadr + 3], qpos[qadr + 4], qpos[qadr + 5], qpos[qadr + 6])
+        """Pose, twist and ranges now; also tracks the driven length and the clearance.
+
+        The clearance is measured only when it could matter: when
+        :meth:`ClearanceProbe.lower_bound_m` shows it above the minimum so far, the
+        danger distance and the contact-free gap, none of the minimum, the time in
+        danger or the batching of :meth:`advance` depends on its value (and beyond
+        the probe's horizon the value is the horizon).
+        """
+        data, scene, step = self.data, self.scene, self.step
+        x, y, _, w, qx, qy, qz = self._base_qpos.tolist()
+        heading = yaw_from_quaternion(w, qx, qy, qz)
         if step:
             self.length_m += math.hypot(x - self.poses[step - 1, 0], y - self.poses[step - 1, 1])
         self.poses[step] = (x, y, heading)
-        self.clearance_m = gap = self.clearance.measure(data, x, y)
-        if gap < self.min_clearance_m:
-            self.min_clearance_m = gap
-        self.in_danger = gap < self.danger_m
-        v, omega = base_twist(data.qvel, scene.free_qvel_adr, heading)
+        self._observed_step = step
+        bound_m = self.clearance_bound_m()
+        if bound_m > CLEARANCE_HORIZON_M:
+            gap: float | None = CLEARANCE_HORIZON_M  # what measure() returns beyond its horizon
+        elif bound_m > max(self.min_clearance_m, self.danger_m, self.contact_free_gap_m):
+            gap = None  # not a new minimum, not in danger, no contact possible: the value is not needed
+        else:
+            gap = self.clearance.measure(data, x, y)
+            # The obstacles the probe saw are where the last mj_step put them (the previous step's).
+            self._shift_at_measure_m = self.obstacle_shift_m[max(step - 1, 0)]
+        self._clearance_m = gap
+        if gap is None:
+            self.in_danger = False
+            self._contact_free = True
+        else:
+            if gap < self.min_clearance_m:
+                self.min_clearance_m = gap
+            self.in_danger = gap < self.danger_m
+            self._contact_free = gap > self.contact_free_gap_m
+        v, omega = base_twist(self._base_qvel.tolist(), 0, heading)
         pose = Pose2D(x, y, heading)
-        ranges = ranges_from_sensors(data.sensordata[scene.range_sensor_adr], scene.range_cutoff_m)
+        raw = self._range_raw if self._range_raw is not None else data.sensordata[scene.range_sensor_adr]
+        ranges = ranges_from_sensors(raw, scene.range_cutoff_m)
         return Observation(time_s=self.time_s, pose=pose, twist=Twist(v, omega), ranges_m=ranges,
                            range_angles_rad=scene.range_angles_rad, range_offset_m=scene.range_offset_m,
                            range_cutoff_m=scene.range_cutoff_m,
@@ -335,7 +387,7 @@ class StepLoop:
         control steps), no contact can begin, and the k steps run in one call.
         """
         model, data, monitor, qpos, qadr = self.model, self.data, self.monitor, self.data.qpos, self.qadr
-        if self.clearance_m > self.contact_free_gap_m and not monitor.in_contact:
+        if self._contact_free and not monitor.in_contact:
             mujoco.mj_step(model, data, self.k)
             self.step += 1
             return

@@ -18,10 +18,15 @@ import numpy as np
 
 
 def ranges_from_sensors(raw: np.ndarray, cutoff_m: float) -> np.ndarray:
-    """MuJoCo rangefinder values -> metres, with ``inf`` for "nothing in range"."""
-    out = np.array(raw, dtype=float)
-    out[(out < 0.0) | (out >= cutoff_m if cutoff_m > 0 else False)] = np.inf
-    return out
+    """MuJoCo rangefinder values -> metres, with ``inf`` for "nothing in range".
+
+    A dozen beams every control step: one pass over a list costs less than
+    NumPy's masks (the same values; a NaN stays NaN).
+    """
+    inf = math.inf
+    if cutoff_m > 0:
+        return np.array([inf if r < 0.0 or r >= cutoff_m else r for r in np.asarray(raw, dtype=float).tolist()])
+    return np.array([inf if r < 0.0 else r for r in np.asarray(raw, dtype=float).tolist()])
 
 
 def yaw_from_quaternion(w: float, x: float, y: float, z: float) -> float:

@@ -1,0 +1,137 @@
+"""The control loop's shortcuts give exactly what the plain computation gives.
+
+* rangefinder conversion: one pass over a list against the NumPy masks it replaced;
+* the clearance bound: never above what the probe measures, on random poses and
+  obstacle shifts;
+* a run that may skip clearance measurements against one that measures at every
+  step: the same trajectory, minimum clearance, time in danger and collisions.
+"""
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from swarmnav.models.scenario import load_scenario
+from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
+from swarmnav.sim.episode import EpisodeSpec, run_episode
+from swarmnav.sim.runner import Simulation
+from swarmnav.sim.sensing import ranges_from_sensors
+
+
+def ranges_reference(raw, cutoff_m):
+    out = np.array(raw, dtype=float)
+    out[(out < 0.0) | (out >= cutoff_m if cutoff_m > 0 else False)] = np.inf
+    return out
+
+
+def test_ranges_match_the_numpy_masks_bit_for_bit():
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        cutoff = float(rng.choice([0.4, 1.5, 0.0, -1.0]))
+        raw = rng.uniform(-1.5, 2.0, int(rng.integers(0, 20)))
+        special = [-1.0, 0.0, -0.0, cutoff, abs(cutoff), np.nan, np.inf, -np.inf, np.nextafter(cutoff, -9)]
+        pick = rng.random(raw.size) < 0.4
+        raw[pick] = rng.choice(special, int(pick.sum()))
+        fast, reference = ranges_from_sensors(raw, cutoff), ranges_reference(raw, cutoff)
+        assert fast.dtype == reference.dtype and fast.shape == reference.shape
+        assert fast.tobytes() == reference.tobytes()
+
+
+@pytest.mark.parametrize("name", ["dense-field-30", "immas-env4-blocks", "dyn-crowd-1"])
+def test_the_clearance_bound_never_exceeds_the_measured_clearance(name):
+    """After a measure at one pose, the bound at a nearby pose (obstacles shifted by at most s)
+    is below what measure returns there, and beyond the horizon measure returns the horizon."""
+    simulation = Simulation(load_scenario(name))
+    scene, model = simulation.scene, simulation.model
+    data = simulation.reset()
+    probe = ClearanceProbe(scene, data)
+    mocap = data.mocap_pos.copy()
+    rng = np.random.default_rng(1)
+    adr = scene.free_qpos_adr
+    width, height = simulation.scenario.arena_width_m, simulation.scenario.arena_height_m
+
+    def place(x, y, heading, shift):
+        data.qpos[adr:adr + 2] = [x, y]
+        data.qpos[adr + 3:adr + 7] = [math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2)]
+        if len(mocap):
+            angle = rng.uniform(0, 2 * math.pi, len(mocap))
+            data.mocap_pos[:, :2] = mocap[:, :2] + shift * np.column_stack([np.cos(angle), np.sin(angle)])
+        mujoco.mj_forward(model, data)
+
+    bounded = tight = beyond = 0
+    for _ in range(400):
+        x0, y0 = rng.uniform(0.3, width - 0.3), rng.uniform(0.3, height - 0.3)
+        place(x0, y0, rng.uniform(-math.pi, math.pi), 0.0)
+        probe.measure(data, x0, y0)
+        step = rng.uniform(0.0, 0.3)
+        direction = rng.uniform(0, 2 * math.pi)
+        x, y = x0 + step * math.cos(direction), y0 + step * math.sin(direction)
+        shift = float(rng.uniform(0.0, 0.1)) if len(mocap) else 0.0
+        place(x, y, rng.uniform(-math.pi, math.pi), shift)
+        bound = probe.lower_bound_m(shift)
+        gap = probe.measure(data, x, y)
+        if bound > CLEARANCE_HORIZON_M:
+            beyond += 1
+            assert gap == CLEARANCE_HORIZON_M
+        else:
+            assert gap > bound
+            bounded += bound > 0.0
+            tight += bound > 0.0 and gap < bound + 0.05
+    assert bounded >= 50 and tight >= 5   # the bound is used, and sometimes close to the truth
+    assert beyond >= 5 or name == "dense-field-30"
+
+
+def test_no_bound_before_a_measure():
+    simulation = Simulation(load_scenario("dense-field-30"))
+    data = simulation.reset()
+    probe = ClearanceProbe(simulation.scene, data)
+    assert probe.lower_bound_m(0.0) == -math.inf
+    probe.measure(data, 5.0, 5.0)
+    assert -math.inf < probe.lower_bound_m(0.0) < probe.measure(data, 5.0, 5.0)
+
+
+@pytest.mark.parametrize("name, navigator", [("dense-field-30", None), ("dyn-crowd-1", "follow"),
+                                             ("dyn-crossing-1", "dwa"), ("immas-env1-dynamic", None)])
+def test_skipping_clearance_measurements_changes_nothing(monkeypatch, name, navigator):
+    spec = EpisodeSpec(load_scenario(name), navigator=navigator)
+    fast = run_episode(spec, time_limit_s=30.0).result
+    bounds = []
+    original = ClearanceProbe.lower_bound_m
+
+    def no_bound(self, shift_m):
+        bounds.append(original(self, shift_m))
+        return -math.inf
+
+    monkeypatch.setattr(ClearanceProbe, "lower_bound_m", no_bound)
+    slow = run_episode(spec, time_limit_s=30.0).result
+    assert sum(b > 0.1 for b in bounds) >= 50            # measurements the fast run could skip
+    assert np.array_equal(fast.poses, slow.poses)
+    assert np.array_equal(fast.wheel_command_rad_s, slow.wheel_command_rad_s)
+    assert fast.min_clearance_m == slow.min_clearance_m
+    assert fast.time_in_danger_s == slow.time_in_danger_s
+    assert (fast.collisions, fast.first_collision_s) == (slow.collisions, slow.first_collision_s)
+
+
+@pytest.mark.parametrize("name, navigator", [("dyn-crowd-1", "follow"), ("dyn-head-on-1", "follow"),
+                                             ("immas-env1-dynamic", None)])
+def test_the_runners_bound_is_below_the_clearance_at_every_step_among_moving_obstacles(monkeypatch, name, navigator):
+    """The bound the loop acts on (its obstacle-shift bookkeeping included) against a fresh probe's measure."""
+    from swarmnav.sim import runner
+
+    original = runner.StepLoop.observe
+    checked = []
+
+    def checking_observe(self):
+        truth = ClearanceProbe(self.scene)
+        x, y = self.data.qpos[self.qadr:self.qadr + 2].tolist()
+        bound = self.clearance_bound_m()
+        gap = truth.measure(self.data, x, y)
+        assert gap == CLEARANCE_HORIZON_M if bound > CLEARANCE_HORIZON_M else gap > bound
+        checked.append(bound > 0.0)
+        return original(self)
+
+    monkeypatch.setattr(runner.StepLoop, "observe", checking_observe)
+    run_episode(EpisodeSpec(load_scenario(name), navigator=navigator), time_limit_s=40.0)
+    assert sum(checked) >= 200
