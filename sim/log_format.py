@@ -32,6 +32,7 @@ give identical message bytes on every channel.
 
 from __future__ import annotations
 
+import functools
 import importlib.metadata
 import json
 import math
@@ -134,13 +135,18 @@ def ranges_from_scan(scan_m: np.ndarray, beam_offset_m: float) -> np.ndarray:
     return np.where(np.isnan(scan), np.inf, scan - beam_offset_m)
 
 
+@functools.lru_cache(maxsize=1)
+def _foxglove_sdk_version() -> str:
+    """Looked up once per process: reading package metadata costs about a millisecond."""
+    try:
+        return importlib.metadata.version("foxglove-sdk")
+    except importlib.metadata.PackageNotFoundError:
+        return "unknown"
+
+
 def writer_versions(run_versions: dict[str, str]) -> dict[str, str]:
     """The run's versions (swarmnav, MuJoCo, Python) plus the log writer's."""
-    try:
-        writer = importlib.metadata.version("foxglove-sdk")
-    except importlib.metadata.PackageNotFoundError:
-        writer = "unknown"
-    return {"foxglove_sdk": writer, **run_versions}
+    return {"foxglove_sdk": _foxglove_sdk_version(), **run_versions}
 
 
 def default_log_path(scenario: str, planner: str, seed: int, stamp: str, directory: str | Path = "logs") -> Path:

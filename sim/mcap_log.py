@@ -27,13 +27,7 @@ from typing import Any, Callable
 
 import foxglove
 import numpy as np
-from foxglove.channels import (
-    FrameTransformChannel,
-    LaserScanChannel,
-    PoseInFrameChannel,
-    PosesInFrameChannel,
-    SceneUpdateChannel,
-)
+from foxglove.channels import PosesInFrameChannel, SceneUpdateChannel
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 from foxglove.messages import (
     FrameTransform,
@@ -41,13 +35,13 @@ from foxglove.messages import (
     Pose,
     PoseInFrame,
     PosesInFrame,
-    Quaternion,
     SceneEntity,
     SceneUpdate,
     Vector3,
 )
 
 from swarmnav.sim.live_view import DEFAULT_LIVE_HOST, DEFAULT_LIVE_PORT, LiveServer
+from swarmnav.sim.log_encoding import StepEncoder, timestamp_field
 from swarmnav.sim.log_file import LogFile
 from swarmnav.sim.log_format import (
     BASE_FRAME,
@@ -183,11 +177,15 @@ class McapRecorder:
             compression_threads=0,  # the 2 cores belong to the simulation
         )
         self._writer = foxglove.open_mcap(self._file, context=self._fox, writer_options=options)
-        self._tf = FrameTransformChannel("/tf", context=self._fox)
-        self._pose = PoseInFrameChannel("/robot/pose", context=self._fox)
+        # The per-step protobuf channels take bytes from a StepEncoder (sim.log_encoding): the SDK's
+        # schemas and encoding, without building its message objects every step.
+        self._tf, self._pose = (
+            foxglove.Channel(topic, schema=message.get_schema(), message_encoding="protobuf", context=self._fox)
+            for topic, message in (("/tf", FrameTransform), ("/robot/pose", PoseInFrame)))
         self._path = PosesInFrameChannel("/planner/path", context=self._fox)
         self._obstacles = SceneUpdateChannel("/obstacles", context=self._fox)
-        self._scan = LaserScanChannel("/range/scan", context=self._fox)
+        self._scan = foxglove.Channel("/range/scan", schema=LaserScan.get_schema(), message_encoding="protobuf",
+                                      context=self._fox)
         self._wheels, self._controller, self._events = self._json_channels = [
             foxglove.Channel(topic, schema=json_schema(schema), message_encoding="json", context=self._fox)
             for topic, schema in (("/wheels", WHEELS_SCHEMA), ("/controller", CONTROLLER_SCHEMA),
@@ -198,7 +196,9 @@ class McapRecorder:
         self._scan_start_rad = float(angles[0]) if angles.size else 0.0
         self._scan_end_rad = float(angles[-1]) if angles.size else 0.0
         self._beam_offset_m = float(context.sensor_offset_m)
-        self._scan_pose = Pose(position=Vector3(z=float(context.sensor_height_m)), orientation=Quaternion(w=1.0))
+        self._encoder = StepEncoder(WORLD_FRAME, BASE_FRAME,
+                                    ((0.0, 0.0, float(context.sensor_height_m)), (0.0, 0.0, 0.0, 1.0)),
+                                    self._scan_start_rad, self._scan_end_rad)  # end: inclusive
         self._moving_infos = tuple(o for o in context.obstacles if o.moving)
         self._static_entities = [
             obstacle_entity(o, o.position_m[0], o.position_m[1], 0)
@@ -235,40 +235,15 @@ class McapRecorder:
     def step(self, frame: StepFrame) -> None:
         """Log one control step on every per-step channel."""
         t_ns = time_ns(frame.time_s)
-        time_stamp = stamp(t_ns)
+        time_stamp = timestamp_field(t_ns)
         px, py, pz = np.asarray(frame.position_m, dtype=float).tolist()
         qw, qx, qy, qz = np.asarray(frame.quaternion_wxyz, dtype=float).tolist()
-        translation = Vector3(x=px, y=py, z=pz)
-        rotation = Quaternion(x=qx, y=qy, z=qz, w=qw)
-        self._tf.log(
-            FrameTransform(
-                timestamp=time_stamp,
-                parent_frame_id=WORLD_FRAME,
-                child_frame_id=BASE_FRAME,
-                translation=translation,
-                rotation=rotation,
-            ),
-            log_time=t_ns,
-        )
-        self._pose.log(
-            PoseInFrame(
-                timestamp=time_stamp,
-                frame_id=WORLD_FRAME,
-                pose=Pose(position=translation, orientation=rotation),
-            ),
-            log_time=t_ns,
-        )
-        self._scan.log(
-            LaserScan(
-                timestamp=time_stamp,
-                frame_id=BASE_FRAME,
-                pose=self._scan_pose,
-                start_angle=self._scan_start_rad,
-                end_angle=self._scan_end_rad,  # inclusive
-                ranges=scan_list_from_ranges(frame.range_m, self._beam_offset_m),
-            ),
-            log_time=t_ns,
-        )
+        encoder = self._encoder
+        tf, pose = encoder.transform(time_stamp, (px, py, pz), (qx, qy, qz, qw))
+        self._tf.base.log(tf, t_ns, None)
+        self._pose.base.log(pose, t_ns, None)
+        self._scan.base.log(encoder.scan(time_stamp, scan_list_from_ranges(frame.range_m, self._beam_offset_m)),
+                            t_ns, None)
         # The JSON channels' own ``log`` only encodes text and calls its ``base``: called directly.
         self._wheels.base.log(wheels_json(frame.wheel_command_rad_s, frame.wheel_measured_rad_s).encode(), t_ns, None)
         self._controller.base.log(

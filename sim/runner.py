@@ -248,6 +248,7 @@ class StepLoop:
         # Views into data, made once: the base's position and quaternion, its velocity, the rangefinders.
         self._base_qpos = self.data.qpos[qadr:qadr + 7]
         self._base_qvel = self.data.qvel[scene.free_qvel_adr:scene.free_qvel_adr + 6]
+        self._wheel_qvel_adr = np.array(scene.wheel_qvel_adr)
         adr = np.asarray(scene.range_sensor_adr)
         contiguous = len(adr) > 0 and np.array_equal(adr, np.arange(adr[0], adr[0] + len(adr)))
         self._range_raw = self.data.sensordata[adr[0]:adr[0] + len(adr)] if contiguous else None
@@ -420,13 +421,12 @@ class StepLoop:
             replans=self.replans, safety_triggers=self.safety_triggers)
 
     def _frame(self, observation: Observation, command: ControlCommand, belief: Belief | None = None) -> StepFrame:
-        data, scene, adr = self.data, self.scene, self.qadr
+        base_qpos = self._base_qpos
         return StepFrame(
-            time_s=observation.time_s, position_m=data.qpos[adr:adr + 3].copy(),
-            quaternion_wxyz=data.qpos[adr + 3:adr + 7].copy(), heading_rad=observation.pose.heading_rad,
-            range_m=observation.ranges_m,
+            time_s=observation.time_s, position_m=base_qpos[:3].copy(), quaternion_wxyz=base_qpos[3:].copy(),
+            heading_rad=observation.pose.heading_rad, range_m=observation.ranges_m,
             wheel_command_rad_s=np.array([command.wheels.left_rad_s, command.wheels.right_rad_s]),
-            wheel_measured_rad_s=np.array([data.qvel[scene.wheel_qvel_adr[0]], data.qvel[scene.wheel_qvel_adr[1]]]),
+            wheel_measured_rad_s=self.data.qvel[self._wheel_qvel_adr],
             linear_m_s=command.linear_m_s, angular_rad_s=command.angular_rad_s,
-            waypoint_index=command.waypoint_index, moving_obstacles_m=np.array(self.obstacle_track_m[self.step]),
+            waypoint_index=command.waypoint_index, moving_obstacles_m=self.obstacle_track_m[self.step].copy(),
             belief=belief)
