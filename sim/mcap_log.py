@@ -75,6 +75,8 @@ from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
 # TOPICS and default_log_path live in sim.log_format; re-exported for existing callers.
 __all__ = ["McapRecorder", "TOPICS", "default_log_path"]
 
+ZSTD_LEVEL = 1  # chunk compression level (see start)
+
 
 class _WriteFailureFilter(logging.Filter):
     """Drops foxglove's per-message "error logging message: McapError(...)" lines.
@@ -172,6 +174,9 @@ class McapRecorder:
             raise
         options = MCAPWriteOptions(
             compression=MCAPCompression.Zstd,
+            # zstd level 1: in the closed loop it compresses a second of log in half the time of the
+            # default level (3), to about the same size (dense-field-30: 289 vs 292 kB for 20 s).
+            compression_level=ZSTD_LEVEL,
             profile=LOG_PROFILE,
             disable_seeking=True,
             compression_threads=0,  # the 2 cores belong to the simulation
