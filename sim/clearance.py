@@ -65,8 +65,16 @@ class ClearanceProbe:
         self.half_m = np.where(is_box[:, None], size, 0.0)
         self.radius_m = np.where(is_box, 0.0, size[:, 0])
         self._fromto = np.zeros(6)
-        # For lower_bound_m: each outer robot geom's centre (a view into data) and bounding radius.
-        self._robot_xy = [] if data is None else [(data.geom_xpos[g], float(model.geom_rbound[g]))
+        # Obstacle centres: those fixed to the world read once (MuJoCo recomputes the same values every
+        # step), the others (mocap) at every measure; work arrays for the footprint distances.
+        self._moving = np.flatnonzero(model.geom_bodyid[self.obstacle_ids] != 0)
+        initial = mujoco.MjData(model)
+        mujoco.mj_kinematics(model, initial)
+        self._centres_m = initial.geom_xpos[self.obstacle_ids, :2].copy()
+        self._point_m = np.zeros(2)
+        self._work = np.zeros_like(self._centres_m)
+        # For lower_bound_m: each outer robot geom's centre (a view of x, y into data) and bounding radius.
+        self._robot_xy = [] if data is None else [(data.geom_xpos[g, :2], float(model.geom_rbound[g]))
                                                   for g in self.robot_geom_ids]
         self._bound_valid = bool(self._robot_xy) and len(self.obstacle_ids) > 0 and \
             _upright_footprints(model, self.obstacle_ids, is_box)
@@ -75,9 +83,18 @@ class ClearanceProbe:
     def measure(self, data: mujoco.MjData, x_m: float, y_m: float) -> float:
         if not len(self.obstacle_ids):
             return math.inf
-        d = np.maximum(np.abs(data.geom_xpos[self.obstacle_ids, :2] - (x_m, y_m)) - self.half_m, 0.0)
-        footprint_m = np.sqrt(np.einsum("ij,ij->i", d, d)) - self.radius_m
-        i = int(np.argmin(footprint_m))
+        if self._moving.size:
+            self._centres_m[self._moving] = data.geom_xpos[self.obstacle_ids[self._moving], :2]
+        point = self._point_m
+        point[0], point[1] = x_m, y_m
+        d = self._work
+        np.subtract(self._centres_m, point, out=d)
+        np.abs(d, out=d)
+        np.subtract(d, self.half_m, out=d)
+        np.maximum(d, 0.0, out=d)
+        np.multiply(d, d, out=d)
+        footprint_m = np.sqrt(d[:, 0] + d[:, 1]) - self.radius_m
+        i = int(footprint_m.argmin())
         self._reference = (x_m, y_m, float(footprint_m[i]))
         nearest = int(self.obstacle_ids[i])
         model, fromto = self.model, self._fromto
@@ -99,7 +116,10 @@ class ClearanceProbe:
         if reference is None or not self._bound_valid:
             return -math.inf
         x0, y0, footprint_m = reference
-        reach_m = max(math.hypot(xpos[0] - x0, xpos[1] - y0) + rbound_m for xpos, rbound_m in self._robot_xy)
+        reach_m = 0.0
+        for xy, rbound_m in self._robot_xy:
+            gx, gy = xy.tolist()
+            reach_m = max(reach_m, math.hypot(gx - x0, gy - y0) + rbound_m)
         return footprint_m - obstacle_shift_m - reach_m - BOUND_MARGIN_M
 
 

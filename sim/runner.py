@@ -319,7 +319,8 @@ class StepLoop:
         x, y, _, w, qx, qy, qz = self._base_qpos.tolist()
         heading = yaw_from_quaternion(w, qx, qy, qz)
         if step:
-            self.length_m += math.hypot(x - self.poses[step - 1, 0], y - self.poses[step - 1, 1])
+            last_x, last_y, _ = self.poses[step - 1].tolist()
+            self.length_m += math.hypot(x - last_x, y - last_y)
         self.poses[step] = (x, y, heading)
         self._observed_step = step
         bound_m = self.clearance_bound_m()
@@ -344,11 +345,11 @@ class StepLoop:
         pose = Pose2D(x, y, heading)
         raw = self._range_raw if self._range_raw is not None else data.sensordata[scene.range_sensor_adr]
         ranges = ranges_from_sensors(raw, scene.range_cutoff_m)
-        return Observation(time_s=self.time_s, pose=pose, twist=Twist(v, omega), ranges_m=ranges,
+        time_s = step * self.dt_s
+        return Observation(time_s=time_s, pose=pose, twist=Twist(v, omega), ranges_m=ranges,
                            range_angles_rad=scene.range_angles_rad, range_offset_m=scene.range_offset_m,
                            range_cutoff_m=scene.range_cutoff_m,
-                           detections=self.sensing.sense(step, self.time_s, pose, ranges)
-                           if self.sense_obstacles else ())
+                           detections=self.sensing.sense(step, time_s, pose, ranges) if self.sense_obstacles else ())
 
     def count_events(self, events) -> None:
         """Count the navigator's replans and safety-filter triggers."""

@@ -135,3 +135,39 @@ def test_the_runners_bound_is_below_the_clearance_at_every_step_among_moving_obs
     monkeypatch.setattr(runner.StepLoop, "observe", checking_observe)
     run_episode(EpisodeSpec(load_scenario(name), navigator=navigator), time_limit_s=40.0)
     assert sum(checked) >= 200
+
+
+def nearest_reference(probe, data, x_m, y_m):
+    """The probe's pick as first written: footprint distances with einsum, read from data every time."""
+    d = np.maximum(np.abs(data.geom_xpos[probe.obstacle_ids, :2] - (x_m, y_m)) - probe.half_m, 0.0)
+    footprint = np.sqrt(np.einsum("ij,ij->i", d, d)) - probe.radius_m
+    return int(probe.obstacle_ids[np.argmin(footprint)]), float(np.min(footprint))
+
+
+@pytest.mark.parametrize("name", ["dense-field-30", "immas-env4-blocks", "dyn-crowd-1", "iaco-dynamic"])
+def test_the_nearest_obstacle_pick_matches_its_reference(name):
+    """Cached static centres and the unrolled sum of squares pick the same obstacle, with the same
+    footprint distance bit for bit, on random points (inside obstacles, on the arena's edge, beyond it)
+    and with the moving obstacles moved."""
+    simulation = Simulation(load_scenario(name))
+    data = simulation.reset()
+    probe = ClearanceProbe(simulation.scene, data)
+    width, height = simulation.scenario.arena_width_m, simulation.scenario.arena_height_m
+    rng = np.random.default_rng(5)
+    mocap = data.mocap_pos.copy()
+    centres = data.geom_xpos[probe.obstacle_ids, :2].copy()
+    for k in range(300):
+        if len(mocap) and k % 10 == 0:
+            data.mocap_pos[:, :2] = mocap[:, :2] + rng.normal(0.0, 0.5, (len(mocap), 2))
+            mujoco.mj_kinematics(simulation.model, data)
+        x, y = rng.uniform(-0.5, width + 0.5), rng.uniform(-0.5, height + 0.5)
+        if k % 7 == 0:                                 # exactly on an obstacle's centre
+            x, y = (float(v) for v in centres[rng.integers(len(centres))])
+        expected_id, expected_footprint = nearest_reference(probe, data, x, y)
+        probe.measure(data, x, y)
+        assert probe._reference[2] == expected_footprint
+        assert probe._reference[:2] == (x, y)
+        fromto = np.zeros(6)
+        expected_gap = min(mujoco.mj_geomDistance(simulation.model, data, g, expected_id, CLEARANCE_HORIZON_M, fromto)
+                           for g in probe.robot_geom_ids)
+        assert probe.measure(data, x, y) == expected_gap
