@@ -143,3 +143,37 @@ class StepEncoder:
                                                   struct.Struct(f"<{len(ranges)}d"))
         field_head, doubles_struct = packer
         return b"".join((stamp, self._scan_head, field_head, doubles_struct.pack(*ranges)))
+
+
+# SceneEntity's primitive lists (foxglove.SceneEntity field numbers).
+_PRIMITIVE_FIELDS = {"cubes": 8, "cylinders": 10}
+_IDENTITY_ORIENTATION = length_delimited(2, quaternion(0.0, 0.0, 0.0, 1.0))
+
+
+class SceneEncoder:
+    """``/obstacles`` (a ``foxglove.SceneUpdate``) bodies: the static entities encoded once, each
+    moving one per step from its position.
+
+    Args:
+        static_entities: the encoded static ``SceneEntity`` messages, in order.
+        frame_id: the moving entities' frame.
+        moving: per moving obstacle, its entity id and :func:`sim.log_messages.obstacle_template`.
+    """
+
+    def __init__(self, static_entities: list[bytes], frame_id: str,
+                 moving: list[tuple[str, tuple[str, float, bytes]]]):
+        self._static = b"".join(length_delimited(2, entity) for entity in static_entities)
+        self._moving = [(string_field(2, frame_id) + string_field(3, entity_id), tag(_PRIMITIVE_FIELDS[kind], _WIRE_LENGTH),
+                         z_m, tail) for entity_id, (kind, z_m, tail) in moving]
+
+    def update(self, stamp: bytes, moving_xy_m: list[list[float]]) -> bytes:
+        """The update with the moving obstacles at ``moving_xy_m`` (one (x, y) per moving obstacle);
+        ``stamp`` (:func:`timestamp_field`) is their entities' time stamp."""
+        parts = [self._static]
+        for (ids, primitive_tag, z_m, tail), (x_m, y_m) in zip(self._moving, moving_xy_m):
+            position = vector3(x_m, y_m, z_m)
+            pose = b"\x0a" + bytes((len(position),)) + position + _IDENTITY_ORIENTATION
+            primitive = b"\x0a" + bytes((len(pose),)) + pose + tail
+            entity = b"".join((stamp, ids, primitive_tag, varint(len(primitive)), primitive))
+            parts.append(b"\x12" + varint(len(entity)) + entity)
+        return b"".join(parts)

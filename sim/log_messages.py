@@ -45,12 +45,12 @@ def json_schema(schema: dict[str, Any]) -> foxglove.Schema:
     )
 
 
-def _obstacle_primitive(info: ObstacleInfo, x_m: float, y_m: float):
-    """A SceneEntity primitive for one obstacle (cylinder or box) at (x, y)."""
+def _obstacle_primitive(info: ObstacleInfo, x_m: float, y_m: float, with_pose: bool = True):
+    """A SceneEntity primitive for one obstacle (cylinder or box) at (x, y) (its pose left out without ``with_pose``)."""
     z_m = info.position_m[2]
     rgba = _MOVING_COLOUR if info.moving else _STATIC_COLOUR
     colour = Color(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3])
-    pose = Pose(position=Vector3(x=x_m, y=y_m, z=z_m), orientation=Quaternion(w=1.0))
+    pose = Pose(position=Vector3(x=x_m, y=y_m, z=z_m), orientation=Quaternion(w=1.0)) if with_pose else None
     if info.shape == "box":
         hx, hy, hz = info.size_m
         return "cubes", CubePrimitive(
@@ -65,6 +65,15 @@ def _obstacle_primitive(info: ObstacleInfo, x_m: float, y_m: float):
         top_scale=1.0,
         color=colour,
     )
+
+
+def obstacle_template(info: ObstacleInfo) -> tuple[str, float, bytes]:
+    """What :class:`sim.log_encoding.SceneEncoder` needs to encode :func:`obstacle_entity` at any
+    position: the primitive list's name ("cylinders" or "cubes"), the centre's height and the
+    primitive's encoding without its pose (size, scales, colour); the pose is the position and
+    the identity orientation."""
+    kind, primitive = _obstacle_primitive(info, 0.0, 0.0, with_pose=False)
+    return kind, float(info.position_m[2]), primitive.encode()
 
 
 def obstacle_entity(info: ObstacleInfo, x_m: float, y_m: float, t_ns: int) -> SceneEntity:

@@ -35,13 +35,12 @@ from foxglove.messages import (
     Pose,
     PoseInFrame,
     PosesInFrame,
-    SceneEntity,
     SceneUpdate,
     Vector3,
 )
 
 from swarmnav.sim.live_view import DEFAULT_LIVE_HOST, DEFAULT_LIVE_PORT, LiveServer
-from swarmnav.sim.log_encoding import StepEncoder, timestamp_field
+from swarmnav.sim.log_encoding import SceneEncoder, StepEncoder, timestamp_field
 from swarmnav.sim.log_file import LogFile
 from swarmnav.sim.log_format import (
     BASE_FRAME,
@@ -64,6 +63,7 @@ from swarmnav.sim.log_messages import (
     controller_json,
     json_schema,
     obstacle_entity,
+    obstacle_template,
     run_metadata,
     stamp,
     wheels_json,
@@ -150,7 +150,6 @@ class McapRecorder:
         self._next_flush_ns = 0
         self._last_ns = 0
         self._moving_infos: tuple[ObstacleInfo, ...] = ()
-        self._static_entities: list[SceneEntity] = []
         self._json_channels: list[foxglove.Channel] = []
         self._navigator: SceneUpdateChannel | None = None  # made at the first belief with obstacles
         self._belief_drawn = False
@@ -188,7 +187,8 @@ class McapRecorder:
             foxglove.Channel(topic, schema=message.get_schema(), message_encoding="protobuf", context=self._fox)
             for topic, message in (("/tf", FrameTransform), ("/robot/pose", PoseInFrame)))
         self._path = PosesInFrameChannel("/planner/path", context=self._fox)
-        self._obstacles = SceneUpdateChannel("/obstacles", context=self._fox)
+        self._obstacles = foxglove.Channel("/obstacles", schema=SceneUpdate.get_schema(), message_encoding="protobuf",
+                                           context=self._fox)
         self._scan = foxglove.Channel("/range/scan", schema=LaserScan.get_schema(), message_encoding="protobuf",
                                       context=self._fox)
         self._wheels, self._controller, self._events = self._json_channels = [
@@ -205,12 +205,11 @@ class McapRecorder:
                                     ((0.0, 0.0, float(context.sensor_height_m)), (0.0, 0.0, 0.0, 1.0)),
                                     self._scan_start_rad, self._scan_end_rad)  # end: inclusive
         self._moving_infos = tuple(o for o in context.obstacles if o.moving)
-        self._static_entities = [
-            obstacle_entity(o, o.position_m[0], o.position_m[1], 0)
-            for o in context.obstacles
-            if not o.moving
-        ]
-        self._obstacles.log(self._scene_update(0, None), log_time=0)
+        static_entities = [obstacle_entity(o, o.position_m[0], o.position_m[1], 0).encode()
+                           for o in context.obstacles if not o.moving]
+        self._scene = SceneEncoder(static_entities, WORLD_FRAME,
+                                   [(o.entity_id, obstacle_template(o)) for o in self._moving_infos])
+        self._obstacles.base.log(self._scene_update(0, None), 0, None)
         self.messages_written += 1
         self._next_flush_ns = time_ns(self.flush_interval_s)
         if self._pacer is not None:
@@ -256,7 +255,7 @@ class McapRecorder:
         written = 5
         late = self._server.late_topics() if self._server is not None else ()
         if self._moving_infos or "/obstacles" in late:
-            self._obstacles.log(self._scene_update(t_ns, frame.moving_obstacles_m), log_time=t_ns)
+            self._obstacles.base.log(self._scene_update(t_ns, frame.moving_obstacles_m), t_ns, None)
             written += 1
         if "/planner/path" in late and self._last_path is not None:
             self._path.log(self._last_path, log_time=t_ns)
@@ -347,13 +346,11 @@ class McapRecorder:
             data=context.mjcf_xml.encode(),
         )
 
-    def _scene_update(self, t_ns: int, moving_xy_m: np.ndarray | None) -> SceneUpdate:
-        entities = list(self._static_entities)
+    def _scene_update(self, t_ns: int, moving_xy_m: np.ndarray | None) -> bytes:
+        """``/obstacles``: every entity, the moving ones at ``moving_xy_m`` (None: where they start)."""
         if moving_xy_m is None:
             moving_xy_m = np.array([o.position_m[:2] for o in self._moving_infos]).reshape(-1, 2)
-        for info, (x_m, y_m) in zip(self._moving_infos, np.asarray(moving_xy_m, dtype=float)):
-            entities.append(obstacle_entity(info, float(x_m), float(y_m), t_ns))
-        return SceneUpdate(entities=entities)
+        return self._scene.update(timestamp_field(t_ns), np.asarray(moving_xy_m, dtype=float).tolist())
 
     def _log_belief(self, belief: Any, t_ns: int) -> int:
         """``/navigator`` while the navigator acts on sensed obstacles, and once more when it stops."""

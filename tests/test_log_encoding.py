@@ -65,3 +65,29 @@ def test_varint_against_the_definition():
             shift += 7
             assert (byte & 0x80 != 0) == (i < len(encoded) - 1)   # continuation bit on all but the last
         assert decoded == value % 2**64
+
+
+def test_obstacle_scene_update_is_the_sdk_encoding():
+    """Static entities encoded once plus moving cylinders and boxes at random positions (zeros, NaN
+    and infinities among them) give the bytes of the SceneUpdate the SDK builds from obstacle_entity."""
+    from foxglove.messages import SceneUpdate
+
+    from swarmnav.sim.log_encoding import SceneEncoder
+    from swarmnav.sim.log_messages import obstacle_entity, obstacle_template
+    from swarmnav.sim.recording import ObstacleInfo
+
+    rng = np.random.default_rng(9)
+    static = [ObstacleInfo("obstacle_00", "cylinder", (0.3, 0.5), (1.0, 2.0, 0.5), False),
+              ObstacleInfo("map_box_001", "box", (0.5, 0.25, 0.4), (3.0, 0.0, 0.4), False)]
+    moving = [ObstacleInfo("obstacle_01", "cylinder", (0.2, 0.6), (0.0, 0.0, 0.6), True),
+              ObstacleInfo("crate", "box", (0.1, 0.2, 0.3), (5.0, 5.0, 0.3), True),
+              ObstacleInfo("o" * 150, "cylinder", (0.25, 0.0), (1.0, 1.0, 0.0), True)]
+    for n_static, n_moving in ((2, 3), (0, 1), (2, 0), (0, 0)):
+        encoder = SceneEncoder([obstacle_entity(o, o.position_m[0], o.position_m[1], 0).encode()
+                                for o in static[:n_static]], "world",
+                               [(o.entity_id, obstacle_template(o)) for o in moving[:n_moving]])
+        for t_ns in times_ns(rng):
+            xy = [values(rng, 2) for _ in range(n_moving)]
+            entities = [obstacle_entity(o, o.position_m[0], o.position_m[1], 0) for o in static[:n_static]]
+            entities += [obstacle_entity(o, x, y, t_ns) for o, (x, y) in zip(moving, xy)]
+            assert encoder.update(timestamp_field(t_ns), xy) == SceneUpdate(entities=entities).encode()
