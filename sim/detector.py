@@ -105,13 +105,18 @@ class ObstacleSensing:
     def sense(self, step: int, time_s: float, pose: Pose2D, ranges_m: np.ndarray) -> tuple[DetectedObstacle, ...]:
         if self.model == "detector":
             return self.detect(step, pose)
-        hits, origins = hit_points(pose, ranges_m, self.angles_rad, self.offset_m)
-        unknown = known_surface_gap_m(hits, self.scenario, self.surfaces) > STATIC_HIT_TOLERANCE_M
+        # Every beam's direction and origin once; the hits are those of the finite ranges
+        # (the same element-wise arithmetic as hit_points).
+        ranges = np.asarray(ranges_m, dtype=float)
         world = pose.heading_rad + np.asarray(self.angles_rad)
         directions = np.column_stack([np.cos(world), np.sin(world)])
         beam_origins = np.array([pose.x_m, pose.y_m]) + self.offset_m * directions
-        beams = (beam_origins, directions, np.asarray(ranges_m, dtype=float))
-        return self.tracker.update(time_s, hits[unknown], origins[unknown], beams)
+        hit = np.isfinite(ranges)
+        origins = beam_origins[hit]
+        hits = origins + ranges[hit][:, None] * directions[hit]
+        unknown = known_surface_gap_m(hits, self.scenario, self.surfaces) > STATIC_HIT_TOLERANCE_M \
+            if len(hits) else np.zeros(0, dtype=bool)
+        return self.tracker.update(time_s, hits[unknown], origins[unknown], (beam_origins, directions, ranges))
 
     def detect(self, step: int, pose: Pose2D) -> tuple[DetectedObstacle, ...]:
         """The ``detector`` model: the true moving obstacles whose surface is within range of the rim."""

@@ -27,6 +27,8 @@ _FULL_TAGS = (0x09, 0x11, 0x19, 0x21)  # fields 1..4, wire type 1 (64-bit)
 
 def varint(value: int) -> bytes:
     """Protobuf base-128 varint; a negative value as its 64-bit two's complement (int64)."""
+    if 0 <= value < 0x80:
+        return bytes((value,))
     value &= (1 << 64) - 1
     out = bytearray()
     while value > 0x7F:

@@ -171,3 +171,36 @@ def test_the_nearest_obstacle_pick_matches_its_reference(name):
         expected_gap = min(mujoco.mj_geomDistance(simulation.model, data, g, expected_id, CLEARANCE_HORIZON_M, fromto)
                            for g in probe.robot_geom_ids)
         assert probe.measure(data, x, y) == expected_gap
+
+
+@pytest.mark.parametrize("name", ["dyn-crowd-1", "immas-env4-blocks", "iaco-dynamic"])
+def test_rangefinder_sensing_hands_the_tracker_what_hit_points_and_the_map_give(monkeypatch, name):
+    """The sensing's one pass over the beams against hit_points and known_surface_gap_m, bit for bit,
+    for random poses and ranges (no hit at all, every beam a hit)."""
+    from swarmnav.controllers.tracking import HitTracker
+    from swarmnav.models.world import Pose2D
+    from swarmnav.sim.detector import STATIC_HIT_TOLERANCE_M, ObstacleSensing, hit_points, known_surface_gap_m
+
+    scenario = load_scenario(name)
+    simulation = Simulation(scenario)
+    scene = simulation.scene
+    track = simulation.obstacle_positions(np.arange(3) * 0.02)
+    sensing = ObstacleSensing(scenario, track, np.full(track.shape[1], 0.2), 0.02, scene.range_angles_rad,
+                              scene.range_offset_m)
+    sensing.model = "rangefinder"
+    seen = []
+    monkeypatch.setattr(HitTracker, "update", lambda self, t, hits, origins, beams: seen.append((hits, origins, beams)))
+    rng = np.random.default_rng(11)
+    for k in range(200):
+        pose = Pose2D(*rng.uniform(0.0, scenario.arena_width_m, 2), rng.uniform(-math.pi, math.pi))
+        ranges = rng.uniform(0.0, scene.range_cutoff_m, len(scene.range_angles_rad))
+        ranges[rng.random(ranges.size) < (0.5 if k % 3 else (1.0 if k % 2 else 0.0))] = np.inf
+        sensing.sense(0, 0.0, pose, ranges)
+        hits, origins, (beam_origins, directions, beam_ranges) = seen.pop()
+        ref_hits, ref_origins = hit_points(pose, ranges, scene.range_angles_rad, scene.range_offset_m)
+        unknown = known_surface_gap_m(ref_hits, scenario) > STATIC_HIT_TOLERANCE_M
+        assert hits.tobytes() == ref_hits[unknown].tobytes() and hits.shape == ref_hits[unknown].shape
+        assert origins.tobytes() == ref_origins[unknown].tobytes()
+        world = pose.heading_rad + scene.range_angles_rad
+        assert directions.tobytes() == np.column_stack([np.cos(world), np.sin(world)]).tobytes()
+        assert beam_ranges.tobytes() == ranges.tobytes() and beam_origins.shape == (len(ranges), 2)
