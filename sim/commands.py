@@ -25,7 +25,7 @@ SINGLE_THREAD_ENVIRONMENT = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OP
                              "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
 DEFAULT_FPS = 30.0  # frames per simulated second of a video (run --video, replay --video)
 MIN_DPI, MAX_DPI = 10, 600  # plot: 600 dpi is 4800 x 6300 pixels (about 120 MB of RGBA)
-BENCH_SIM_QUICK = (5.0, 2)  # bench sim --quick: simulated seconds, repeats (under a minute)
+BENCH_SIM_QUICK = (5.0, 5)  # bench sim --quick: simulated seconds, repeats (under a minute)
 BENCH_ENV_QUICK = (4.0, 2)  # bench env --quick: a smoke run of the same measurement (noisier figures)
 BENCH_RENDER_QUICK_FRAMES = 40
 BENCH_PLANNERS_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3",
@@ -40,7 +40,7 @@ BENCH_STUDY_QUICK = (5, 20)  # bench study --quick: seeds per scenario, GWO iter
 def add_bench_sim_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default="dense-field-30")
     parser.add_argument("--duration", type=options.positive_float, default=20.0, help="simulated seconds per measurement")
-    parser.add_argument("--repeats", type=options.positive_int, default=3)
+    parser.add_argument("--repeats", type=options.positive_int, default=7, help="bare, closed-loop and logged runs back to back; medians over them (default 7)")
     parser.add_argument("--quick", action="store_true",
                         help="%g simulated seconds, %d repeats (under a minute)" % BENCH_SIM_QUICK)
     parser.add_argument("--json", action="store_true")
