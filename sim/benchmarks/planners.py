@@ -314,8 +314,10 @@ def print_table(result: dict[str, Any]) -> None:
                   f"{speedup:.1f}x ({verdict})")
     for f in result.get("fields", []):
         ok = f["feasible_runs"] == f["runs"] and f["fields_within_1_03"] == f["fields"]
+        verdict = ("met" if ok else "NOT met") if f["mode"] != "paper" else \
+            ("also holds" if ok else "does not hold: the target is the robust mode's; the paper's algorithm for contrast")
         print(f"  {f['planner']} {f['mode']} on random fields: 100 % feasible and every field's median <= 1.03 x "
-              f"the optimum ({'met' if ok else 'NOT met'})")
+              f"the optimum ({verdict})")
     for r in result["rows"]:
         if r["mode"] == "robust" and r["ratio_to_optimum"] is not None:
             ok = r["ratio_to_optimum"] <= 1.03 and r["feasible_runs"] == r["runs"]
