@@ -10,8 +10,8 @@ Three of the robust options of :class:`planners.continuous.ContinuousPlanner` st
 * or ``guess = "grid"`` (:func:`grid_guesses`): a grid A* path, exactly shortcut by line of sight
   (:class:`planners.grid_search.AStarPlanner`), on the problem's own grid of the inflated
   discs (``guess_cell_m`` to choose another cell).  On dense-field-30 it is 1.007 x the
-  exact optimum in about 10 ms, where the exact tangent graph (:mod:`planners.optimal`)
-  takes 0.3 s.  A coarser grid is faster but closes narrow gaps: on one random 33-disc
+  exact optimum in about 10 ms (the exact tangent graph, :mod:`planners.tangent_graph`, now
+  takes about 7 ms there, so it is the default guess up to 100 discs).  A coarser grid is faster but closes narrow gaps: on one random 33-disc
   field the 0.1 m guess is 1.14 x the optimum, the 0.05 m one 1.013 x; seeding with both
   let the wrong one win (its fit is clear of the discs, the right one's cuts a little);
 * the number of via-points chosen from the scene: for the tangent guess

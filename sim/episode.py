@@ -145,7 +145,8 @@ _REFERENCE_LENGTHS: dict[str, float | None] = {}
 
 
 def reference_length_m(scenario: Scenario) -> float | None:
-    """L* for SPL: the exact shortest path among the static discs (``optimal``), or Theta* on a map.
+    """L* for SPL: the exact shortest length among the static discs (``optimal``'s ``optimum_length_m``, not its
+    polygon's slightly longer length), or Theta*'s path length on a map.
 
     None when there is no path among the static obstacles.  Cached by the
     scenario's text (the static geometry does not depend on the world seed).
@@ -155,7 +156,8 @@ def reference_length_m(scenario: Scenario) -> float | None:
         problem = static_problem(scenario)
         planner = ThetaStarPlanner() if problem.boxes or problem.grid_override is not None else OptimalPlanner()
         try:
-            _REFERENCE_LENGTHS[key] = planner.plan(problem, np.random.default_rng(0)).stats.length_m
+            stats = planner.plan(problem, np.random.default_rng(0)).stats
+            _REFERENCE_LENGTHS[key] = float(stats.extra.get("optimum_length_m", stats.length_m))
         except PlanningError:
             _REFERENCE_LENGTHS[key] = None
     return _REFERENCE_LENGTHS[key]

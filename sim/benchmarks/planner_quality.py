@@ -19,6 +19,7 @@ path is a row (outcome ``no_path``) and counts in ``runs``, never in the lengths
 
 from __future__ import annotations
 
+import json
 import math
 import statistics
 from pathlib import Path as FilePath
@@ -60,11 +61,12 @@ def _arms(rows: list[dict[str, Any]]) -> dict[tuple[str, str], list[dict[str, An
 
 
 def optimum_by_scenario(rows: list[dict[str, Any]]) -> dict[str, float | None]:
-    """The exact optimum of each scenario from its ``optimal`` rows (None: no path exists)."""
+    """The exact optimum of each scenario from its ``optimal`` rows (their ``optimum_length_m``: the exact
+    length, a hair below that of the polygon ``optimal`` returns); None where no path exists."""
     out: dict[str, float | None] = {}
     for (scenario, label), arm in _arms(rows).items():
         if label == OPTIMUM_LABEL:
-            lengths = {r["plan_length_m"] for r in arm if r["success"]}
+            lengths = {json.loads(r["plan_extra"])["optimum_length_m"] for r in arm if r["success"]}
             if len(lengths) > 1:
                 raise AssertionError(f"the exact optimum of {scenario} differs between seeds: {sorted(lengths)}")
             out[scenario] = lengths.pop() if lengths else None
