@@ -156,8 +156,10 @@ def run_bench_navigation(args: argparse.Namespace) -> int:
 
 
 def add_bench_study_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--seeds", type=int, default=20, help="seeds per scenario (2 scenarios: 40 cells by default)")
-    parser.add_argument("--iterations", type=int, default=60, help="GWO iterations per cell")
+    parser.add_argument("--seeds", type=options.positive_int, default=20, help="seeds per scenario (2 scenarios: 40 cells by default)")
+    parser.add_argument("--iterations", type=options.positive_int, default=600,
+                        help="GWO iterations per cell (default 600: about 75 ms a cell, so a worker's start-up of "
+                             "about a second is small against the work, as in a real study)")
     parser.add_argument("--no-ray", action="store_true", help="skip the Ray comparison")
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--quick", action="store_true",
