@@ -34,7 +34,7 @@ BENCH_PLANNERS_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3"
 BENCH_PLANNERS_PLANNERS = ("abc", "adl_abc", "gwo", "pso")
 # bench navigation --quick: one world seed on one scenario of each generated kind.
 BENCH_NAVIGATION_QUICK_SCENARIOS = ("dyn-crossing-1", "dyn-head-on-1", "dyn-overtake-1", "dyn-crowd-1")
-BENCH_STUDY_QUICK = (5, 20)  # bench study --quick: seeds per scenario, GWO iterations; no Ray
+BENCH_STUDY_QUICK = (10, 300)  # bench study --quick: seeds per scenario, GWO iterations; no Ray
 
 
 def add_bench_sim_arguments(parser: argparse.ArgumentParser) -> None:
@@ -160,6 +160,8 @@ def add_bench_study_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--iterations", type=options.positive_int, default=600,
                         help="GWO iterations per cell (default 600: about 75 ms a cell, so a worker's start-up of "
                              "about a second is small against the work, as in a real study)")
+    parser.add_argument("--rounds", type=options.positive_int, default=3,
+                        help="rounds of 1 worker then 2, back to back; medians over them (default 3)")
     parser.add_argument("--no-ray", action="store_true", help="skip the Ray comparison")
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--quick", action="store_true",
@@ -169,7 +171,7 @@ def add_bench_study_arguments(parser: argparse.ArgumentParser) -> None:
 def run_bench_study(args: argparse.Namespace) -> int:
     from swarmnav.sim.benchmarks import study
     if args.quick:
-        (args.seeds, args.iterations), args.no_ray = BENCH_STUDY_QUICK, True
+        (args.seeds, args.iterations), args.no_ray, args.rounds = BENCH_STUDY_QUICK, True, 1
     return study.run(args)
 
 

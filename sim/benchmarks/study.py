@@ -58,11 +58,15 @@ def run(args: argparse.Namespace) -> int:
     cells = expand(study)
     out: dict = {"cells": len(cells)}
 
-    one, two = _arrivals(run_local(cells, 1)), _arrivals(run_local(cells, 2))
-    one_s, two_s = one[-1], two[-1]
-    out.update(local_1_worker_s=round(one_s, 3), local_2_workers_s=round(two_s, 3),
-               parallel_speedup=round(one_s / two_s, 3),
-               parallel_speedup_steady=round(steady_rate(two, 2) / steady_rate(one, 1), 3))
+    # Rounds of 1 worker then 2, back to back; medians over the rounds (one run of the same engine varies by
+    # 15 % here from one minute to the next).
+    rounds = [(_arrivals(run_local(cells, 1)), _arrivals(run_local(cells, 2))) for _ in range(args.rounds)]
+    one_s = statistics.median(one[-1] for one, _ in rounds)
+    two_s = statistics.median(two[-1] for _, two in rounds)
+    out.update(rounds=args.rounds, local_1_worker_s=round(one_s, 3), local_2_workers_s=round(two_s, 3),
+               parallel_speedup=round(statistics.median(one[-1] / two[-1] for one, two in rounds), 3),
+               parallel_speedup_steady=round(statistics.median(steady_rate(two, 2) / steady_rate(one, 1)
+                                                               for one, two in rounds), 3))
 
     # The overhead is the same whatever the cell's size: measured on light cells (20 iterations) so that the
     # planner's own run-to-run noise does not drown it.
@@ -94,12 +98,14 @@ def run(args: argparse.Namespace) -> int:
             out["ray_startup_s"] = round(time.perf_counter() - t0, 3)
             arrivals = _arrivals(run_ray(cells))
             ray.shutdown()
+            local_rate = statistics.median(steady_rate(two, 2) for _, two in rounds)
             out.update(ray_2_cpus_s=round(arrivals[-1], 3),
-                       ray_throughput_vs_local=round(steady_rate(arrivals, 2) / steady_rate(two, 2), 3))
+                       ray_throughput_vs_local=round(steady_rate(arrivals, 2) / local_rate, 3))
     if args.json:
         print(json.dumps(out))
     else:
-        print(f"{out['cells']}-cell plan-only study (gwo, {args.iterations} iterations):")
+        print(f"{out['cells']}-cell plan-only study (gwo, {args.iterations} iterations), medians of "
+              f"{args.rounds} rounds:")
         print(f"  local engine: 1 worker {one_s:.2f} s, 2 workers {two_s:.2f} s -> speed-up "
               f"{out['parallel_speedup']:.2f}x (start-up included), {out['parallel_speedup_steady']:.2f}x in the "
               f"steady state (cells per second once every worker has delivered its first; target >= 1.8x)")
