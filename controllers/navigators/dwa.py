@@ -53,12 +53,10 @@ from typing import ClassVar
 import numpy as np
 
 from swarmnav.controllers.controller import ControlCommand
-from swarmnav.controllers.guidance import PathCarrot
+from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.replan import check_positive
-from swarmnav.controllers.prediction import LocalObstacles
-from swarmnav.controllers.safety_filter import SafetyFilter
 from swarmnav.models.world import wrap_angle_rad
 
 
@@ -105,17 +103,11 @@ class DynamicWindowNavigator:
         check_positive(self, ("v_samples", "omega_samples"))
 
     def reset(self, setup: NavigationSetup) -> None:
-        known = setup.map_problem
-        self.geometry = setup.controller.geometry
-        self.max_speed = setup.max_speed_m_s
-        self.inflation = known.robot_radius_m + self.margin_m
-        self.local = LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m)
-        self.carrot = PathCarrot(setup.path.waypoints, self.lookahead_m)
-        self.goal = np.array([setup.goal.x_m, setup.goal.y_m])
+        (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal,
+         self.filter) = local_setup(setup, self.margin_m, self.lookahead_m, self.safety_filter,
+                                    self.time_before_collision_s)
         self.goal_tolerance_m = setup.goal.tolerance_m
         self.times = np.arange(1, int(round(self.horizon_s / self.sim_step_s)) + 1) * self.sim_step_s  # (T,)
-        self.filter = SafetyFilter(self.geometry, known.robot_radius_m,
-                                   self.time_before_collision_s) if self.safety_filter else None
         self.reach = self.max_speed * self.horizon_s + 1.0
         # The lattice V_s and its arcs in the robot's frame (start at the origin facing +x).
         self.speeds = np.linspace(0.0, self.max_speed, self.v_samples) if self.v_samples > 1 \

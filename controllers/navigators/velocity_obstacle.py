@@ -39,12 +39,11 @@ from typing import ClassVar
 import numpy as np
 
 from swarmnav.controllers.controller import ControlCommand
-from swarmnav.controllers.guidance import PathCarrot
+from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.replan import check_positive
-from swarmnav.controllers.prediction import LocalObstacles, time_to_collision_s
-from swarmnav.controllers.safety_filter import SafetyFilter
+from swarmnav.controllers.prediction import time_to_collision_s
 from swarmnav.models.geometry import segment_box_distances
 
 
@@ -85,15 +84,9 @@ class VelocityObstacleNavigator:
                        ("margin_m",))
 
     def reset(self, setup: NavigationSetup) -> None:
-        known = setup.map_problem
-        self.geometry = setup.controller.geometry
-        self.max_speed = setup.max_speed_m_s
-        self.inflation = known.robot_radius_m + self.margin_m
-        self.local = LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m)
-        self.carrot = PathCarrot(setup.path.waypoints, self.lookahead_m)
-        self.goal = np.array([setup.goal.x_m, setup.goal.y_m])
-        self.filter = SafetyFilter(self.geometry, known.robot_radius_m,
-                                   self.time_before_collision_s) if self.safety_filter else None
+        (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal,
+         self.filter) = local_setup(setup, self.margin_m, self.lookahead_m, self.safety_filter,
+                                    self.time_before_collision_s)
         speeds = np.linspace(self.max_speed / self.speed_samples, self.max_speed, self.speed_samples)
         offsets = np.linspace(-self.max_turn_rad, self.max_turn_rad, self.heading_samples)
         speed, offset = (a.ravel() for a in np.meshgrid(speeds, offsets, indexing="ij"))
