@@ -128,8 +128,9 @@ class Scenario:
                 only moving obstacles): its clearance is part of that map.
         """
         clearance_m = float(clearance_m)
-        if not clearance_m >= 0.0:
-            raise ConfigError(field_name, f"must be a non-negative number, got {clearance_m:g}", self.source_path)
+        if not 0.0 <= clearance_m < math.inf:
+            raise ConfigError(field_name, f"must be a finite non-negative number, got {clearance_m:g}",
+                              self.source_path)
         if clearance_m == self.clearance_m:
             return self
         if self.map_grid is not None:

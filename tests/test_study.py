@@ -224,6 +224,8 @@ BAD_STUDIES = {
                                          'paired_seeds = true\n[[planners]]\nname = "astar"\n', "paired_seeds"),
     "negative clearance": ('scenarios = ["gwo-scenario-1"]\nclearance_m = -0.1\n[[planners]]\nname = "astar"\n',
                            "clearance_m"),
+    "infinite clearance": ('scenarios = ["gwo-scenario-1"]\nclearance_m = inf\n[[planners]]\nname = "astar"\n',
+                           "clearance_m"),
     "clearance of a pre-inflated map": ('scenarios = ["immas-env1-dynamic"]\nclearance_m = 0.0\n'
                                         '[[planners]]\nname = "astar"\n', "clearance_m"),
 }

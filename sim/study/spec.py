@@ -291,8 +291,6 @@ def _clearance(source: str, data: dict, scenarios: tuple[str, ...]) -> float | N
     if "clearance_m" not in data:
         return None
     clearance_m = _number(source, data["clearance_m"], "clearance_m")
-    if clearance_m < 0:
-        _fail(source, "clearance_m", f"must be non-negative, got {clearance_m:g}")
     for ref in scenarios:
         try:
             load_scenario(ref).with_clearance(clearance_m)
