@@ -53,7 +53,8 @@ def run_bench_sim(args: argparse.Namespace) -> int:
 
 def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenarios", nargs="+", default=list(BENCH_PLANNERS_SCENARIOS), metavar="NAME")
-    parser.add_argument("--planners", nargs="+", default=list(BENCH_PLANNERS_PLANNERS), metavar="NAME")
+    parser.add_argument("--planners", nargs="+", default=list(BENCH_PLANNERS_PLANNERS), choices=BENCH_PLANNERS_PLANNERS,
+                        metavar="NAME", help=f"continuous planners among {', '.join(BENCH_PLANNERS_PLANNERS)}")
     parser.add_argument("--seeds", type=options.positive_int, default=10, help="runs per planner and scenario (default 10)")
     parser.add_argument("--population", type=options.positive_int, default=50)
     parser.add_argument("--iterations", type=options.positive_int, default=100)

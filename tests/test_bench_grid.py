@@ -79,3 +79,11 @@ def test_the_map_table_is_the_study_rows(tmp_path, capsys):
     assert set(maco.planner) == {"maco", "astar"} and len(maco) == 4
     swarm = result["movingai"]["swarm_ratio_to_optimum"]
     assert all(v["instances"] >= 1 and (v["median"] is None or v["median"] >= 1 - 1e-9) for v in swarm.values())
+
+
+def test_a_map_option_naming_a_scenario_without_a_map_is_one_line(capsys):
+    from swarmnav.sim.cli import main
+
+    assert main(["bench", "grid", "--quick", "--maps", "gwo-scenario-1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--maps" in err and "gwo-scenario-1" in err

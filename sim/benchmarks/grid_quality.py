@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import list_scenarios, load_scenario
 from swarmnav.planners.problem import scenario_problem
 from swarmnav.sim.study.execute import run_study_tables
@@ -41,12 +42,18 @@ MOVINGAI_CLEARANCE_M = 0.05  # robot radius + clearance = half a cell: the infla
 
 
 def map_scenarios(names: list[str] | None) -> list[str]:
-    """The named scenarios with a map, or every bundled ``immas-*`` / ``iaco-*`` one with a map."""
+    """The named scenarios with a map, or every bundled ``immas-*`` / ``iaco-*`` one with a map.
+
+    Raises:
+        ConfigError: a named scenario has no map (``--maps``).
+    """
     out = []
     for name in names or list_scenarios():
         scenario = load_scenario(name)
         if scenario.boxes and (names or name.startswith(("immas-", "iaco-"))):
             out.append(name)
+        elif names:
+            raise ConfigError("--maps", f"scenario {name!r} has no map (box obstacles): bench grid plans on maps")
     return out
 
 

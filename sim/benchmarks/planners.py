@@ -48,7 +48,9 @@ from swarmnav.planners.path_cost import PathObjective
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.problem import scenario_problem
 from swarmnav.sim.benchmarks.planner_quality import field_summary, scenario_rows, study_tables
+from swarmnav.sim.commands import BENCH_PLANNERS_SCENARIOS
 
+SOURCE = "swarmnav bench planners"  # what an error in the options' study names
 PEERS = (("gwo", "mealpy.OriginalGWO"), ("abc", "mealpy.OriginalABC"))
 
 # Lengths the papers report for their best path (Abdulla & Hadi 2025 Sects. 6.1-6.3; Kamil et al. 2020 Table 2).
@@ -178,7 +180,7 @@ def quality_rows(args: argparse.Namespace, out_dir: FilePath) -> tuple[list[dict
     runs = run_study_tables(
         study_tables("bench-planners", args.scenarios, args.planners, args.modes, args.seeds, args.population,
                      args.iterations, clearance_m=args.clearance_m, paper_lengths_m=PAPER_LENGTHS_M),
-        out_dir / "scenarios", workers=args.workers)
+        out_dir / "scenarios", workers=args.workers, source=SOURCE)
     rows = scenario_rows(runs, args.planners, args.modes)
     notes = []
     for row in rows:
@@ -199,7 +201,7 @@ def quality_rows(args: argparse.Namespace, out_dir: FilePath) -> tuple[list[dict
             paths.append(str(path))
         field_runs = run_study_tables(study_tables("bench-planners-fields", paths, args.planners, args.modes,
                                                    args.seeds, args.population, args.iterations),
-                                      out_dir / "fields", workers=args.workers)
+                                      out_dir / "fields", workers=args.workers, source=SOURCE)
         fields = field_summary(field_runs, args.planners, args.modes)
     return rows, fields, notes
 
@@ -207,8 +209,9 @@ def quality_rows(args: argparse.Namespace, out_dir: FilePath) -> tuple[list[dict
 def benchmark(args: argparse.Namespace) -> dict[str, Any]:
     """All figures of the benchmark as one JSON-ready object."""
     if getattr(args, "quick", False):
-        args.scenarios, args.seeds, args.peer_runs = (["gwo-scenario-1", "dense-field-30"], min(args.seeds, 3),
-                                                      min(args.peer_runs, 1))
+        if args.scenarios == list(BENCH_PLANNERS_SCENARIOS):  # scenarios named on the command line stay
+            args.scenarios = ["gwo-scenario-1", "dense-field-30"]
+        args.seeds, args.peer_runs = min(args.seeds, 3), min(args.peer_runs, 1)
         args.fields = min(args.fields, 2)
     params = {"population": args.population, "iterations": args.iterations}
     if args.out is None:

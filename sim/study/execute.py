@@ -137,7 +137,7 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
 
 
 def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, workers: int = 1,
-                     source: str = "<benchmark>", show_progress: bool = False) -> list[dict[str, Any]]:
+                     source: str = "swarmnav bench", show_progress: bool = False) -> list[dict[str, Any]]:
     """Validate a study built in code (the tables its TOML file would hold), run it into ``out_dir`` (in this
     process with ``workers=1``, else on that many local processes), and return every run row of the folder
     (what the benchmarks tabulate)."""
