@@ -33,6 +33,7 @@ from scipy import ndimage
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import list_scenarios, load_scenario
 from swarmnav.planners.problem import scenario_problem
+from swarmnav.sim.benchmarks.planner_quality import arms, run_time_s
 from swarmnav.sim.study.execute import run_study_tables
 
 GRID_PLANNERS = ("astar", "dijkstra", "theta_star", "dstar_lite", "immas", "iaco")
@@ -109,22 +110,15 @@ def _extra(row: dict[str, Any]) -> dict[str, Any]:
     return json.loads(row["plan_extra"]) if row.get("plan_extra") else {}
 
 
-def _mean_cell_clearance_m(ref: str, cells: list) -> float:
+def cell_clearance_m(ref: str) -> np.ndarray:
+    """Each cell's distance to the nearest occupied cell of scenario ``ref``'s planning grid, in metres."""
     grid = scenario_problem(load_scenario(ref)).grid
-    clearance = ndimage.distance_transform_edt(~grid.occupied) * grid.cell_m
+    return ndimage.distance_transform_edt(~grid.occupied) * grid.cell_m
+
+
+def _mean_at(clearance: np.ndarray, cells: list) -> float:
     idx = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
     return float(np.mean(clearance[idx[:, 0], idx[:, 1]]))
-
-
-def _by_arm(rows: list[dict[str, Any]]) -> dict[tuple[str, str], list[dict[str, Any]]]:
-    out: dict[tuple[str, str], list[dict[str, Any]]] = {}
-    for row in rows:
-        out.setdefault((row["scenario"], row["planner"]), []).append(row)
-    return out
-
-
-def _time_s(row: dict[str, Any]) -> float:
-    return row["plan_time_s"] if row["plan_time_s"] is not None else row["cell_wall_s"]
 
 
 def maps_study(args, out_dir: FilePath) -> list[dict[str, Any]]:
@@ -135,17 +129,18 @@ def maps_study(args, out_dir: FilePath) -> list[dict[str, Any]]:
                  for ref in list(refs) for k in range(len(load_scenario(ref).map_pairs))]
     runs = run_study_tables({"name": "bench-grid-maps", "scenarios": refs, "mode": "plan", "seeds": args.runs,
                              "planners": [{"name": p} for p in GRID_PLANNERS]}, out_dir / "maps")
-    arms = _by_arm(runs)
+    by_arm = arms(runs)
     table = []
     for scenario in dict.fromkeys(r["scenario"] for r in runs):
-        astar = [r for r in arms.get((scenario, "astar"), []) if r["success"]]
+        clearance = cell_clearance_m(next(r["scenario_ref"] for r in runs if r["scenario"] == scenario))
+        astar = [r for r in by_arm.get((scenario, "astar"), []) if r["success"]]
         astar_len = astar[0]["plan_length_m"] if astar else None
         astar_raw = astar[0]["plan_raw_length_m"] if astar else None
         for planner in GRID_PLANNERS:
-            arm = arms.get((scenario, planner), [])
+            arm = by_arm.get((scenario, planner), [])
             good = [r for r in arm if r["success"]]
             row = {"map": scenario, "planner": planner, "runs": len(arm), "feasible_runs": len(good),
-                   "mean_plan_time_s": statistics.fmean(_time_s(r) for r in arm) if arm else None,
+                   "mean_plan_time_s": statistics.fmean(run_time_s(r) for r in arm) if arm else None,
                    "astar_length_m": astar_len, "astar_raw_length_m": astar_raw}
             if good:
                 median = statistics.median(r["plan_length_m"] for r in good)
@@ -153,9 +148,8 @@ def maps_study(args, out_dir: FilePath) -> list[dict[str, Any]]:
                 extras = [_extra(r) for r in good]
                 row.update(median_length_m=median, ratio_to_astar=median / astar_len if astar_len else None,
                            median_raw_length_m=raw, raw_ratio_to_astar=raw / astar_raw if astar_raw else None,
-                           mean_cell_clearance_m=statistics.fmean(
-                               _mean_cell_clearance_m(good[i]["scenario_ref"], e["raw_cells"])
-                               for i, e in enumerate(extras)))
+                           mean_cell_clearance_m=statistics.fmean(_mean_at(clearance, e["raw_cells"])
+                                                                  for e in extras))
                 if planner == "immas":
                     row.update({k: extras[0][k] for k in ("gates_raised", "tunnels_closed", "moves", "total_arc_cost")})
                 if planner == "iaco":
@@ -171,16 +165,16 @@ def restaurant_study(runs: int, out_dir: FilePath) -> list[dict[str, Any]]:
     rows = run_study_tables({"name": "bench-grid-restaurant", "scenarios": ["restaurant-table-2"], "mode": "plan",
                              "seeds": runs, "planners": [{"name": "maco"}, {"name": "astar"}]},
                             out_dir / "restaurant")
-    arms = _by_arm(rows)
-    maco = arms.get(("restaurant-table-2", "maco"), [])
+    by_arm = arms(rows)
+    maco = by_arm.get(("restaurant-table-2", "maco"), [])
     good = [r for r in maco if r["success"]]
-    astar = [r for r in arms.get(("restaurant-table-2", "astar"), []) if r["success"]]
+    astar = [r for r in by_arm.get(("restaurant-table-2", "astar"), []) if r["success"]]
     astar_len = astar[0]["plan_length_m"] if astar else None
     median = statistics.median(r["plan_length_m"] for r in good) if good else None
     return [{"map": "restaurant-table-2", "planner": "maco", "runs": len(maco), "feasible_runs": len(good),
              "median_length_m": median, "astar_length_m": astar_len,
              "ratio_to_astar": median / astar_len if (median is not None and astar_len) else None,
-             "mean_plan_time_s": statistics.fmean(_time_s(r) for r in maco) if maco else None,
+             "mean_plan_time_s": statistics.fmean(run_time_s(r) for r in maco) if maco else None,
              "node_baseline_runs_colliding": sum(bool(_extra(r).get("dijkstra_colliding_links")) for r in good)}]
 
 

@@ -53,7 +53,13 @@ def study_tables(name: str, scenarios: list[str], planners: list[str], modes: li
     return tables
 
 
-def _arms(rows: list[dict[str, Any]]) -> dict[tuple[str, str], list[dict[str, Any]]]:
+def run_time_s(row: dict[str, Any]) -> float:
+    """A run's plan time, or its whole cell time when it has none (it found no path or raised)."""
+    return row["plan_time_s"] if row["plan_time_s"] is not None else row["cell_wall_s"]
+
+
+def arms(rows: list[dict[str, Any]]) -> dict[tuple[str, str], list[dict[str, Any]]]:
+    """(scenario, planner label) -> its rows."""
     out: dict[tuple[str, str], list[dict[str, Any]]] = {}
     for row in rows:
         out.setdefault((row["scenario"], row["label"]), []).append(row)
@@ -64,7 +70,7 @@ def optimum_by_scenario(rows: list[dict[str, Any]]) -> dict[str, float | None]:
     """The exact optimum of each scenario from its ``optimal`` rows (their ``optimum_length_m``: the exact
     length, a hair below that of the polygon ``optimal`` returns); None where no path exists."""
     out: dict[str, float | None] = {}
-    for (scenario, label), arm in _arms(rows).items():
+    for (scenario, label), arm in arms(rows).items():
         if label == OPTIMUM_LABEL:
             lengths = {json.loads(r["plan_extra"])["optimum_length_m"] for r in arm if r["success"]}
             if len(lengths) > 1:
@@ -78,7 +84,7 @@ def arm_figures(arm: list[dict[str, Any]]) -> dict[str, Any]:
 
     The plan time of a run that found no path is its whole cell time (it has no plan time of its own)."""
     lengths = [r["plan_length_m"] for r in arm if r["success"]]
-    times = [r["plan_time_s"] if r["plan_time_s"] is not None else r["cell_wall_s"] for r in arm]
+    times = [run_time_s(r) for r in arm]
     evaluations = [r["plan_evaluations"] for r in arm if r["plan_evaluations"] is not None]
     return {"runs": len(arm), "feasible_runs": len(lengths),
             "failed_runs": sum(r["outcome"] != "ok" for r in arm),
@@ -92,12 +98,12 @@ def arm_figures(arm: list[dict[str, Any]]) -> dict[str, Any]:
 
 def scenario_rows(rows: list[dict[str, Any]], planners: list[str], modes: list[str]) -> list[dict[str, Any]]:
     """One table row per scenario, planner and mode, in the order asked."""
-    arms, optimum = _arms(rows), optimum_by_scenario(rows)
+    by_arm, optimum = arms(rows), optimum_by_scenario(rows)
     out = []
     for scenario in dict.fromkeys(r["scenario"] for r in rows):
         for planner in planners:
             for mode in modes:
-                arm = arms.get((scenario, mode_label(planner, mode)), [])
+                arm = by_arm.get((scenario, mode_label(planner, mode)), [])
                 figures = arm_figures(arm)
                 best = optimum.get(scenario)
                 median = figures["median_length_m"]
@@ -112,18 +118,17 @@ def field_summary(rows: list[dict[str, Any]], planners: list[str], modes: list[s
     """Per planner and mode over the random fields: feasible runs, the median and worst of the per-field
     median length over the exact optimum, fields within :data:`WITHIN_RATIO`, the median plan time.  A field
     without any path (the exact planner proves it) is counted in ``fields_without_path`` and has no ratio."""
-    arms, optimum = _arms(rows), optimum_by_scenario(rows)
+    by_arm, optimum = arms(rows), optimum_by_scenario(rows)
     with_path = [s for s, best in optimum.items() if best is not None]
     out = []
     for planner in planners:
         for mode in modes:
             ratios, times, feasible, runs = [], [], 0, 0
             for scenario in with_path:
-                figures = arm_figures(arms.get((scenario, mode_label(planner, mode)), []))
+                figures = arm_figures(by_arm.get((scenario, mode_label(planner, mode)), []))
                 runs += figures["runs"]
                 feasible += figures["feasible_runs"]
-                times += [r["plan_time_s"] if r["plan_time_s"] is not None else r["cell_wall_s"]
-                          for r in arms.get((scenario, mode_label(planner, mode)), [])]
+                times += [run_time_s(r) for r in by_arm.get((scenario, mode_label(planner, mode)), [])]
                 median = figures["median_length_m"]
                 ratios.append(median / optimum[scenario] if median is not None else math.inf)
             out.append({"planner": planner, "mode": mode, "fields": len(with_path),

@@ -126,7 +126,7 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
                                                 scenario.goal.y_m - scenario.start.y_m)
             spec = EpisodeSpec(scenario, cell.planner, cell.planner_params, cell.navigator, cell.navigator_params,
                                seed=cell.seed, world_seed=cell.world_seed, clearance_m=cell.clearance_m)
-            row["clearance_m"] = spec.resolved().scenario.clearance_m
+            row["clearance_m"] = scenario.clearance_m if cell.clearance_m is None else cell.clearance_m
             episode = plan_episode(spec)
             if cell.physics:
                 tally = EventTally()

@@ -23,7 +23,6 @@ from swarmnav.sim.commands import SINGLE_THREAD_ENVIRONMENT
 from swarmnav.sim.study.cell import run_cell
 from swarmnav.sim.study.grid import Cell
 
-WORKER_ENVIRONMENT = SINGLE_THREAD_ENVIRONMENT  # the CLI's own setting, also for Ray tasks on other hosts
 PARENT_POLL_S = 0.5
 RAY_AUTH_LOGGER = "ray._private.authentication.authentication_token_setup"
 
@@ -31,7 +30,7 @@ Result = tuple[dict[str, Any], list[dict[str, Any]]]
 
 
 def worker_environment() -> dict[str, str]:
-    return {**WORKER_ENVIRONMENT, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+    return {**SINGLE_THREAD_ENVIRONMENT, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
 
 
 @contextlib.contextmanager

@@ -21,8 +21,8 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.study.engines import check_reachable, run_inline, run_local, run_ray
 from swarmnav.sim.study.grid import Cell, expand
-from swarmnav.sim.study.rows import RowWriter, done_hashes
-from swarmnav.sim.study.spec import Study
+from swarmnav.sim.study.rows import RowWriter, done_hashes, read_table
+from swarmnav.sim.study.spec import Study, study_from_tables
 
 METADATA = "study.json"
 
@@ -141,9 +141,6 @@ def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, work
     """Validate a study built in code (the tables its TOML file would hold), run it into ``out_dir`` (in this
     process with ``workers=1``, else on that many local processes), and return every run row of the folder
     (what the benchmarks tabulate)."""
-    from swarmnav.sim.study.rows import read_table
-    from swarmnav.sim.study.spec import study_from_tables
-
     study = study_from_tables(tables, source, str(tables.get("name", "study")))
     run_study(study, out_dir, engine="inline" if workers == 1 else "local", workers=workers,
               show_progress=show_progress)
