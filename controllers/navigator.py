@@ -81,7 +81,8 @@ class NavigationSetup:
     Attributes:
         path: the path planned at t = 0 on ``problem``.
         problem: the planning problem the first path was planned on.
-        planner: the scenario's planner, for navigators that replan.
+        planner: the run's planner (the one that planned ``path``), for navigators that declare
+            ``uses_planner``; None for the others.
         rng: the generator of the run's ``seed`` (planner and navigator randomness).
         controller: turns a path into wheel speeds.
         goal: the goal checker.
@@ -95,7 +96,7 @@ class NavigationSetup:
 
     path: Path
     problem: Problem
-    planner: Planner
+    planner: Planner | None
     rng: np.random.Generator
     controller: Controller
     goal: GoalChecker
@@ -142,10 +143,23 @@ class NavigationStep:
 
 
 class Navigator(Protocol):
-    """``uses_detections`` (optional, default True): False for a navigator that never reads
-    ``Observation.detections``, which then stays empty and costs nothing."""
+    """What a navigator is, and what it declares it uses (every navigator states all three).
+
+    Attributes:
+        name: the registry name.
+        uses_detections: whether :meth:`step` reads ``Observation.detections``; when False
+            they stay empty and the sensing model's work is spared.  Read after :meth:`reset`
+            (a navigator may decide per run, e.g. from the scenario).
+        uses_planner: whether :meth:`step` may call ``NavigationSetup.planner`` (replanning
+            with the run's planner); when False the setup's ``planner`` is None.
+        replan_wall_s: wall time spent planning inside :meth:`step` since :meth:`reset`
+            (0 for a navigator that never plans); reported as the run's ``replan_wall_s``.
+    """
 
     name: ClassVar[str]
+    uses_detections: bool
+    uses_planner: ClassVar[bool]
+    replan_wall_s: float
 
     def reset(self, setup: NavigationSetup) -> None: ...
     def step(self, observation: Observation) -> NavigationStep: ...

@@ -184,8 +184,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         from swarmnav.sim.render import VideoRecorder
         recorders.append(VideoRecorder(args.video, camera=args.camera, width=args.width,
                                        height=args.height, fps=args.fps))
-    episode = run_episode(spec, recorders, stop_on_collision=True if args.stop_on_collision else None,
-                          planned=planned)
+    episode = run_episode(planned, recorders, stop_on_collision=True if args.stop_on_collision else None)
     result, path = episode.result, episode.path
     out = {**episode.summary(), "log": str(log_path) if log_path else None, "video": args.video}
     if args.json:

@@ -119,7 +119,7 @@ def test_an_episode_records_to_mcap_like_a_run(tmp_path):
     while not truncated:
         _, _, _, truncated, info = env.step(np.array([0.5, 0.2]))
         steps += 1
-    poses = env.task.loop.poses[:steps + 1].copy()
+    poses = env.task.stepper.poses[:steps + 1].copy()
     env.reset(seed=0)  # the second episode is closed before its end
     for _ in range(5):
         env.step(np.array([0.5, 0.2]))

@@ -118,9 +118,9 @@ def test_skipping_clearance_measurements_changes_nothing(monkeypatch, name, navi
                                              ("immas-env1-dynamic", None)])
 def test_the_runners_bound_is_below_the_clearance_at_every_step_among_moving_obstacles(monkeypatch, name, navigator):
     """The bound the loop acts on (its obstacle-shift bookkeeping included) against a fresh probe's measure."""
-    from swarmnav.sim import runner
+    from swarmnav.sim import stepper
 
-    original = runner.StepLoop.observe
+    original = stepper.EpisodeStepper._observe
     checked = []
 
     def checking_observe(self):
@@ -132,7 +132,7 @@ def test_the_runners_bound_is_below_the_clearance_at_every_step_among_moving_obs
         checked.append(bound > 0.0)
         return original(self)
 
-    monkeypatch.setattr(runner.StepLoop, "observe", checking_observe)
+    monkeypatch.setattr(stepper.EpisodeStepper, "_observe", checking_observe)
     run_episode(EpisodeSpec(load_scenario(name), navigator=navigator), time_limit_s=40.0)
     assert sum(checked) >= 200
 
