@@ -284,3 +284,23 @@ def test_gymnasium_reset_reports_an_episode_over_at_its_start_and_the_first_step
     assert info["outcome"] == "goal_reached" and info["metrics"]["reached"]
     _, reward, terminated, truncated, info = env.step(env.action_space.sample())
     assert terminated and not truncated and reward == 0.0
+
+
+@pytest.mark.parametrize("name, spl", [("restaurant-table-5", "positive"), ("gwo-scenario-2", "zero"),
+                                       ("dyn-crossing-3", "zero")])  # success; collisions (rangefinder, detector)
+def test_the_environments_final_metrics_are_run_jsons_for_the_same_wheel_commands(name, spl, capsys):
+    """SPL included: the environment's episode is the same stepper's, with the same L*.  (``follow``
+    runs: the environment has no navigator to replan or trigger a safety filter.)"""
+    import json
+
+    from swarmnav.sim.cli import main
+    assert main(["run", name, "--navigator", "follow", "--json", "--no-log"]) == 0
+    run = json.loads(capsys.readouterr().out)
+    commands = run_episode(EpisodeSpec(load_scenario(name), navigator="follow")).result.wheel_command_rad_s
+    env = make_environment(name, action="wheels")
+    replay_commands(env, commands)
+    metrics = env.task.info()["metrics"]
+    assert (run["spl"] > 0.0) if spl == "positive" else (run["spl"] == 0.0 and run["collisions"] > 0)
+    wall = {"wall_time_s"}
+    assert {k: v for k, v in metrics.items() if k not in wall} == \
+        {k: run[k] for k in metrics if k not in wall}
