@@ -46,7 +46,7 @@ class DetectedObstacle:
     track_id: int = -1
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class Observation:
     """What the robot senses at one control step.
 
@@ -72,6 +72,16 @@ class Observation:
     range_offset_m: float
     detections: tuple[DetectedObstacle, ...] = ()
     range_cutoff_m: float = math.inf
+
+    def __init__(self, time_s: float, pose: Pose2D, twist: Twist, ranges_m: np.ndarray,
+                 range_angles_rad: np.ndarray, range_offset_m: float, detections: tuple[DetectedObstacle, ...] = (),
+                 range_cutoff_m: float = math.inf):
+        # One built every control step: the fields go straight into the instance's dict, once (the
+        # generated frozen __init__ sets each through object.__setattr__, four times the cost).
+        # Still frozen: assigning a field afterwards raises FrozenInstanceError.
+        self.__dict__.update(time_s=time_s, pose=pose, twist=twist, ranges_m=ranges_m,
+                             range_angles_rad=range_angles_rad, range_offset_m=range_offset_m,
+                             detections=detections, range_cutoff_m=range_cutoff_m)
 
 
 @dataclass(frozen=True, eq=False)

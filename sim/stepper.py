@@ -247,11 +247,12 @@ class EpisodeStepper:
                 recorder.path(time_s, new_path.waypoints)
             for kind, details in events:
                 recorder.event(time_s, kind, details)
-        for kind, _ in events:
-            if kind == "replan":
-                self.replans += 1
-            elif kind == "safety_trigger":
-                self.safety_triggers += 1
+        if events:
+            for kind, _ in events:
+                if kind == "replan":
+                    self.replans += 1
+                elif kind == "safety_trigger":
+                    self.safety_triggers += 1
         wheels = command.wheels
         left, right = wheels.left_rad_s, wheels.right_rad_s
         data = self.data
@@ -437,9 +438,9 @@ class EpisodeStepper:
             recorder.finish(self.result.log_summary())
 
     def _frame(self, observation: Observation, command: ControlCommand, belief: Belief | None = None) -> StepFrame:
-        base_qpos = self._base_qpos
+        base_qpos = self._base_qpos.copy()  # one fresh copy; position and quaternion are views of it
         return StepFrame(
-            time_s=observation.time_s, position_m=base_qpos[:3].copy(), quaternion_wxyz=base_qpos[3:].copy(),
+            time_s=observation.time_s, position_m=base_qpos[:3], quaternion_wxyz=base_qpos[3:],
             heading_rad=observation.pose.heading_rad, range_m=observation.ranges_m,
             wheel_command_rad_s=np.array([command.wheels.left_rad_s, command.wheels.right_rad_s]),
             wheel_measured_rad_s=self.data.qvel[self._wheel_qvel_adr],

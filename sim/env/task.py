@@ -216,7 +216,7 @@ class NavigationTask(control.Task):
         self._collisions = collisions
 
     def get_observation(self, physics: SwarmnavPhysics) -> dict[str, np.ndarray]:
-        return {key: value.copy() for key, value in self.obs.items()}
+        return dict(self.obs)  # the observer builds fresh arrays at every observation: nothing to copy
 
     def get_reward(self, physics: SwarmnavPhysics) -> float:
         return self.reward_value
