@@ -204,3 +204,30 @@ def test_rangefinder_sensing_hands_the_tracker_what_hit_points_and_the_map_give(
         world = pose.heading_rad + scene.range_angles_rad
         assert directions.tobytes() == np.column_stack([np.cos(world), np.sin(world)]).tobytes()
         assert beam_ranges.tobytes() == ranges.tobytes() and beam_origins.shape == (len(ranges), 2)
+
+
+@pytest.mark.parametrize("name", ["dyn-crowd-1", "dyn-crossing-3"])  # rangefinder tracker, detector
+def test_skipping_the_sensing_model_for_a_navigator_that_never_reads_it_changes_nothing(monkeypatch, name):
+    """``follow`` declares ``uses_detections = False``: its observations carry no detections and the
+    sensing model does no work; sensing anyway gives the same run, bit for bit (and does sense)."""
+    from swarmnav.controllers.navigators.follow import FollowNavigator
+    from swarmnav.sim.detector import ObstacleSensing
+
+    spec = EpisodeSpec(load_scenario(name), navigator="follow")
+    sensed = []
+    original = ObstacleSensing.sense
+
+    def counting_sense(self, *args):
+        detections = original(self, *args)
+        sensed.append(len(detections))
+        return detections
+
+    monkeypatch.setattr(ObstacleSensing, "sense", counting_sense)
+    fast = run_episode(spec, time_limit_s=30.0).result
+    assert not sensed
+    monkeypatch.setattr(FollowNavigator, "uses_detections", True)
+    slow = run_episode(spec, time_limit_s=30.0).result
+    assert len(sensed) == slow.steps + 1 and sum(sensed) > 0
+    assert np.array_equal(fast.poses, slow.poses)
+    assert np.array_equal(fast.wheel_command_rad_s, slow.wheel_command_rad_s)
+    assert fast.summary() | {"wall_time_s": 0} == slow.summary() | {"wall_time_s": 0}
