@@ -30,14 +30,15 @@ import numpy as np
 from swarmnav.controllers.navigator import NavigationSetup, Navigator
 from swarmnav.controllers.navigators import make_navigator
 from swarmnav.controllers.point_to_point import PointToPointController
-from swarmnav.models.scenario import Scenario, Seeds
+from swarmnav.models.scenario import Scenario
+from swarmnav.models.seeds import Seeds
 from swarmnav.planners.registry import make_planner
 from swarmnav.planners.problem import Path, Planner, Problem, scenario_problem
 from swarmnav.sim.recording import Recorder, RecorderGroup
 from swarmnav.sim.reference import reference_length_m, static_problem
 from swarmnav.sim.runner import Simulation
 from swarmnav.sim.scene import CompiledScene
-from swarmnav.sim.stepper import RunResult
+from swarmnav.sim.run_result import RunResult
 
 def json_safe(value: Any) -> Any:
     """A planner's extra statistics as JSON values (NumPy scalars and arrays to numbers and lists)."""

@@ -21,7 +21,8 @@ from swarmnav.controllers.navigator import NavigationSetup, Navigator
 from swarmnav.models.scenario import Scenario
 from swarmnav.sim.recording import ObstacleInfo, Recorder, RunContext
 from swarmnav.sim.scene import CompiledScene, compile_scene
-from swarmnav.sim.stepper import (EpisodeStepper, RunResult, goal_checker, obstacle_positions, reset_data,
+from swarmnav.sim.run_result import RunResult
+from swarmnav.sim.stepper import (EpisodeStepper, goal_checker, obstacle_positions, reset_data,
                                   steps_per_control)
 from swarmnav.sim.versions import software_versions
 

@@ -31,7 +31,7 @@ import numpy as np
 from dm_env import specs
 from gymnasium import spaces
 
-from swarmnav.models.scenario import Seeds
+from swarmnav.models.seeds import Seeds
 from swarmnav.sim.env.task import EnvOptions, NavigationTask, make_environment
 
 ENV_ID = "swarmnav/Navigate-v0"

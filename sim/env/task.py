@@ -49,7 +49,8 @@ from dm_control.rl import control
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command, observation_layout
 from swarmnav.models.errors import ConfigError
-from swarmnav.models.scenario import Scenario, Seeds, load_scenario
+from swarmnav.models.scenario import Scenario, load_scenario
+from swarmnav.models.seeds import Seeds
 from swarmnav.sim.episode import EpisodeSpec, plan_episode
 from swarmnav.sim.env.observations import action_spec, observation_specs
 from swarmnav.sim.env.reward import RewardWeights
