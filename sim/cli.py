@@ -195,6 +195,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise _blame_options(args, exc) from None
     out = outcome.to_dict()
     result, path = outcome.result, outcome.path
+    if args.json_out:
+        FilePath(args.json_out).write_text(json.dumps(out) + "\n", encoding="utf-8")
     if args.json:
         print(json.dumps(out))
     else:
@@ -204,11 +206,14 @@ def cmd_run(args: argparse.Namespace) -> int:
               f"({result.wall_time_s:.2f} s wall); driven {result.path_length_m:.3f} m "
               f"(planned {path.stats.length_m:.3f} m); collisions {result.collisions}"
               + (f", first at {result.first_collision_s:.2f} s" if result.first_collision_s is not None else "")
-              + f"; min clearance {result.min_clearance_m:.3f} m")
+              + f"; min clearance {result.min_clearance_m:.3f} m"
+              + (f"; SPL {out['spl']:.3f}" if out.get("spl") is not None else ""))
         if outcome.log:
             print(f"log: {outcome.log}")
         if args.video:
             print(f"video: {args.video}")
+        if args.json_out:
+            print(f"summary (run --json): {args.json_out}")
     return expectation_exit(args.expect, outcome)
 
 
@@ -268,6 +273,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--stop-on-collision", action="store_true", help="stop at the first collision")
     p.add_argument("--waypoints", metavar="FILE", help="drive this path instead of planning: CSV with x,y columns, "
                    "a JSON list of [x, y] pairs, or the output of `plan --json`")
+    p.add_argument("--json-out", metavar="FILE", help="also write the `--json` object to FILE")
     p.add_argument("--expect", choices=("success", "reached"),
                    help=f"exit {EXIT_EXPECTATION} unless the goal is reached with no collision (success) or reached "
                    "at all (reached): a CI smoke check")

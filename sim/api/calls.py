@@ -115,7 +115,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
         log_path = FilePath(log) if log is not True else default_log_path(
             planned.spec.scenario.name, planned.spec.planner, planned.spec.seed, time.strftime("%Y%m%d-%H%M%S"))
         if log_path.is_dir():
-            raise ConfigError("--out", "is a directory (give a file path)", str(log_path))
+            raise ConfigError("--out", "Is a directory (give a file path)", str(log_path))
         if log_path.exists() and not overwrite:
             raise ConfigError("--out", "file exists (use --overwrite)", str(log_path))
         recorders.append(McapRecorder(log_path, live=live, overwrite=True, on_live=on_live))
