@@ -173,3 +173,17 @@ class Navigator(Protocol):
 
     def reset(self, setup: NavigationSetup) -> None: ...
     def step(self, observation: Observation) -> NavigationStep: ...
+
+
+DECLARATIONS = ("uses_detections", "uses_planner", "replan_wall_s")  # what every navigator class states
+
+
+def check_declarations(cls: type) -> type:
+    """``cls`` if it declares what it uses (:class:`Navigator`'s ``uses_detections``, ``uses_planner`` as
+    booleans and ``replan_wall_s`` as a number, on the class); TypeError naming what is missing."""
+    missing = [name for name, kind in zip(DECLARATIONS, (bool, bool, (int, float)))
+               if not isinstance(getattr(cls, name, None), kind)]
+    if missing:
+        raise TypeError(f"navigator {cls.__name__} does not declare {', '.join(missing)} "
+                        "(controllers.navigator.Navigator)")
+    return cls

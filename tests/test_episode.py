@@ -202,3 +202,23 @@ def test_every_navigator_is_deterministic_and_names_a_bad_parameter(name, contra
         plan_episode(EpisodeSpec(scenario, "astar", navigator=name,
                                  navigator_params={**NEEDS_PARAMS.get(name, {}), "no_such_knob": 1}))
     assert info.value.field == "navigator.params.no_such_knob"
+
+
+def test_a_navigator_that_does_not_declare_what_it_uses_is_refused_at_registration():
+    from swarmnav.controllers.navigators import register
+    from swarmnav.controllers.navigators.follow import FollowNavigator
+
+    class Undeclared:
+        name = "undeclared"
+        uses_detections = False
+
+    with pytest.raises(TypeError, match="uses_planner, replan_wall_s"):
+        register(Undeclared)
+    assert "undeclared" not in NAVIGATORS
+
+    class HalfDeclared(FollowNavigator):
+        name = "half_declared"
+        uses_planner = "no"
+
+    with pytest.raises(TypeError, match="does not declare uses_planner"):
+        register(HalfDeclared)
