@@ -171,7 +171,8 @@ def pheromone_intensity(q: float, t_c: float, collar_length: float, lengths: np.
 def prune_length(q: float, t_c: float, collar_length: float, negligible: float) -> float:
     """Tour length beyond which Eq. (7) gives ``Q_m < negligible``: ``L_GL + (log(Q / negligible) / log t_c) ** (1/3)``.
 
-    Infinite when ``t_c <= 1`` (Eq. (7) then never shrinks a deposit).
+    Infinite when ``t_c = 1`` (Eq. (7) is then the constant ``Q``: it never shrinks a deposit); the
+    planner refuses ``t_c < 1``.
     """
     if t_c <= 1.0:
         return math.inf
@@ -257,7 +258,8 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
             ("iterations", self.iterations >= 1, "must be at least 1"),
             ("kappa", 0.0 < self.kappa < 1.0, "must lie in (0, 1)"),
             ("rho", 0.0 <= self.rho < 1.0, "must lie in [0, 1)"),
-            ("t_c", self.t_c > 0, "must be positive"),
+            ("t_c", self.t_c >= 1.0, "must be at least 1 (below 1, Eq. (7) would reward longer tours "
+                                     "without bound; Table 1's values are 1 to 5)"),
             ("q", self.q > 0, "must be positive"),
             ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
         ))
@@ -306,7 +308,8 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
                      prune_length(self.q, self.t_c, data["collar_length"], self.tau_floor))
                  if best_cells is not None else max(4.0 * data["collar_length"], float(rows + cols)))
         # An ant that backtracks keeps walking without growing its tour: cap its NumPy steps too.
-        max_steps = self.max_steps or min(rows * cols // 2, int(max(rows + cols, self.step_ratio * limit)))
+        # (``limit`` is infinite when t_c = 1: Eq. (7) is then the constant Q and prunes nothing.)
+        max_steps = self.max_steps or int(min(rows * cols // 2, max(rows + cols, self.step_ratio * limit)))
         ants = int(min(self.ants, state.evaluations_left))       # a tour is one evaluation
         walk = walk_colony(data["graph"], data["start"], data["goal"], ants, cell_weights, bend_beta, rng,
                            max_steps, max_length=limit)
