@@ -56,6 +56,7 @@ from swarmnav.planners.ant_colony import roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.grid_graph import DIRECTIONS, Cell, cells_to_waypoints, count_bends, grid_endpoints, grid_problem
 from swarmnav.planners.grid_shortcut import exact_shortcut
+from swarmnav.planners.max_min_trails import P_BEST, TrailLimits, unit_limits
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 
@@ -77,6 +78,7 @@ class EnvironmentAnalysis:
         tunnels: cells closed by CheckTightTunnelState.
         expansions: cells expanded by the propagation.
         closing_reverted: closing disconnected start from goal, so nothing was closed.
+        limits: the MAX-MIN bounds of the trails (``None`` for ``propagation="route_cost"``).
     """
 
     blocked: np.ndarray
@@ -88,6 +90,7 @@ class EnvironmentAnalysis:
     tunnels: list[Cell] = field(default_factory=list)
     expansions: int = 0
     closing_reverted: bool = False
+    limits: TrailLimits | None = None
 
 
 def is_gate(blocked: list[list[bool]], r: int, c: int) -> bool:
@@ -116,10 +119,23 @@ def is_tight_tunnel(blocked: list[list[bool]], r: int, c: int, dr: int, dc: int)
     return occ(r - 1, c + dc) and occ(r + 1, c + dc)
 
 
+PROPAGATIONS = ("mmas", "route_cost")
+
+
 def analyse_environment(occupied: np.ndarray, start: Cell, goal: Cell, rho: float = 0.98,
                         clean_weight: float = 0.5, diagonal_factor: float = 1.4,
-                        close: bool = True) -> EnvironmentAnalysis:
+                        close: bool = True, propagation: str = "mmas", evaporation_doubling: bool = False,
+                        p_best: float = P_BEST, trace: list[tuple[Cell, float]] | None = None
+                        ) -> EnvironmentAnalysis:
     """Algorithms 1-2: propagate pheromone from the goal, closing gates and tight tunnels.
+
+    Args:
+        propagation: ``"mmas"`` (the MAX-MIN trails of the module docstring) or ``"route_cost"``
+            (the trail is the route cost, ``tau(Y) = rho tau(X) + c``, unbounded).
+        evaporation_doubling: §3.2's prose: the evaporation rate rho doubles with each expansion
+            (``"mmas"`` only; Algorithm 1 and §4.2 keep rho = 0.98).
+        trace: if given, every ``(cell, tau)`` written, in order (tests check the bounds after
+            every update).
 
     Raises:
         NoPathFound: the start is unreachable from the goal even without closing.
@@ -127,8 +143,11 @@ def analyse_environment(occupied: np.ndarray, start: Cell, goal: Cell, rho: floa
     occ = np.asarray(occupied, dtype=bool)
     rows, cols = occ.shape
     blocked = occ.tolist()
+    bounded = propagation == "mmas"
+    limits = mmas_limits(occ, rho, diagonal_factor, p_best) if bounded else None
     k = [[INF] * cols for _ in range(rows)]
-    tau = [[INF] * cols for _ in range(rows)]
+    # MMAS: every trail starts at tau_max (§2 item 3); the goal's goal_pher = 0 (Algorithm 1 line 6), clamped.
+    tau = [[limits.tau_max if bounded else INF] * cols for _ in range(rows)]
     parent = [[None] * cols for _ in range(rows)]
     closed_set = [[False] * cols for _ in range(rows)]
     keep = {start, goal}
@@ -136,11 +155,14 @@ def analyse_environment(occupied: np.ndarray, start: Cell, goal: Cell, rho: floa
     tunnels: list[Cell] = []
     gr, gc = goal
     k[gr][gc] = 0.0
-    tau[gr][gc] = 0.0
+    tau[gr][gc] = limits.clamp_value(0.0) if bounded else 0.0
+    if trace is not None:
+        trace.append((goal, tau[gr][gc]))
     heap = [(0.0, gr, gc)]
     expansions = 0
     reached = False
     moves = [(dr, dc, diagonal_factor if dr and dc else 1.0) for dr, dc in DIRECTIONS]
+    persistence = rho
     while heap:
         kx, r, c = heapq.heappop(heap)
         if closed_set[r][c] or blocked[r][c] or kx > k[r][c]:
@@ -171,12 +193,23 @@ def analyse_environment(occupied: np.ndarray, start: Cell, goal: Cell, rho: floa
             ky = kx + cost
             if ky < k[yr][yc]:
                 k[yr][yc] = ky
-                tau[yr][yc] = rho * tx + cost
+                if bounded:
+                    # Eq. (2) by the iteration-best ant X (unit deposit), then "multiply by 1.4 or 1"
+                    # (§3.2), then the MMAS bounds (§2.1).
+                    tau[yr][yc] = limits.clamp_value(cost * (persistence * tx + 1.0))
+                else:
+                    tau[yr][yc] = rho * tx + cost
+                if trace is not None:
+                    trace.append(((yr, yc), tau[yr][yc]))
                 parent[yr][yc] = (r, c)
                 heapq.heappush(heap, (ky, yr, yc))
+        if bounded and evaporation_doubling:
+            persistence *= 2.0                                   # §3.2: "the evaporation rate doubles"
     if not reached:
         if close:
-            result = analyse_environment(occ, start, goal, rho, clean_weight, diagonal_factor, close=False)
+            result = analyse_environment(occ, start, goal, rho, clean_weight, diagonal_factor, close=False,
+                                         propagation=propagation, evaporation_doubling=evaporation_doubling,
+                                         p_best=p_best, trace=trace)
             result.closing_reverted = True
             return result
         raise NoPathFound(f"goal cell {goal} is unreachable from start cell {start}")
@@ -188,9 +221,26 @@ def analyse_environment(occupied: np.ndarray, start: Cell, goal: Cell, rho: floa
         for c in range(cols):
             if parent[r][c] is not None:
                 parent_arr[r, c] = parent[r][c]
-    return EnvironmentAnalysis(blocked=blocked_arr, route_cost=np.array(k), pheromone=np.array(tau),
+    tau_arr = np.array(tau)
+    if bounded:
+        tau_arr[~np.isfinite(np.array(k))] = INF   # never propagated: no trail (Algorithm 3 skips them)
+    return EnvironmentAnalysis(blocked=blocked_arr, route_cost=np.array(k), pheromone=tau_arr,
                                clean=clean_weight * neighbours * ~blocked_arr, parent=parent_arr,
-                               gates=gates, tunnels=tunnels, expansions=expansions)
+                               gates=gates, tunnels=tunnels, expansions=expansions, limits=limits)
+
+
+def mmas_limits(occupied: np.ndarray, rho: float, diagonal_factor: float, p_best: float = P_BEST) -> TrailLimits:
+    """The propagation's ``[tau_min, tau_max]`` (Stützle & Hoos 2000 Eqs. 7 and 11, :mod:`planners.max_min_trails`).
+
+    ``tau_max = 1 / (1 - rho)``: Eq. (7) for the unit deposit of Eq. (2) (the fixed point of
+    ``tau <- rho tau + 1``); ``n`` of Eq. (11) is the number of free cells (each a decision
+    point of the tour) and ``avg`` half the eight moves, 4.  With the persistence at 1 or more
+    (no evaporation, or §3.2's doubling) the bound is ``diagonal_factor / (1 - 0.98)`` instead
+    (the default rho's limit), so that it stays finite.
+    """
+    free = int(np.count_nonzero(~np.asarray(occupied, dtype=bool)))
+    persistence = rho if rho < 1.0 else 0.98
+    return unit_limits(persistence, 1.0 if rho < 1.0 else diagonal_factor, max(free, 1), 4.0, p_best)
 
 
 def tour_scores(tau: np.ndarray, clean: np.ndarray, eta: np.ndarray, alpha: float, beta: float) -> np.ndarray:
@@ -212,6 +262,11 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
         clean_weight: added per obstacle neighbour (0.5).
         diagonal_factor: arc cost of a diagonal move (1.4).
         close_gates_and_tunnels: apply GateRaiseState and Algorithm 2.
+        propagation: ``"mmas"`` (the MAX-MIN trails, see the module docstring) or ``"route_cost"``
+            (swarmnav's earlier reading: the trail is the unbounded route cost ``rho tau(X) + c``).
+        evaporation_doubling: §3.2's prose, "the evaporation rate doubles for each instance"
+            (off: Algorithm 1 line 4 and §4.2 keep rho = 0.98).
+        p_best: Stützle & Hoos (2000)'s p_best of ``tau_min`` (0.05).
         selection: "best" (Algorithm 3: the smallest Eq. (3) value) or "roulette".
         iterations: max_itr, the move budget; 0 means the number of cells.
         cell_m: grid resolution; ``None`` keeps the problem's.  The grid may have at most
@@ -227,6 +282,9 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
     clean_weight: float = 0.5
     diagonal_factor: float = 1.4
     close_gates_and_tunnels: bool = True
+    propagation: str = "mmas"
+    evaporation_doubling: bool = False
+    p_best: float = P_BEST
     selection: str = "best"
     iterations: int = 0
     cell_m: float | None = None
@@ -236,6 +294,8 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
     def __post_init__(self) -> None:
         check_parameters(self, (
             ("selection", self.selection in ("best", "roulette"), "must be 'best' or 'roulette'"),
+            ("propagation", self.propagation in PROPAGATIONS, f"must be one of {', '.join(PROPAGATIONS)}"),
+            ("p_best", 0.0 < self.p_best < 1.0, "must lie in (0, 1)"),
             ("rho", 0.0 < self.rho <= 1.0, "must lie in (0, 1]"),
             ("iterations", self.iterations >= 0, "must not be negative"),
             ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
@@ -243,6 +303,12 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
 
     def prepare(self, problem: Problem) -> Problem:
         return grid_problem(problem, self.cell_m)
+
+    def analyse(self, occupied: np.ndarray, start: Cell, goal: Cell) -> EnvironmentAnalysis:
+        """Algorithms 1-2 with this planner's settings (the ``immas_stepwise`` navigator's too)."""
+        return analyse_environment(occupied, start, goal, self.rho, self.clean_weight, self.diagonal_factor,
+                                   self.close_gates_and_tunnels, self.propagation, self.evaporation_doubling,
+                                   self.p_best)
 
     def iteration_limit(self, problem: Problem) -> int:
         """max_itr: ``iterations``, or the number of cells when it is 0."""
@@ -253,8 +319,7 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
         t0 = time.perf_counter()
         grid = problem.grid
         start, goal = grid_endpoints(problem, grid)
-        analysis = analyse_environment(grid.occupied, start, goal, self.rho, self.clean_weight,
-                                       self.diagonal_factor, self.close_gates_and_tunnels)
+        analysis = self.analyse(grid.occupied, start, goal)
         rows, cols = grid.shape
         rr, cc = np.mgrid[0:rows, 0:cols]
         eta = np.hypot(rr - goal[0], cc - goal[1])
@@ -338,6 +403,8 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
             "mean_cell_clearance_m": float(np.mean(clearance[idx[:, 0], idx[:, 1]])),
             "analysis_time_s": data["analysis_time_s"],
         }
+        if a.limits is not None:
+            extra.update({"tau_min": a.limits.tau_min, "tau_max": a.limits.tau_max})
         return waypoints, extra
 
 
