@@ -54,7 +54,8 @@ from scipy import ndimage
 
 from swarmnav.planners.ant_colony import roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
-from swarmnav.planners.grid_graph import DIRECTIONS, Cell, cells_to_waypoints, count_bends, grid_endpoints, grid_problem
+from swarmnav.planners.grid_graph import (DIRECTIONS, Cell, cell_clearance_m, cells_to_waypoints, count_bends,
+                                          grid_endpoints, grid_problem)
 from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.max_min_trails import P_BEST, TrailLimits, unit_limits
 from swarmnav.planners.problem import Problem
@@ -386,7 +387,7 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
         raw = cells_to_waypoints(problem, grid, cells)
         waypoints = exact_shortcut(problem, raw) if self.shortcut else raw
         a: EnvironmentAnalysis = data["analysis"]
-        clearance = ndimage.distance_transform_edt(~grid.occupied) * grid.cell_m
+        clearance = cell_clearance_m(grid)
         idx = np.array(cells)
         extra = {
             "raw_cells": [list(cell) for cell in cells],
