@@ -6,7 +6,7 @@ import logging
 import pandas as pd
 import pytest
 
-from swarmnav.sim.study.engines import RAY_AUTH_LOGGER, start_ray
+from swarmnav.sim.study.ray_engine import RAY_AUTH_LOGGER, start_ray
 from swarmnav.sim.study.execute import run_study
 from swarmnav.sim.study.rows import TIMING_COLUMNS
 from swarmnav.sim.study.spec import parse_study

@@ -22,6 +22,8 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--logs", action="store_true", help="keep the MCAP log of every physics run in DIR/logs/")
     p.add_argument("--quick", action="store_true",
                    help="only the study's first quick_seeds seeds (a later full run into the same --out resumes)")
+    p.add_argument("--retry-errors", action="store_true",
+                   help="run again the cells whose row is an error (by default a resume runs only cells without a row)")
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
 
 
@@ -43,7 +45,7 @@ def run_study(args: argparse.Namespace) -> int:
     from swarmnav.sim.study.execute import run_study as execute
     out = args.out or str(FilePath("studies") / study.name)
     summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,
-                      show_progress=not args.json and sys.stderr.isatty())
+                      show_progress=not args.json and sys.stderr.isatty(), retry_errors=args.retry_errors)
     if args.json:
         print(json.dumps(summary))
     else:
