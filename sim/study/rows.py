@@ -144,7 +144,7 @@ def _last_of_each(table: pa.Table, keys: tuple[str, ...]) -> pa.Table:
     last = indexed.group_by(list(keys), use_threads=False).aggregate([("_row", "max")]).column("_row_max")
     if len(last) == table.num_rows:
         return table
-    return table.take(pc.sort_indices(last))
+    return table.take(pc.take(last, pc.sort_indices(last)))
 
 
 def read_table(out_dir: str | os.PathLike, name: str = RUNS, columns: list[str] | None = None) -> pa.Table:
