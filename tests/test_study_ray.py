@@ -133,3 +133,30 @@ def test_a_ray_worker_killed_from_outside_is_one_error_row(ray_start_log, tmp_pa
     error = rows[rows.outcome == "error"].error.iloc[0]
     assert error.startswith("the worker running this cell died (WorkerCrashedError")
     assert error.endswith("1 try, Ray's own retries are off)")
+
+
+def test_sigterm_ends_a_ray_study_with_one_line_and_keeps_its_rows(tmp_path):
+    import subprocess
+    import sys
+    path = tmp_path / "study.toml"
+    path.write_text('name = "terminated"\nscenarios = ["gwo-scenario-1", "gwo-scenario-2"]\nseeds = 1500\n'
+                    '[[planners]]\nname = "astar"\n')
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out)]
+    process = subprocess.Popen(command + ["--engine", "ray", "--workers", "2"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not list((out / "runs.parquet").glob("part-*.parquet")) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 128 + signal.SIGTERM
+    assert "SIGTERM received" not in err and "PC: @" not in err and "Traceback" not in err
+    assert [line for line in err.splitlines() if line.startswith("swarmnav:")] == [
+        f"swarmnav: study stopped (SIGTERM); the rows of the finished cells are kept in {out}: run the same command "
+        "to resume"]
+    kept = len(pd.read_parquet(out / "runs.parquet"))
+    assert 0 < kept < 3000
+    subprocess.run(command + ["--workers", "2"], check=True, capture_output=True, timeout=300)
+    rows = pd.read_parquet(out / "runs.parquet")
+    assert len(rows) == 3000 and rows.config_hash.is_unique

@@ -44,8 +44,16 @@ def run_study(args: argparse.Namespace) -> int:
         study = study.quick()
     from swarmnav.sim.study.execute import run_study as execute
     out = args.out or str(FilePath("studies") / study.name)
-    summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,
-                      show_progress=not args.json and sys.stderr.isatty(), retry_errors=args.retry_errors)
+    try:
+        summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,
+                          show_progress=not args.json and sys.stderr.isatty(), retry_errors=args.retry_errors)
+    except (KeyboardInterrupt, SystemExit) as exc:  # Ctrl-C, or SIGTERM (the CLI's handler raises SystemExit)
+        how = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else "SIGTERM" if exc.code == 143 else f"exit {exc.code}"
+        print(f"swarmnav: study stopped ({how}); the rows of the finished cells are kept in {out}: run the same "
+              "command to resume", file=sys.stderr)
+        if isinstance(exc, KeyboardInterrupt):
+            return 130
+        raise
     if args.json:
         print(json.dumps(summary))
     else:
