@@ -121,9 +121,10 @@ def _run_locked(study: Study, out_dir: FilePath, engine: str, workers: int | Non
     todo, pending, total = pending_cells(study, out_dir, retry_errors)
     workers = workers or os.cpu_count() or 1
     logs_dir = str((out_dir / "logs").resolve()) if logs else None
+    nodes: set[str] = set()
     if engine == "ray":
         from swarmnav.sim.study.ray_engine import run_ray
-        results: Iterator = run_ray(todo, address, None if address else workers, logs_dir)
+        results: Iterator = run_ray(todo, address, None if address else workers, logs_dir, nodes)
     elif engine == "inline":
         results = run_inline(todo, logs_dir)
     else:
@@ -149,7 +150,7 @@ def _run_locked(study: Study, out_dir: FilePath, engine: str, workers: int | Non
     ran = sum(counts.values())
     return {"study": study.name, "out": str(out_dir), "cells": total, "skipped": total - pending, "ran": ran,
             "failed": ran - counts.get("ok", 0), "outcomes": counts, "engine": engine, "workers": workers,
-            "wall_s": round(wall_s, 3), "parts_compacted": parts}
+            "wall_s": round(wall_s, 3), "parts_compacted": parts, **({"ray_nodes": len(nodes)} if nodes else {})}
 
 
 def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, workers: int = 1,

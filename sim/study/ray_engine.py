@@ -91,7 +91,9 @@ def run_batch(cells: list[Cell], keep_logs: bool) -> dict[str, Any]:
         else:
             (row, progress), data = run_cell(cell), None
         results.append((row, progress, data))
-    return {"node": ray.util.get_node_ip_address(), "versions": _versions_json(), "results": results}
+    context = ray.get_runtime_context()
+    return {"node": ray.util.get_node_ip_address(), "node_id": context.get_node_id(), "versions": _versions_json(),
+            "results": results}
 
 
 def _check_versions(answer: dict[str, Any], driver: str) -> None:
@@ -100,7 +102,7 @@ def _check_versions(answer: dict[str, Any], driver: str) -> None:
     theirs, ours = json.loads(answer["versions"]), json.loads(driver)
     differ = ", ".join(f"{k} {theirs.get(k)} (driver {ours.get(k)})" for k in sorted(set(theirs) | set(ours))
                        if theirs.get(k) != ours.get(k))
-    raise ConfigError("--address", f"node {answer['node']} runs {differ}; install the driver's versions on "
+    raise ConfigError("--address", f"node {answer['node']} (id {answer.get('node_id', '?')[:12]}) runs {differ}; install the driver's versions on "
                                    "every node of the cluster")
 
 
@@ -120,8 +122,9 @@ def _failure(exc: Exception) -> str:
 
 
 def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | None = None,
-            logs_dir: str | None = None) -> Iterator[Result]:
-    """Run the cells as Ray tasks (one CPU each) on a local instance or the cluster at ``address``."""
+            logs_dir: str | None = None, nodes: set[str] | None = None) -> Iterator[Result]:
+    """Run the cells as Ray tasks (one CPU each) on a local instance or the cluster at ``address``; the ids of
+    the nodes that ran them are added to ``nodes``."""
     import ray
     start_ray(address, workers)
     task = ray.remote(num_cpus=1, max_retries=0)(run_batch)
@@ -150,6 +153,8 @@ def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | No
                         solo.extend(batch)  # again one cell per task: only the cell that fails is an error row
                     continue
                 _check_versions(answer, driver_versions)
+                if nodes is not None:
+                    nodes.add(answer["node_id"])
                 for row, progress, log in answer["results"]:
                     if log is not None:
                         row["log"] = _save_log(logs_dir, row["config_hash"], log)
