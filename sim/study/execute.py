@@ -150,7 +150,13 @@ def _run_locked(study: Study, out_dir: FilePath, engine: str, workers: int | Non
     ran = sum(counts.values())
     return {"study": study.name, "out": str(out_dir), "cells": total, "skipped": total - pending, "ran": ran,
             "failed": ran - counts.get("ok", 0), "outcomes": counts, "engine": engine, "workers": workers,
-            "wall_s": round(wall_s, 3), "parts_compacted": parts, **({"ray_nodes": len(nodes)} if nodes else {})}
+            "wall_s": round(wall_s, 3), "parts_compacted": parts, "driver_peak_mb": round(_peak_rss_mb(), 1), **({"ray_nodes": len(nodes)} if nodes else {})}
+
+
+def _peak_rss_mb() -> float:
+    """This process's peak resident memory so far (the driver's; workers are processes of their own)."""
+    import resource
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # KiB on Linux
 
 
 def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, workers: int = 1,
