@@ -255,7 +255,7 @@ def test_bench_planners_random_fields_are_a_study_of_scenario_files(tmp_path):
     add_bench_planners_arguments(parser)
     args = parser.parse_args(["--scenarios", "gwo-scenario-1", "--planners", "gwo", "--modes", "robust",
                               "--seeds", "2", "--population", "10", "--iterations", "5", "--peer-runs", "0",
-                              "--fields", "2", "--out", str(tmp_path)])
+                              "--fields", "2", "--sampling", "--out", str(tmp_path)])
     (summary,) = bench_continuous.benchmark(args)["fields"]
     runs = pd.read_parquet(tmp_path / "fields" / "runs.parquet")
     assert summary["runs"] == 4 and summary["fields"] + summary["fields_without_path"] == 2
