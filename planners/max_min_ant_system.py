@@ -156,6 +156,10 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
         check_parameters(self, (
             ("selection", self.selection in ("best", "roulette"), "must be 'best' or 'roulette'"),
             ("propagation", self.propagation in PROPAGATIONS, f"must be one of {', '.join(PROPAGATIONS)}"),
+            ("rho", self.propagation != "mmas" or self.rho < 1.0,
+             "must be below 1 with propagation = 'mmas' (tau_max = 1 / (1 - rho))"),
+            ("evaporation_doubling", self.propagation == "mmas" or not self.evaporation_doubling,
+             "applies to propagation = 'mmas' only"),
             ("p_best", 0.0 < self.p_best < 1.0, "must lie in (0, 1)"),
             ("rho", 0.0 < self.rho <= 1.0, "must lie in (0, 1]"),
             ("iterations", self.iterations >= 0, "must not be negative"),
