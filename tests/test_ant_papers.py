@@ -83,9 +83,10 @@ class CheckedColony(MaxMinColonyPlanner):
             self.updates += 1
 
 
-def test_mmas_trails_stay_within_the_bounds_after_every_update():
+@pytest.mark.parametrize("deposit", ["iteration_best", "best_so_far"])
+def test_mmas_trails_stay_within_the_bounds_after_every_update(deposit):
     problem, *_ = endpoints(load_scenario("immas-env4-blocks"))
-    planner = CheckedColony(iterations=30)
+    planner = CheckedColony(iterations=30, deposit=deposit)
     path = planner.plan(problem, np.random.default_rng(3))
     assert planner.updates >= 25
     extra = path.stats.extra
@@ -99,6 +100,8 @@ def test_mmas_is_registered_and_refuses_a_persistence_of_one():
         make_planner("mmas", {"rho": 1.0})
     with pytest.raises(ConfigError, match="planner.params.deposit"):
         make_planner("mmas", {"deposit": "all"})
+    with pytest.raises(ConfigError, match="planner.params.evaporation_doubling"):
+        make_planner("immas", {"propagation": "route_cost", "evaporation_doubling": True})
 
 
 def test_immas_10x10_alpha_2_takes_the_papers_14_moves():
