@@ -214,3 +214,22 @@ def test_new_scenarios_validate_and_sit_on_their_maps():
         scenario = load_scenario(str(path))
         assert scenario.name == path.stem and scenario.map_grid is not None
         assert not (SCENARIO_DIR / path.name).exists()  # not bundled twice
+
+
+def test_each_deviation_row_names_code_that_states_it():
+    """Every row of the README's "Deviations from the papers" names files that exist, and a planner file it
+    names cites the paper of the row in its docstring."""
+    root = Path(__file__).resolve().parent.parent
+    text = (root / "README.md").read_text(encoding="utf-8")
+    section = text.split("## Deviations from the papers", 1)[1].split("\n## ", 1)[0]
+    rows = [line for line in section.splitlines() if line.startswith("| ") and not line.startswith("| paper")
+            and not line.startswith("| ---")]
+    assert len(rows) >= 10
+    for row in rows:
+        author = row.split("|")[1].strip().split(" ")[0]
+        files = [f for f in row.split("`") if f.endswith((".py", ".md"))]
+        assert files, row
+        for name in files:
+            assert (root / name).is_file(), name
+            if name.startswith("planners/"):
+                assert author in (root / name).read_text(encoding="utf-8"), (author, name)
