@@ -210,6 +210,9 @@ class ImmasStepwiseNavigator:
     """
 
     name: ClassVar[str] = "immas_stepwise"
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = True
+    replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured
     alpha: float | None = None
     beta: float | None = None
     reach_m: float = 0.1

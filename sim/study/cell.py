@@ -139,7 +139,7 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
                     log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
                     recorders.append(McapRecorder(log_path, overwrite=True))
                     row["log"] = str(log_path)
-                episode = run_episode(spec, recorders, planned=episode, time_limit_s=cell.time_limit_s)
+                episode = run_episode(episode, recorders, time_limit_s=cell.time_limit_s)
                 row["run_events"] = tally.as_json()
         row["outcome"] = "ok"
     except WallLimitExceeded:
