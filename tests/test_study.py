@@ -394,7 +394,7 @@ def test_an_unreachable_ray_address_is_one_line_naming_the_option(tmp_path):
     import socket
 
     from swarmnav.models.errors import ConfigError
-    from swarmnav.sim.study.engines import check_reachable
+    from swarmnav.sim.study.ray_engine import check_reachable
 
     with socket.socket() as listener:  # a port that surely refuses: bound, never listening
         listener.bind(("127.0.0.1", 0))

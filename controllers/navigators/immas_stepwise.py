@@ -235,8 +235,7 @@ class ImmasStepwiseNavigator:
         start = grid.cell_of(problem.start.x_m, problem.start.y_m)
         goal = grid.cell_of(problem.goal.x_m, problem.goal.y_m)
         t0 = time.perf_counter()
-        analysis = analyse_environment(grid.occupied, start, goal, planner.rho, planner.clean_weight,
-                                       planner.diagonal_factor, planner.close_gates_and_tunnels)
+        analysis = planner.analyse(grid.occupied, start, goal)
         self.analysis_time_s = time.perf_counter() - t0
         self.walk = StepwiseWalk(analysis, goal, alpha, beta)
         self.walker = CellWalker(setup.controller, grid, self.reach_m)
