@@ -4,6 +4,12 @@ A component is a dataclass registered under a name; its parameters are its
 init fields.  A user's table (from a scenario file or ``--set``) is checked
 against the fields' annotations, and every problem is a :class:`ConfigError`
 naming ``<kind>.params.<key>`` (or ``<kind>.name``).
+
+A parameter that names code (the ``policy`` navigator's ``module:function``) is
+declared with :func:`code_parameter`.  Data is not code: such a value is taken
+from the command line and the Python API, but from a data file (a scenario, a
+study, a log) only when the user passes ``--trust-code`` for that invocation;
+:func:`refuse_code` checks it before anything is imported.
 """
 
 from __future__ import annotations
@@ -15,6 +21,37 @@ import typing
 from typing import Any
 
 from swarmnav.models.errors import ConfigError
+
+TRUST_OPTION = "--trust-code"  # the opt-in that lets a data file name code
+_NAMES_CODE = "names_code"
+
+
+def code_parameter(default: str = "") -> Any:
+    """A dataclass field whose value names code to import and call (``"module:function"``)."""
+    return dataclasses.field(default=default, metadata={_NAMES_CODE: True})
+
+
+def code_parameters(cls: type) -> tuple[str, ...]:
+    """The init fields of a component class that name code."""
+    return tuple(f.name for f in dataclasses.fields(cls) if f.init and f.metadata.get(_NAMES_CODE))
+
+
+def refuse_code(registry: dict[str, type], kind: str, name: str, params: dict[str, Any] | None,
+                source: str | None, field_prefix: str | None = None) -> None:
+    """Raise a :class:`ConfigError` if ``params`` (read from a data file) give a parameter that names code.
+
+    Nothing is imported: only the component's declaration is read.  An unknown
+    component name passes here (the registry's own check reports it).
+    """
+    cls = registry.get(name)
+    if cls is None or not params:
+        return
+    option = "--set" if kind == "planner" else f"--{kind}-set"
+    for key in code_parameters(cls):
+        if key in params:
+            raise ConfigError(f"{field_prefix or kind}.params.{key}",
+                              f"names code ({params[key]!r}); a data file's code runs only with {TRUST_OPTION} "
+                              f"(or give it on the command line: {option} {key}=...)", source)
 
 
 def _coerce(value: Any, annotation: Any, field: str) -> Any:
@@ -68,11 +105,13 @@ def register_component(registry: dict[str, type], kind: str, cls: type) -> type:
 
 
 def build_component(registry: dict[str, type], kind: str, name: str, params: dict[str, Any] | None = None,
-                    source: str | None = None) -> Any:
+                    source: str | None = None, trust_code: bool = True) -> Any:
     """Build ``registry[name]`` from a parameter table, checking every value against its field's type.
 
     Args:
         kind: what the registry holds, for error fields (``"planner"``, ``"navigator"``).
+        trust_code: False when ``params`` come from a data file the user did not vouch for: a parameter
+            that names code is then refused (:func:`refuse_code`) before the component is built.
 
     Raises:
         ConfigError: unknown name, unknown parameter, or a value of the wrong type.
@@ -80,6 +119,8 @@ def build_component(registry: dict[str, type], kind: str, name: str, params: dic
     if name not in registry:
         raise ConfigError(f"{kind}.name", f"unknown {kind} {name!r} (known: {', '.join(sorted(registry))})",
                           source)
+    if not trust_code:
+        refuse_code(registry, kind, name, params, source)
     cls = registry[name]
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
     hints = typing.get_type_hints(cls)

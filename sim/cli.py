@@ -24,7 +24,7 @@ from typing import Any, Callable
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
 from swarmnav.sim import options
-from swarmnav.sim.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT
+from swarmnav.sim.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
 
 # As sim.render does, before any subcommand imports mujoco (which reads it once, on import).
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -63,7 +63,7 @@ def parse_settings(pairs: list[str] | None, option: str = "--set") -> dict[str, 
 
 def _load(args: argparse.Namespace):
     from swarmnav.models.scenario import load_scenario
-    return load_scenario(args.scenario)
+    return load_scenario(args.scenario, trust_code=args.trust_code)
 
 
 def _episode_spec(args: argparse.Namespace):
@@ -214,6 +214,7 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--navigator", help="navigator name (default: the scenario's, else follow)")
     p.add_argument("--navigator-set", action="append", metavar="KEY=VALUE", help="navigator parameter (repeatable)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_trust_code_argument(p)
 
 
 def build_parser() -> argparse.ArgumentParser:

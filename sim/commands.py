@@ -37,6 +37,13 @@ BENCH_NAVIGATION_QUICK_SCENARIOS = ("dyn-crossing-1", "dyn-head-on-1", "dyn-over
 BENCH_STUDY_QUICK = (10, 300)  # bench study --quick: seeds per scenario, GWO iterations; no Ray
 
 
+def add_trust_code_argument(parser: argparse.ArgumentParser) -> None:
+    """``--trust-code``: this invocation may run code that a file it reads names (a ``policy``)."""
+    parser.add_argument("--trust-code", action="store_true",
+                        help="let the files this command reads name code to run (the policy navigator's "
+                             "policy = 'module:function'); without it such a value is an error")
+
+
 def add_bench_sim_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default="dense-field-30")
     parser.add_argument("--duration", type=options.positive_float, default=20.0, help="simulated seconds per measurement")
@@ -217,8 +224,12 @@ def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-trail", action="store_true", help="do not draw the driven trajectory")
     parser.add_argument("--verify", action="store_true",
                         help="re-simulate from the log and compare every pose and range scan "
-                             "(exit 1 if they differ)")
+                             "(exit 4 if they differ)")
     parser.add_argument("--json", action="store_true", help="print the results as JSON")
+    parser.add_argument("--navigator-set", action="append", metavar="KEY=VALUE",
+                        help="with --verify: the code a log's navigator ran (policy=module:function), named "
+                             "here because a log's own is never run without --trust-code")
+    add_trust_code_argument(parser)
 
 
 def run_replay(args: argparse.Namespace) -> int:

@@ -131,8 +131,47 @@ def render_log(log: RunLog, video_path: str | Path, *, camera: str = "top", widt
     return {"frames": recorder.frames, "video_s": recorder.frames / fps, "render_s": recorder.render_seconds}
 
 
-def verify_log(log: RunLog) -> VerifyReport:
-    """Re-simulate a logged run from the log alone and compare poses step by step."""
+def code_for_verify(context: RunContext, named: dict, trust_code: bool, source: str) -> tuple[dict, dict]:
+    """The navigator parameters to re-simulate with, and the code parameters named on the command line.
+
+    A log is data: a parameter of its planner or navigator that names code (the
+    ``policy`` navigator's ``policy``) is re-run only when the user names it on the
+    command line (``--navigator-set policy=module:function``), or with
+    ``--trust-code``.  Nothing is imported here; only declarations are read.
+
+    Raises:
+        ConfigError: a logged code parameter that is neither named nor trusted, or a ``--navigator-set``
+            key that is not a code parameter of the logged navigator.
+    """
+    from swarmnav.controllers.navigators import NAVIGATORS
+    from swarmnav.models.parameters import TRUST_OPTION, code_parameters, refuse_code
+    from swarmnav.planners.registry import PLANNERS
+
+    cls = NAVIGATORS.get(context.navigator_name)
+    code_keys = code_parameters(cls) if cls is not None else ()
+    for key in named:
+        if key not in code_keys:
+            raise ConfigError("--navigator-set", f"{key!r}: replay --verify takes only the parameters of the log's "
+                              f"navigator {context.navigator_name!r} that name code "
+                              f"({', '.join(code_keys) or 'it has none'}); the rest come from the log")
+    if not trust_code:
+        refuse_code(PLANNERS, "planner", context.planner_name, context.planner_params, source)
+        for key in code_keys:
+            if key in context.navigator_params and key not in named:
+                raise ConfigError(f"navigator.params.{key}",
+                                  f"the log was recorded with {key}={context.navigator_params[key]!r}, which names "
+                                  f"code; replay --verify re-simulates it only when you name it: --navigator-set "
+                                  f"{key}=MODULE:FUNCTION (or {TRUST_OPTION})", source)
+    return {**context.navigator_params, **named}, dict(named)
+
+
+def verify_log(log: RunLog, named: dict | None = None, trust_code: bool = False) -> VerifyReport:
+    """Re-simulate a logged run from the log alone and compare poses step by step.
+
+    Args:
+        named: code parameters of the navigator named on the command line (see :func:`code_for_verify`).
+        trust_code: run the code the log names.
+    """
     import mujoco
 
     from swarmnav.models.scenario import parse_scenario
@@ -140,9 +179,11 @@ def verify_log(log: RunLog) -> VerifyReport:
     from swarmnav.sim.scene import index_scene
 
     context = context_from_log(log)
-    scenario = parse_scenario(context.scenario_toml, f"{log.raw.path}[scenario]")
+    source = str(log.raw.path)
+    navigator_params, _ = code_for_verify(context, named or {}, trust_code, source)
+    scenario = parse_scenario(context.scenario_toml, f"{source}[scenario]", trust_code=trust_code)
     spec = EpisodeSpec(scenario, context.planner_name, context.planner_params, context.navigator_name,
-                       context.navigator_params, context.seed, context.world_seed, context.clearance_m)
+                       navigator_params, context.seed, context.world_seed, context.clearance_m)
     model = mujoco.MjModel.from_xml_string(context.mjcf_xml)
     # Reproduce how the logged run stopped: a timeout at T means the limit was T.
     kinds = [kind for _, kind, _ in log.events]
@@ -162,6 +203,8 @@ def run(args: argparse.Namespace) -> int:
     --verify finds a difference, 2 on bad input."""
     if not args.video and not args.verify:
         raise ConfigError("replay", "nothing to do: give --video OUT.mp4 and/or --verify")
+    if (args.navigator_set or args.trust_code) and not args.verify:
+        raise ConfigError("--navigator-set" if args.navigator_set else "--trust-code", "needs --verify")
     if args.video:
         from swarmnav.sim.render import check_video_size
         check_video_size(args.width, args.height, args.fps)
@@ -176,9 +219,15 @@ def run(args: argparse.Namespace) -> int:
             print(f"video: {args.video}: {info['frames']} frames, {info['video_s']:.1f} s at {args.fps:g} fps "
                   f"({info['frames'] / max(info['render_s'], 1e-9):.0f} frames/s rendered)")
     if args.verify:
-        report = verify_log(log)
-        results["verify"] = report.as_dict()
+        from swarmnav.sim.cli import parse_settings  # loaded already: the CLI is what calls this
+        named = parse_settings(args.navigator_set, "--navigator-set")
+        report = verify_log(log, named, args.trust_code)
+        results["verify"] = {**report.as_dict(), "named_on_command_line": named}
         if not args.json:
+            for key, value in named.items():
+                logged = context_from_log(log).navigator_params.get(key)
+                print(f"re-simulated with {key}={value!r} as named on the command line (the log recorded "
+                      f"{logged!r})")
             print("\n".join(report.lines()))
         status = 0 if report.passed else EXIT_DIFFERENT
     if args.json:

@@ -9,7 +9,10 @@ Loading the callable: ``pkgutil.resolve_name`` (the standard library's
 ``module:attribute`` resolver) imports the user's module.  This is the one place
 outside ``sim/`` that loads code by name, and it only ever loads the user's
 policy, never project code (the registry of navigators stays explicit);
-``tests/test_layering.py`` allows exactly this module and this call.
+``tests/test_layering.py`` allows exactly this module and this call.  ``policy``
+is declared a code parameter (:func:`models.parameters.code_parameter`): a
+scenario file, a study file or a log may name it only when the user passes
+``--trust-code`` (the check reads the declaration and imports nothing).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import numpy as np
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command, observation_layout
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.parameters import code_parameter
 
 FIELD = "navigator.params.policy"
 
@@ -59,7 +63,7 @@ class PolicyNavigator:
 
     name: ClassVar[str] = "policy"
     uses_detections: ClassVar[bool] = True  # per run after reset: only when the observation has obstacles
-    policy: str = ""
+    policy: str = code_parameter()  # names code: never taken from a data file without --trust-code
     action: str = "twist"
     path_waypoints: int = 0
     obstacle_slots: int | None = None

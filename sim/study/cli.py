@@ -23,6 +23,8 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quick", action="store_true",
                    help="only the study's first quick_seeds seeds (a later full run into the same --out resumes)")
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
+    from swarmnav.sim.commands import add_trust_code_argument  # here: sim.commands imports this module
+    add_trust_code_argument(p)
 
 
 def run_study(args: argparse.Namespace) -> int:
@@ -37,8 +39,11 @@ def run_study(args: argparse.Namespace) -> int:
             import ray  # noqa: F401
         except ImportError:
             raise ConfigError("--engine", "ray is not installed (pip install 'swarmnav[ray]')") from None
-    study = load_study(args.file)
+    study = load_study(args.file, trust_code=args.trust_code)
     if args.quick:
+        if study.quick_seeds is None:
+            print(f"swarmnav: warning: study {study.name!r} has no quick_seeds: --quick runs the full study",
+                  file=sys.stderr)
         study = study.quick()
     from swarmnav.sim.study.execute import run_study as execute
     out = args.out or str(FilePath("studies") / study.name)

@@ -45,10 +45,11 @@ from dataclasses import dataclass, replace
 from pathlib import Path as FilePath
 from typing import Any
 
-from swarmnav.controllers.navigators import make_navigator
+from swarmnav.controllers.navigators import NAVIGATORS, make_navigator
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, load_scenario, resolve_scenario_path
-from swarmnav.planners.registry import make_planner
+from swarmnav.models.parameters import refuse_code
+from swarmnav.planners.registry import PLANNERS, make_planner
 
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
@@ -100,6 +101,7 @@ class Study:
     quick_seeds: int | None = None  # the first N seeds make the quick run (None: the quick run is the full one)
     clearance_m: float | None = None  # planning clearance override for every scenario (None: each scenario's)
     paired_seeds: bool = False  # the k-th seed runs with the k-th world seed only
+    trust_code: bool = False  # --trust-code: its files (study, scenarios) may name code to run
 
     def seed_pairs(self) -> list[tuple[int | None, int]]:
         """(world seed, seed) of every run of one setting, in the grid's order."""
@@ -138,8 +140,9 @@ def resolve_study_path(name_or_path: str) -> FilePath:
     return bundled
 
 
-def load_study(name_or_path: str) -> Study:
-    """Read and validate a study file (bundled name or path).
+def load_study(name_or_path: str, trust_code: bool = False) -> Study:
+    """Read and validate a study file (bundled name or path); ``trust_code``: the study and its scenarios
+    may name code to run (``--trust-code``; otherwise such a parameter is a ConfigError, nothing imported).
 
     Raises:
         ConfigError: missing file, malformed TOML, or any field that breaks the schema.
@@ -149,7 +152,7 @@ def load_study(name_or_path: str) -> Study:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError("study", f"cannot be read ({exc})", str(path)) from None
-    return parse_study(text, str(path), default_name=path.stem)
+    return parse_study(text, str(path), default_name=path.stem, trust_code=trust_code)
 
 
 def _fail(source: str, field: str, problem: str):
@@ -216,7 +219,7 @@ def _seeds(source: str, data: dict, key: str, default: Any) -> tuple:
     return tuple(value)
 
 
-def _components(source: str, value: Any, key: str, kind: str, make) -> tuple[Component, ...]:
+def _components(source: str, value: Any, key: str, kind: str, make, trust_code: bool) -> tuple[Component, ...]:
     if not isinstance(value, list) or not value:
         _fail(source, key, f"empty grid: expected a non-empty array of [[{key}]] tables")
     out: list[Component] = []
@@ -238,7 +241,7 @@ def _components(source: str, value: Any, key: str, kind: str, make) -> tuple[Com
         component = Component(name, label, dict(params), swept)
         for setting in component.settings():  # every combination builds: names and every swept value checked
             try:
-                make(name, setting, source)
+                make(name, setting, source, trust_code=trust_code)
             except ConfigError as exc:
                 field = exc.field.replace(f"{kind}.", f"{where}.", 1)
                 if field == f"{where}.params" and swept:
@@ -250,6 +253,21 @@ def _components(source: str, value: Any, key: str, kind: str, make) -> tuple[Com
         if label in labels[:i]:
             _fail(source, f"{key}[{i}].label", f"label {label!r} is used twice (give each entry its own label)")
     return tuple(out)
+
+
+def _refuse_scenario_code(scenarios: tuple[str, ...], planners: tuple[Component, ...],
+                          navigators: tuple[Component, ...]) -> None:
+    """A scenario file's own planner or navigator parameter that names code, where the study would use it
+    (the same component, not set by the study), is refused before any cell runs (models.parameters)."""
+    for ref in scenarios:
+        scenario = load_scenario(ref)
+        for kind, registry, own, params, components in (
+                ("planner", PLANNERS, scenario.planner_name, scenario.planner_params, planners),
+                ("navigator", NAVIGATORS, scenario.navigator_name, scenario.navigator_params, navigators)):
+            for component in components:
+                if component.name == own:
+                    unset = {k: v for k, v in params.items() if k not in component.params}
+                    refuse_code(registry, kind, own, unset, scenario.source_path)
 
 
 def _paper(source: str, value: Any, scenarios: tuple[str, ...], labels: list[str]) -> tuple[PaperValue, ...]:
@@ -278,13 +296,13 @@ def _paper(source: str, value: Any, scenarios: tuple[str, ...], labels: list[str
     return tuple(out)
 
 
-def parse_study(text: str, source: str = "<string>", default_name: str = "study") -> Study:
+def parse_study(text: str, source: str = "<string>", default_name: str = "study", trust_code: bool = False) -> Study:
     """Validate study TOML text (see :func:`load_study`)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError("toml", f"malformed TOML ({exc})", source) from None
-    return study_from_tables(data, source, default_name)
+    return study_from_tables(data, source, default_name, trust_code)
 
 
 def _clearance(source: str, data: dict, scenarios: tuple[str, ...]) -> float | None:
@@ -299,7 +317,8 @@ def _clearance(source: str, data: dict, scenarios: tuple[str, ...]) -> float | N
     return clearance_m
 
 
-def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_name: str = "study") -> Study:
+def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_name: str = "study",
+                      trust_code: bool = False) -> Study:
     """Validate a study given as the tables its TOML file would hold (what a benchmark builds in code)."""
     for key in sorted(set(data) - TOP_KEYS):
         _fail(source, key, "unknown key")
@@ -330,9 +349,11 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
             _fail(source, "time_limit_s", f"must be positive, got {time_limit_s:g}")
     if "planners" not in data:
         _fail(source, "planners", "is required")
-    planners = _components(source, data["planners"], "planners", "planner", make_planner)
+    planners = _components(source, data["planners"], "planners", "planner", make_planner, trust_code)
     navigators = _components(source, data.get("navigators", [{"name": "follow"}]), "navigators", "navigator",
-                             make_navigator)
+                             make_navigator, trust_code)
+    if not trust_code:
+        _refuse_scenario_code(scenarios, planners, navigators)
     labels = [p.label for p in planners]
     reference = _string(source, data, "reference", "reference", labels[0])
     if reference not in labels and not any(reference.startswith(f"{label}(") for label in labels):
@@ -345,4 +366,5 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
         _fail(source, "paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                       f"{len(world_seeds) if 'world_seeds' in data else 'no'} world seeds")
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
-                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired)
+                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired,
+                 bool(trust_code))
