@@ -159,6 +159,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from swarmnav.sim.episode import plan_episode, run_episode
+    if args.video:
+        from swarmnav.sim.render import check_video_size
+        check_video_size(args.width, args.height, args.fps)  # before the plan: bad options fail at once
     spec = _episode_spec(args)
     try:
         planned = plan_episode(spec)  # bad input or no path fails before any file is made
@@ -243,7 +246,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--camera", default="top", choices=("top", "chase"))
     p.add_argument("--width", type=int, default=640)
     p.add_argument("--height", type=int, default=480)
-    p.add_argument("--fps", type=float, default=DEFAULT_FPS)
+    p.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 1..240")
     p.add_argument("--stop-on-collision", action="store_true", help="stop at the first collision")
     p.set_defaults(func=cmd_run)
 
