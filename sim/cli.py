@@ -246,7 +246,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--camera", default="top", choices=("top", "chase"))
     p.add_argument("--width", type=int, default=640)
     p.add_argument("--height", type=int, default=480)
-    p.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 1..240")
+    p.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 0.1..240")
     p.add_argument("--stop-on-collision", action="store_true", help="stop at the first collision")
     p.set_defaults(func=cmd_run)
 

@@ -24,7 +24,7 @@ Runner = Callable[[argparse.Namespace], int]
 SINGLE_THREAD_ENVIRONMENT = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
                              "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
 DEFAULT_FPS = 30.0  # frames per simulated second of a video (run --video, replay --video)
-MIN_FPS, MAX_FPS = 1.0, 240.0  # --fps bounds: each simulated second is MAX_FPS frames at most
+MIN_FPS, MAX_FPS = 0.1, 240.0  # --fps bounds: each simulated second is MAX_FPS frames at most
 MIN_DPI, MAX_DPI = 10, 600  # plot: 600 dpi is 4800 x 6300 pixels (about 120 MB of RGBA)
 BENCH_SIM_QUICK = (5.0, 5)  # bench sim --quick: simulated seconds, repeats (under a minute)
 BENCH_ENV_QUICK = (4.0, 2)  # bench env --quick: a smoke run of the same measurement (noisier figures)
@@ -221,7 +221,7 @@ def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--camera", choices=("top", "chase"), default="top")
     parser.add_argument("--width", type=int, default=640)
     parser.add_argument("--height", type=int, default=480)
-    parser.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second")
+    parser.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 0.1..240")
     parser.add_argument("--no-trail", action="store_true", help="do not draw the driven trajectory")
     parser.add_argument("--verify", action="store_true",
                         help="re-simulate from the log and compare every pose and range scan "

@@ -10,8 +10,12 @@ parameters, seed, and the attached MJCF, not today's model files) and compares
 every logged pose and range scan with the re-simulated one (the comparison and
 its verdict are :mod:`sim.verify_report`).  On the same machine and versions we
 expect bitwise equality; otherwise the largest deviation is reported and where it
-first appeared.  A log that ends early (killed, interrupted, recovered) passes
-when every step it holds is equal: "prefix bitwise equal, the log ends at t = ...".
+first appeared.  A log that ends early (killed, interrupted, recovered, or a file
+without its footer, read as far as it goes with a warning line) passes when every
+step it holds is equal: "prefix bitwise equal, the log ends at t = ...".
+
+Both stream the log (:func:`sim.log_reader.read_log`): memory is the arrays of
+numbers the comparison or the frames need, not the log's messages.
 """
 
 from __future__ import annotations
@@ -20,13 +24,14 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim.commands import DEFAULT_FPS
 from swarmnav.sim.log_format import ranges_from_scan
-from swarmnav.sim.log_reader import RunLog, read_log
+from swarmnav.sim.log_reader import RunLog, read_log, truncation_advice
 from swarmnav.sim.mcap_records import LogError
 from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
 from swarmnav.sim.verify_report import TrajectoryCapture, VerifyReport, compare_with_log
@@ -67,8 +72,9 @@ def context_from_log(log: RunLog) -> RunContext:
     )
 
 
-def frames_from_log(log: RunLog) -> list[StepFrame]:
-    """One StepFrame per logged control step (``/tf`` times), other channels aligned by time."""
+def frames_from_log(log: RunLog) -> Iterator[StepFrame]:
+    """One StepFrame per logged control step (``/tf`` times), other channels aligned by time, made as
+    they are consumed (a long log is never a list of frames)."""
     times = log.time_s
     count = len(times)
 
@@ -88,14 +94,13 @@ def frames_from_log(log: RunLog) -> list[StepFrame]:
         track_t, track_xy = log.obstacle_tracks.get(name, (np.zeros(0), np.zeros((0, 2))))
         tracks.append((align(track_t), track_xy))
 
-    frames = []
     for k in range(count):
         range_m = np.full(len(log.scan_angles_rad), np.inf)
         if ranges is not None and scan_index[k] >= 0:
             range_m = ranges[scan_index[k]]
         moving_xy = np.array([xy[i[k]] if len(xy) else (np.nan, np.nan) for i, xy in tracks]).reshape(-1, 2)
         w, c = wheel_index[k], control_index[k]
-        frames.append(StepFrame(
+        yield StepFrame(
             time_s=float(times[k]),
             position_m=log.position_m[k],
             quaternion_wxyz=log.quaternion_wxyz[k],
@@ -107,8 +112,7 @@ def frames_from_log(log: RunLog) -> list[StepFrame]:
             angular_rad_s=float(log.angular_rad_s[c]) if c >= 0 else 0.0,
             waypoint_index=int(log.waypoint_index[c]) if c >= 0 else 0,
             moving_obstacles_m=moving_xy,
-        ))
-    return frames
+        )
 
 
 def render_log(log: RunLog, video_path: str | Path, *, camera: str = "top", width: int = 640,
@@ -180,6 +184,8 @@ def verify_log(log: RunLog, named: dict | None = None, trust_code: bool = False)
 
     context = context_from_log(log)
     source = str(log.raw.path)
+    if len(log.time_s) == 0:
+        raise LogError(source, "holds no step to replay")
     navigator_params, _ = code_for_verify(context, named or {}, trust_code, source)
     scenario = parse_scenario(context.scenario_toml, f"{source}[scenario]", trust_code=trust_code)
     spec = EpisodeSpec(scenario, context.planner_name, context.planner_params, context.navigator_name,
@@ -208,8 +214,12 @@ def run(args: argparse.Namespace) -> int:
     if args.video:
         from swarmnav.sim.render import check_video_size
         check_video_size(args.width, args.height, args.fps)
-    log = read_log(args.log)
-    results: dict = {"log": str(args.log)}
+    log = read_log(args.log, allow_truncated=True)  # as plot and log info: what was recovered, with a warning
+    if len(log.time_s) == 0:  # nothing to render or compare: one error line, no warning before it
+        raise LogError(args.log, f"holds no step to replay ({log.raw.recovery_line()})")
+    if not log.complete:
+        print(f"warning: {args.log}: {truncation_advice(log.raw)}", file=sys.stderr)
+    results: dict = {"log": str(args.log), "complete": log.complete}
     status = 0
     if args.video:
         info = render_log(log, args.video, camera=args.camera, width=args.width, height=args.height,
