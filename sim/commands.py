@@ -195,6 +195,19 @@ def run_bench_cli(args: argparse.Namespace) -> int:
     return cli_start.run(args)
 
 
+def add_bench_log_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--duration", type=options.positive_float, default=3000.0,
+                        help="simulated seconds of the logged run (default 3000: about 750,000 messages)")
+    parser.add_argument("--no-video", action="store_true", help="skip replay --video")
+    parser.add_argument("--quick", action="store_true", help="a 300 s run (under a minute)")
+    parser.add_argument("--json", action="store_true")
+
+
+def run_bench_log(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import log
+    return log.run(args)
+
+
 def add_log_info_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", help="an .mcap run log")
     parser.add_argument("--json", action="store_true", help="print the facts as JSON")
@@ -264,6 +277,8 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
      "every navigator on the dynamic suite (dyn-*) x world seeds"),
     (("bench", "cli"), add_bench_cli_arguments, run_bench_cli,
      "start-up of `swarmnav scenarios` against a bare `python -c pass`"),
+    (("bench", "log"), add_bench_log_arguments, run_bench_log,
+     "write a long run log, then time and peak memory of each reader beside the mcap library's"),
     (("log", "info"), add_log_info_arguments, run_log_info, "what a log holds"),
     (("log", "recover"), add_log_recover_arguments, run_log_recover, "rewrite a truncated log as a complete one"),
     (("replay",), add_replay_arguments, run_replay, "re-render or re-simulate a log"),
