@@ -52,6 +52,7 @@ from typing import Any, Callable, ClassVar, Iterable
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, static_grid
 from swarmnav.models.errors import ConfigError
@@ -210,6 +211,8 @@ class ImmasStepwiseNavigator:
     """
 
     name: ClassVar[str] = "immas_stepwise"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "alpha": within(0, 100), "beta": within(0, 100), "reach_m": above(0, 100)}  # models.parameters: checked on build
     alpha: float | None = None
     beta: float | None = None
     reach_m: float = 0.1

@@ -26,7 +26,7 @@ import numpy as np
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command, observation_layout
 from swarmnav.models.errors import ConfigError
-from swarmnav.models.parameters import code_parameter
+from swarmnav.models.parameters import Range, above, code_parameter, within
 
 FIELD = "navigator.params.policy"
 
@@ -62,6 +62,8 @@ class PolicyNavigator:
     """
 
     name: ClassVar[str] = "policy"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "path_waypoints": within(0, 1000), "obstacle_slots": within(1, 1000)}  # models.parameters: checked on build
     uses_detections: ClassVar[bool] = True  # per run after reset: only when the observation has obstacles
     policy: str = code_parameter()  # names code: never taken from a data file without --trust-code
     action: str = "twist"

@@ -7,7 +7,8 @@ runs as its own process, the command a user would type, and is measured from
 outside: wall time and the process's peak resident memory (``ru_maxrss`` from
 ``os.wait4``), so the figures include the interpreter and the libraries each
 command loads.  Beside swarmnav's readers, the ``mcap`` library's own summary read
-and message stream of the same file give the yardstick.
+and message stream (``StreamReader``: front to back, one chunk at a time; the seeking
+reader's ``iter_messages`` holds far more) of the same file give the yardstick.
 """
 
 from __future__ import annotations
@@ -58,11 +59,12 @@ print(s.statistics.message_count)
 
 MCAP_STREAM = """
 import sys
-from mcap.reader import make_reader
+from mcap.records import Message
+from mcap.stream_reader import StreamReader
 n = 0
 with open(sys.argv[1], "rb") as f:
-    for _ in make_reader(f).iter_messages(log_time_order=False):
-        n += 1
+    for record in StreamReader(f, skip_magic=False).records:
+        n += isinstance(record, Message)
 print(n)
 """
 

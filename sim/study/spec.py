@@ -40,6 +40,7 @@ from __future__ import annotations
 import fnmatch
 import glob
 import itertools
+import math
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path as FilePath
@@ -51,6 +52,10 @@ from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, load_scenario
 from swarmnav.models.parameters import refuse_code
 from swarmnav.planners.registry import PLANNERS, make_planner
 
+MAX_SEEDS = 100_000  # seeds (or world seeds) of one study
+MAX_SEED = 2**63 - 1  # as --seed and a scenario's seed (a TOML integer; NumPy's seeds take it)
+MAX_CELLS = 2_000_000  # runs of one study (scenarios x settings x seed pairs), each a row
+MAX_WALL_LIMIT_S = 1e6
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
 TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
@@ -206,14 +211,16 @@ def _seeds(source: str, data: dict, key: str, default: Any) -> tuple:
     if isinstance(value, bool):
         _fail(source, key, f"expected a count or a list of integers, got {value!r}")
     if isinstance(value, int):
-        if value < 1:
-            _fail(source, key, f"empty grid: the count must be at least 1, got {value}")
+        if not 1 <= value <= MAX_SEEDS:
+            _fail(source, key, f"the count must be from 1 to {MAX_SEEDS:,}, got {value}")
         return tuple(range(value))
     if not isinstance(value, list) or not value:
         _fail(source, key, "empty grid: expected a count or a non-empty list of integers")
+    if len(value) > MAX_SEEDS:
+        _fail(source, key, f"lists {len(value):,} seeds, at most {MAX_SEEDS:,}")
     for i, seed in enumerate(value):
-        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-            _fail(source, f"{key}[{i}]", f"expected a non-negative integer, got {seed!r}")
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
+            _fail(source, f"{key}[{i}]", f"expected an integer from 0 to {MAX_SEED}, got {seed!r}")
     if len(set(value)) != len(value):
         _fail(source, key, "lists a seed twice")
     return tuple(value)
@@ -340,13 +347,13 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
             _fail(source, "quick_seeds", f"expected a count from 1 to the {len(seeds)} seeds, got {quick_seeds!r}")
     world_seeds: tuple = _seeds(source, data, "world_seeds", [0]) if "world_seeds" in data else (None,)
     wall_limit_s = _number(source, data.get("wall_limit_s", 600.0), "wall_limit_s")
-    if wall_limit_s <= 0:
-        _fail(source, "wall_limit_s", f"must be positive, got {wall_limit_s:g}")
+    if not 0 < wall_limit_s <= MAX_WALL_LIMIT_S:
+        _fail(source, "wall_limit_s", f"must be positive and at most {MAX_WALL_LIMIT_S:g} s, got {wall_limit_s:g}")
     time_limit_s = None
     if "time_limit_s" in data:
         time_limit_s = _number(source, data["time_limit_s"], "time_limit_s")
-        if time_limit_s <= 0:
-            _fail(source, "time_limit_s", f"must be positive, got {time_limit_s:g}")
+        if not 0 < time_limit_s < math.inf:
+            _fail(source, "time_limit_s", f"must be positive and finite, got {time_limit_s:g}")
     if "planners" not in data:
         _fail(source, "planners", "is required")
     planners = _components(source, data["planners"], "planners", "planner", make_planner, trust_code)
@@ -365,6 +372,10 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
     if paired and len(world_seeds) != len(seeds):
         _fail(source, "paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                       f"{len(world_seeds) if 'world_seeds' in data else 'no'} world seeds")
+    settings = math.prod(len(c.settings()) for c in planners) * math.prod(len(c.settings()) for c in navigators)
+    cells = len(scenarios) * settings * (len(seeds) if paired else len(seeds) * len(world_seeds))
+    if cells > MAX_CELLS:
+        _fail(source, "seeds", f"the grid has {cells:,} runs (scenarios x settings x seeds), at most {MAX_CELLS:,}")
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
                  reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired,
                  bool(trust_code))
