@@ -127,8 +127,11 @@ def read_summary(path: str | Path) -> LogSummary:
     """
     path = Path(path)
     found = _from_summary(path)
-    if found is not None:
-        return found
+    return found if found is not None else from_records(path)
+
+
+def from_records(path: str | Path) -> LogSummary:
+    """What a log holds, walking its records (what :func:`read_summary` does for a file without summary)."""
     events: list[tuple[float, str, dict[str, Any]]] = []
     topics: dict[int, bool] = {}
 
@@ -139,6 +142,6 @@ def read_summary(path: str | Path) -> LogSummary:
         if topics[message.channel_id]:
             events.append(_event(raw, message))
 
-    raw = read_records(path, on_message=keep_events)
+    raw = read_records(Path(path), on_message=keep_events)
     check_channels(raw)
     return LogSummary(raw, events, _outcome(raw), from_summary=False)
