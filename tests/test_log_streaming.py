@@ -58,3 +58,20 @@ def test_rows_grow_without_losing_a_number():
         rows.append(row)
     assert np.array_equal(rows.array(), data) and len(rows) == 1000
     assert Rows().array().shape == (0, 0)
+
+
+def test_bench_log_measures_every_reader_of_the_log_it_writes():
+    import json
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "bench", "log", "--duration", "2",
+                          "--no-video", "--json"], capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr
+    figures = json.loads(out.stdout)
+    assert not [key for key in figures if key.endswith(": exit")], figures  # every command ran
+    readers = ["mcap summary read", "mcap message stream", "swarmnav log info", "swarmnav plot",
+               "swarmnav log recover", "swarmnav replay --verify"]
+    for name in ["write (swarmnav run)"] + readers:
+        assert figures[f"{name}: peak MB"] > 1 and figures[f"{name}: s"] > 0
+    assert figures["log_mb"] > 0
