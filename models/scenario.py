@@ -105,6 +105,8 @@ class Scenario:
     map_pairs: tuple[tuple[int, int, int, int], ...] = ()
     # How moving obstacles are sensed: "rangefinder" (rays, tracked) or "detector" (true state within range_m).
     sensor_model: str = "rangefinder"
+    # The user vouched for the file's code parameters (--trust-code): see models.parameters.refuse_code.
+    trust_code: bool = False
 
     @property
     def bounds(self) -> Rect:
@@ -262,8 +264,8 @@ def resolve_scenario_path(name_or_path: str) -> FilePath:
     return bundled
 
 
-def load_scenario(name_or_path: str) -> Scenario:
-    """Read and validate a scenario.
+def load_scenario(name_or_path: str, trust_code: bool = False) -> Scenario:
+    """Read and validate a scenario (``trust_code``: its planner or navigator may name code to run).
 
     Raises:
         ConfigError: the file is missing, is not valid TOML, or breaks the schema.
@@ -273,10 +275,10 @@ def load_scenario(name_or_path: str) -> Scenario:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError("scenario", f"cannot be read ({exc})", str(path)) from None
-    return parse_scenario(text, str(path))
+    return parse_scenario(text, str(path), trust_code)
 
 
-def parse_scenario(text: str, source: str = "<string>") -> Scenario:
+def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False) -> Scenario:
     """Validate scenario TOML text (see :func:`load_scenario`)."""
     try:
         data = tomllib.loads(text)
@@ -441,7 +443,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         planner_name=planner_name, planner_params=dict(params),
         navigator_name=navigator_name, navigator_params=dict(navigator_params), obstacles=tuple(obstacles),
         sim=sim, cell_m=cell_m, source_text=text, source_path=source, boxes=boxes, world_seed=seed,
-        map_grid=map_grid, map_pairs=map_pairs, sensor_model=sensor_model)
+        map_grid=map_grid, map_pairs=map_pairs, sensor_model=sensor_model, trust_code=bool(trust_code))
     _check_endpoints(scenario, source)
     return scenario
 

@@ -36,6 +36,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.ant_colony import STEP_LENGTHS, GridGraph, best_tour_result, deposit, evaporate, walk_colony
 from swarmnav.planners.errors import check_parameters
 from swarmnav.planners.grid_graph import grid_endpoints, grid_problem
@@ -66,6 +67,10 @@ class AntSystemPlanner(SwarmPlanner):
     """
 
     name: ClassVar[str] = "aco"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "ants": within(1, MAX_ANTS), "iterations": within(1, 1_000_000), "alpha": within(0, 100),
+        "beta": within(0, 100), "rho": within(0, 1), "q": above(0, 1e12), "initial_pheromone": above(0, 1e12),
+        "max_steps": within(0, 100_000_000), "cell_m": within(1e-6, 100), "max_evaluations": within(0, 1e9)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     ants: int = 50
     iterations: int = 100

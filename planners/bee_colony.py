@@ -39,6 +39,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.continuous import ContinuousPlanner, ContinuousState
 from swarmnav.planners.path_cost import inverse_fitness
 from swarmnav.models.errors import ConfigError
@@ -91,6 +92,7 @@ class BeeColonyPlanner(ContinuousPlanner):
     """
 
     name: ClassVar[str] = "abc"
+    parameter_ranges: ClassVar[dict[str, Range]] = {"limit": within(0, 1e9), "mcn": within(1, 1_000_000)}  # models.parameters: checked on build
 
     population: int = 100
     limit: float = 5.0

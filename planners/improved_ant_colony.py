@@ -68,6 +68,7 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.ant_colony import (STEP_LENGTHS, GridGraph, best_tour_result, cosine_table, deposit, evaporate,
                                           walk_colony)
 from swarmnav.planners.errors import check_parameters
@@ -247,6 +248,13 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
     """
 
     name: ClassVar[str] = "iaco"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "ants": within(1, MAX_ANTS), "iterations": within(1, 1_000_000), "alpha": within(0, 100),
+        "beta": within(0, 100), "rho": within(0, 1), "q": above(0, 1e12), "t_c": above(0, 1e6),
+        "delta": within(0, 100), "kappa": above(0, 1), "initial_pheromone": above(0, 1e12),
+        "collar_pheromone": within(0, 1e12), "tau_floor": above(0, 1e6), "exponent_limit": within(0, 700),
+        "max_steps": within(0, 100_000_000), "step_ratio": above(0, 1000), "prune_ratio": above(0, 1000),
+        "cell_m": within(1e-6, 100), "max_evaluations": within(0, 1e9)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     ants: int = 50
     iterations: int = 100

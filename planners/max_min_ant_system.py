@@ -91,6 +91,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.ant_colony import roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.grid_graph import (DIRECTIONS, Cell, cell_clearance_m, cells_to_waypoints, count_bends,
@@ -138,6 +139,10 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
     """
 
     name: ClassVar[str] = "immas"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "alpha": within(0, 100), "beta": within(0, 100), "rho": above(0, 1), "clean_weight": within(0, 1e6),
+        "diagonal_factor": within(1, 10), "iterations": within(0, 10_000_000), "cell_m": within(1e-6, 100),
+        "max_evaluations": within(0, 1e9), "p_best": above(0, 1)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     alpha: float = 3.0
     beta: float = 1.0

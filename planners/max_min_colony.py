@@ -37,6 +37,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.ant_colony import STEP_LENGTHS, GridGraph, best_tour_result, deposit, walk_colony
 from swarmnav.planners.errors import check_parameters
 from swarmnav.planners.grid_graph import grid_endpoints, grid_problem
@@ -67,6 +68,10 @@ class MaxMinColonyPlanner(SwarmPlanner):
     """
 
     name: ClassVar[str] = "mmas"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "ants": within(1, MAX_ANTS), "iterations": within(1, 1_000_000), "alpha": within(0, 100),
+        "beta": within(0, 100), "rho": within(0, 1), "p_best": above(0, 1), "max_steps": within(0, 100_000_000),
+        "cell_m": within(1e-6, 100), "max_evaluations": within(0, 1e9)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     ants: int = 50
     iterations: int = 100

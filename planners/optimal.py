@@ -34,6 +34,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
@@ -77,6 +78,7 @@ class OptimalPlanner:
     """
 
     name: ClassVar[str] = "optimal"
+    parameter_ranges: ClassVar[dict[str, Range]] = {"arc_bulge_m": above(0, 1)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs"})
 
     arc_bulge_m: float = 1e-5

@@ -21,6 +21,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.continuous import ContinuousPlanner, ContinuousState
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.problem import Problem
@@ -41,6 +42,9 @@ class ParticleSwarmPlanner(ContinuousPlanner):
     """
 
     name: ClassVar[str] = "pso"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "inertia": within(-10, 10), "cognitive": within(0, 10), "social": within(0, 10),
+        "velocity_limit": above(0, 100)}  # models.parameters: checked on build
 
     inertia: float = 0.7298
     cognitive: float = 1.49618

@@ -46,13 +46,14 @@ for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, D
     register(_cls)
 
 
-def make_planner(name: str, params: dict[str, Any] | None = None, source: str | None = None) -> Any:
-    """Build a registered planner from its name and a parameter table.
+def make_planner(name: str, params: dict[str, Any] | None = None, source: str | None = None,
+                 trust_code: bool = True) -> Any:
+    """Build a registered planner from its name and a parameter table (``trust_code``: see build_component).
 
     Raises:
         ConfigError: unknown planner, unknown parameter, or a value of the wrong type.
     """
-    return build_component(PLANNERS, "planner", name, params, source)
+    return build_component(PLANNERS, "planner", name, params, source, trust_code)
 
 
 __all__ = [

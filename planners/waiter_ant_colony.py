@@ -54,6 +54,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.ant_colony import deposit, evaporate, roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.grid_shortcut import exact_shortcut
@@ -170,6 +171,10 @@ class WaiterAntColonyPlanner(SwarmPlanner):
     """
 
     name: ClassVar[str] = "maco"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "nodes": within(1, MAX_NODES), "corridor_m": above(0, 1000), "ants": within(1, MAX_ANTS),
+        "iterations": within(0, 1_000_000), "alpha": within(0, 100), "rho": within(0, 1), "p0": within(0, 1),
+        "q": above(0, 1e12), "max_evaluations": within(0, 1e9)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     nodes: int = 15
     corridor_m: float = 1.5

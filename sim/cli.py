@@ -25,7 +25,7 @@ from typing import Any, Callable
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
 from swarmnav.sim import options
-from swarmnav.sim.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT
+from swarmnav.sim.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
 
 # As sim.render does, before any subcommand imports mujoco (which reads it once, on import).
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -69,8 +69,9 @@ def parse_settings(pairs: list[str] | None, option: str = "--set") -> dict[str, 
 
 
 def _load(args: argparse.Namespace):
-    from swarmnav.models.scenario import load_scenario
-    return load_scenario(args.scenario)
+    """The scenario, as the API loads it (plugins' too); ``--trust-code``: its code parameters may run."""
+    from swarmnav.calls import load_scenario
+    return load_scenario(args.scenario, trust_code=args.trust_code)
 
 
 def _episode_spec(args: argparse.Namespace):
@@ -182,8 +183,11 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from swarmnav.calls import run
+    if args.video:
+        from swarmnav.sim.render import check_video_size
+        check_video_size(args.width, args.height, args.fps)  # before the plan: bad options fail at once
     try:
-        outcome = run(args.scenario, args.planner, parse_settings(args.set, "--set"), args.navigator,
+        outcome = run(_load(args), args.planner, parse_settings(args.set, "--set"), args.navigator,
                       parse_settings(args.navigator_set, "--navigator-set"), args.seed, args.world_seed,
                       waypoints=args.waypoints, log=False if args.no_log else (args.out or True),
                       overwrite=args.overwrite, video=args.video, camera=args.camera, width=args.width,
@@ -244,6 +248,7 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--navigator", help="navigator name (default: the scenario's, else follow)")
     p.add_argument("--navigator-set", action="append", metavar="KEY=VALUE", help="navigator parameter (repeatable)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_trust_code_argument(p)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -272,7 +277,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--camera", default="top", choices=("top", "chase"))
     p.add_argument("--width", type=int, default=640)
     p.add_argument("--height", type=int, default=480)
-    p.add_argument("--fps", type=float, default=DEFAULT_FPS)
+    p.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 0.1..240")
     p.add_argument("--stop-on-collision", action="store_true", help="stop at the first collision")
     p.add_argument("--waypoints", metavar="FILE", help="drive this path instead of planning: CSV with x,y columns, "
                    "a JSON list of [x, y] pairs, or the output of `plan --json`")

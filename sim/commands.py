@@ -24,6 +24,7 @@ Runner = Callable[[argparse.Namespace], int]
 SINGLE_THREAD_ENVIRONMENT = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
                              "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
 DEFAULT_FPS = 30.0  # frames per simulated second of a video (run --video, replay --video)
+MIN_FPS, MAX_FPS = 0.1, 240.0  # --fps bounds: each simulated second is MAX_FPS frames at most
 MIN_DPI, MAX_DPI = 10, 600  # plot: 600 dpi is 4800 x 6300 pixels (about 120 MB of RGBA)
 BENCH_SIM_QUICK = (5.0, 5)  # bench sim --quick: simulated seconds, repeats (under a minute)
 BENCH_ENV_QUICK = (4.0, 2)  # bench env --quick: a smoke run of the same measurement (noisier figures)
@@ -36,6 +37,13 @@ BENCH_PLANNERS_SAMPLING = ("rrt_star", "informed_rrt_star", "bit_star", "prm_sta
 # bench navigation --quick: one world seed on one scenario of each generated kind.
 BENCH_NAVIGATION_QUICK_SCENARIOS = ("dyn-crossing-1", "dyn-head-on-1", "dyn-overtake-1", "dyn-crowd-1")
 BENCH_STUDY_QUICK = (10, 300)  # bench study --quick: seeds per scenario, GWO iterations; no Ray
+
+
+def add_trust_code_argument(parser: argparse.ArgumentParser) -> None:
+    """``--trust-code``: this invocation may run code that a file it reads names (a ``policy``)."""
+    parser.add_argument("--trust-code", action="store_true",
+                        help="let the files this command reads name code to run (the policy navigator's "
+                             "policy = 'module:function'); without it such a value is an error")
 
 
 def add_bench_sim_arguments(parser: argparse.ArgumentParser) -> None:
@@ -196,6 +204,19 @@ def run_bench_cli(args: argparse.Namespace) -> int:
     return cli_start.run(args)
 
 
+def add_bench_log_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--duration", type=options.positive_float, default=3000.0,
+                        help="simulated seconds of the logged run (default 3000: about 750,000 messages)")
+    parser.add_argument("--no-video", action="store_true", help="skip replay --video")
+    parser.add_argument("--quick", action="store_true", help="a 300 s run (under a minute)")
+    parser.add_argument("--json", action="store_true")
+
+
+def run_bench_log(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import log
+    return log.run(args)
+
+
 def add_log_info_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", help="an .mcap run log")
     parser.add_argument("--json", action="store_true", help="print the facts as JSON")
@@ -222,12 +243,16 @@ def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--camera", choices=("top", "chase"), default="top")
     parser.add_argument("--width", type=int, default=640)
     parser.add_argument("--height", type=int, default=480)
-    parser.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second")
+    parser.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 0.1..240")
     parser.add_argument("--no-trail", action="store_true", help="do not draw the driven trajectory")
     parser.add_argument("--verify", action="store_true",
                         help="re-simulate from the log and compare every pose and range scan "
-                             "(exit 1 if they differ)")
+                             "(exit 4 if they differ)")
     parser.add_argument("--json", action="store_true", help="print the results as JSON")
+    parser.add_argument("--navigator-set", action="append", metavar="KEY=VALUE",
+                        help="with --verify: the code a log's navigator ran (policy=module:function), named "
+                             "here because a log's own is never run without --trust-code")
+    add_trust_code_argument(parser)
 
 
 def run_replay(args: argparse.Namespace) -> int:
@@ -261,6 +286,8 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
      "every navigator on the dynamic suite (dyn-*) x world seeds"),
     (("bench", "cli"), add_bench_cli_arguments, run_bench_cli,
      "start-up of `swarmnav scenarios` against a bare `python -c pass`"),
+    (("bench", "log"), add_bench_log_arguments, run_bench_log,
+     "write a long run log, then time and peak memory of each reader beside the mcap library's"),
     (("log", "info"), add_log_info_arguments, run_log_info, "what a log holds"),
     (("log", "recover"), add_log_recover_arguments, run_log_recover, "rewrite a truncated log as a complete one"),
     (("replay",), add_replay_arguments, run_replay, "re-render or re-simulate a log"),

@@ -28,11 +28,12 @@ from typing import Any, Sequence
 import numpy as np
 
 from swarmnav.controllers.navigator import NavigationSetup, Navigator
-from swarmnav.controllers.navigators import make_navigator
+from swarmnav.controllers.navigators import NAVIGATORS, make_navigator
 from swarmnav.controllers.point_to_point import PointToPointController
 from swarmnav.models.scenario import Scenario
+from swarmnav.models.parameters import refuse_code
 from swarmnav.models.seeds import Seeds
-from swarmnav.planners.registry import make_planner
+from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.planners.problem import Path, Planner, Problem, scenario_problem
 from swarmnav.sim.recording import Recorder, RecorderGroup
 from swarmnav.sim.reference import reference_length_m, static_problem
@@ -55,6 +56,10 @@ def json_safe(value: Any) -> Any:
     if isinstance(value, (str, int, float, bool)) or value is None:
         return value
     return repr(value)
+
+
+def _not_in(params: dict[str, Any], overrides: dict[str, Any] | None) -> dict[str, Any]:
+    return {k: v for k, v in params.items() if k not in (overrides or {})}
 
 
 NAVIGATOR_STREAM = 1  # spawn key of the navigator's generator under the run's seed
@@ -82,10 +87,14 @@ class EpisodeSpec:
         scenario = self.scenario
         planner = self.planner or scenario.planner_name
         navigator = self.navigator or scenario.navigator_name
-        planner_params = {**(scenario.planner_params if planner == scenario.planner_name else {}),
-                          **(self.planner_params or {})}
-        navigator_params = {**(scenario.navigator_params if navigator == scenario.navigator_name else {}),
-                            **(self.navigator_params or {})}
+        from_file = (scenario.planner_params if planner == scenario.planner_name else {},
+                     scenario.navigator_params if navigator == scenario.navigator_name else {})
+        if not scenario.trust_code:  # the file's own code parameters, unless this spec names them itself
+            refuse_code(PLANNERS, "planner", planner, _not_in(from_file[0], self.planner_params), scenario.source_path)
+            refuse_code(NAVIGATORS, "navigator", navigator, _not_in(from_file[1], self.navigator_params),
+                        scenario.source_path)
+        planner_params = {**from_file[0], **(self.planner_params or {})}
+        navigator_params = {**from_file[1], **(self.navigator_params or {})}
         fallback = scenario.seeds
         seed = fallback.planner if self.seed is None else int(self.seed)
         world_seed = fallback.world if self.world_seed is None else int(self.world_seed)

@@ -1,9 +1,12 @@
 """``swarmnav log info LOG`` and ``swarmnav log recover IN OUT``.
 
 ``info`` prints the scenario, planner, seed, duration, outcome and every channel
-with its message count and schema.  A file without footer (a killed run) is an
-error (exit 2) that says how much of it is readable; ``recover`` turns it into a
-complete, indexed file holding every message up to the writer's last flush.
+with its message count and schema, from the file's summary section
+(:mod:`sim.log_summary`: a log of any length answers at once).  A file without
+footer (a killed run) is read as ``plot`` reads it: what was recovered, with a
+warning line that says how much and advises ``log recover``, exit 0.  ``recover``
+turns it into a complete, indexed file holding every message up to the writer's
+last flush, streaming the messages (memory: one chunk).
 """
 
 from __future__ import annotations
@@ -11,12 +14,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 
-from swarmnav.sim.log_reader import RunLog, outcome_text, read_log
+from swarmnav.sim.log_reader import outcome_text, truncation_advice
 from swarmnav.sim.log_recover import recover_log
+from swarmnav.sim.log_summary import LogSummary, read_summary
 
 
-def describe(log: RunLog) -> list[str]:
+def describe(log: LogSummary) -> list[str]:
     """Lines for ``swarmnav log info``."""
     planner = log.metadata.get("planner", {})
     lines = [
@@ -52,7 +57,9 @@ def describe(log: RunLog) -> list[str]:
 
 
 def run_info(args: argparse.Namespace) -> int:
-    log = read_log(args.log)
+    log = read_summary(args.log)
+    if not log.complete:
+        print(f"warning: {args.log}: {truncation_advice(log.raw)}", file=sys.stderr)
     if not args.json:
         print("\n".join(describe(log)))
         return 0
@@ -67,6 +74,8 @@ def run_info(args: argparse.Namespace) -> int:
         "channels": {topic: {"count": count, "schema": log.schema_names.get(topic, "")}
                      for topic, count in log.counts.items()},
         "versions": log.metadata.get("versions", {}),
+        "complete": log.complete,
+        "file": log.raw.recovery_line(),
     }, sort_keys=True))
     return 0
 

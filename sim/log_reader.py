@@ -3,8 +3,10 @@
 Only this module, :mod:`sim.mcap_records` and the writer know MCAP.  Everything
 else (replay, plot, ``log info``) gets a :class:`RunLog` of NumPy arrays.  The
 records are read by :func:`sim.mcap_records.read_records`, which survives a file
-cut off anywhere; a truncated file is an error here unless the caller accepts
-one (``plot`` does, ``log info`` and ``replay`` point to ``log recover``).
+cut off anywhere, and streamed into arrays as they are read (:class:`_Decoder`),
+so memory follows the arrays, not the file.  ``plot``, ``log info`` and ``replay``
+read a truncated file as far as it goes, with a warning line
+(:func:`truncation_advice`); with ``allow_truncated=False`` it is an error.
 """
 
 from __future__ import annotations
@@ -15,11 +17,12 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
-from mcap.records import Channel
+from mcap.records import Channel, Message
 from google.protobuf.message import DecodeError
 from mcap_protobuf.decoder import DecoderFactory
 
 from swarmnav.sim.log_format import CHANNELS, LOG_PROFILE, MJCF_ATTACHMENT, TOPICS
+from swarmnav.sim.log_columns import Rows
 from swarmnav.sim.mcap_records import LogError, RawLog, read_records
 
 
@@ -95,6 +98,18 @@ def _decoder_for(raw: RawLog, channel: Channel, protobuf: DecoderFactory) -> Cal
     return decoder
 
 
+def _check_channel(raw: RawLog, channel: Channel) -> None:
+    expected = CHANNELS.get(channel.topic)
+    if expected is None:
+        return  # channels of other topics are left alone
+    schema = raw.schemas.get(channel.schema_id)
+    found = (channel.message_encoding, schema.name if schema is not None else "")
+    if found != expected:
+        raise LogError(raw.path, f"not a swarmnav run log: channel {channel.topic} carries "
+                                 f"{found[1] or 'no schema'} ({found[0]}), expected {expected[1]} "
+                                 f"({expected[0]})")
+
+
 def check_channels(raw: RawLog) -> None:
     """Every channel on a swarmnav topic carries the schema and encoding the writer uses.
 
@@ -103,125 +118,120 @@ def check_channels(raw: RawLog) -> None:
             channel and is not a swarmnav log at all.
     """
     for channel in raw.channels.values():
-        expected = CHANNELS.get(channel.topic)
-        if expected is None:
-            continue  # channels of other topics are left alone
-        schema = raw.schemas.get(channel.schema_id)
-        found = (channel.message_encoding, schema.name if schema is not None else "")
-        if found != expected:
-            raise LogError(raw.path, f"not a swarmnav run log: channel {channel.topic} carries "
-                                     f"{found[1] or 'no schema'} ({found[0]}), expected {expected[1]} "
-                                     f"({expected[0]})")
+        _check_channel(raw, channel)
     if "/tf" not in {c.topic for c in raw.channels.values()} and raw.profile != LOG_PROFILE:
         raise LogError(raw.path, "not a swarmnav run log (no /tf channel)")
 
 
-def decode(raw: RawLog) -> RunLog:
-    """Decode a :class:`RawLog` of a swarmnav run into arrays.
+class _Decoder:
+    """Turns each message, as it is read, into rows of numbers (:class:`sim.log_columns.Rows`).
 
-    Raises:
-        LogError: a channel or a message is not what a swarmnav log holds.
+    Nothing decoded is kept as a message object: memory is the numbers of the
+    arrays a :class:`RunLog` holds, for a log of any length.
     """
-    check_channels(raw)
-    try:
-        return _decode(raw)
-    except (DecodeError, ValueError, KeyError, TypeError, AttributeError, IndexError) as error:
-        raise LogError(raw.path, f"a message cannot be decoded ({type(error).__name__}: {error})") from None
 
+    def __init__(self) -> None:
+        self._protobuf = DecoderFactory()
+        self._decoders: dict[int, tuple[str, Callable[[bytes], Any]] | None] = {}
+        self.tf = Rows(8)  # t, x, y, z, qw, qx, qy, qz
+        self.scan_time_s = Rows(1)
+        self.ranges = Rows()
+        self.scan_span_rad: tuple[float, float] | None = None
+        self.wheels = Rows(5)  # t, command left/right, measured left/right
+        self.controller = Rows(4)  # t, v, omega, waypoint index
+        self.paths: list[tuple[float, np.ndarray]] = []
+        self.tracks: dict[str, tuple[Rows, list]] = {}  # id -> ((t, x, y) rows, [last time])
+        self.events: list[tuple[float, str, dict[str, Any]]] = []
 
-def _decode(raw: RawLog) -> RunLog:
-    protobuf = DecoderFactory()
-    decoders = {cid: _decoder_for(raw, c, protobuf) for cid, c in raw.channels.items() if c.topic in CHANNELS}
-    by_topic: dict[str, list[tuple[float, Any]]] = {topic: [] for topic in TOPICS}
-    for m in raw.messages:
-        decoder = decoders.get(m.channel_id)
-        if decoder is not None:
-            by_topic[raw.channels[m.channel_id].topic].append((m.log_time * 1e-9, decoder(m.data)))
+    def __call__(self, raw: RawLog, message: Message) -> None:
+        channel_id = message.channel_id
+        if channel_id not in self._decoders:
+            channel = raw.channels.get(channel_id)
+            if channel is None or channel.topic not in CHANNELS:
+                self._decoders[channel_id] = None
+            else:
+                _check_channel(raw, channel)
+                self._decoders[channel_id] = (channel.topic, _decoder_for(raw, channel, self._protobuf))
+        entry = self._decoders[channel_id]
+        if entry is None:
+            return
+        topic, decoder = entry
+        try:
+            self._add(topic, message.log_time * 1e-9, decoder(message.data))
+        except (DecodeError, ValueError, KeyError, TypeError, AttributeError, IndexError) as error:
+            raise LogError(raw.path, f"a message cannot be decoded ({type(error).__name__}: {error})") from None
 
-    tf = by_topic["/tf"]
-    time_s = np.array([t for t, _ in tf], dtype=float)
-    position_m = np.array(
-        [(d.translation.x, d.translation.y, d.translation.z) for _, d in tf], dtype=float
-    ).reshape(-1, 3)
-    quaternion_wxyz = np.array(
-        [(d.rotation.w, d.rotation.x, d.rotation.y, d.rotation.z) for _, d in tf], dtype=float
-    ).reshape(-1, 4)
-    w, x, y, z = quaternion_wxyz.T
-    heading_rad = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    def _add(self, topic: str, t: float, d: Any) -> None:
+        if topic == "/tf":
+            self.tf.append((t, d.translation.x, d.translation.y, d.translation.z,
+                            d.rotation.w, d.rotation.x, d.rotation.y, d.rotation.z))
+        elif topic == "/range/scan":
+            if self.scan_span_rad is None:
+                self.scan_span_rad = (d.start_angle, d.end_angle)
+                self.ranges = Rows(len(d.ranges))
+            self.scan_time_s.append((t,))
+            self.ranges.append(d.ranges)
+        elif topic == "/wheels":
+            self.wheels.append((t, d["command_left_rad_s"], d["command_right_rad_s"],
+                                d["measured_left_rad_s"], d["measured_right_rad_s"]))
+        elif topic == "/controller":
+            self.controller.append((t, d["linear_m_s"], d["angular_rad_s"], d["waypoint_index"]))
+        elif topic == "/planner/path":
+            self.paths.append((t, np.array([(p.position.x, p.position.y) for p in d.poses],
+                                           dtype=float).reshape(-1, 2)))
+        elif topic == "/obstacles":
+            for entity in d.entities:
+                primitives = entity.cylinders or entity.cubes
+                if not primitives:
+                    continue
+                position = primitives[0].pose.position
+                rows, last = self.tracks.setdefault(entity.id, (Rows(3), [None]))
+                if last[0] == t:
+                    continue
+                last[0] = t
+                rows.append((t, position.x, position.y))
+        elif topic == "/events":
+            self.events.append((t, d.get("kind", "?"), d.get("details", {})))
 
-    scans = by_topic["/range/scan"]
-    beams = len(scans[0][1].ranges) if scans else 0
-    range_m = np.array([list(d.ranges) for _, d in scans], dtype=float).reshape(-1, beams)
-    if scans:
-        first = scans[0][1]
-        scan_angles_rad = np.linspace(first.start_angle, first.end_angle, beams)
-    else:
-        scan_angles_rad = np.zeros(0)
-
-    wheels = by_topic["/wheels"]
-    wheel_command = np.array(
-        [(d["command_left_rad_s"], d["command_right_rad_s"]) for _, d in wheels], dtype=float
-    ).reshape(-1, 2)
-    wheel_measured = np.array(
-        [(d["measured_left_rad_s"], d["measured_right_rad_s"]) for _, d in wheels], dtype=float
-    ).reshape(-1, 2)
-
-    controller = by_topic["/controller"]
-    paths = [
-        (t, np.array([(p.position.x, p.position.y) for p in d.poses], dtype=float).reshape(-1, 2))
-        for t, d in by_topic["/planner/path"]
-    ]
-    tracks: dict[str, tuple[list[float], list[tuple[float, float]]]] = {}
-    for t, update in by_topic["/obstacles"]:
-        for entity in update.entities:
-            primitives = list(entity.cylinders) or list(entity.cubes)
-            if not primitives:
-                continue
-            position = primitives[0].pose.position
-            times, xy = tracks.setdefault(entity.id, ([], []))
-            if times and times[-1] == t:
-                continue
-            times.append(t)
-            xy.append((position.x, position.y))
-    events = [(t, d.get("kind", "?"), d.get("details", {})) for t, d in by_topic["/events"]]
-
-    outcome = None
-    if "outcome" in raw.metadata:
-        outcome = {k: _loads_or_text(v) for k, v in raw.metadata["outcome"].items()}
-    obstacles = json.loads(raw.metadata.get("run", {}).get("obstacles", "[]"))
-    attachment = raw.attachments.get(MJCF_ATTACHMENT)
-    return RunLog(
-        raw=raw,
-        metadata=raw.metadata,
-        mjcf_xml=attachment.data.decode() if attachment is not None else None,
-        counts=raw.counts(),
-        schema_names={
-            c.topic: raw.schemas[c.schema_id].name if c.schema_id in raw.schemas else ""
-            for c in raw.channels.values()
-        },
-        time_s=time_s,
-        position_m=position_m,
-        quaternion_wxyz=quaternion_wxyz,
-        heading_rad=heading_rad,
-        scan_time_s=np.array([t for t, _ in scans], dtype=float),
-        scan_angles_rad=scan_angles_rad,
-        range_m=range_m,
-        wheel_time_s=np.array([t for t, _ in wheels], dtype=float),
-        wheel_command_rad_s=wheel_command,
-        wheel_measured_rad_s=wheel_measured,
-        controller_time_s=np.array([t for t, _ in controller], dtype=float),
-        linear_m_s=np.array([d["linear_m_s"] for _, d in controller], dtype=float),
-        angular_rad_s=np.array([d["angular_rad_s"] for _, d in controller], dtype=float),
-        waypoint_index=np.array([d["waypoint_index"] for _, d in controller], dtype=int),
-        paths=paths,
-        obstacles=obstacles,
-        obstacle_tracks={
-            k: (np.array(ts, dtype=float), np.array(xy, dtype=float).reshape(-1, 2))
-            for k, (ts, xy) in tracks.items()
-        },
-        events=events,
-        outcome=outcome,
-    )
+    def run_log(self, raw: RawLog) -> RunLog:
+        tf = self.tf.array()
+        quaternion_wxyz = tf[:, 4:8]
+        w, x, y, z = quaternion_wxyz.T
+        beams = self.ranges.width or 0
+        start, end = self.scan_span_rad or (0.0, 0.0)
+        wheels, controller = self.wheels.array(), self.controller.array()
+        outcome = None
+        if "outcome" in raw.metadata:
+            outcome = {k: _loads_or_text(v) for k, v in raw.metadata["outcome"].items()}
+        attachment = raw.attachments.get(MJCF_ATTACHMENT)
+        return RunLog(
+            raw=raw,
+            metadata=raw.metadata,
+            mjcf_xml=attachment.data.decode() if attachment is not None else None,
+            counts=raw.counts(),
+            schema_names={c.topic: raw.schemas[c.schema_id].name if c.schema_id in raw.schemas else ""
+                          for c in raw.channels.values()},
+            time_s=tf[:, 0].copy(),
+            position_m=tf[:, 1:4].copy(),
+            quaternion_wxyz=quaternion_wxyz.copy(),
+            heading_rad=np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)),
+            scan_time_s=self.scan_time_s.array()[:, 0],
+            scan_angles_rad=np.linspace(start, end, beams) if self.scan_span_rad else np.zeros(0),
+            range_m=self.ranges.array() if beams else np.zeros((0, 0)),
+            wheel_time_s=wheels[:, 0].copy(),
+            wheel_command_rad_s=wheels[:, 1:3].copy(),
+            wheel_measured_rad_s=wheels[:, 3:5].copy(),
+            controller_time_s=controller[:, 0].copy(),
+            linear_m_s=controller[:, 1].copy(),
+            angular_rad_s=controller[:, 2].copy(),
+            waypoint_index=controller[:, 3].astype(int),
+            paths=self.paths,
+            obstacles=json.loads(raw.metadata.get("run", {}).get("obstacles", "[]")),
+            obstacle_tracks={k: (rows.array()[:, 0].copy(), rows.array()[:, 1:3].copy())
+                             for k, (rows, _) in self.tracks.items()},
+            events=self.events,
+            outcome=outcome,
+        )
 
 
 def _loads_or_text(text: str) -> Any:
@@ -232,7 +242,7 @@ def _loads_or_text(text: str) -> Any:
 
 
 def read_log(path: str | Path, *, allow_truncated: bool = False) -> RunLog:
-    """Read and decode a run log.
+    """Read and decode a run log, streaming its messages into arrays (memory: the arrays, not the file).
 
     Args:
         path: the ``.mcap`` file.
@@ -242,13 +252,17 @@ def read_log(path: str | Path, *, allow_truncated: bool = False) -> RunLog:
     Raises:
         LogError: not an MCAP file, not a swarmnav log, or truncated (unless allowed).
     """
-    raw = read_records(path)
+    decoder = _Decoder()
+    raw = read_records(path, on_message=decoder)
     if not raw.complete and not allow_truncated:
-        raise LogError(
-            path,
-            f"{raw.recovery_line()}; run 'swarmnav log recover {path} OUT' for an indexed copy",
-        )
-    return decode(raw)
+        raise LogError(path, truncation_advice(raw))
+    check_channels(raw)
+    return decoder.run_log(raw)
+
+
+def truncation_advice(raw: RawLog) -> str:
+    """What was recovered of a file without footer, and how to get an indexed copy."""
+    return f"{raw.recovery_line()}; run 'swarmnav log recover {raw.path} OUT' for an indexed copy"
 
 
 def outcome_text(log: RunLog) -> str:

@@ -7,6 +7,10 @@ top-level records by their heads (opcode, u64 length) and parses each complete
 one with ``mcap``'s record classes (chunk CRCs checked).  Every complete chunk,
 that is everything up to the writer's last flush, is kept, and :class:`RawLog`
 says how much that was and why the rest could not be read.
+
+Memory is bounded by one chunk, not by the file: with ``on_message`` each message
+is handed over as it is read and not kept (``plot``, ``replay``, ``log recover``
+stream a log of any length this way); only counts and the last time stamp are.
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ import stat
 import struct
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import BinaryIO
+from typing import BinaryIO, Callable
 
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import McapError
@@ -49,7 +53,8 @@ class RawLog:
         bytes_read: bytes up to the end of the last record read intact.
         file_bytes: size of the file.
         problem: why reading stopped early (None when complete).
-        messages: every complete message, in file order.
+        messages: every complete message, in file order (empty when they were streamed to a callback).
+        message_count, channel_counts, last_time_ns: what was read, streamed or kept.
     """
 
     path: Path
@@ -64,6 +69,9 @@ class RawLog:
     bytes_read: int = 0
     file_bytes: int = 0
     problem: str | None = None
+    message_count: int = 0
+    channel_counts: dict[int, int] = field(default_factory=dict)
+    last_time_ns: int = 0
 
     def topic_of(self, message: Message) -> str:
         return self.channels[message.channel_id].topic
@@ -71,25 +79,25 @@ class RawLog:
     def counts(self) -> dict[str, int]:
         """Messages per topic, in channel order."""
         per_channel = {cid: 0 for cid in self.channels}
-        for message in self.messages:
-            per_channel[message.channel_id] = per_channel.get(message.channel_id, 0) + 1
+        for cid, count in self.channel_counts.items():
+            per_channel[cid] = per_channel.get(cid, 0) + count
         return {self.channels[cid].topic if cid in self.channels else f"channel {cid}": n
                 for cid, n in per_channel.items()}
 
     def last_time_s(self) -> float:
-        return max((m.log_time for m in self.messages), default=0) * 1e-9
+        return self.last_time_ns * 1e-9
 
     def recovery_line(self) -> str:
         """One sentence on how much of a damaged file could be read."""
         if self.complete:
-            return f"complete: {len(self.messages)} messages"
+            return f"complete: {self.message_count} messages"
         return (
-            f"truncated ({self.problem}): recovered {len(self.messages)} messages up to "
+            f"truncated ({self.problem}): recovered {self.message_count} messages up to "
             f"t={self.last_time_s():.3f} s from {self.bytes_read} of {self.file_bytes} bytes"
         )
 
 
-def _open_regular(path: Path) -> BinaryIO:
+def open_regular(path: Path) -> BinaryIO:
     """Open a regular file for reading; anything else is a one-line LogError."""
     try:
         mode = path.stat().st_mode
@@ -163,9 +171,18 @@ def _parse(opcode: int, body: bytes) -> list:
     return _chunk_records(record) if opcode == Opcode.CHUNK else [record]
 
 
-def _keep(raw: RawLog, record) -> None:
+OnMessage = Callable[[RawLog, Message], None]
+
+
+def _keep(raw: RawLog, record, on_message: OnMessage | None) -> None:
     if isinstance(record, Message):
-        raw.messages.append(record)
+        raw.message_count += 1
+        raw.channel_counts[record.channel_id] = raw.channel_counts.get(record.channel_id, 0) + 1
+        raw.last_time_ns = max(raw.last_time_ns, record.log_time)
+        if on_message is None:
+            raw.messages.append(record)
+        else:
+            on_message(raw, record)
     elif isinstance(record, Channel):
         raw.channels.setdefault(record.id, record)
     elif isinstance(record, Schema):
@@ -178,8 +195,12 @@ def _keep(raw: RawLog, record) -> None:
         raw.profile, raw.library = record.profile, record.library
 
 
-def read_records(path: str | Path) -> RawLog:
+def read_records(path: str | Path, on_message: OnMessage | None = None) -> RawLog:
     """Read every intact record of an MCAP file, tolerating a cut at any byte.
+
+    Args:
+        on_message: called with each message as it is read (its channel is in ``raw.channels`` by
+            then); the messages are then not kept.  None: kept in ``raw.messages``.
 
     Walks the top-level records by their (opcode, length) heads; a record that
     does not fit in the file, or whose contents do not parse (CRC, zstd), ends the
@@ -191,7 +212,7 @@ def read_records(path: str | Path) -> RawLog:
             MCAP at all, or is cut before its first record.
     """
     path = Path(path)
-    with _open_regular(path) as stream:
+    with open_regular(path) as stream:
         size = os.fstat(stream.fileno()).st_size
         raw = RawLog(path=path, file_bytes=size)
         _check_magic(stream, path, size)
@@ -214,7 +235,7 @@ def read_records(path: str | Path) -> RawLog:
                     problem = f"corrupt record at byte {position} ({_describe(error)})"
                     break
                 for record in records:
-                    _keep(raw, record)
+                    _keep(raw, record, on_message)
             else:
                 stream.seek(end)
             position = raw.bytes_read = end

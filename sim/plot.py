@@ -17,7 +17,7 @@ import numpy as np
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim.commands import MAX_DPI, MIN_DPI
-from swarmnav.sim.log_reader import RunLog, outcome_text, read_log
+from swarmnav.sim.log_reader import RunLog, outcome_text, read_log, truncation_advice
 
 MAX_SWEEP_DISCS = 40
 MAX_SCANS = 400
@@ -194,7 +194,7 @@ def run(args: argparse.Namespace) -> int:
     image_format(args.out, args.dpi)  # before the work: a bad -o or --dpi is exit 2 at once
     log = read_log(args.log, allow_truncated=True)
     if not log.complete:
-        print(f"warning: {args.log}: {log.raw.recovery_line()}", file=sys.stderr)
+        print(f"warning: {args.log}: {truncation_advice(log.raw)}", file=sys.stderr)
     out = plot_run(log, args.out, dpi=args.dpi)
     print(out)
     return 0

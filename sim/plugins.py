@@ -113,6 +113,7 @@ def describe_components(kind: str) -> list[dict[str, Any]]:
     import dataclasses
     import typing
 
+    from swarmnav.models.parameters import parameter_ranges
     load_plugins()
     if kind == "planner":
         from swarmnav.planners.registry import PLANNERS as registry_map
@@ -126,7 +127,7 @@ def describe_components(kind: str) -> list[dict[str, Any]]:
             hints = typing.get_type_hints(cls)
         except Exception:
             hints = {}
-        ranges = getattr(cls, "parameter_ranges", None) or {}
+        ranges = {k: str(v) for k, v in parameter_ranges(cls).items()}  # merged along the class hierarchy
         params = []
         for f in (dataclasses.fields(cls) if dataclasses.is_dataclass(cls) else ()):
             if not f.init:

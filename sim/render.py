@@ -34,6 +34,7 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from swarmnav.models.errors import ConfigError  # noqa: E402
+from swarmnav.sim.commands import MAX_FPS, MIN_FPS  # noqa: E402
 from swarmnav.sim.recording import RunContext, StepFrame  # noqa: E402
 from swarmnav.sim.video_file import VideoWriter  # noqa: E402
 
@@ -64,13 +65,13 @@ def check_video_size(width: int, height: int, fps: float) -> None:
     """H.264 in yuv420p needs even sizes; reject silly values early.
 
     Raises:
-        ConfigError: on odd, too small or too large sizes, or a non-positive fps.
+        ConfigError: on odd, too small or too large sizes, or a frame rate outside MIN_FPS..MAX_FPS.
     """
     for name, value in (("width", width), ("height", height)):
         if value < 16 or value > 4096 or value % 2:
             raise ConfigError(f"--{name}", f"must be an even number of pixels in 16..4096, got {value}")
-    if not fps > 0:
-        raise ConfigError("--fps", f"must be positive, got {fps}")
+    if not MIN_FPS <= fps <= MAX_FPS:  # NaN fails too
+        raise ConfigError("--fps", f"must be from {MIN_FPS:g} to {MAX_FPS:g} frames per simulated second, got {fps:g}")
 
 
 class ScenePoser:

@@ -10,8 +10,12 @@ parameters, seed, and the attached MJCF, not today's model files) and compares
 every logged pose and range scan with the re-simulated one (the comparison and
 its verdict are :mod:`sim.verify_report`).  On the same machine and versions we
 expect bitwise equality; otherwise the largest deviation is reported and where it
-first appeared.  A log that ends early (killed, interrupted, recovered) passes
-when every step it holds is equal: "prefix bitwise equal, the log ends at t = ...".
+first appeared.  A log that ends early (killed, interrupted, recovered, or a file
+without its footer, read as far as it goes with a warning line) passes when every
+step it holds is equal: "prefix bitwise equal, the log ends at t = ...".
+
+Both stream the log (:func:`sim.log_reader.read_log`): memory is the arrays of
+numbers the comparison or the frames need, not the log's messages.
 """
 
 from __future__ import annotations
@@ -20,13 +24,14 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim.commands import DEFAULT_FPS
 from swarmnav.sim.log_format import ranges_from_scan
-from swarmnav.sim.log_reader import RunLog, read_log
+from swarmnav.sim.log_reader import RunLog, read_log, truncation_advice
 from swarmnav.sim.mcap_records import LogError
 from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
 from swarmnav.sim.verify_report import TrajectoryCapture, VerifyReport, compare_with_log
@@ -67,8 +72,9 @@ def context_from_log(log: RunLog) -> RunContext:
     )
 
 
-def frames_from_log(log: RunLog) -> list[StepFrame]:
-    """One StepFrame per logged control step (``/tf`` times), other channels aligned by time."""
+def frames_from_log(log: RunLog) -> Iterator[StepFrame]:
+    """One StepFrame per logged control step (``/tf`` times), other channels aligned by time, made as
+    they are consumed (a long log is never a list of frames)."""
     times = log.time_s
     count = len(times)
 
@@ -88,14 +94,13 @@ def frames_from_log(log: RunLog) -> list[StepFrame]:
         track_t, track_xy = log.obstacle_tracks.get(name, (np.zeros(0), np.zeros((0, 2))))
         tracks.append((align(track_t), track_xy))
 
-    frames = []
     for k in range(count):
         range_m = np.full(len(log.scan_angles_rad), np.inf)
         if ranges is not None and scan_index[k] >= 0:
             range_m = ranges[scan_index[k]]
         moving_xy = np.array([xy[i[k]] if len(xy) else (np.nan, np.nan) for i, xy in tracks]).reshape(-1, 2)
         w, c = wheel_index[k], control_index[k]
-        frames.append(StepFrame(
+        yield StepFrame(
             time_s=float(times[k]),
             position_m=log.position_m[k],
             quaternion_wxyz=log.quaternion_wxyz[k],
@@ -107,8 +112,7 @@ def frames_from_log(log: RunLog) -> list[StepFrame]:
             angular_rad_s=float(log.angular_rad_s[c]) if c >= 0 else 0.0,
             waypoint_index=int(log.waypoint_index[c]) if c >= 0 else 0,
             moving_obstacles_m=moving_xy,
-        ))
-    return frames
+        )
 
 
 def render_log(log: RunLog, video_path: str | Path, *, camera: str = "top", width: int = 640,
@@ -131,8 +135,48 @@ def render_log(log: RunLog, video_path: str | Path, *, camera: str = "top", widt
     return {"frames": recorder.frames, "video_s": recorder.frames / fps, "render_s": recorder.render_seconds}
 
 
-def verify_log(log: RunLog) -> VerifyReport:
-    """Re-simulate a logged run from the log alone and compare poses step by step."""
+def code_for_verify(context: RunContext, named: dict, trust_code: bool, source: str) -> dict:
+    """The navigator parameters to re-simulate with: the log's, with the code parameters named on the command
+    line in place of the logged ones.
+
+    A log is data: a parameter of its planner or navigator that names code (the
+    ``policy`` navigator's ``policy``) is re-run only when the user names it on the
+    command line (``--navigator-set policy=module:function``), or with
+    ``--trust-code``.  Nothing is imported here; only declarations are read.
+
+    Raises:
+        ConfigError: a logged code parameter that is neither named nor trusted, or a ``--navigator-set``
+            key that is not a code parameter of the logged navigator.
+    """
+    from swarmnav.controllers.navigators import NAVIGATORS
+    from swarmnav.models.parameters import TRUST_OPTION, code_parameters, refuse_code
+    from swarmnav.planners.registry import PLANNERS
+
+    cls = NAVIGATORS.get(context.navigator_name)
+    code_keys = code_parameters(cls) if cls is not None else ()
+    for key in named:
+        if key not in code_keys:
+            raise ConfigError("--navigator-set", f"{key!r}: replay --verify takes only the parameters of the log's "
+                              f"navigator {context.navigator_name!r} that name code "
+                              f"({', '.join(code_keys) or 'it has none'}); the rest come from the log")
+    if not trust_code:
+        refuse_code(PLANNERS, "planner", context.planner_name, context.planner_params, source)
+        for key in code_keys:
+            if key in context.navigator_params and key not in named:
+                raise ConfigError(f"navigator.params.{key}",
+                                  f"the log was recorded with {key}={context.navigator_params[key]!r}, which names "
+                                  f"code; replay --verify re-simulates it only when you name it: --navigator-set "
+                                  f"{key}=MODULE:FUNCTION (or {TRUST_OPTION})", source)
+    return {**context.navigator_params, **named}
+
+
+def verify_log(log: RunLog, named: dict | None = None, trust_code: bool = False) -> VerifyReport:
+    """Re-simulate a logged run from the log alone and compare poses step by step.
+
+    Args:
+        named: code parameters of the navigator named on the command line (see :func:`code_for_verify`).
+        trust_code: run the code the log names.
+    """
     import mujoco
 
     from swarmnav.models.scenario import parse_scenario
@@ -140,9 +184,13 @@ def verify_log(log: RunLog) -> VerifyReport:
     from swarmnav.sim.scene import index_scene
 
     context = context_from_log(log)
-    scenario = parse_scenario(context.scenario_toml, f"{log.raw.path}[scenario]")
+    source = str(log.raw.path)
+    if len(log.time_s) == 0:
+        raise LogError(source, "holds no step to replay")
+    navigator_params = code_for_verify(context, named or {}, trust_code, source)
+    scenario = parse_scenario(context.scenario_toml, f"{source}[scenario]", trust_code=trust_code)
     spec = EpisodeSpec(scenario, context.planner_name, context.planner_params, context.navigator_name,
-                       context.navigator_params, context.seed, context.world_seed, context.clearance_m)
+                       navigator_params, context.seed, context.world_seed, context.clearance_m)
     model = mujoco.MjModel.from_xml_string(context.mjcf_xml)
     # Reproduce how the logged run stopped: a timeout at T means the limit was T.
     kinds = [kind for _, kind, _ in log.events]
@@ -162,11 +210,17 @@ def run(args: argparse.Namespace) -> int:
     --verify finds a difference, 2 on bad input."""
     if not args.video and not args.verify:
         raise ConfigError("replay", "nothing to do: give --video OUT.mp4 and/or --verify")
+    if (args.navigator_set or args.trust_code) and not args.verify:
+        raise ConfigError("--navigator-set" if args.navigator_set else "--trust-code", "needs --verify")
     if args.video:
         from swarmnav.sim.render import check_video_size
         check_video_size(args.width, args.height, args.fps)
-    log = read_log(args.log)
-    results: dict = {"log": str(args.log)}
+    log = read_log(args.log, allow_truncated=True)  # as plot and log info: what was recovered, with a warning
+    if len(log.time_s) == 0:  # nothing to render or compare: one error line, no warning before it
+        raise LogError(args.log, f"holds no step to replay ({log.raw.recovery_line()})")
+    if not log.complete:
+        print(f"warning: {args.log}: {truncation_advice(log.raw)}", file=sys.stderr)
+    results: dict = {"log": str(args.log), "complete": log.complete}
     status = 0
     if args.video:
         info = render_log(log, args.video, camera=args.camera, width=args.width, height=args.height,
@@ -176,9 +230,15 @@ def run(args: argparse.Namespace) -> int:
             print(f"video: {args.video}: {info['frames']} frames, {info['video_s']:.1f} s at {args.fps:g} fps "
                   f"({info['frames'] / max(info['render_s'], 1e-9):.0f} frames/s rendered)")
     if args.verify:
-        report = verify_log(log)
-        results["verify"] = report.as_dict()
+        from swarmnav.sim.cli import parse_settings  # loaded already: the CLI is what calls this
+        named = parse_settings(args.navigator_set, "--navigator-set")
+        report = verify_log(log, named, args.trust_code)
+        results["verify"] = {**report.as_dict(), "named_on_command_line": named}
         if not args.json:
+            for key, value in named.items():
+                logged = context_from_log(log).navigator_params.get(key)
+                print(f"re-simulated with {key}={value!r} as named on the command line (the log recorded "
+                      f"{logged!r})")
             print("\n".join(report.lines()))
         status = 0 if report.passed else EXIT_DIFFERENT
     if args.json:

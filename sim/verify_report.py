@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from swarmnav.sim.log_columns import Rows
 from swarmnav.sim.log_format import scan_from_ranges
 from swarmnav.sim.log_reader import RunLog, outcome_text
 from swarmnav.sim.recording import RunContext, StepFrame
@@ -88,13 +89,12 @@ class VerifyReport:
 
 
 class TrajectoryCapture:
-    """A Recorder that keeps the time, base pose and ranges of every step in memory."""
+    """A Recorder that keeps the time, base pose and ranges of every step, as rows of numbers
+    (:class:`sim.log_columns.Rows`: a long run costs its numbers, not an object per step)."""
 
     def __init__(self) -> None:
-        self.times_s: list[float] = []
-        self.positions_m: list[np.ndarray] = []
-        self.quaternions_wxyz: list[np.ndarray] = []
-        self.ranges_m: list[np.ndarray] = []
+        self._poses = Rows(8)  # t, x, y, z, qw, qx, qy, qz
+        self._ranges = Rows()
 
     def start(self, context: RunContext) -> None:
         pass
@@ -103,10 +103,12 @@ class TrajectoryCapture:
         pass
 
     def step(self, frame: StepFrame) -> None:
-        self.times_s.append(frame.time_s)
-        self.positions_m.append(np.array(frame.position_m, dtype=float))
-        self.quaternions_wxyz.append(np.array(frame.quaternion_wxyz, dtype=float))
-        self.ranges_m.append(np.array(frame.range_m, dtype=float))
+        row = np.empty(8)
+        row[0] = frame.time_s
+        row[1:4] = frame.position_m
+        row[4:8] = frame.quaternion_wxyz
+        self._poses.append(row)
+        self._ranges.append(np.asarray(frame.range_m, dtype=float))
 
     def event(self, time_s: float, kind: str, details: dict) -> None:
         pass
@@ -116,9 +118,12 @@ class TrajectoryCapture:
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(T,) times, (T, 3) positions, (T, 4) quaternions."""
-        return (np.array(self.times_s, dtype=float),
-                np.array(self.positions_m, dtype=float).reshape(-1, 3),
-                np.array(self.quaternions_wxyz, dtype=float).reshape(-1, 4))
+        poses = self._poses.array()
+        return poses[:, 0].copy(), poses[:, 1:4].copy(), poses[:, 4:8].copy()
+
+    def ranges(self) -> np.ndarray:
+        """(T, K) ranges of every step."""
+        return self._ranges.array()
 
 
 def log_stops_early(log: RunLog) -> bool:
@@ -163,7 +168,7 @@ def compare_with_log(log: RunLog, capture: TrajectoryCapture, planned_waypoints_
                   if logged_path.shape == replanned.shape and len(replanned) else math.inf)
 
     offset_m = float(log.run_value("sensor_offset_m", 0.0))
-    sim_ranges = np.array(capture.ranges_m, dtype=float).reshape(len(sim_t), -1)
+    sim_ranges = capture.ranges().reshape(len(sim_t), -1)
     m = min(len(sim_ranges), len(log.range_m))
     ranges_equal, range_error = _range_deviation_m(scan_from_ranges(sim_ranges[:m], offset_m), log.range_m[:m])
 

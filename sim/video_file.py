@@ -5,6 +5,12 @@ that its messages never reach the user's terminal unasked and a failure is one
 ``OSError`` naming the video file: the file is created here first (a refused path
 fails before ffmpeg starts), ffmpeg's stderr goes to a temporary file, and its
 exit status is checked when the video is closed.
+
+A writer stops when its consumer fails: ffmpeg runs with ``-xerror`` (it exits at
+its first error rather than reading and dropping every further frame), and each
+frame first checks that ffmpeg is still running, so a dead or failed encoder ends
+the run at the next frame with that one ``OSError`` (the run's log is then finished
+by the runner as for any error).
 """
 
 from __future__ import annotations
@@ -41,13 +47,15 @@ class VideoWriter:
         except OSError as error:
             raise type(error)(error.errno, error.strerror, str(self.path)) from None
         self._messages = tempfile.TemporaryFile()
-        command = [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-v", "error", "-f", "rawvideo", "-vcodec", "rawvideo",
+        command = [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-v", "error", "-xerror", "-f", "rawvideo", "-vcodec", "rawvideo",
                    "-s", f"{width}x{height}", "-pix_fmt", "rgb24", "-r", f"{fps:.12g}", "-i", "-",
                    *ENCODER_OPTIONS, str(self.path)]
         self._process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
                                          stderr=self._messages)
 
     def add(self, frame: np.ndarray) -> None:
+        if self._process is None or self._process.poll() is not None:  # ffmpeg stopped: never feed it
+            self._fail()
         try:
             self._process.stdin.write(np.ascontiguousarray(frame, dtype=np.uint8).data)
         except (BrokenPipeError, ValueError):
@@ -69,6 +77,8 @@ class VideoWriter:
 
     def _fail(self) -> None:
         process, self._process = self._process, None
+        if process is None and self._messages.closed:
+            raise OSError(errno.EIO, "ffmpeg could not write the video (it stopped earlier)", str(self.path))
         if process is not None:
             try:
                 process.stdin.close()

@@ -130,7 +130,7 @@ def test_a_tiny_study_runs_the_policy_navigator_beside_replan(policy_module, tmp
         [[navigators]]
         name = "replan"
     '''))
-    out = swarmnav("study", str(study), "--out", str(tmp_path / "out"), "--workers", "1", "--json")
+    out = swarmnav("study", str(study), "--out", str(tmp_path / "out"), "--workers", "1", "--json", "--trust-code")
     assert out.returncode == 0, out.stderr
     assert json.loads(out.stdout)["failed"] == 0
     rows = pq.read_table(tmp_path / "out" / "runs.parquet").to_pylist()

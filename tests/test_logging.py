@@ -234,13 +234,27 @@ def test_log_info_prints_channels_and_outcome(full_run, capsys):
         assert topic in out
 
 
-@pytest.mark.parametrize("kind", ["truncated", "not_mcap", "empty"])
+@pytest.mark.parametrize("command", [["log info"], ["replay", "--verify"], ["plot", "-o", "p.png"]])
+def test_a_log_without_its_footer_is_read_with_one_warning_line(tmp_path, full_run, capsys, command):
+    """log info, replay and plot read a cut log alike: what was recovered, a warning line, exit 0."""
+    cut = tmp_path / "truncated.mcap"
+    cut.write_bytes(full_run[0].read_bytes()[:40_000])
+    argv = command[0].split() + [str(cut)] + [str(tmp_path / a) if a.endswith(".png") else a for a in command[1:]]
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"warning: {cut}: truncated") and "log recover" in lines[0]
+    if command[0] == "log info":
+        assert "messages" in captured.out and "none: the run did not finish" in captured.out
+    if command[0] == "replay":
+        assert "prefix bitwise equal" in captured.out
+
+
+@pytest.mark.parametrize("kind", ["not_mcap", "empty"])
 @pytest.mark.parametrize("command", [["log", "info"], ["replay"]])
 def test_bad_log_gives_one_line_error_and_exit_2(tmp_path, full_run, capsys, kind, command):
     bad = tmp_path / f"{kind}.mcap"
-    if kind == "truncated":
-        bad.write_bytes(full_run[0].read_bytes()[:40_000])
-    elif kind == "not_mcap":
+    if kind == "not_mcap":
         bad.write_text("name = 'not a log'\n")
     else:
         bad.write_bytes(b"")

@@ -32,9 +32,11 @@ for _cls in (FollowNavigator, ReplanNavigator, DStarReplanNavigator, DynamicWind
     register(_cls)
 
 
-def make_navigator(name: str, params: dict[str, Any] | None = None, source: str | None = None) -> Any:
-    """Build a registered navigator from its name and a parameter table (ConfigError naming the field)."""
-    return build_component(NAVIGATORS, "navigator", name, params, source)
+def make_navigator(name: str, params: dict[str, Any] | None = None, source: str | None = None,
+                   trust_code: bool = True) -> Any:
+    """Build a registered navigator from its name and a parameter table (ConfigError naming the field;
+    ``trust_code``: see :func:`models.parameters.build_component`)."""
+    return build_component(NAVIGATORS, "navigator", name, params, source, trust_code)
 
 
 __all__ = ["NAVIGATORS", "register", "make_navigator"]

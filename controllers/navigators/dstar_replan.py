@@ -51,6 +51,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.replan import check_positive, keep_outside
@@ -79,6 +80,9 @@ class DStarReplanNavigator:
     """
 
     name: ClassVar[str] = "dstar_replan"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "horizon_s": within(0, 600), "margin_m": within(0, 100), "cell_m": within(0, 100),
+        "improvement_m": within(0, 1e6), "update_period_s": within(0, 1e6), "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: float = field(default=0.0, init=False, repr=False)

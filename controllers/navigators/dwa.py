@@ -52,6 +52,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.kinematics import wheel_speeds
@@ -78,6 +79,13 @@ class DynamicWindowNavigator:
     """
 
     name: ClassVar[str] = "dwa"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        # v_samples x omega_samples x horizon_s / sim_step_s rollout points: at most 50 x 100 x 500
+        "alpha": within(0, 1e6), "beta": within(0, 1e6), "gamma": within(0, 1e6), "accel_m_s2": above(0, 1000),
+        "angular_accel_rad_s2": above(0, 1000), "window_s": above(0, 10), "max_angular_rad_s": above(0, 100),
+        "v_samples": within(1, 50), "omega_samples": within(1, 100), "horizon_s": above(0, 10),
+        "sim_step_s": within(0.02, 1), "dist_cap_m": above(0, 1000), "margin_m": within(0, 100),
+        "lookahead_m": above(0, 1000), "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()

@@ -48,6 +48,7 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import (Cell, CellWalker, cells_of_path, grid_problem, heading_of,
                                                        static_grid, step_line)
@@ -79,6 +80,9 @@ class IacoLocalNavigator:
     """
 
     name: ClassVar[str] = "iaco_local"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "same_line_deg": within(0, 180), "margin_m": within(0, 100), "horizon_cells": within(1, 1000),
+        "reach_m": above(0, 100), "lead_steps": within(0, 1000)}  # models.parameters: checked on build
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured

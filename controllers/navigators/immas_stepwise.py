@@ -52,6 +52,7 @@ from typing import Any, Callable, ClassVar, Iterable
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, static_grid
 from swarmnav.models.errors import ConfigError
@@ -210,6 +211,8 @@ class ImmasStepwiseNavigator:
     """
 
     name: ClassVar[str] = "immas_stepwise"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "alpha": within(0, 100), "beta": within(0, 100), "reach_m": above(0, 100)}  # models.parameters: checked on build
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured

@@ -9,7 +9,10 @@ Loading the callable: ``pkgutil.resolve_name`` (the standard library's
 ``module:attribute`` resolver) imports the user's module.  This is the one place
 outside ``sim/`` that loads code by name, and it only ever loads the user's
 policy, never project code (the registry of navigators stays explicit);
-``tests/test_layering.py`` allows exactly this module and this call.
+``tests/test_layering.py`` allows exactly this module and this call.  ``policy``
+is declared a code parameter (:func:`models.parameters.code_parameter`): a
+scenario file, a study file or a log may name it only when the user passes
+``--trust-code`` (the check reads the declaration and imports nothing).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import numpy as np
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command, observation_layout
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.parameters import Range, above, code_parameter, within
 
 FIELD = "navigator.params.policy"
 
@@ -58,10 +62,12 @@ class PolicyNavigator:
     """
 
     name: ClassVar[str] = "policy"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "path_waypoints": within(0, 1000), "obstacle_slots": within(1, 1000)}  # models.parameters: checked on build
     uses_detections: bool = field(default=True, init=False, repr=False)  # per run: set by reset
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
-    policy: str = ""
+    policy: str = code_parameter()  # names code: never taken from a data file without --trust-code
     action: str = "twist"
     path_waypoints: int = 0
     obstacle_slots: int | None = None

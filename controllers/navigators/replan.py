@@ -43,6 +43,7 @@ import time
 from dataclasses import dataclass, replace, field
 from typing import Any, ClassVar
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_discs
@@ -112,6 +113,10 @@ class ReplanNavigator:
     """
 
     name: ClassVar[str] = "replan"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "lookahead_m": within(0, 1000), "horizon_s": within(0, 600), "margin_m": within(0, 100),
+        "cooldown_s": within(0, 1e6), "retry_s": within(0, 1e6), "planning_latency_s": within(0, 1e6),
+        "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: float = field(default=0.0, init=False, repr=False)

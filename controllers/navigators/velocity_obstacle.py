@@ -38,6 +38,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.kinematics import wheel_speeds
@@ -65,6 +66,11 @@ class VelocityObstacleNavigator:
     """
 
     name: ClassVar[str] = "velocity_obstacle"
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "time_horizon_s": above(0, 60), "speed_samples": within(1, 100), "heading_samples": within(1, 360),
+        "max_turn_rad": within(0, math.pi), "margin_m": within(0, 100), "lookahead_m": above(0, 1000),
+        "heading_gain": within(0, 1000), "max_angular_rad_s": above(0, 100), "turn_in_place_rad": within(0, math.pi),
+        "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()

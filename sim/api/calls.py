@@ -21,8 +21,9 @@ if TYPE_CHECKING:
 ScenarioLike = "str | os.PathLike | Scenario"
 
 
-def load_scenario(name_or_path: str | os.PathLike) -> "Scenario":
-    """A bundled scenario by name (``swarmnav scenarios``), an installed package's, or a ``.toml`` path.
+def load_scenario(name_or_path: str | os.PathLike, trust_code: bool = False) -> "Scenario":
+    """A bundled scenario by name (``swarmnav scenarios``), an installed package's, or a ``.toml`` path
+    (``trust_code``: the file may name code to run, e.g. a ``policy``; see ``--trust-code``).
 
     Raises:
         ConfigError: missing file, malformed TOML or a field that breaks the schema (naming it).
@@ -30,7 +31,7 @@ def load_scenario(name_or_path: str | os.PathLike) -> "Scenario":
     from swarmnav.models.scenario import load_scenario as load
     from swarmnav.sim.plugins import load_plugins
     load_plugins()
-    return load(str(name_or_path))
+    return load(str(name_or_path), trust_code)
 
 
 def _scenario(scenario: Any) -> "Scenario":

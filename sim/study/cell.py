@@ -124,7 +124,7 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
     started = time.perf_counter()
     try:
         with _WallLimit(cell.wall_limit_s):
-            scenario = load_scenario(cell.scenario)
+            scenario = load_scenario(cell.scenario, trust_code=cell.trust_code)
             row["straight_line_m"] = math.hypot(scenario.goal.x_m - scenario.start.x_m,
                                                 scenario.goal.y_m - scenario.start.y_m)
             spec = EpisodeSpec(scenario, cell.planner, cell.planner_params, cell.navigator, cell.navigator_params,

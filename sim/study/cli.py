@@ -28,6 +28,8 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--retry-errors", action="store_true",
                    help="run again the cells whose row is an error (by default a resume runs only cells without a row)")
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
+    from swarmnav.sim.commands import add_trust_code_argument  # here: sim.commands imports this module
+    add_trust_code_argument(p)
     p.add_argument("--junit", metavar="FILE", help="write the study's rows as JUnit XML (one test suite per scenario, "
                    "a failure per row that is not a success)")
     p.add_argument("--min-success", type=_rate, metavar="RATE",
@@ -60,8 +62,11 @@ def run_study(args: argparse.Namespace) -> int:
             import ray  # noqa: F401
         except ImportError:
             raise ConfigError("--engine", "ray is not installed (pip install 'swarmnav[ray]')") from None
-    study = load_study(args.file)
+    study = load_study(args.file, trust_code=args.trust_code)
     if args.quick:
+        if study.quick_seeds is None:
+            print(f"swarmnav: warning: study {study.name!r} has no quick_seeds: --quick runs the full study",
+                  file=sys.stderr)
         study = study.quick()
     from swarmnav.sim.study.execute import run_study as execute
     out = args.out or str(FilePath("studies") / study.name)

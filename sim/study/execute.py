@@ -164,7 +164,10 @@ def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, work
     """Validate a study built in code (the tables its TOML file would hold), run it into ``out_dir`` (in this
     process with ``workers=1``, else on that many local processes), and return every run row of the folder
     (what the benchmarks tabulate)."""
-    study = study_from_tables(tables, source, str(tables.get("name", "study")))
+    # Tables built in code from the command line's options (bench navigation's --navigator-set policy=...): their
+    # code is the user's; the scenario files they name are still data (a cell whose file names code is an error).
+    study = study_from_tables(tables, source, str(tables.get("name", "study")), trust_code=True)
+    study = dataclasses.replace(study, trust_code=False)
     run_study(study, out_dir, engine="inline" if workers == 1 else "local", workers=workers,
               show_progress=show_progress)
     return read_table(out_dir).to_pylist()

@@ -38,6 +38,7 @@ class Cell:
     wall_limit_s: float
     config_hash: str
     clearance_m: float | None = None  # the study's planning clearance override (None: the scenario's)
+    trust_code: bool = False  # the study's --trust-code (not part of the hash: it decides no result)
 
     @property
     def physics(self) -> bool:
@@ -90,7 +91,7 @@ def iter_cells(study: Study) -> Iterator[Cell]:
                 navigator_params=navigator_params, seed=seed, world_seed=world_seed,
                 mode=study.mode, time_limit_s=study.time_limit_s,
                 wall_limit_s=study.wall_limit_s, config_hash=config_hash(config),
-                clearance_m=study.clearance_m)
+                clearance_m=study.clearance_m, trust_code=study.trust_code)
 
 
 def count_cells(study: Study) -> int:

@@ -40,16 +40,22 @@ from __future__ import annotations
 import fnmatch
 import glob
 import itertools
+import math
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path as FilePath
 from typing import Any
 
-from swarmnav.controllers.navigators import make_navigator
+from swarmnav.controllers.navigators import NAVIGATORS, make_navigator
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, load_scenario, resolve_scenario_path
-from swarmnav.planners.registry import make_planner
+from swarmnav.models.parameters import refuse_code
+from swarmnav.planners.registry import PLANNERS, make_planner
 
+MAX_SEEDS = 100_000  # seeds (or world seeds) of one study
+MAX_SEED = 2**63 - 1  # as --seed and a scenario's seed (a TOML integer; NumPy's seeds take it)
+MAX_CELLS = 2_000_000  # runs of one study (scenarios x settings x seed pairs), each a row
+MAX_WALL_LIMIT_S = 1e6
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
 TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
@@ -101,6 +107,7 @@ class Study:
     clearance_m: float | None = None  # planning clearance override for every scenario (None: each scenario's)
     paired_seeds: bool = False  # the k-th seed runs with the k-th world seed only
     claims: tuple[dict[str, Any], ...] = ()  # [[claims]] tables as written (their verdicts: swarmnav report)
+    trust_code: bool = False  # --trust-code: its files (study, scenarios) may name code to run
 
     def seed_pairs(self) -> list[tuple[int | None, int]]:
         """(world seed, seed) of every run of one setting, in the grid's order."""
@@ -139,8 +146,9 @@ def resolve_study_path(name_or_path: str) -> FilePath:
     return bundled
 
 
-def load_study(name_or_path: str) -> Study:
-    """Read and validate a study file (bundled name or path).
+def load_study(name_or_path: str, trust_code: bool = False) -> Study:
+    """Read and validate a study file (bundled name or path); ``trust_code``: the study and its scenarios
+    may name code to run (``--trust-code``; otherwise such a parameter is a ConfigError, nothing imported).
 
     Raises:
         ConfigError: missing file, malformed TOML, or any field that breaks the schema.
@@ -150,7 +158,7 @@ def load_study(name_or_path: str) -> Study:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError("study", f"cannot be read ({exc})", str(path)) from None
-    return parse_study(text, str(path), default_name=path.stem)
+    return parse_study(text, str(path), default_name=path.stem, trust_code=trust_code)
 
 
 def _fail(source: str, field: str, problem: str):
@@ -204,20 +212,22 @@ def _seeds(source: str, data: dict, key: str, default: Any) -> tuple:
     if isinstance(value, bool):
         _fail(source, key, f"expected a count or a list of integers, got {value!r}")
     if isinstance(value, int):
-        if value < 1:
-            _fail(source, key, f"empty grid: the count must be at least 1, got {value}")
+        if not 1 <= value <= MAX_SEEDS:
+            _fail(source, key, f"the count must be from 1 to {MAX_SEEDS:,}, got {value}")
         return tuple(range(value))
     if not isinstance(value, list) or not value:
         _fail(source, key, "empty grid: expected a count or a non-empty list of integers")
+    if len(value) > MAX_SEEDS:
+        _fail(source, key, f"lists {len(value):,} seeds, at most {MAX_SEEDS:,}")
     for i, seed in enumerate(value):
-        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-            _fail(source, f"{key}[{i}]", f"expected a non-negative integer, got {seed!r}")
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
+            _fail(source, f"{key}[{i}]", f"expected an integer from 0 to {MAX_SEED}, got {seed!r}")
     if len(set(value)) != len(value):
         _fail(source, key, "lists a seed twice")
     return tuple(value)
 
 
-def _components(source: str, value: Any, key: str, kind: str, make) -> tuple[Component, ...]:
+def _components(source: str, value: Any, key: str, kind: str, make, trust_code: bool) -> tuple[Component, ...]:
     if not isinstance(value, list) or not value:
         _fail(source, key, f"empty grid: expected a non-empty array of [[{key}]] tables")
     out: list[Component] = []
@@ -239,7 +249,7 @@ def _components(source: str, value: Any, key: str, kind: str, make) -> tuple[Com
         component = Component(name, label, dict(params), swept)
         for setting in component.settings():  # every combination builds: names and every swept value checked
             try:
-                make(name, setting, source)
+                make(name, setting, source, trust_code=trust_code)
             except ConfigError as exc:
                 field = exc.field.replace(f"{kind}.", f"{where}.", 1)
                 if field == f"{where}.params" and swept:
@@ -251,6 +261,21 @@ def _components(source: str, value: Any, key: str, kind: str, make) -> tuple[Com
         if label in labels[:i]:
             _fail(source, f"{key}[{i}].label", f"label {label!r} is used twice (give each entry its own label)")
     return tuple(out)
+
+
+def _refuse_scenario_code(scenarios: tuple[str, ...], planners: tuple[Component, ...],
+                          navigators: tuple[Component, ...]) -> None:
+    """A scenario file's own planner or navigator parameter that names code, where the study would use it
+    (the same component, not set by the study), is refused before any cell runs (models.parameters)."""
+    for ref in scenarios:
+        scenario = load_scenario(ref)
+        for kind, registry, own, params, components in (
+                ("planner", PLANNERS, scenario.planner_name, scenario.planner_params, planners),
+                ("navigator", NAVIGATORS, scenario.navigator_name, scenario.navigator_params, navigators)):
+            for component in components:
+                if component.name == own:
+                    unset = {k: v for k, v in params.items() if k not in component.params}
+                    refuse_code(registry, kind, own, unset, scenario.source_path)
 
 
 def _paper(source: str, value: Any, scenarios: tuple[str, ...], labels: list[str]) -> tuple[PaperValue, ...]:
@@ -279,13 +304,13 @@ def _paper(source: str, value: Any, scenarios: tuple[str, ...], labels: list[str
     return tuple(out)
 
 
-def parse_study(text: str, source: str = "<string>", default_name: str = "study") -> Study:
+def parse_study(text: str, source: str = "<string>", default_name: str = "study", trust_code: bool = False) -> Study:
     """Validate study TOML text (see :func:`load_study`)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError("toml", f"malformed TOML ({exc})", source) from None
-    return study_from_tables(data, source, default_name)
+    return study_from_tables(data, source, default_name, trust_code)
 
 
 def _clearance(source: str, data: dict, scenarios: tuple[str, ...]) -> float | None:
@@ -300,7 +325,8 @@ def _clearance(source: str, data: dict, scenarios: tuple[str, ...]) -> float | N
     return clearance_m
 
 
-def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_name: str = "study") -> Study:
+def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_name: str = "study",
+                      trust_code: bool = False) -> Study:
     """Validate a study given as the tables its TOML file would hold (what a benchmark builds in code)."""
     for key in sorted(set(data) - TOP_KEYS):
         _fail(source, key, "unknown key")
@@ -322,18 +348,20 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
             _fail(source, "quick_seeds", f"expected a count from 1 to the {len(seeds)} seeds, got {quick_seeds!r}")
     world_seeds: tuple = _seeds(source, data, "world_seeds", [0]) if "world_seeds" in data else (None,)
     wall_limit_s = _number(source, data.get("wall_limit_s", 600.0), "wall_limit_s")
-    if wall_limit_s <= 0:
-        _fail(source, "wall_limit_s", f"must be positive, got {wall_limit_s:g}")
+    if not 0 < wall_limit_s <= MAX_WALL_LIMIT_S:
+        _fail(source, "wall_limit_s", f"must be positive and at most {MAX_WALL_LIMIT_S:g} s, got {wall_limit_s:g}")
     time_limit_s = None
     if "time_limit_s" in data:
         time_limit_s = _number(source, data["time_limit_s"], "time_limit_s")
-        if time_limit_s <= 0:
-            _fail(source, "time_limit_s", f"must be positive, got {time_limit_s:g}")
+        if not 0 < time_limit_s < math.inf:
+            _fail(source, "time_limit_s", f"must be positive and finite, got {time_limit_s:g}")
     if "planners" not in data:
         _fail(source, "planners", "is required")
-    planners = _components(source, data["planners"], "planners", "planner", make_planner)
+    planners = _components(source, data["planners"], "planners", "planner", make_planner, trust_code)
     navigators = _components(source, data.get("navigators", [{"name": "follow"}]), "navigators", "navigator",
-                             make_navigator)
+                             make_navigator, trust_code)
+    if not trust_code:
+        _refuse_scenario_code(scenarios, planners, navigators)
     labels = [p.label for p in planners]
     reference = _string(source, data, "reference", "reference", labels[0])
     if reference not in labels and not any(reference.startswith(f"{label}(") for label in labels):
@@ -345,9 +373,13 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
     if paired and len(world_seeds) != len(seeds):
         _fail(source, "paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                       f"{len(world_seeds) if 'world_seeds' in data else 'no'} world seeds")
+    settings = sum(len(c.settings()) for c in planners) * sum(len(c.settings()) for c in navigators)
+    cells = len(scenarios) * settings * (len(seeds) if paired else len(seeds) * len(world_seeds))
+    if cells > MAX_CELLS:
+        _fail(source, "seeds", f"the grid has {cells:,} runs (scenarios x settings x seeds), at most {MAX_CELLS:,}")
     claims = data.get("claims", [])
     if not isinstance(claims, list) or not all(isinstance(c, dict) for c in claims):
         _fail(source, "claims", "expected an array of [[claims]] tables")
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
                  reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired,
-                 tuple(claims))
+                 tuple(claims), bool(trust_code))

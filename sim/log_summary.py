@@ -1,0 +1,147 @@
+"""What a log holds, without reading its messages: ``swarmnav log info`` on a log of any length.
+
+A complete MCAP file ends with a summary section: the schemas, the channels, a
+statistics record (messages per channel, first and last time stamp) and indexes
+of the metadata records and the chunks.  :func:`read_summary` answers from those,
+and reads only the ``/events`` messages, through the chunk index (the chunks that
+hold none are skipped), so a long log costs what its summary and events cost.
+A damaged chunk inside a file whose summary is intact is therefore not noticed
+here; ``plot``, ``replay`` and ``log recover``, which read every message, report it.
+
+A file without a usable summary (cut off by a killed run, or written without one)
+is walked record by record instead (:func:`sim.mcap_records.read_records`),
+decoding only its ``/events`` messages: what was recovered, with the file marked
+incomplete so the caller can warn.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from mcap.reader import SeekingReader
+from mcap.records import Message
+
+from swarmnav.sim.log_reader import check_channels
+from swarmnav.sim.mcap_records import LogError, RawLog, open_regular, read_records
+
+EVENTS_TOPIC = "/events"
+
+
+@dataclass
+class LogSummary:
+    """The facts ``log info`` prints (the attributes :func:`sim.log_commands.describe` reads)."""
+
+    raw: RawLog  # schemas, channels, metadata, counts; no messages
+    events: list[tuple[float, str, dict[str, Any]]]
+    outcome: dict[str, Any] | None
+    from_summary: bool  # True: answered from the summary section, no message but the events read
+
+    @property
+    def metadata(self) -> dict[str, dict[str, str]]:
+        return self.raw.metadata
+
+    @property
+    def complete(self) -> bool:
+        return self.raw.complete
+
+    @property
+    def scenario_name(self) -> str:
+        return self.metadata.get("scenario", {}).get("name", "?")
+
+    @property
+    def duration_s(self) -> float:
+        return self.raw.last_time_s()
+
+    @property
+    def counts(self) -> dict[str, int]:
+        return self.raw.counts()
+
+    @property
+    def schema_names(self) -> dict[str, str]:
+        raw = self.raw
+        return {c.topic: raw.schemas[c.schema_id].name if c.schema_id in raw.schemas else ""
+                for c in raw.channels.values()}
+
+
+def _event(raw: RawLog, message: Message) -> tuple[float, str, dict[str, Any]]:
+    try:
+        data = json.loads(message.data)
+        return message.log_time * 1e-9, str(data.get("kind", "?")), data.get("details", {})
+    except (ValueError, AttributeError) as error:
+        raise LogError(raw.path, f"an event cannot be decoded ({type(error).__name__}: {error})") from None
+
+
+def _outcome(raw: RawLog) -> dict[str, Any] | None:
+    if "outcome" not in raw.metadata:
+        return None
+    out = {}
+    for key, text in raw.metadata["outcome"].items():
+        try:
+            out[key] = json.loads(text)
+        except ValueError:
+            out[key] = text
+    return out
+
+
+def _from_summary(path: Path) -> LogSummary | None:
+    """The summary of a complete file with statistics, or None when it has none (or is cut)."""
+    with open_regular(path) as stream:
+        size = os.fstat(stream.fileno()).st_size
+        try:
+            reader = SeekingReader(stream, validate_crcs=True)
+            summary = reader.get_summary()
+            if summary is None or summary.statistics is None:
+                return None
+            header = reader.get_header()
+            metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+        except Exception:  # no footer, a damaged summary: the caller walks the records instead
+            return None
+        statistics = summary.statistics
+        raw = RawLog(path=path, profile=header.profile, library=header.library, schemas=dict(summary.schemas),
+                     channels=dict(summary.channels), metadata=metadata, complete=True, bytes_read=size,
+                     file_bytes=size, message_count=statistics.message_count,
+                     channel_counts=dict(statistics.channel_message_counts),
+                     last_time_ns=statistics.message_end_time if statistics.message_count else 0)
+        check_channels(raw)
+        events = []
+        if any(c.topic == EVENTS_TOPIC for c in raw.channels.values()):
+            try:
+                for _, _, message in reader.iter_messages(topics=[EVENTS_TOPIC], log_time_order=True):
+                    events.append(_event(raw, message))
+            except LogError:
+                raise
+            except Exception:  # an index that does not hold: walk the records instead
+                return None
+    return LogSummary(raw, events, _outcome(raw), from_summary=True)
+
+
+def read_summary(path: str | Path) -> LogSummary:
+    """What a log holds: from its summary section, else from its records (a truncated file).
+
+    Raises:
+        LogError: not a readable MCAP file or not a swarmnav log.
+    """
+    path = Path(path)
+    found = _from_summary(path)
+    return found if found is not None else from_records(path)
+
+
+def from_records(path: str | Path) -> LogSummary:
+    """What a log holds, walking its records (what :func:`read_summary` does for a file without summary)."""
+    events: list[tuple[float, str, dict[str, Any]]] = []
+    topics: dict[int, bool] = {}
+
+    def keep_events(raw: RawLog, message: Message) -> None:
+        if message.channel_id not in topics:
+            channel = raw.channels.get(message.channel_id)
+            topics[message.channel_id] = channel is not None and channel.topic == EVENTS_TOPIC
+        if topics[message.channel_id]:
+            events.append(_event(raw, message))
+
+    raw = read_records(Path(path), on_message=keep_events)
+    check_channels(raw)
+    return LogSummary(raw, events, _outcome(raw), from_summary=False)
