@@ -262,6 +262,15 @@ def run_plot(args: argparse.Namespace) -> int:
     return plot.run(args)
 
 
+def add_foxglove_layout_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("-o", "--out", metavar="FILE", help="write the layout to FILE (default: print it)")
+
+
+def run_foxglove_layout(args: argparse.Namespace) -> int:
+    from swarmnav.sim import foxglove_layout
+    return foxglove_layout.run(args)
+
+
 # (words, add the options, run, help): the CLI builds one subparser from each row.
 MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
     (("bench", "sim"), add_bench_sim_arguments, run_bench_sim,
@@ -283,6 +292,8 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
     (("log", "recover"), add_log_recover_arguments, run_log_recover, "rewrite a truncated log as a complete one"),
     (("replay",), add_replay_arguments, run_replay, "re-render or re-simulate a log"),
     (("plot",), add_plot_arguments, run_plot, "plot a log to PNG"),
+    (("foxglove-layout",), add_foxglove_layout_arguments, run_foxglove_layout,
+     "the Foxglove layout for run logs (3D scene, wheel speeds, range readings, events)"),
     (("study",), study_cli.add_study_arguments, study_cli.run_study,
      "run a study (scenarios x planners x navigators x seeds) into Parquet rows"),
     (("studies",), study_cli.add_studies_arguments, study_cli.run_studies, "list the bundled studies"),
