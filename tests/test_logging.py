@@ -227,6 +227,41 @@ def test_plot_writes_an_image(tmp_path, full_run):
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_plot_svg_names_everything_it_draws(tmp_path, full_run):
+    """The legend names obstacles, plans, the driven trajectory and collisions; time has a colour bar."""
+    path, episode = full_run
+    out = tmp_path / "run.svg"
+    assert main(["plot", str(path), "-o", str(out)]) == 0
+    svg = out.read_text()
+    for label in ("static obstacle", "moving obstacle", "planned path", "driven trajectory (time colour)",
+                  "start", "goal", "simulation time [s]"):
+        assert label in svg, label
+    if episode.result.collisions:
+        assert f"collision begins ({episode.result.collisions})" in svg
+
+
+def test_plot_title_wraps_so_it_is_never_clipped(full_run):
+    import dataclasses
+
+    from swarmnav.sim.plot import TITLE_CHARS, figure_title
+
+    log = read_log(full_run[0])
+    long_name = "a-scenario-with-a-very-long-name-" * 4
+    metadata = {**log.metadata, "scenario": {**log.metadata["scenario"], "name": long_name}}
+    title = figure_title(dataclasses.replace(log, metadata=metadata))
+    assert "".join(title.split()).startswith("".join(long_name.split())[:40])
+    assert len(title.splitlines()) >= 3 and all(len(line) <= TITLE_CHARS for line in title.splitlines())
+
+
+def test_plot_marks_time_along_moving_tracks_and_the_trajectory():
+    from swarmnav.sim.plot import _mark_step_s, decimated
+
+    assert [_mark_step_s(d) for d in (4.0, 72.4, 3000.0)] == [0.5, 10.0, 300.0]
+    picked = decimated(1_000_000, 4000)
+    assert len(picked) <= 4000 and picked[0] == 0 and picked[-1] == 999_999
+    assert np.array_equal(decimated(10, 4000), np.arange(10))
+
+
 def test_log_info_prints_channels_and_outcome(full_run, capsys):
     assert main(["log", "info", str(full_run[0])]) == 0
     out = capsys.readouterr().out
