@@ -113,7 +113,8 @@ def add_bench_render_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--width", type=int, default=640)
     parser.add_argument("--height", type=int, default=480)
     parser.add_argument("--frames", type=int, default=150)
-    parser.add_argument("--camera", choices=("top", "chase"), default="top")
+    parser.add_argument("--camera", choices=("top", "chase", "follow"), default="top",
+                        help="top: the whole arena; chase: behind the robot; follow: straight down on the robot")
     parser.add_argument("--compare-defaults", action="store_true",
                         help="also time MuJoCo's default quality (multisampling, shadows, reflections)")
     parser.add_argument("--quick", action="store_true", help=f"{BENCH_RENDER_QUICK_FRAMES} frames (a few seconds)")
@@ -231,7 +232,8 @@ def run_log_recover(args: argparse.Namespace) -> int:
 def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", help="an .mcap run log")
     parser.add_argument("--video", metavar="OUT.mp4", help="render the run to an MP4 (offscreen EGL)")
-    parser.add_argument("--camera", choices=("top", "chase"), default="top")
+    parser.add_argument("--camera", choices=("top", "chase", "follow"), default="top",
+                        help="top: the whole arena; chase: behind the robot; follow: straight down on the robot")
     parser.add_argument("--width", type=int, default=640)
     parser.add_argument("--height", type=int, default=480)
     parser.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 0.1..240")

@@ -42,8 +42,9 @@ from swarmnav.sim.log_format import (
 )
 from swarmnav.sim.recording import ObstacleInfo, RunContext
 
-_STATIC_COLOUR = (0.55, 0.35, 0.25, 1.0)
-_MOVING_COLOUR = (0.85, 0.25, 0.2, 1.0)
+# The shared palette (sim.palette), as plot and the video draw obstacles.
+_STATIC_COLOUR = palette.rgba(palette.OBSTACLE)
+_MOVING_COLOUR = palette.rgba(palette.MOVING_OBSTACLE)
 
 
 def stamp(t_ns: int) -> Timestamp:

@@ -4,6 +4,14 @@ The only module that knows about EGL: ``MUJOCO_GL`` is set to ``egl`` here (unle
 the user chose another backend) before ``mujoco`` is imported, so rendering works
 on headless, GPU-less servers through Mesa.
 
+What a frame shows: the scene from the ``top`` camera (the whole arena), the
+robot's ``chase`` camera, or ``follow`` (straight down on the robot, about
+:data:`FOLLOW_VIEW_M` of its surroundings in view, so the robot stays a readable
+size in any arena); obstacles in the shared palette (:mod:`sim.palette`); a
+visual-only ground past the floor's edge (decor boxes, not in the model: no
+black background in the chase view, and logs and physics are untouched); a title
+bar and the simulation time (:mod:`sim.frame_caption`).
+
 Speed: shadows, reflections and multisampling are switched off, which takes a
 640x480 frame from ~267 ms to ~20 ms on the reference machine, and the floor is
 drawn without its checker texture but with a metre grid of lines (a third less
@@ -34,14 +42,23 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from swarmnav.models.errors import ConfigError  # noqa: E402
+from swarmnav.sim import palette  # noqa: E402
+from swarmnav.sim.frame_caption import FrameCaption, run_title  # noqa: E402
 from swarmnav.sim.commands import MAX_FPS, MIN_FPS  # noqa: E402
 from swarmnav.sim.recording import RunContext, StepFrame  # noqa: E402
 from swarmnav.sim.video_file import VideoWriter  # noqa: E402
 
-CAMERAS = ("top", "chase")
-PATH_RGBA = np.array([0.1, 0.75, 0.2, 1.0], dtype=np.float32)
-DRIVEN_RGBA = np.array([0.15, 0.35, 0.9, 0.9], dtype=np.float32)
-BEAM_HIT_RGBA = np.array([1.0, 0.15, 0.1, 1.0], dtype=np.float32)
+CAMERAS = ("top", "chase", "follow")
+# The follow camera looks straight down on the robot from this high: the frame's height
+# spans about FOLLOW_VIEW_M metres of its surroundings whatever the arena's size.
+FOLLOW_VIEW_M = 3.0
+# A visual-only ground beyond the scene's floor (decor boxes around it), so no camera ever
+# sees the black background past the floor's edge; drawn, never part of the model.
+GROUND_HALF_M = 200.0
+GROUND_RGBA = np.array([0.78, 0.79, 0.8, 1.0], dtype=np.float32)
+PATH_RGBA = np.array(palette.rgba(palette.PLANNED), dtype=np.float32)
+DRIVEN_RGBA = np.array(palette.rgba(palette.DRIVEN, 0.9), dtype=np.float32)
+BEAM_HIT_RGBA = np.array(palette.rgba(palette.COLLISION), dtype=np.float32)
 BEAM_MISS_RGBA = np.array([1.0, 0.75, 0.2, 0.35], dtype=np.float32)
 # Lines (widths in pixels) cost ~30 us each to draw, capsules ~200 us: the path,
 # the trail and the beams are lines, and the trail keeps a point per TRAIL_STEP_M.
@@ -175,6 +192,75 @@ def floor_grid(width_m: float, height_m: float, step_m: float = GRID_STEP_M) -> 
     return np.array(vertical + horizontal, dtype=float).reshape(-1, 2, 3)
 
 
+def follow_camera(model: mujoco.MjModel, view_m: float = FOLLOW_VIEW_M) -> mujoco.MjvCamera:
+    """A free camera looking straight down (x to the right, y up), high enough that the
+    frame's height spans ``view_m`` metres; its ``lookat`` is set to the robot each frame."""
+    camera = mujoco.MjvCamera()
+    camera.type = mujoco.mjtCamera.mjCAMERA_FREE
+    camera.elevation = -90.0
+    camera.azimuth = 90.0
+    camera.distance = 0.5 * view_m / math.tan(math.radians(0.5 * float(model.vis.global_.fovy)))
+    return camera
+
+
+def paint_obstacles(model: mujoco.MjModel) -> None:
+    """Give obstacles the shared palette's colours (:mod:`sim.palette`), as ``plot`` draws them.
+
+    Colours only: nothing a simulation reads changes, so a log's MJCF renders the same
+    whichever colours it was written with.
+    """
+    static, moving, wall = (np.array(palette.rgba(c)) for c in (palette.OBSTACLE, palette.MOVING_OBSTACLE,
+                                                                   palette.ARENA))
+    for g in range(model.ngeom):
+        name = model.geom(g).name
+        if name.startswith(("obstacle_", "map_box_")):
+            moving_body = model.body_mocapid[model.geom_bodyid[g]] >= 0
+            model.geom_rgba[g] = moving if moving_body else static
+        elif name.startswith("wall_"):
+            model.geom_rgba[g] = wall
+
+
+def soften_lights(model: mujoco.MjModel) -> None:
+    """Lights that add up to about 1 on a surface facing up (the scene's add up to 1.6, which
+    washed the palette's light greys out to white): ambient and headlight 0.3 each, the
+    scene's lights 0.4."""
+    model.vis.headlight.ambient[:] = 0.3
+    model.vis.headlight.diffuse[:] = 0.3
+    model.light_diffuse[:] = 0.4
+    model.light_specular[:] = 0.1
+
+
+def ground_boxes(model: mujoco.MjModel, reach_m: float = GROUND_HALF_M) -> np.ndarray:
+    """(B, 2, 3) centres and half-sizes of thin boxes that tile the ground around the floor.
+
+    Four strips around the ``floor`` geom (one box under the whole view when the scene has no
+    finite floor), so every pixel is drawn once: a box under the floor would cost a second fill
+    of most of the frame in a software renderer.
+    """
+    floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
+    z, half_z = -0.011, 0.01
+    if floor < 0 or model.geom_size[floor, 0] <= 0 or model.geom_size[floor, 1] <= 0:
+        return np.array([[[0.0, 0.0, z], [reach_m, reach_m, half_z]]])
+    cx, cy = model.geom_pos[floor, :2]
+    hx, hy = model.geom_size[floor, :2]
+    x0, x1, y0, y1 = cx - hx, cx + hx, cy - hy, cy + hy
+    side = (reach_m - hx) / 2
+    strips = [((x0 - side, cy), (side, reach_m)), ((x1 + side, cy), (side, reach_m)),
+              ((cx, y0 - (reach_m - hy) / 2), (hx, (reach_m - hy) / 2)),
+              ((cx, y1 + (reach_m - hy) / 2), (hx, (reach_m - hy) / 2))]
+    return np.array([[[px, py, z], [sx, sy, half_z]] for (px, py), (sx, sy) in strips])
+
+
+def _add_boxes(scene: mujoco.MjvScene, boxes: np.ndarray, rgba: np.ndarray) -> None:
+    for centre, half in boxes:
+        if scene.ngeom >= scene.maxgeom:
+            return
+        geom = scene.geoms[scene.ngeom]
+        mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_BOX, half, centre, _EYE9, rgba)
+        geom.category = mujoco.mjtCatBit.mjCAT_DECOR
+        scene.ngeom += 1
+
+
 class SceneRenderer:
     """Offscreen frames of a posed scene, with the planned path and beams drawn in.
 
@@ -190,9 +276,16 @@ class SceneRenderer:
 
     def __init__(self, model: mujoco.MjModel, width: int = 640, height: int = 480, camera: str = "top",
                  fast: bool = True, grid_m: tuple[float, float] | None = None):
-        if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
-            names = [model.camera(i).name for i in range(model.ncam)]
+        self._follow: mujoco.MjvCamera | None = None
+        if camera == "follow":
+            self._follow = follow_camera(model)
+        elif mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
+            names = [model.camera(i).name for i in range(model.ncam)] + ["follow"]
             raise ConfigError("--camera", f"no camera {camera!r} in the scene (has {names})")
+        paint_obstacles(model)
+        soften_lights(model)
+        # The top camera frames the floor; the others can look past its edge.
+        self._ground = ground_boxes(model) if camera != "top" else np.zeros((0, 2, 3))
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
         self._grid = np.zeros((0, 2, 3))
@@ -220,10 +313,18 @@ class SceneRenderer:
         path_m: np.ndarray | None = None,
         beams: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
         trail_m: np.ndarray | None = None,
+        follow_xy_m: np.ndarray | None = None,
     ) -> np.ndarray:
-        """One (height, width, 3) uint8 RGB frame."""
-        self._renderer.update_scene(data, camera=self.camera, scene_option=self._option)
+        """One (height, width, 3) uint8 RGB frame; ``follow_xy_m`` centres the follow camera."""
+        if self._follow is not None:
+            if follow_xy_m is not None:
+                self._follow.lookat[:2] = follow_xy_m[:2]
+            camera = self._follow
+        else:
+            camera = self.camera
+        self._renderer.update_scene(data, camera=camera, scene_option=self._option)
         scene = self._renderer.scene
+        _add_boxes(scene, self._ground, GROUND_RGBA)
         for start, end in self._grid:
             _add_line(scene, start, end, GRID_WIDTH_PX, GRID_RGBA)
         if beams is not None:
@@ -249,8 +350,11 @@ class VideoRecorder:
 
     Args:
         path: the MP4 to write.
-        camera, width, height, fps: view and video settings.
+        camera, width, height, fps: view and video settings (``follow``: a top view
+            centred on the robot, :data:`FOLLOW_VIEW_M` high).
         trail: also draw the driven trajectory so far.
+        caption: draw the title bar (scenario, planner + navigator, seeds) and the
+            simulation time on every frame (:class:`sim.frame_caption.FrameCaption`).
     """
 
     def __init__(
@@ -262,6 +366,7 @@ class VideoRecorder:
         height: int = 480,
         fps: float = 30.0,
         trail: bool = True,
+        caption: bool = True,
     ):
         check_video_size(width, height, fps)
         if camera not in CAMERAS:
@@ -269,6 +374,8 @@ class VideoRecorder:
         self.video_path = Path(path)
         self.camera, self.width, self.height, self.fps = camera, width, height, float(fps)
         self.trail = trail
+        self.caption = caption
+        self._caption: FrameCaption | None = None
         self._next_frame = 0
         self._path_m: np.ndarray | None = None
         self._trail: list[np.ndarray] = []
@@ -286,6 +393,10 @@ class VideoRecorder:
         self._poser = ScenePoser(model, moving)
         self._renderer = SceneRenderer(model, self.width, self.height, self.camera,
                                        grid_m=tuple(context.arena_size_m))
+        if self.caption:
+            self._caption = FrameCaption(run_title(context.scenario_name, context.planner_name,
+                                                   context.navigator_name, context.seed, context.world_seed),
+                                         self.width, self.height)
         self._video = VideoWriter(self.video_path, self.width, self.height, self.fps)
 
     def path(self, time_s: float, waypoints_m: np.ndarray) -> None:
@@ -307,7 +418,10 @@ class VideoRecorder:
             path_m=self._path_m,
             beams=self._poser.beams(frame.range_m),
             trail_m=np.array(self._trail + [frame.position_m[:2]]) if self.trail and self._trail else None,
+            follow_xy_m=frame.position_m,
         )
+        if self._caption is not None:
+            self._caption.draw(image, frame.time_s)
         self.render_seconds += time.perf_counter() - started
         while self._next_frame / self.fps <= frame.time_s + 1e-9:
             self._video.add(image)
