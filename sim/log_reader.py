@@ -107,9 +107,6 @@ def _decoder_for(raw: RawLog, channel: Channel, protobuf: DecoderFactory) -> Cal
     return decoder
 
 
-Event = tuple[float, str, dict[str, Any]]
-
-
 def event_decoder(raw: RawLog, channel: Channel,
                   protobuf: DecoderFactory | None = None) -> Callable[[bytes], tuple[str, dict[str, Any]]]:
     """Bytes of an ``/events`` message to (kind, details): a ``foxglove.Log`` whose message is

@@ -137,7 +137,7 @@ def read_summary(path: str | Path) -> LogSummary:
         return found
     events: list[tuple[float, str, dict[str, Any]]] = []
     topics: dict[int, bool] = {}
-    decoders: list[_Events] = []
+    decoders: list[_Events] = []  # made at the first event, on the RawLog being read
 
     def keep_events(raw: RawLog, message: Message) -> None:
         if message.channel_id not in topics:

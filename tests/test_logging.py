@@ -30,6 +30,8 @@ from swarmnav.sim.mcap_records import read_records  # noqa: E402
 REPO = Path(__file__).resolve().parent.parent
 SCENARIO = "gwo-scenario-2"  # moving obstacles and collisions: every channel has traffic
 PER_STEP = ("/tf", "/robot/pose", "/range/scan", "/wheels", "/controller")
+# The foxglove.* names are those @foxglove/schemas defines (checked against Foxglove's schema reference:
+# FrameTransform, PoseInFrame, PosesInFrame, SceneUpdate, LaserScan, Log); Foxglove recognises only these.
 EXPECTED_SCHEMAS = {
     "/tf": "foxglove.FrameTransform",
     "/robot/pose": "foxglove.PoseInFrame",
