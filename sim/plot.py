@@ -257,9 +257,11 @@ def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
     # Below the map, outside it: the legend never hides an obstacle or the trajectory.
     ax.legend(handles=_legend_handles(log, len(collisions)), loc="upper center", bbox_to_anchor=(0.5, -0.07),
               ncol=3, fontsize=7, frameon=False)
-    if driven is not None or any(ob["moving"] for ob in log.obstacles):
+    moving = any(ob["moving"] for ob in log.obstacles)
+    if driven is not None or moving:
         colourbar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.8, pad=0.02)
-        colourbar.set_label("simulation time [s] (trajectory, moving obstacles)")
+        what = ", ".join(w for w, shown in (("trajectory", driven is not None), ("moving obstacles", moving)) if shown)
+        colourbar.set_label(f"simulation time [s] ({what})")
 
     t = log.wheel_time_s
     for column, side, colour in ((0, "left", palette.PLANNERS[0]), (1, "right", palette.PLANNERS[1])):
