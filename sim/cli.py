@@ -70,11 +70,8 @@ def parse_settings(pairs: list[str] | None, option: str = "--set") -> dict[str, 
 
 def _load(args: argparse.Namespace):
     """The scenario, as the API loads it (plugins' too); ``--trust-code``: its code parameters may run."""
-    from dataclasses import replace
-
     from swarmnav.calls import load_scenario
-    scenario = load_scenario(args.scenario)
-    return replace(scenario, trust_code=True) if args.trust_code else scenario
+    return load_scenario(args.scenario, trust_code=args.trust_code)
 
 
 def _episode_spec(args: argparse.Namespace):

@@ -133,8 +133,11 @@ def read_summary(path: str | Path) -> LogSummary:
     """
     path = Path(path)
     found = _from_summary(path)
-    if found is not None:
-        return found
+    return found if found is not None else from_records(path)
+
+
+def from_records(path: str | Path) -> LogSummary:
+    """What a log holds, walking its records (what :func:`read_summary` does for a file without summary)."""
     events: list[tuple[float, str, dict[str, Any]]] = []
     topics: dict[int, bool] = {}
     decoders: list[_Events] = []  # made at the first event, on the RawLog being read
@@ -148,6 +151,6 @@ def read_summary(path: str | Path) -> LogSummary:
                 decoders.append(_Events(raw))
             events.append(decoders[0](message))
 
-    raw = read_records(path, on_message=keep_events)
+    raw = read_records(Path(path), on_message=keep_events)
     check_channels(raw)
     return LogSummary(raw, events, _outcome(raw), from_summary=False)

@@ -135,8 +135,9 @@ def render_log(log: RunLog, video_path: str | Path, *, camera: str = "top", widt
     return {"frames": recorder.frames, "video_s": recorder.frames / fps, "render_s": recorder.render_seconds}
 
 
-def code_for_verify(context: RunContext, named: dict, trust_code: bool, source: str) -> tuple[dict, dict]:
-    """The navigator parameters to re-simulate with, and the code parameters named on the command line.
+def code_for_verify(context: RunContext, named: dict, trust_code: bool, source: str) -> dict:
+    """The navigator parameters to re-simulate with: the log's, with the code parameters named on the command
+    line in place of the logged ones.
 
     A log is data: a parameter of its planner or navigator that names code (the
     ``policy`` navigator's ``policy``) is re-run only when the user names it on the
@@ -166,7 +167,7 @@ def code_for_verify(context: RunContext, named: dict, trust_code: bool, source: 
                                   f"the log was recorded with {key}={context.navigator_params[key]!r}, which names "
                                   f"code; replay --verify re-simulates it only when you name it: --navigator-set "
                                   f"{key}=MODULE:FUNCTION (or {TRUST_OPTION})", source)
-    return {**context.navigator_params, **named}, dict(named)
+    return {**context.navigator_params, **named}
 
 
 def verify_log(log: RunLog, named: dict | None = None, trust_code: bool = False) -> VerifyReport:
@@ -179,14 +180,14 @@ def verify_log(log: RunLog, named: dict | None = None, trust_code: bool = False)
     import mujoco
 
     from swarmnav.models.scenario import parse_scenario
-    from swarmnav.sim.episode import EpisodeSpec, run_episode
+    from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
     from swarmnav.sim.scene import index_scene
 
     context = context_from_log(log)
     source = str(log.raw.path)
     if len(log.time_s) == 0:
         raise LogError(source, "holds no step to replay")
-    navigator_params, _ = code_for_verify(context, named or {}, trust_code, source)
+    navigator_params = code_for_verify(context, named or {}, trust_code, source)
     scenario = parse_scenario(context.scenario_toml, f"{source}[scenario]", trust_code=trust_code)
     spec = EpisodeSpec(scenario, context.planner_name, context.planner_params, context.navigator_name,
                        navigator_params, context.seed, context.world_seed, context.clearance_m)
@@ -199,7 +200,7 @@ def verify_log(log: RunLog, named: dict | None = None, trust_code: bool = False)
     if "stopped_on_collision" in kinds:
         options["stop_on_collision"] = True
     capture = TrajectoryCapture()
-    episode = run_episode(spec, [capture], scene=index_scene(model, context.mjcf_xml), **options)
+    episode = run_episode(plan_episode(spec, scene=index_scene(model, context.mjcf_xml)), [capture], **options)
     path, result = episode.path, episode.result
     return compare_with_log(log, capture, np.asarray(path.waypoints, dtype=float)[:, :2], result.outcome)
 

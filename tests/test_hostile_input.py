@@ -305,3 +305,14 @@ def test_an_unanticipated_exception_is_reported_as_a_bug_with_its_traceback_save
 def test_sizes_too_small_for_the_mujoco_model_are_refused_not_a_bug(tmp_path, capsys, edit, field):
     # Each parsed before and then failed to compile (MuJoCo's XML rounds them to 0).
     assert f": {field}:" in bad_input(capsys, "run", write(tmp_path, edit(BASE)), "--no-log")
+
+
+def test_study_quick_without_quick_seeds_says_so_in_one_line(tmp_path, capsys):
+    study = tmp_path / "no-quick.toml"
+    study.write_text('scenarios = ["gwo-scenario-1"]\nseeds = 1\n[[planners]]\nname = "straight"\n')
+    code, out, err = run_cli(capsys, "study", str(study), "--out", str(tmp_path / "rows"), "--workers", "1",
+                             "--quick", "--json")
+    assert code == 0
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "no quick_seeds" in lines[0] and "full study" in lines[0]
+    assert '"cells": 1' in out

@@ -61,7 +61,7 @@ CONTINUOUS = {"population": 4, "iterations": 2, "samples": 16, "polish_rounds": 
 TINY_BUDGETS = {
     "abc": {**CONTINUOUS, "mcn": 2}, "adl_abc": {**CONTINUOUS, "mcn": 2}, "gwo": CONTINUOUS, "pso": CONTINUOUS,
     "immas": {"iterations": 2, "max_evaluations": 200},
-    "iaco": {"ants": 2, "iterations": 2}, "aco": {"ants": 2, "iterations": 2},
+    "iaco": {"ants": 2, "iterations": 2}, "aco": {"ants": 2, "iterations": 2}, "mmas": {"ants": 2, "iterations": 2},
     "maco": {"ants": 2, "iterations": 2, "nodes": 5},
     "policy": {"policy": "reactive_policy:act"},
 }
@@ -137,15 +137,15 @@ def test_every_planner_parameter_gives_a_result_or_one_config_error(tiny, name):
 
 @pytest.mark.parametrize("name", sorted(NAVIGATORS))
 def test_every_navigator_parameter_gives_a_run_or_one_config_error(tiny, name, monkeypatch):
-    from swarmnav.sim.episode import EpisodeSpec, run_episode
-    from swarmnav.sim.runner import Simulation
+    from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
+    from swarmnav.sim.scene import compile_scene
 
     monkeypatch.syspath_prepend(os.path.dirname(__file__))  # reactive_policy for the policy navigator
     names = numeric_parameters(NAVIGATORS[name])
     if not names:
         pytest.skip(f"{name} has no numeric parameter")
     scenario, _ = tiny
-    simulation = Simulation(scenario)
+    scene = compile_scene(scenario)  # compiled once: every example runs on it
     budgets = TINY_BUDGETS.get(name, {})
 
     @HYPOTHESIS
@@ -155,8 +155,8 @@ def test_every_navigator_parameter_gives_a_run_or_one_config_error(tiny, name, m
         with time_guard(GUARD_S):
             try:
                 make_navigator(name, params, "<fuzz>")
-                episode = run_episode(EpisodeSpec(scenario, navigator=name, navigator_params=params),
-                                      simulation=simulation)
+                episode = run_episode(plan_episode(EpisodeSpec(scenario, navigator=name, navigator_params=params),
+                                                   scene=scene))
             except ConfigError as error:
                 assert accepts(error, params, budgets), str(error)
                 return

@@ -146,9 +146,24 @@ def test_the_python_api_takes_a_policy_and_a_trusted_file(tmp_path, monkeypatch)
 
     (tmp_path / "marker_policy.py").write_text(MARKER_MODULE)
     monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "marker_policy", raising=False)  # imported afresh: its marker is this test's
     path = policy_scenario(tmp_path)
     with pytest.raises(ConfigError, match="--trust-code"):
         plan_episode(EpisodeSpec(load_scenario(str(path))))
     assert not (tmp_path / "marker.txt").exists()
     assert plan_episode(EpisodeSpec(load_scenario(str(path), trust_code=True))).spec.navigator == "policy"
     assert (tmp_path / "marker.txt").exists()
+
+
+def test_the_public_api_refuses_a_files_policy_unless_trusted(tmp_path, monkeypatch):
+    import swarmnav
+
+    (tmp_path / "marker_policy.py").write_text(MARKER_MODULE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "marker_policy", raising=False)  # imported afresh: its marker is this test's
+    path = policy_scenario(tmp_path)
+    with pytest.raises(swarmnav.ConfigError, match="navigator.params.policy.*--trust-code"):
+        swarmnav.run(str(path), log=False)
+    assert not (tmp_path / "marker.txt").exists()
+    result = swarmnav.run(swarmnav.load_scenario(str(path), trust_code=True), log=False)
+    assert result.to_dict()["navigator"] == "policy" and (tmp_path / "marker.txt").exists()

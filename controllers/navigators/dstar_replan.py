@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -83,6 +83,9 @@ class DStarReplanNavigator:
     parameter_ranges: ClassVar[dict[str, Range]] = {
         "horizon_s": within(0, 600), "margin_m": within(0, 100), "cell_m": within(0, 100),
         "improvement_m": within(0, 1e6), "update_period_s": within(0, 1e6), "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: float = field(default=0.0, init=False, repr=False)
 
     horizon_s: float = 3.0
     margin_m: float = 0.1

@@ -86,6 +86,9 @@ class DynamicWindowNavigator:
         "v_samples": within(1, 50), "omega_samples": within(1, 100), "horizon_s": above(0, 10),
         "sim_step_s": within(0.02, 1), "dist_cap_m": above(0, 1000), "margin_m": within(0, 100),
         "lookahead_m": above(0, 1000), "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
 
     alpha: float = 1.0
     beta: float = 1.2

@@ -83,6 +83,9 @@ class IacoLocalNavigator:
     parameter_ranges: ClassVar[dict[str, Range]] = {
         "same_line_deg": within(0, 180), "margin_m": within(0, 100), "horizon_cells": within(1, 1000),
         "reach_m": above(0, 100), "lead_steps": within(0, 1000)}  # models.parameters: checked on build
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = True
+    replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured
     strategy: str = "paper"
     same_line_deg: float = 15.0
     margin_m: float = 0.05

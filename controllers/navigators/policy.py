@@ -18,7 +18,7 @@ scenario file, a study file or a log may name it only when the user passes
 from __future__ import annotations
 
 import pkgutil
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, ClassVar
 
 import numpy as np
@@ -64,7 +64,9 @@ class PolicyNavigator:
     name: ClassVar[str] = "policy"
     parameter_ranges: ClassVar[dict[str, Range]] = {
         "path_waypoints": within(0, 1000), "obstacle_slots": within(1, 1000)}  # models.parameters: checked on build
-    uses_detections: ClassVar[bool] = True  # per run after reset: only when the observation has obstacles
+    uses_detections: bool = field(default=True, init=False, repr=False)  # per run: set by reset
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
     policy: str = code_parameter()  # names code: never taken from a data file without --trust-code
     action: str = "twist"
     path_waypoints: int = 0

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, replace, field
 from typing import Any, ClassVar
 
 from swarmnav.models.parameters import Range, above, within
@@ -117,6 +117,9 @@ class ReplanNavigator:
         "lookahead_m": within(0, 1000), "horizon_s": within(0, 600), "margin_m": within(0, 100),
         "cooldown_s": within(0, 1e6), "retry_s": within(0, 1e6), "planning_latency_s": within(0, 1e6),
         "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = True
+    replan_wall_s: float = field(default=0.0, init=False, repr=False)
 
     lookahead_m: float = 2.5
     horizon_s: float = 6.0

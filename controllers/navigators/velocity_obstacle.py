@@ -71,6 +71,9 @@ class VelocityObstacleNavigator:
         "max_turn_rad": within(0, math.pi), "margin_m": within(0, 100), "lookahead_m": above(0, 1000),
         "heading_gain": within(0, 1000), "max_angular_rad_s": above(0, 100), "turn_in_place_rad": within(0, math.pi),
         "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
 
     time_horizon_s: float = 4.0
     speed_samples: int = 5

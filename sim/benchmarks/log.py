@@ -14,7 +14,7 @@ reader's ``iter_messages`` holds far more) of the same file give the yardstick.
 from __future__ import annotations
 
 import argparse
-import os
+import json
 import subprocess
 import sys
 import tempfile
@@ -69,19 +69,27 @@ print(n)
 """
 
 
+# Each command is started by this small launcher, not by the benchmark's own process: Linux carries a
+# process's peak memory across fork and exec, so a child of a large parent would report the parent's size.
+LAUNCHER = """
+import json, os, subprocess, sys, time
+argv = json.loads(sys.argv[1])
+started = time.perf_counter()
+process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+error = process.stderr.read().decode(errors="replace").strip().splitlines()
+_, status, usage = os.wait4(process.pid, 0)
+code = os.waitstatus_to_exitcode(status)
+print(json.dumps({"s": time.perf_counter() - started, "cpu_s": usage.ru_utime + usage.ru_stime,
+                  "peak_mb": usage.ru_maxrss / 1024.0, "exit": code, "error": error[-1] if code and error else ""}))
+"""
+
+
 def measure(argv: list[str]) -> dict[str, Any]:
     """Run one command; its wall time (s), CPU time (s: user + system, what a loaded machine does not
-    inflate), peak resident memory (MB) and exit status."""
-    started = time.perf_counter()
-    process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(process.pid, 0)
-    wall_s = time.perf_counter() - started
-    process.returncode = os.waitstatus_to_exitcode(status)
-    error = process.stderr.read().decode(errors="replace").strip().splitlines() if process.stderr else []
-    process.stderr.close()
-    return {"s": wall_s, "cpu_s": usage.ru_utime + usage.ru_stime, "peak_mb": usage.ru_maxrss / 1024.0,
-            "exit": process.returncode,
-            "error": error[-1] if process.returncode else ""}
+    inflate), peak resident memory (MB, ``ru_maxrss``) and exit status, measured by :data:`LAUNCHER`."""
+    out = subprocess.run([sys.executable, "-S", "-c", LAUNCHER, json.dumps(argv)], capture_output=True, text=True,
+                         check=True)
+    return json.loads(out.stdout)
 
 
 def benchmark_log(duration_s: float, video: bool = True) -> dict[str, Any]:

@@ -60,7 +60,7 @@ STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bu
 MODES = ("plan", "physics")
 TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
             "time_limit_s", "reference", "planners", "navigators", "paper", "clearance_m",
-            "paired_seeds"}
+            "paired_seeds", "claims"}
 
 
 @dataclass(frozen=True)
@@ -106,6 +106,7 @@ class Study:
     quick_seeds: int | None = None  # the first N seeds make the quick run (None: the quick run is the full one)
     clearance_m: float | None = None  # planning clearance override for every scenario (None: each scenario's)
     paired_seeds: bool = False  # the k-th seed runs with the k-th world seed only
+    claims: tuple[dict[str, Any], ...] = ()  # [[claims]] tables as written (their verdicts: swarmnav report)
     trust_code: bool = False  # --trust-code: its files (study, scenarios) may name code to run
 
     def seed_pairs(self) -> list[tuple[int | None, int]]:
@@ -372,10 +373,13 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
     if paired and len(world_seeds) != len(seeds):
         _fail(source, "paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                       f"{len(world_seeds) if 'world_seeds' in data else 'no'} world seeds")
-    settings = math.prod(len(c.settings()) for c in planners) * math.prod(len(c.settings()) for c in navigators)
+    settings = sum(len(c.settings()) for c in planners) * sum(len(c.settings()) for c in navigators)
     cells = len(scenarios) * settings * (len(seeds) if paired else len(seeds) * len(world_seeds))
     if cells > MAX_CELLS:
         _fail(source, "seeds", f"the grid has {cells:,} runs (scenarios x settings x seeds), at most {MAX_CELLS:,}")
+    claims = data.get("claims", [])
+    if not isinstance(claims, list) or not all(isinstance(c, dict) for c in claims):
+        _fail(source, "claims", "expected an array of [[claims]] tables")
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
                  reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired,
-                 bool(trust_code))
+                 tuple(claims), bool(trust_code))
