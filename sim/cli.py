@@ -274,7 +274,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-log", action="store_true", help="write no MCAP log")
     p.add_argument("--live", action="store_true", help="also serve the channels to Foxglove on 127.0.0.1")
     p.add_argument("--video", help="render an MP4 while running (offscreen EGL)")
-    p.add_argument("--camera", default="top", choices=("top", "chase"))
+    p.add_argument("--camera", default="top", choices=("top", "chase", "follow"),
+                   help="top: the whole arena; chase: behind the robot; follow: straight down on the robot")
     p.add_argument("--width", type=int, default=640)
     p.add_argument("--height", type=int, default=480)
     p.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 0.1..240")

@@ -117,7 +117,8 @@ def add_bench_render_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--width", type=int, default=640)
     parser.add_argument("--height", type=int, default=480)
     parser.add_argument("--frames", type=int, default=150)
-    parser.add_argument("--camera", choices=("top", "chase"), default="top")
+    parser.add_argument("--camera", choices=("top", "chase", "follow"), default="top",
+                        help="top: the whole arena; chase: behind the robot; follow: straight down on the robot")
     parser.add_argument("--compare-defaults", action="store_true",
                         help="also time MuJoCo's default quality (multisampling, shadows, reflections)")
     parser.add_argument("--quick", action="store_true", help=f"{BENCH_RENDER_QUICK_FRAMES} frames (a few seconds)")
@@ -240,7 +241,8 @@ def run_log_recover(args: argparse.Namespace) -> int:
 def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", help="an .mcap run log")
     parser.add_argument("--video", metavar="OUT.mp4", help="render the run to an MP4 (offscreen EGL)")
-    parser.add_argument("--camera", choices=("top", "chase"), default="top")
+    parser.add_argument("--camera", choices=("top", "chase", "follow"), default="top",
+                        help="top: the whole arena; chase: behind the robot; follow: straight down on the robot")
     parser.add_argument("--width", type=int, default=640)
     parser.add_argument("--height", type=int, default=480)
     parser.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 0.1..240")
@@ -271,6 +273,15 @@ def run_plot(args: argparse.Namespace) -> int:
     return plot.run(args)
 
 
+def add_foxglove_layout_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("-o", "--out", metavar="FILE", help="write the layout to FILE (default: print it)")
+
+
+def run_foxglove_layout(args: argparse.Namespace) -> int:
+    from swarmnav.sim import foxglove_layout
+    return foxglove_layout.run(args)
+
+
 # (words, add the options, run, help): the CLI builds one subparser from each row.
 MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
     (("bench", "sim"), add_bench_sim_arguments, run_bench_sim,
@@ -292,6 +303,8 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
     (("log", "recover"), add_log_recover_arguments, run_log_recover, "rewrite a truncated log as a complete one"),
     (("replay",), add_replay_arguments, run_replay, "re-render or re-simulate a log"),
     (("plot",), add_plot_arguments, run_plot, "plot a log to PNG"),
+    (("foxglove-layout",), add_foxglove_layout_arguments, run_foxglove_layout,
+     "the Foxglove layout for run logs (3D scene, wheel speeds, range readings, events)"),
     (("study",), study_cli.add_study_arguments, study_cli.run_study,
      "run a study (scenarios x planners x navigators x seeds) into Parquet rows"),
     (("studies",), study_cli.add_studies_arguments, study_cli.run_studies, "list the bundled studies"),

@@ -17,7 +17,18 @@ Channels (Foxglove well-known protobuf schemas unless said otherwise):
 ``/range/scan``         LaserScan in ``base_link``; misses are NaN
 ``/wheels``             JSON ``swarmnav.WheelSpeeds``: commanded and measured rad/s
 ``/controller``         JSON ``swarmnav.ControllerState``: v, omega, active waypoint
-``/events``             JSON ``swarmnav.Event``: goal_reached, collision_begin/end, timeout
+                        (both JSON with a JSON Schema (``jsonschema``), which Foxglove
+                        decodes and plots by field path, e.g. ``/wheels.measured_left_rad_s``)
+``/events``             ``foxglove.Log``: one per event (goal_reached, collision_begin/end,
+                        timeout, replan, ...); ``message`` is the kind, then a space and the
+                        details as JSON when there are any (:func:`event_text`); collisions
+                        and timeouts at level WARNING, the rest INFO.  Logs written before
+                        this carried JSON ``swarmnav.Event``; readers accept both.
+``/scene``              SceneUpdate, once at t = 0: the arena's outline (``arena``, in
+                        ``world``) and the robot's footprint (``robot_footprint``, a disc of
+                        the chassis radius with a heading arrow, in ``base_link`` and
+                        ``frame_locked``, so it follows ``/tf``): Foxglove's 3D panel shows
+                        the scene with no set-up.
 ``/navigator``          SceneUpdate: what the navigator acted on (its sensed obstacles,
                         their velocities and predicted sweeps); only in logs of navigators
                         that use the sensing, from the first step they sensed something,
@@ -65,7 +76,8 @@ CONTROLLER_SCHEMA = {
         "waypoint_index": {"type": "integer"},
     },
 }
-EVENT_SCHEMA = {
+# The schema of ``/events`` in logs written before events became ``foxglove.Log``; still read.
+LEGACY_EVENT_SCHEMA = {
     "title": "swarmnav.Event",
     "type": "object",
     "properties": {
@@ -86,8 +98,15 @@ CHANNELS: dict[str, tuple[str, str]] = {
     "/range/scan": ("protobuf", "foxglove.LaserScan"),
     "/wheels": ("json", WHEELS_SCHEMA["title"]),
     "/controller": ("json", CONTROLLER_SCHEMA["title"]),
-    "/events": ("json", EVENT_SCHEMA["title"]),
+    "/events": ("protobuf", "foxglove.Log"),
+    "/scene": ("protobuf", "foxglove.SceneUpdate"),
 }
+# Older logs may carry these instead: topic -> (message encoding, schema name).
+LEGACY_CHANNELS: dict[str, tuple[str, str]] = {"/events": ("json", LEGACY_EVENT_SCHEMA["title"])}
+EVENTS_TOPIC = "/events"
+SCENE_TOPIC = "/scene"
+ARENA_ENTITY = "arena"
+FOOTPRINT_ENTITY = "robot_footprint"
 TOPICS = tuple(CHANNELS)
 NAVIGATOR_TOPIC = "/navigator"  # a foxglove.SceneUpdate; optional (see the table above)
 
@@ -109,6 +128,46 @@ def _json_value(value: Any) -> Any:
 def dumps(value: Any) -> str:
     """Deterministic JSON text for metadata values and JSON messages."""
     return json.dumps(value, sort_keys=True, default=_json_value)
+
+
+def event_text(kind: str, details: dict[str, Any]) -> str:
+    """The ``message`` of an event's ``foxglove.Log``: the kind, then its details as JSON if any."""
+    return f"{kind} {dumps(details)}" if details else kind
+
+
+def event_from_text(text: str) -> tuple[str, dict[str, Any]]:
+    """The inverse of :func:`event_text`: (kind, details).
+
+    Raises:
+        ValueError: the details are not a JSON object.
+    """
+    kind, _, rest = text.partition(" ")
+    details = json.loads(rest) if rest else {}
+    if not isinstance(details, dict):
+        raise ValueError(f"event details are not a JSON object: {rest[:60]!r}")
+    return kind, details
+
+
+def metadata_text(value: Any) -> str:
+    """A metadata value as Foxglove should show it: a string as itself, anything else as JSON.
+
+    A string that would read back as JSON (``"true"``, ``"12"``, ``"null"``) is written as
+    JSON text (quoted) instead, so :func:`metadata_value` always recovers the value written.
+    """
+    if isinstance(value, str):
+        try:
+            json.loads(value)
+        except ValueError:
+            return value
+    return dumps(value)
+
+
+def metadata_value(text: str) -> Any:
+    """The value :func:`metadata_text` wrote: JSON where the text is JSON, else the text itself."""
+    try:
+        return json.loads(text)
+    except ValueError:
+        return text
 
 
 def scan_from_ranges(range_m: np.ndarray, beam_offset_m: float) -> np.ndarray:

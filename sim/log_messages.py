@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import math
+import xml.etree.ElementTree as ElementTree
 from typing import Any
 
 import foxglove
@@ -14,6 +15,8 @@ from foxglove.messages import (
     ArrowPrimitive,
     Color,
     CubePrimitive,
+    Log,
+    LogLevel,
     CylinderPrimitive,
     LinePrimitive,
     LinePrimitiveLineType,
@@ -28,11 +31,20 @@ from foxglove.messages import (
     Vector3,
 )
 
-from swarmnav.sim.log_format import WORLD_FRAME, dumps
+from swarmnav.sim import palette
+from swarmnav.sim.log_format import (
+    ARENA_ENTITY,
+    BASE_FRAME,
+    FOOTPRINT_ENTITY,
+    WORLD_FRAME,
+    dumps,
+    event_text,
+)
 from swarmnav.sim.recording import ObstacleInfo, RunContext
 
-_STATIC_COLOUR = (0.55, 0.35, 0.25, 1.0)
-_MOVING_COLOUR = (0.85, 0.25, 0.2, 1.0)
+# The shared palette (sim.palette), as plot and the video draw obstacles.
+_STATIC_COLOUR = palette.rgba(palette.OBSTACLE)
+_MOVING_COLOUR = palette.rgba(palette.MOVING_OBSTACLE)
 
 
 def stamp(t_ns: int) -> Timestamp:
@@ -127,6 +139,62 @@ def belief_update(obstacles, horizon_s: float, t_ns: int) -> SceneUpdate:
                                     cylinders=cylinders, lines=lines, arrows=arrows))
     return SceneUpdate(deletions=[SceneEntityDeletion(timestamp=time_stamp, type=SceneEntityDeletionType.All)],
                        entities=entities)
+
+
+_WARNING_EVENTS = {"collision_begin", "stopped_on_collision", "timeout"}
+_ERROR_EVENTS = {"error", "interrupted"}
+_ARENA_Z_M = 0.002
+_FOOTPRINT_HEIGHT_M = 0.01
+_FOOTPRINT_Z_M = 0.005  # just above the floor, under the chassis
+
+
+def event_log(time_s_ns: int, kind: str, details: dict[str, Any]) -> Log:
+    """``/events``: one ``foxglove.Log`` (Foxglove's Log panel lists it, filterable by level)."""
+    level = (LogLevel.Warning if kind in _WARNING_EVENTS else LogLevel.Error if kind in _ERROR_EVENTS
+             else LogLevel.Info)
+    return Log(timestamp=stamp(time_s_ns), level=level, message=event_text(kind, details), name="swarmnav")
+
+
+def _colour(hex_colour: str, alpha: float = 1.0) -> Color:
+    r, g, b, a = palette.rgba(hex_colour, alpha)
+    return Color(r=r, g=g, b=b, a=a)
+
+
+def chassis_radius_m(mjcf_xml: str) -> float:
+    """The robot's footprint radius: the size of the ``chassis`` geom of the run's MJCF.
+
+    Raises:
+        ValueError: the MJCF has no chassis geom with a size.
+    """
+    for geom in ElementTree.fromstring(mjcf_xml).iter("geom"):
+        if geom.get("name") == "chassis" and geom.get("size"):
+            return float(geom.get("size").split()[0])
+    raise ValueError("the scene has no chassis geom with a size")
+
+
+def scene_update(arena_size_m: tuple[float, float], robot_radius_m: float) -> SceneUpdate:
+    """``/scene`` at t = 0: the arena's outline in ``world`` and the robot's footprint in ``base_link``.
+
+    The footprint is ``frame_locked``: Foxglove moves it with ``base_link`` as ``/tf`` goes, so
+    it is sent once and never expires (no lifetime).
+    """
+    width_m, height_m = (float(v) for v in arena_size_m)
+    corners = [Point3(x=x, y=y, z=_ARENA_Z_M) for x, y in ((0.0, 0.0), (width_m, 0.0), (width_m, height_m),
+                                                           (0.0, height_m))]
+    arena = SceneEntity(timestamp=stamp(0), frame_id=WORLD_FRAME, id=ARENA_ENTITY, lines=[LinePrimitive(
+        type=LinePrimitiveLineType.LineLoop, thickness=0.04, points=corners, color=_colour(palette.ARENA))])
+    r = float(robot_radius_m)
+    footprint = SceneEntity(
+        timestamp=stamp(0), frame_id=BASE_FRAME, id=FOOTPRINT_ENTITY, frame_locked=True,
+        cylinders=[CylinderPrimitive(pose=Pose(position=Vector3(x=0.0, y=0.0, z=_FOOTPRINT_Z_M),
+                                               orientation=Quaternion(w=1.0)),
+                                     size=Vector3(x=2 * r, y=2 * r, z=_FOOTPRINT_HEIGHT_M), bottom_scale=1.0,
+                                     top_scale=1.0, color=_colour(palette.ROBOT, 0.6))],
+        arrows=[ArrowPrimitive(pose=Pose(position=Vector3(x=0.0, y=0.0, z=2 * _FOOTPRINT_Z_M),
+                                         orientation=Quaternion(w=1.0)),
+                               shaft_length=0.7 * r, shaft_diameter=0.15 * r, head_length=0.3 * r,
+                               head_diameter=0.35 * r, color=_colour(palette.DRIVEN))])
+    return SceneUpdate(entities=[arena, footprint])
 
 
 def yaw_quaternion(yaw_rad: float) -> Quaternion:

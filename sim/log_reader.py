@@ -21,7 +21,16 @@ from mcap.records import Channel, Message
 from google.protobuf.message import DecodeError
 from mcap_protobuf.decoder import DecoderFactory
 
-from swarmnav.sim.log_format import CHANNELS, LOG_PROFILE, MJCF_ATTACHMENT, TOPICS
+from swarmnav.sim.log_format import (
+    CHANNELS,
+    EVENTS_TOPIC,
+    LEGACY_CHANNELS,
+    LOG_PROFILE,
+    MJCF_ATTACHMENT,
+    TOPICS,
+    event_from_text,
+    metadata_value,
+)
 from swarmnav.sim.log_columns import Rows
 from swarmnav.sim.mcap_records import LogError, RawLog, read_records
 
@@ -98,13 +107,26 @@ def _decoder_for(raw: RawLog, channel: Channel, protobuf: DecoderFactory) -> Cal
     return decoder
 
 
+def event_decoder(raw: RawLog, channel: Channel,
+                  protobuf: DecoderFactory | None = None) -> Callable[[bytes], tuple[str, dict[str, Any]]]:
+    """Bytes of an ``/events`` message to (kind, details): a ``foxglove.Log`` whose message is
+    :func:`sim.log_format.event_text`, or the JSON ``swarmnav.Event`` of older logs."""
+    decode = _decoder_for(raw, channel, protobuf or DecoderFactory())
+    if channel.message_encoding == "json":
+        def legacy(data: bytes) -> tuple[str, dict[str, Any]]:
+            event = decode(data)
+            return str(event.get("kind", "?")), event.get("details", {})
+        return legacy
+    return lambda data: event_from_text(decode(data).message)
+
+
 def _check_channel(raw: RawLog, channel: Channel) -> None:
     expected = CHANNELS.get(channel.topic)
     if expected is None:
         return  # channels of other topics are left alone
     schema = raw.schemas.get(channel.schema_id)
     found = (channel.message_encoding, schema.name if schema is not None else "")
-    if found != expected:
+    if found != expected and found != LEGACY_CHANNELS.get(channel.topic):
         raise LogError(raw.path, f"not a swarmnav run log: channel {channel.topic} carries "
                                  f"{found[1] or 'no schema'} ({found[0]}), expected {expected[1]} "
                                  f"({expected[0]})")
@@ -151,7 +173,9 @@ class _Decoder:
                 self._decoders[channel_id] = None
             else:
                 _check_channel(raw, channel)
-                self._decoders[channel_id] = (channel.topic, _decoder_for(raw, channel, self._protobuf))
+                decode = (event_decoder(raw, channel, self._protobuf) if channel.topic == EVENTS_TOPIC
+                          else _decoder_for(raw, channel, self._protobuf))
+                self._decoders[channel_id] = (channel.topic, decode)
         entry = self._decoders[channel_id]
         if entry is None:
             return
@@ -190,8 +214,9 @@ class _Decoder:
                     continue
                 last[0] = t
                 rows.append((t, position.x, position.y))
-        elif topic == "/events":
-            self.events.append((t, d.get("kind", "?"), d.get("details", {})))
+        elif topic == EVENTS_TOPIC:
+            kind, details = d
+            self.events.append((t, kind, details))
 
     def run_log(self, raw: RawLog) -> RunLog:
         tf = self.tf.array()
@@ -202,7 +227,7 @@ class _Decoder:
         wheels, controller = self.wheels.array(), self.controller.array()
         outcome = None
         if "outcome" in raw.metadata:
-            outcome = {k: _loads_or_text(v) for k, v in raw.metadata["outcome"].items()}
+            outcome = {k: metadata_value(v) for k, v in raw.metadata["outcome"].items()}
         attachment = raw.attachments.get(MJCF_ATTACHMENT)
         return RunLog(
             raw=raw,
@@ -232,13 +257,6 @@ class _Decoder:
             events=self.events,
             outcome=outcome,
         )
-
-
-def _loads_or_text(text: str) -> Any:
-    try:
-        return json.loads(text)
-    except ValueError:
-        return text
 
 
 def read_log(path: str | Path, *, allow_truncated: bool = False) -> RunLog:

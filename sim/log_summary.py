@@ -16,7 +16,6 @@ incomplete so the caller can warn.
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,10 +24,9 @@ from typing import Any
 from mcap.reader import SeekingReader
 from mcap.records import Message
 
-from swarmnav.sim.log_reader import check_channels
+from swarmnav.sim.log_format import EVENTS_TOPIC, metadata_value
+from swarmnav.sim.log_reader import check_channels, event_decoder
 from swarmnav.sim.mcap_records import LogError, RawLog, open_regular, read_records
-
-EVENTS_TOPIC = "/events"
 
 
 @dataclass
@@ -67,24 +65,31 @@ class LogSummary:
                 for c in raw.channels.values()}
 
 
-def _event(raw: RawLog, message: Message) -> tuple[float, str, dict[str, Any]]:
-    try:
-        data = json.loads(message.data)
-        return message.log_time * 1e-9, str(data.get("kind", "?")), data.get("details", {})
-    except (ValueError, AttributeError) as error:
-        raise LogError(raw.path, f"an event cannot be decoded ({type(error).__name__}: {error})") from None
+class _Events:
+    """Decodes ``/events`` messages (``foxglove.Log``, or the JSON of older logs) into event tuples."""
+
+    def __init__(self, raw: RawLog):
+        self.raw = raw
+        self._decoders: dict[int, Any] = {}
+
+    def __call__(self, message: Message) -> tuple[float, str, dict[str, Any]]:
+        try:
+            decode = self._decoders.get(message.channel_id)
+            if decode is None:
+                decode = self._decoders[message.channel_id] = event_decoder(
+                    self.raw, self.raw.channels[message.channel_id])
+            kind, details = decode(message.data)
+            return message.log_time * 1e-9, kind, details
+        except LogError:
+            raise
+        except Exception as error:  # protobuf's DecodeError, JSON's ValueError, a missing field
+            raise LogError(self.raw.path, f"an event cannot be decoded ({type(error).__name__}: {error})") from None
 
 
 def _outcome(raw: RawLog) -> dict[str, Any] | None:
     if "outcome" not in raw.metadata:
         return None
-    out = {}
-    for key, text in raw.metadata["outcome"].items():
-        try:
-            out[key] = json.loads(text)
-        except ValueError:
-            out[key] = text
-    return out
+    return {key: metadata_value(text) for key, text in raw.metadata["outcome"].items()}
 
 
 def _from_summary(path: Path) -> LogSummary | None:
@@ -109,9 +114,10 @@ def _from_summary(path: Path) -> LogSummary | None:
         check_channels(raw)
         events = []
         if any(c.topic == EVENTS_TOPIC for c in raw.channels.values()):
+            decode = _Events(raw)
             try:
                 for _, _, message in reader.iter_messages(topics=[EVENTS_TOPIC], log_time_order=True):
-                    events.append(_event(raw, message))
+                    events.append(decode(message))
             except LogError:
                 raise
             except Exception:  # an index that does not hold: walk the records instead
@@ -134,13 +140,16 @@ def from_records(path: str | Path) -> LogSummary:
     """What a log holds, walking its records (what :func:`read_summary` does for a file without summary)."""
     events: list[tuple[float, str, dict[str, Any]]] = []
     topics: dict[int, bool] = {}
+    decoders: list[_Events] = []  # made at the first event, on the RawLog being read
 
     def keep_events(raw: RawLog, message: Message) -> None:
         if message.channel_id not in topics:
             channel = raw.channels.get(message.channel_id)
             topics[message.channel_id] = channel is not None and channel.topic == EVENTS_TOPIC
         if topics[message.channel_id]:
-            events.append(_event(raw, message))
+            if not decoders:
+                decoders.append(_Events(raw))
+            events.append(decoders[0](message))
 
     raw = read_records(Path(path), on_message=keep_events)
     check_channels(raw)

@@ -7,7 +7,9 @@ same messages.  The channels, time stamps and names are in :mod:`sim.log_format`
 
 Metadata records: ``scenario`` (name, TOML text), ``planner`` and ``navigator`` (name, JSON params),
 ``run`` (seed, world seed, time steps, sensor layout, obstacles), ``versions`` and, from
-``finish``, ``outcome`` (the runner's summary, JSON-encoded values).  Attachment:
+``finish``, ``outcome`` (the runner's summary).  Values are plain text where they are
+strings (Foxglove shows ``goal_reached``, not ``"goal_reached"``) and JSON where they are
+numbers, booleans, lists or objects (:func:`sim.log_format.metadata_text`).  Attachment:
 ``scene.xml``, the compiled MJCF.  Everything needed to re-simulate is in the file.
 
 The writer is the foxglove SDK with ``disable_seeking=True``, so the file is
@@ -27,7 +29,7 @@ from typing import Any, Callable
 
 import foxglove
 import numpy as np
-from foxglove.channels import PosesInFrameChannel, SceneUpdateChannel
+from foxglove.channels import LogChannel, PosesInFrameChannel, SceneUpdateChannel
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 from foxglove.messages import (
     FrameTransform,
@@ -45,26 +47,31 @@ from swarmnav.sim.log_file import LogFile
 from swarmnav.sim.log_format import (
     BASE_FRAME,
     CONTROLLER_SCHEMA,
-    EVENT_SCHEMA,
+    EVENTS_TOPIC,
     LOG_PROFILE,
     MJCF_ATTACHMENT,
     NAVIGATOR_TOPIC,
+    SCENE_TOPIC,
     TOPICS,
     WHEELS_SCHEMA,
     WORLD_FRAME,
     default_log_path,
     dumps,
+    metadata_text,
     scan_list_from_ranges,
     time_ns,
     writer_versions,
 )
 from swarmnav.sim.log_messages import (
     belief_update,
+    chassis_radius_m,
     controller_json,
+    event_log,
     json_schema,
     obstacle_entity,
     obstacle_template,
     run_metadata,
+    scene_update,
     stamp,
     wheels_json,
     yaw_quaternion,
@@ -191,11 +198,12 @@ class McapRecorder:
                                            context=self._fox)
         self._scan = foxglove.Channel("/range/scan", schema=LaserScan.get_schema(), message_encoding="protobuf",
                                       context=self._fox)
-        self._wheels, self._controller, self._events = self._json_channels = [
+        self._wheels, self._controller = self._json_channels = [
             foxglove.Channel(topic, schema=json_schema(schema), message_encoding="json", context=self._fox)
-            for topic, schema in (("/wheels", WHEELS_SCHEMA), ("/controller", CONTROLLER_SCHEMA),
-                                  ("/events", EVENT_SCHEMA))
+            for topic, schema in (("/wheels", WHEELS_SCHEMA), ("/controller", CONTROLLER_SCHEMA))
         ]
+        self._events = LogChannel(EVENTS_TOPIC, context=self._fox)
+        self._scene_channel = SceneUpdateChannel(SCENE_TOPIC, context=self._fox)
         self._guard(self._write_run_records, context)
 
         self._scan_start_rad = float(angles[0]) if angles.size else 0.0
@@ -210,7 +218,9 @@ class McapRecorder:
         self._scene = SceneEncoder(static_entities, WORLD_FRAME,
                                    [(o.entity_id, obstacle_template(o)) for o in self._moving_infos])
         self._obstacles.base.log(self._scene_update(0, None), 0, None)
-        self.messages_written += 1
+        self._scene_message = scene_update(context.arena_size_m, chassis_radius_m(context.mjcf_xml))
+        self._scene_channel.log(self._scene_message, log_time=0)
+        self.messages_written += 2
         self._next_flush_ns = time_ns(self.flush_interval_s)
         if self._pacer is not None:
             self._pacer.start(context)
@@ -257,6 +267,9 @@ class McapRecorder:
         if self._moving_infos or "/obstacles" in late:
             self._obstacles.base.log(self._scene_update(t_ns, frame.moving_obstacles_m), t_ns, None)
             written += 1
+        if SCENE_TOPIC in late:
+            self._scene_channel.log(self._scene_message, log_time=t_ns)
+            written += 1
         if "/planner/path" in late and self._last_path is not None:
             self._path.log(self._last_path, log_time=t_ns)
             written += 1
@@ -268,7 +281,7 @@ class McapRecorder:
     def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
         """Log a discrete event and flush, so it survives a crash right after."""
         t_ns = time_ns(time_s)
-        self._events.log(dumps({"kind": kind, "details": details}), log_time=t_ns)
+        self._events.log(event_log(t_ns, kind, details), log_time=t_ns)
         self._after_write(t_ns, 1)
         self._flush()
 
@@ -286,7 +299,7 @@ class McapRecorder:
         try:
             if log_file.error is None:
                 # Wall-clock figures would make two identical runs' logs differ: left out.
-                outcome = {k: dumps(v) for k, v in summary.items() if not k.startswith("wall_")}
+                outcome = {k: metadata_text(v) for k, v in summary.items() if not k.startswith("wall_")}
                 self._guard(writer.write_metadata, "outcome", outcome)
                 self._guard(writer.close)
             else:

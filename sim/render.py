@@ -4,6 +4,14 @@ The only module that knows about EGL: ``MUJOCO_GL`` is set to ``egl`` here (unle
 the user chose another backend) before ``mujoco`` is imported, so rendering works
 on headless, GPU-less servers through Mesa.
 
+What a frame shows: the scene from the ``top`` camera (the whole arena), the
+robot's ``chase`` camera, or ``follow`` (straight down on the robot, about
+:data:`FOLLOW_VIEW_M` of its surroundings in view, so the robot stays a readable
+size in any arena); obstacles in the shared palette (:mod:`sim.palette`); a
+visual-only ground past the floor's edge (decor boxes, not in the model: no
+black background in the chase view, and logs and physics are untouched); a title
+bar and the simulation time (:mod:`sim.frame_caption`).
+
 Speed: shadows, reflections and multisampling are switched off, which takes a
 640x480 frame from ~267 ms to ~20 ms on the reference machine, and the floor is
 drawn without its checker texture but with a metre grid of lines (a third less
@@ -34,14 +42,24 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from swarmnav.models.errors import ConfigError  # noqa: E402
+from swarmnav.sim import palette  # noqa: E402
+from swarmnav.sim.frame_caption import FrameCaption, run_title  # noqa: E402
+from swarmnav.sim.render_look import (  # noqa: E402
+    FOLLOW_VIEW_M,
+    follow_camera,
+    ground_boxes,
+    paint_obstacles,
+    soften_lights,
+)
 from swarmnav.sim.commands import MAX_FPS, MIN_FPS  # noqa: E402
 from swarmnav.sim.recording import RunContext, StepFrame  # noqa: E402
 from swarmnav.sim.video_file import VideoWriter  # noqa: E402
 
-CAMERAS = ("top", "chase")
-PATH_RGBA = np.array([0.1, 0.75, 0.2, 1.0], dtype=np.float32)
-DRIVEN_RGBA = np.array([0.15, 0.35, 0.9, 0.9], dtype=np.float32)
-BEAM_HIT_RGBA = np.array([1.0, 0.15, 0.1, 1.0], dtype=np.float32)
+CAMERAS = ("top", "chase", "follow")
+GROUND_RGBA = np.array([0.78, 0.79, 0.8, 1.0], dtype=np.float32)
+PATH_RGBA = np.array(palette.rgba(palette.PLANNED), dtype=np.float32)
+DRIVEN_RGBA = np.array(palette.rgba(palette.DRIVEN, 0.9), dtype=np.float32)
+BEAM_HIT_RGBA = np.array(palette.rgba(palette.COLLISION), dtype=np.float32)
 BEAM_MISS_RGBA = np.array([1.0, 0.75, 0.2, 0.35], dtype=np.float32)
 # Lines (widths in pixels) cost ~30 us each to draw, capsules ~200 us: the path,
 # the trail and the beams are lines, and the trail keeps a point per TRAIL_STEP_M.
@@ -175,6 +193,16 @@ def floor_grid(width_m: float, height_m: float, step_m: float = GRID_STEP_M) -> 
     return np.array(vertical + horizontal, dtype=float).reshape(-1, 2, 3)
 
 
+def _add_boxes(scene: mujoco.MjvScene, boxes: np.ndarray, rgba: np.ndarray) -> None:
+    for centre, half in boxes:
+        if scene.ngeom >= scene.maxgeom:
+            return
+        geom = scene.geoms[scene.ngeom]
+        mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_BOX, half, centre, _EYE9, rgba)
+        geom.category = mujoco.mjtCatBit.mjCAT_DECOR
+        scene.ngeom += 1
+
+
 class SceneRenderer:
     """Offscreen frames of a posed scene, with the planned path and beams drawn in.
 
@@ -190,9 +218,16 @@ class SceneRenderer:
 
     def __init__(self, model: mujoco.MjModel, width: int = 640, height: int = 480, camera: str = "top",
                  fast: bool = True, grid_m: tuple[float, float] | None = None):
-        if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
-            names = [model.camera(i).name for i in range(model.ncam)]
+        self._follow: mujoco.MjvCamera | None = None
+        if camera == "follow":
+            self._follow = follow_camera(model)
+        elif mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
+            names = [model.camera(i).name for i in range(model.ncam)] + ["follow"]
             raise ConfigError("--camera", f"no camera {camera!r} in the scene (has {names})")
+        paint_obstacles(model)
+        soften_lights(model)
+        # The top camera frames the floor; the others can look past its edge.
+        self._ground = ground_boxes(model) if camera != "top" else np.zeros((0, 2, 3))
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
         self._grid = np.zeros((0, 2, 3))
@@ -220,10 +255,18 @@ class SceneRenderer:
         path_m: np.ndarray | None = None,
         beams: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
         trail_m: np.ndarray | None = None,
+        follow_xy_m: np.ndarray | None = None,
     ) -> np.ndarray:
-        """One (height, width, 3) uint8 RGB frame."""
-        self._renderer.update_scene(data, camera=self.camera, scene_option=self._option)
+        """One (height, width, 3) uint8 RGB frame; ``follow_xy_m`` centres the follow camera."""
+        if self._follow is not None:
+            if follow_xy_m is not None:
+                self._follow.lookat[:2] = follow_xy_m[:2]
+            camera = self._follow
+        else:
+            camera = self.camera
+        self._renderer.update_scene(data, camera=camera, scene_option=self._option)
         scene = self._renderer.scene
+        _add_boxes(scene, self._ground, GROUND_RGBA)
         for start, end in self._grid:
             _add_line(scene, start, end, GRID_WIDTH_PX, GRID_RGBA)
         if beams is not None:
@@ -249,8 +292,11 @@ class VideoRecorder:
 
     Args:
         path: the MP4 to write.
-        camera, width, height, fps: view and video settings.
+        camera, width, height, fps: view and video settings (``follow``: a top view
+            centred on the robot, :data:`FOLLOW_VIEW_M` high).
         trail: also draw the driven trajectory so far.
+        caption: draw the title bar (scenario, planner + navigator, seeds) and the
+            simulation time on every frame (:class:`sim.frame_caption.FrameCaption`).
     """
 
     def __init__(
@@ -262,6 +308,7 @@ class VideoRecorder:
         height: int = 480,
         fps: float = 30.0,
         trail: bool = True,
+        caption: bool = True,
     ):
         check_video_size(width, height, fps)
         if camera not in CAMERAS:
@@ -269,6 +316,8 @@ class VideoRecorder:
         self.video_path = Path(path)
         self.camera, self.width, self.height, self.fps = camera, width, height, float(fps)
         self.trail = trail
+        self.caption = caption
+        self._caption: FrameCaption | None = None
         self._next_frame = 0
         self._path_m: np.ndarray | None = None
         self._trail: list[np.ndarray] = []
@@ -286,6 +335,10 @@ class VideoRecorder:
         self._poser = ScenePoser(model, moving)
         self._renderer = SceneRenderer(model, self.width, self.height, self.camera,
                                        grid_m=tuple(context.arena_size_m))
+        if self.caption:
+            self._caption = FrameCaption(run_title(context.scenario_name, context.planner_name,
+                                                   context.navigator_name, context.seed, context.world_seed),
+                                         self.width, self.height)
         self._video = VideoWriter(self.video_path, self.width, self.height, self.fps)
 
     def path(self, time_s: float, waypoints_m: np.ndarray) -> None:
@@ -307,7 +360,10 @@ class VideoRecorder:
             path_m=self._path_m,
             beams=self._poser.beams(frame.range_m),
             trail_m=np.array(self._trail + [frame.position_m[:2]]) if self.trail and self._trail else None,
+            follow_xy_m=frame.position_m,
         )
+        if self._caption is not None:
+            self._caption.draw(image, frame.time_s)
         self.render_seconds += time.perf_counter() - started
         while self._next_frame / self.fps <= frame.time_s + 1e-9:
             self._video.add(image)

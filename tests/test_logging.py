@@ -30,6 +30,8 @@ from swarmnav.sim.mcap_records import read_records  # noqa: E402
 REPO = Path(__file__).resolve().parent.parent
 SCENARIO = "gwo-scenario-2"  # moving obstacles and collisions: every channel has traffic
 PER_STEP = ("/tf", "/robot/pose", "/range/scan", "/wheels", "/controller")
+# The foxglove.* names are those @foxglove/schemas defines (checked against Foxglove's schema reference:
+# FrameTransform, PoseInFrame, PosesInFrame, SceneUpdate, LaserScan, Log); Foxglove recognises only these.
 EXPECTED_SCHEMAS = {
     "/tf": "foxglove.FrameTransform",
     "/robot/pose": "foxglove.PoseInFrame",
@@ -38,7 +40,8 @@ EXPECTED_SCHEMAS = {
     "/range/scan": "foxglove.LaserScan",
     "/wheels": "swarmnav.WheelSpeeds",
     "/controller": "swarmnav.ControllerState",
-    "/events": "swarmnav.Event",
+    "/events": "foxglove.Log",
+    "/scene": "foxglove.SceneUpdate",
 }
 
 
@@ -226,6 +229,41 @@ def test_plot_writes_an_image(tmp_path, full_run):
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_plot_svg_names_everything_it_draws(tmp_path, full_run):
+    """The legend names obstacles, plans, the driven trajectory and collisions; time has a colour bar."""
+    path, episode = full_run
+    out = tmp_path / "run.svg"
+    assert main(["plot", str(path), "-o", str(out)]) == 0
+    svg = out.read_text()
+    for label in ("static obstacle", "moving obstacle", "planned path", "driven trajectory (time colour)",
+                  "start", "goal", "simulation time [s]"):
+        assert label in svg, label
+    if episode.result.collisions:
+        assert f"collision begins ({episode.result.collisions})" in svg
+
+
+def test_plot_title_wraps_so_it_is_never_clipped(full_run):
+    import dataclasses
+
+    from swarmnav.sim.plot import TITLE_CHARS, figure_title
+
+    log = read_log(full_run[0])
+    long_name = "a-scenario-with-a-very-long-name-" * 4
+    metadata = {**log.metadata, "scenario": {**log.metadata["scenario"], "name": long_name}}
+    title = figure_title(dataclasses.replace(log, metadata=metadata))
+    assert "".join(title.split()).startswith("".join(long_name.split())[:40])
+    assert len(title.splitlines()) >= 3 and all(len(line) <= TITLE_CHARS for line in title.splitlines())
+
+
+def test_plot_marks_time_along_moving_tracks_and_the_trajectory():
+    from swarmnav.sim.plot import _mark_step_s, decimated
+
+    assert [_mark_step_s(d) for d in (4.0, 72.4, 3000.0)] == [0.5, 10.0, 300.0]
+    picked = decimated(1_000_000, 4000)
+    assert len(picked) <= 4000 and picked[0] == 0 and picked[-1] == 999_999
+    assert np.array_equal(decimated(10, 4000), np.arange(10))
+
+
 def test_log_info_prints_channels_and_outcome(full_run, capsys):
     assert main(["log", "info", str(full_run[0])]) == 0
     out = capsys.readouterr().out
@@ -338,3 +376,79 @@ def test_step_json_is_the_same_text_as_sorted_json_dumps():
         expected = json.dumps({"linear_m_s": float(command_l), "angular_rad_s": float(measured_r),
                                "waypoint_index": index}, sort_keys=True)
         assert controller_json(np.float64(command_l), measured_r, np.int64(index)) == expected
+
+
+def _decoded(path: Path, topic: str) -> list:
+    factory = DecoderFactory()
+    with path.open("rb") as stream:
+        return [factory.decoder_for(channel.message_encoding, schema)(message.data)
+                for schema, channel, message in make_reader(stream).iter_messages(topics=[topic])]
+
+
+def test_scene_has_the_arena_outline_and_the_robot_footprint(full_run):
+    path, _ = full_run
+    scenario = load_scenario(SCENARIO)
+    (update,) = _decoded(path, "/scene")
+    entities = {e.id: e for e in update.entities}
+    assert set(entities) == {"arena", "robot_footprint"}
+    arena, footprint = entities["arena"], entities["robot_footprint"]
+    assert arena.frame_id == "world"
+    corners = {(p.x, p.y) for p in arena.lines[0].points}
+    assert corners == {(0.0, 0.0), (scenario.arena_width_m, 0.0), (0.0, scenario.arena_height_m),
+                       (scenario.arena_width_m, scenario.arena_height_m)}
+    # The footprint follows the robot through /tf: in base_link, frame-locked, the robot's radius.
+    assert footprint.frame_id == "base_link" and footprint.frame_locked
+    (disc,) = footprint.cylinders
+    assert math.isclose(disc.size.x / 2, scenario.robot_radius_m, rel_tol=1e-6)
+    assert disc.top_scale == disc.bottom_scale == 1.0 and disc.color.a > 0
+
+
+def test_events_are_foxglove_log_messages_that_read_back(full_run):
+    path, episode = full_run
+    logs = _decoded(path, "/events")
+    log = read_log(path)
+    assert [m.message.split(" ", 1)[0] for m in logs] == [kind for _, kind, _ in log.events]
+    assert logs[-1].message.startswith(episode.result.outcome)
+    levels = {m.message.split(" ", 1)[0]: m.level for m in logs}
+    assert levels.get("collision_begin", 3) == 3  # WARNING
+    assert levels[episode.result.outcome] in (2, 3)  # INFO for goal_reached, WARNING for a timeout
+    assert all(m.timestamp.seconds * 10**9 + m.timestamp.nanos > 0 for m in logs)
+    collisions = [d for _, k, d in log.events if k == "collision_begin"]
+    assert all(isinstance(d["geom_a"], str) for d in collisions)
+
+
+def test_metadata_values_are_plain_strings_and_read_back_typed(full_run):
+    path, episode = full_run
+    with path.open("rb") as stream:
+        outcome = {m.name: m.metadata for m in make_reader(stream).iter_metadata()}["outcome"]
+    assert outcome["outcome"] == episode.result.outcome  # no JSON quotes for Foxglove to show
+    assert float(outcome["sim_time_s"]) > 0
+    log = read_log(path)
+    assert log.outcome["outcome"] == episode.result.outcome
+    assert log.outcome["collisions"] == episode.result.collisions
+    assert isinstance(log.outcome["reached"], bool)
+
+
+@pytest.mark.parametrize("value", ["goal_reached", "true", "12", "null", '"quoted"', "", "a b", 3, 2.5, None,
+                                   True, [1, 2], {"k": "v"}])
+def test_metadata_text_round_trips_every_value(value):
+    from swarmnav.sim.log_format import metadata_text, metadata_value
+
+    text = metadata_text(value)
+    assert metadata_value(text) == value and type(metadata_value(text)) is type(value)
+    if isinstance(value, str) and value in ("goal_reached", "a b", ""):
+        assert text == value
+
+
+def test_events_of_older_logs_in_json_still_read():
+    from mcap.records import Channel, Schema
+
+    from swarmnav.sim.log_format import LEGACY_EVENT_SCHEMA, dumps
+    from swarmnav.sim.log_reader import event_decoder
+    from swarmnav.sim.mcap_records import RawLog
+
+    raw = RawLog(path=Path("old.mcap"), schemas={1: Schema(id=1, name="swarmnav.Event", encoding="jsonschema",
+                                                          data=dumps(LEGACY_EVENT_SCHEMA).encode())})
+    channel = Channel(id=1, topic="/events", message_encoding="json", schema_id=1, metadata={})
+    decode = event_decoder(raw, channel)
+    assert decode(dumps({"kind": "timeout", "details": {"x_m": 1.5}}).encode()) == ("timeout", {"x_m": 1.5})

@@ -17,6 +17,7 @@ import time
 # anything imports mujoco, and the CLI imports this module before the runner's.
 from swarmnav.sim.benchmarks.figures import print_figures
 from swarmnav.sim.commands import BENCH_RENDER_QUICK_FRAMES
+from swarmnav.sim.frame_caption import FrameCaption, run_title
 from swarmnav.sim.render import ScenePoser, SceneRenderer, check_video_size
 
 import mujoco  # noqa: E402
@@ -42,7 +43,7 @@ def benchmark_render(
     mjcf_xml: str, *, width: int = 640, height: int = 480, frames: int = 120, camera: str = "top",
     fast: bool = True, grid_m: tuple[float, float] | None = None,
 ) -> dict[str, float]:
-    """Rendered frames per second (pose + overlay + render, no encoding) for a scene.
+    """Rendered frames per second (pose + overlay + render + caption, no encoding) for a scene.
 
     The robot drives a circle so the chase camera moves too.  ``fast=False``
     renders with MuJoCo's own defaults instead (:func:`mujoco_default_quality`
@@ -53,18 +54,21 @@ def benchmark_render(
         mujoco_default_quality(model)
     poser = ScenePoser(model)
     renderer = SceneRenderer(model, width, height, camera, fast=fast, grid_m=grid_m)
+    caption = FrameCaption(run_title("bench", "planner", "navigator", 0, 0), width, height)
     path = np.array([[1.0, 1.0], [3.0, 2.0], [5.0, 5.0], [8.0, 9.0]])
     try:
         renderer.render(poser.data)  # warm-up: context, textures
         started = time.perf_counter()
         for k in range(frames):
             angle = 2 * math.pi * k / max(frames, 1)
+            position = np.array([5 + 2 * math.cos(angle), 5 + 2 * math.sin(angle), 0.0])
             poser.apply(
-                np.array([5 + 2 * math.cos(angle), 5 + 2 * math.sin(angle), 0.0]),
+                position,
                 np.array([math.cos(angle / 2 + math.pi / 4), 0, 0, math.sin(angle / 2 + math.pi / 4)]),
                 None,
             )
-            renderer.render(poser.data, path_m=path, beams=poser.beams(None))
+            caption.draw(renderer.render(poser.data, path_m=path, beams=poser.beams(None), follow_xy_m=position),
+                         k / 30.0)
         elapsed = time.perf_counter() - started
     finally:
         renderer.close()
