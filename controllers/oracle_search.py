@@ -37,7 +37,7 @@ are stated in every verdict.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -46,7 +46,7 @@ from swarmnav.models.scenario import Scenario
 
 HEADINGS = 8
 STEPS = np.array([(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)])  # (dx, dy) cells
-MAX_LATTICE = 400_000_000  # states x ticks recorded (one byte each) before the search refuses
+MAX_LATTICE = 100_000_000  # states x ticks recorded (one byte each): a coarser cell beyond (``search``)
 WAIT, MOVE, LEFT, RIGHT = 1, 2, 3, 4
 
 
@@ -150,17 +150,27 @@ def obstacle_speed_bound_m_s(positions: np.ndarray, tick_s: float) -> float:
     return float(np.max(np.linalg.norm(np.diff(positions, axis=0), axis=2))) / tick_s
 
 
+def _lattice_size(scenario: Scenario, settings: OracleSettings, time_limit_s: float | None) -> float:
+    """States x ticks of the lattice (an estimate to within a row and a column)."""
+    speed = settings.speed_fraction * scenario.max_speed_m_s
+    ticks = (scenario.time_limit_s if time_limit_s is None else time_limit_s) * 2.0 * speed / settings.cell_m
+    cells = (scenario.arena_width_m / settings.cell_m + 1) * (scenario.arena_height_m / settings.cell_m + 1)
+    return HEADINGS * cells * (ticks + 1)
+
+
 def search(scenario: Scenario, settings: OracleSettings | None = None,
            time_limit_s: float | None = None) -> OraclePlan:
     """The earliest collision-free arrival on the lattice (module docstring), from the scenario's true motion.
 
-    Raises:
-        ConfigError: the lattice (states x ticks) exceeds :data:`MAX_LATTICE`, naming the cell size.
+    A lattice beyond :data:`MAX_LATTICE` state-ticks at ``settings.cell_m`` is searched at the smallest
+    doubling of the cell that fits (large maps); the verdict states the cell used.
     """
     import time as _time
     wall0 = _time.perf_counter()
     settings = settings or OracleSettings()
     settings.check()
+    while _lattice_size(scenario, settings, time_limit_s) > MAX_LATTICE:
+        settings = replace(settings, cell_m=2.0 * settings.cell_m)
     cell = settings.cell_m
     speed = settings.speed_fraction * scenario.max_speed_m_s
     tick = cell / (2.0 * speed)
@@ -173,10 +183,6 @@ def search(scenario: Scenario, settings: OracleSettings | None = None,
     xs = np.arange(x0, bounds.x_max_m + 1e-9, cell)
     ys = np.arange(y0, bounds.y_max_m + 1e-9, cell)
     rows, cols = len(ys), len(xs)
-    if HEADINGS * rows * cols * ticks > MAX_LATTICE:
-        raise ConfigError("oracle.cell_m", f"the lattice needs {HEADINGS * rows * cols * ticks:.3g} state-ticks "
-                                           f"(at most {MAX_LATTICE:,}); take a coarser cell than {cell:g} m",
-                          scenario.source_path)
     clearance = _Clearance(scenario, xs, ys, tick)
     track = clearance.positions(ticks)
     need = (scenario.robot_radius_m + settings.margin_m
