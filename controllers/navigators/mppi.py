@@ -27,8 +27,9 @@ robot's limits (no reverse: v in [0, top speed]); the state cost sums
   replacing the two path terms.
 
 Choices where the sources leave it open or Nav2's defaults do not fit (ours):
-the temperature ``lambda`` is applied to costs normalised by their spread over the batch (so one
-``temperature`` serves every scene's scale); Nav2's Savitzky-Golay smoothing of the sequence is not applied.
+the update averages the noise as drawn (Williams et al.'s epsilon), while the rollouts apply the controls
+clipped to the limits, so a nominal speed at the limit is not dragged down by the clipped half of its
+samples; Nav2's Savitzky-Golay smoothing of the sequence is not applied.
 """
 
 from __future__ import annotations
@@ -55,7 +56,7 @@ class MppiNavigator:
         samples: K, control sequences sampled per step (Nav2: batch_size).
         horizon_steps: T, steps per rollout (Nav2: time_steps); ``model_dt_s`` apart.
         linear_std_m_s, angular_std_rad_s: Sigma's diagonal (Nav2: vx_std, wz_std).
-        temperature: lambda (Nav2: temperature), on costs normalised by their spread.
+        temperature: lambda (Nav2: temperature), in cost units.
         control_cost: gamma of the control cost term (Nav2: gamma).
         margin_m: clearance kept beyond the robot radius before a point counts as a collision.
         repulsion_m, repulsion_weight: the repulsion band beyond the margin and its weight.
@@ -63,6 +64,9 @@ class MppiNavigator:
         lookahead_m, follow_weight, path_weight: the path-following terms.
         goal_radius_m, goal_weight: the goal term.
         max_angular_rad_s: the turn-rate limit.
+        optimise_period_s: optimise every this long (Nav2: controller_frequency), applying the nominal
+            sequence's step of the moment in between; 0: at every control step.  0.1 s (10 Hz, ours): the
+            model's step, so an optimisation starts where the last one's first step ends.
         noise_bank: draw the noise from a bank of ``noise_bank`` x K sequences made at reset, K consecutive
             ones (circular) from a random start each step; 0: fresh draws every step, as the paper.  Drawing
             60,000 normals was most of a step's time (named option, ours).
@@ -89,6 +93,7 @@ class MppiNavigator:
     goal_weight: float = 5.0
     max_angular_rad_s: float = 1.2
     noise_bank: int = 8
+    optimise_period_s: float = 0.1
     safety_filter: bool = False
     time_before_collision_s: float = 1.0
 
@@ -96,7 +101,7 @@ class MppiNavigator:
         check_positive(self, ("samples", "horizon_steps", "model_dt_s", "linear_std_m_s", "angular_std_rad_s",
                               "temperature", "lookahead_m", "max_angular_rad_s", "time_before_collision_s",
                               "collision_cost", "goal_radius_m"),
-                       ("control_cost", "noise_bank", "margin_m", "repulsion_m", "repulsion_weight", "follow_weight",
+                       ("control_cost", "noise_bank", "optimise_period_s", "margin_m", "repulsion_m", "repulsion_weight", "follow_weight",
                         "path_weight", "goal_weight"))
         if self.samples * self.horizon_steps > 1_000_000:
             raise ConfigError("navigator.params.samples", f"samples x horizon_steps must be at most 1,000,000, "
@@ -107,6 +112,7 @@ class MppiNavigator:
          self.filter) = local_setup(setup, self.margin_m, self.lookahead_m, self.safety_filter,
                                     self.time_before_collision_s)
         self.rng = setup.rng
+        self.optimised_at_s = -1.0
         self.nominal = np.zeros((self.horizon_steps, 2), dtype=np.float32)
         self.std = np.array([self.linear_std_m_s, self.angular_std_rad_s], dtype=np.float32)
         self.lo = np.array([0.0, -self.max_angular_rad_s], dtype=np.float32)
@@ -182,6 +188,14 @@ class MppiNavigator:
 
     def step(self, observation: Observation) -> NavigationStep:
         pose = observation.pose
+        elapsed = observation.time_s - self.optimised_at_s
+        index = min(int(elapsed / self.model_dt_s + 1e-9), self.horizon_steps - 1)  # the sequence's step now
+        if self.optimised_at_s >= 0.0 and elapsed < self.optimise_period_s - 1e-9:
+            v, omega = (float(u) for u in self.nominal[index])
+            return self._answer(pose, v, omega, observation)
+        if self.optimised_at_s >= 0.0 and index > 0:                      # drop the steps already driven
+            self.nominal = np.concatenate([self.nominal[index:], np.repeat(self.nominal[-1:], index, axis=0)])
+        self.optimised_at_s = observation.time_s
         if self.noise_bank > 0:  # K sequences of the bank, from a random start (circular)
             start = int(self.rng.integers(len(self.bank)))
             noise = np.take(self.bank, np.arange(start, start + self.samples), axis=0, mode="wrap")
@@ -189,8 +203,7 @@ class MppiNavigator:
             noise = self.rng.standard_normal((self.samples, self.horizon_steps, 2), dtype=np.float32)
             noise *= self.std
         controls = noise + self.nominal[None]
-        np.clip(controls, self.lo, self.hi, out=controls)
-        noise = np.subtract(controls, self.nominal[None], out=noise)      # the noise actually applied
+        np.clip(controls, self.lo, self.hi, out=controls)                 # rolled out within the limits
         px, py = self.rollouts(pose.x_m, pose.y_m, pose.heading_rad, controls)
         cost = self.costs(px, py, observation)
         # Control cost gamma u^T Sigma^-1 eps (Williams et al. 2017, Eq. 30), summed over the sequence.
@@ -198,12 +211,12 @@ class MppiNavigator:
             cost += np.tensordot(noise, self.nominal / (self.std * self.std), axes=([1, 2], [0, 1])) \
                 * np.float32(self.control_cost)
         low = float(cost.min())
-        spread = max(float(cost.max()) - low, 1e-9)
-        weights = np.exp((cost - low) * np.float32(-1.0 / (self.temperature * spread)))
+        weights = np.exp((cost - low) * np.float32(-1.0 / self.temperature))
         weights /= weights.sum()
         self.nominal = np.clip(self.nominal + np.tensordot(weights, noise, axes=1), self.lo, self.hi)
-        v, omega = float(self.nominal[0, 0]), float(self.nominal[0, 1])
-        self.nominal = np.concatenate([self.nominal[1:], self.nominal[-1:]])  # shift for the next step
+        return self._answer(pose, float(self.nominal[0, 0]), float(self.nominal[0, 1]), observation)
+
+    def _answer(self, pose, v: float, omega: float, observation: Observation) -> NavigationStep:
         command = ControlCommand(wheel_speeds(v, omega, self.geometry), v, omega, 0)
         events = []
         if self.filter is not None:
