@@ -38,10 +38,22 @@ def suite_verdicts(name: str, progress: bool = False) -> dict:
     entries.sort(key=difficulty_key)
     for rank, entry in enumerate(entries):
         entry["difficulty_rank"] = rank
-    return {"suite": suite.name, "version": suite.version, "scenes": entries}
+        verdict = entry["oracle"]
+        entry["oracle"] = {k: verdict[k] for k in ("solvable", "arrival_s", "reason")}
+        settings = {k: v for k, v in verdict.items() if k not in ("solvable", "arrival_s", "reason")}
+    return {"suite": suite.name, "version": suite.version, "oracle_settings": settings if entries else {},
+            "scenes": entries}
+
+
+def write(path, data: dict) -> None:
+    """One scene per line (a small diff when a verdict changes)."""
+    head = {k: v for k, v in data.items() if k != "scenes"}
+    lines = [json.dumps(e, sort_keys=True) for e in data["scenes"]]
+    text = json.dumps(head)[:-1] + ', "scenes": [\n' + ",\n".join(lines) + "\n]}\n"
+    path.write_text(text, encoding="utf-8")
 
 
 if __name__ == "__main__":
     name = sys.argv[1] if len(sys.argv) > 1 else "dyn300"
     data = suite_verdicts(name, progress=True)
-    (SUITE_DIR / f"{name}-verdicts.json").write_text(json.dumps(data, indent=0) + "\n", encoding="utf-8")
+    write(SUITE_DIR / f"{name}-verdicts.json", data)
