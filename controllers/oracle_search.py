@@ -25,8 +25,9 @@ tick at which a goal state is reached is the earliest arrival on the lattice:
   ticks is covered: distances are 1-Lipschitz).  Per tick the clearance of every
   cell centre is one NumPy expression over obstacles x cells; a point on a move,
   ``delta`` from the endpoint it is checked at, needs that much more clearance.
-* **Goal**: any cell centre within the goal's tolerance (the nearest centre when
-  none is).  T* is the tick of the first arrival there times ``tick_s``.
+* **Goal**: any cell centre within half the goal's tolerance (the nearest centre when
+  none is; half, so the physics drive's tracking error stays inside the tolerance).  T* is the tick of
+  the first arrival there times ``tick_s``.
 
 The whole frontier advances one tick per iteration as boolean arrays (headings
 x rows x cols); each state records the action that first reached it, so the
@@ -192,7 +193,7 @@ def search(scenario: Scenario, settings: OracleSettings | None = None,
     start_h = int(round(scenario.start.heading_rad / (math.pi / 4.0))) % HEADINGS
     gx, gy = scenario.goal.x_m, scenario.goal.y_m
     goal_d = np.hypot(xs[None, :] - gx, ys[:, None] - gy)
-    goal_mask = goal_d <= scenario.goal_tolerance_m
+    goal_mask = goal_d <= 0.5 * scenario.goal_tolerance_m
     if not goal_mask.any():
         goal_mask = goal_d <= goal_d.min() + 1e-12
 

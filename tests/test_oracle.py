@@ -31,10 +31,10 @@ def case(obstacles: str = "", limit: float = 60.0):
 def test_an_empty_arena_takes_the_straight_drive_at_the_lattice_speed():
     plan = search(case())
     settings = OracleSettings()
-    straight_s = (4.0 - 0.1) / (settings.speed_fraction * 0.2)  # the goal cell within the tolerance
+    straight_s = 4.0 / (settings.speed_fraction * 0.2)  # the goal's own cell (within half the tolerance)
     assert plan.solvable and plan.reason == ""
     assert plan.arrival_s == pytest.approx(straight_s, abs=plan.tick_s)
-    assert np.allclose(plan.poses[0, :2], (1.0, 3.0)) and math.dist(plan.poses[-1, :2], (5.0, 3.0)) <= 0.1
+    assert np.allclose(plan.poses[0, :2], (1.0, 3.0)) and math.dist(plan.poses[-1, :2], (5.0, 3.0)) <= 0.05
 
 
 def test_a_crosser_on_the_line_costs_time_and_the_trajectory_clears_its_true_motion():
