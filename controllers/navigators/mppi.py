@@ -50,7 +50,7 @@ from swarmnav.models.errors import ConfigError
 
 @dataclass
 class MppiNavigator:
-    """Model-predictive path integral control over sensed obstacles' predicted motion (module docstring).
+    """MPPI (Williams et al. 2017, as Nav2 adapts it) over sensed obstacles' predicted motion.
 
     Args:
         samples: K, control sequences sampled per step (Nav2: batch_size).
