@@ -39,7 +39,7 @@ from swarmnav.models.world import wrap_angle_rad
 
 @dataclass
 class ClairvoyantOracleNavigator:
-    """Clairvoyant yardstick: knows the obstacles' true future, searches space-time for the earliest arrival, tracks it.
+    """Clairvoyant yardstick: knows the true future, searches space-time for the earliest arrival, tracks it.
 
     Args:
         cell_m, speed_fraction, turn_rate_rad_s, margin_m: the lattice (:class:`OracleSettings`).
