@@ -103,7 +103,8 @@ class MppiNavigator:
         check_positive(self, ("samples", "horizon_steps", "model_dt_s", "linear_std_m_s", "angular_std_rad_s",
                               "temperature", "lookahead_m", "max_angular_rad_s", "time_before_collision_s",
                               "collision_cost", "goal_radius_m"),
-                       ("control_cost", "noise_bank", "optimise_period_s", "margin_m", "repulsion_m", "repulsion_weight", "follow_weight",
+                       ("control_cost", "noise_bank", "optimise_period_s", "margin_m", "repulsion_m", "repulsion_weight",
+                        "follow_weight",
                         "path_weight", "goal_weight"))
         if self.samples * self.horizon_steps > 1_000_000:
             raise ConfigError("navigator.params.samples", f"samples x horizon_steps must be at most 1,000,000, "

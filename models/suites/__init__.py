@@ -56,8 +56,8 @@ def _options(source: str, where: str, table: Any) -> dict[str, Any]:
     known = {f.name for f in fields(GeneratorOptions)}
     for key in table:
         if key not in known or key == "name":
-            raise ConfigError(f"{where}.{key}", f"unknown generator option (known: {', '.join(sorted(known - {'name'}))})",
-                              source)
+            known_list = ", ".join(sorted(known - {"name"}))
+            raise ConfigError(f"{where}.{key}", f"unknown generator option (known: {known_list})", source)
     return dict(table)
 
 

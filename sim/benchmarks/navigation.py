@@ -183,7 +183,8 @@ def _row(navigator: str, rows: list[dict[str, Any]], verdicts: dict[tuple[str, i
         out["success_on_solvable"] = out.pop("solved_share")
         out["verdict_mismatches"] = sum(
             1 for r in rows if r["scenario"] in shipped and (r["scenario"], r["world_seed"]) in verdicts
-            and bool(shipped[r["scenario"]]["oracle"]["solvable"]) != bool(verdicts[(r["scenario"], r["world_seed"])]["solvable"]))
+            and bool(shipped[r["scenario"]]["oracle"]["solvable"])
+            != bool(verdicts[(r["scenario"], r["world_seed"])]["solvable"]))
     return out
 
 
