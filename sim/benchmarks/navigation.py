@@ -24,7 +24,8 @@ the runs it called solvable (target: at least 0.95), ``solvable_share`` the shar
 
 ``--suite dyn300``: the 300 generated scenes of ``models/suites/dyn300.toml`` (each with its own world
 seed, ``--seeds`` ignored), in order of difficulty; ``--quick`` a stratified sample (2 per group);
-``--sensor-model detector|rangefinder`` (12 rangefinders at 1 m) overrides their sensing.  Where the
+``--sensor-model detector|rangefinder`` (12 rangefinders at 1 m) overrides their sensing; with
+``--by-scenario`` each scenario's rows carry its shipped ``difficulty`` metrics (to set success against them).  Where the
 shipped verdicts (``dyn300-verdicts.json``) disagree with this run's oracle, ``verdict_mismatches`` says how
 often (the oracle row).
 """
@@ -42,6 +43,9 @@ from swarmnav.models.scenario import list_scenarios, load_scenario
 
 SUITE_PREFIX = "dyn-"
 ORACLE = "oracle"  # the clairvoyant yardstick, run beside every contender
+# A generated suite's per-scenario rows carry these shipped difficulty metrics (sim/difficulty.py).
+DIFFICULTY_KEYS = ("difficulty_rank", "static_density", "dispersion", "survivability", "dynamic_traversability",
+                   "t_star_ratio")
 
 
 def default_navigators(settings: dict[str, dict[str, Any]] | None = None) -> list[str]:
@@ -154,9 +158,10 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     table = [{"scenario": None, **_row(nav, arm, verdicts, shipped)} for nav, arm in runs.items()]
     if by_scenario:
         for name in dict.fromkeys(r["scenario"] for r in rows):
+            extra = {"difficulty": {k: shipped[name][k] for k in DIFFICULTY_KEYS}} if name in shipped else {}
             for nav, arm in runs.items():
                 table.append({"scenario": name, **_row(nav, [r for r in arm if r["scenario"] == name], verdicts,
-                                                       shipped)})
+                                                       shipped), **extra})
     return table
 
 
