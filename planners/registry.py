@@ -14,10 +14,12 @@ from swarmnav.planners.dstar_lite import DStarLitePlanner
 from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, ThetaStarPlanner
 from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
 from swarmnav.planners.max_min_ant_system import MaxMinAntSystemPlanner
+from swarmnav.planners.max_min_colony import MaxMinColonyPlanner
 from swarmnav.planners.waiter_ant_colony import WaiterAntColonyPlanner
 from swarmnav.planners.grey_wolf import GreyWolfPlanner
 from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.particle_swarm import ParticleSwarmPlanner
+from swarmnav.planners.sampling_ompl import OMPL_PLANNERS
 from swarmnav.planners.errors import BudgetExceeded, GoalBlocked, NoPathFound, PlanningError, StartBlocked
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import Box, Disc, Pose2D, Rect
@@ -40,7 +42,7 @@ def register(cls: type) -> type:
 for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,
              MaxMinAntSystemPlanner, ImprovedAntColonyPlanner, WaiterAntColonyPlanner, AntSystemPlanner,
              OptimalPlanner, BeeColonyPlanner, AdaptiveLimitBeeColonyPlanner, GreyWolfPlanner,
-             ParticleSwarmPlanner):
+             ParticleSwarmPlanner, MaxMinColonyPlanner, *OMPL_PLANNERS):
     register(_cls)
 
 

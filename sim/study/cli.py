@@ -22,6 +22,8 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--logs", action="store_true", help="keep the MCAP log of every physics run in DIR/logs/")
     p.add_argument("--quick", action="store_true",
                    help="only the study's first quick_seeds seeds (a later full run into the same --out resumes)")
+    p.add_argument("--retry-errors", action="store_true",
+                   help="run again the cells whose row is an error (by default a resume runs only cells without a row)")
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
     p.add_argument("--junit", metavar="FILE", help="write the study's rows as JUnit XML (one test suite per scenario, "
                    "a failure per row that is not a success)")
@@ -56,8 +58,16 @@ def run_study(args: argparse.Namespace) -> int:
         study = study.quick()
     from swarmnav.sim.study.execute import run_study as execute
     out = args.out or str(FilePath("studies") / study.name)
-    summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,
-                      show_progress=not args.json and sys.stderr.isatty())
+    try:
+        summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,
+                          show_progress=not args.json and sys.stderr.isatty(), retry_errors=args.retry_errors)
+    except (KeyboardInterrupt, SystemExit) as exc:  # Ctrl-C, or SIGTERM (the CLI's handler raises SystemExit)
+        how = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else "SIGTERM" if exc.code == 143 else f"exit {exc.code}"
+        print(f"swarmnav: study stopped ({how}); the rows of the finished cells are kept in {out}: run the same "
+              "command to resume", file=sys.stderr)
+        if isinstance(exc, KeyboardInterrupt):
+            return 130
+        raise
     if args.json:
         print(json.dumps(summary))
     else:
@@ -113,6 +123,8 @@ def run_studies(args: argparse.Namespace) -> int:
 def add_report_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("dir", help="a study's output directory (holding runs.parquet)")
     p.add_argument("--out", help="HTML report path (default: DIR/report.html); the Markdown twin goes beside it")
+    p.add_argument("--ompl-log", metavar="OUT", help="also write the rows as OMPL benchmark logs, OUT/<scenario>.log "
+                   "(one experiment each), for `ompl_benchmark_statistics OUT/*.log -d bench.db` and Planner Arena")
 
 
 def run_report(args: argparse.Namespace) -> int:
@@ -124,4 +136,8 @@ def run_report(args: argparse.Namespace) -> int:
     html_path = FilePath(args.out) if args.out else directory / "report.html"
     markdown_path = write_report(directory, html_path)
     print(f"report: {html_path}  markdown: {markdown_path}")
+    if args.ompl_log:
+        from swarmnav.sim.study.ompl_log import write_ompl_logs
+        logs = write_ompl_logs(directory, args.ompl_log)
+        print(f"OMPL logs: {len(logs)} in {args.ompl_log}  (ompl_benchmark_statistics {args.ompl_log}/*.log -d bench.db)")
     return 0

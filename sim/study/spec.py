@@ -54,7 +54,7 @@ STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bu
 MODES = ("plan", "physics")
 TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
             "time_limit_s", "reference", "planners", "navigators", "paper", "clearance_m",
-            "paired_seeds"}
+            "paired_seeds", "claims"}
 
 
 @dataclass(frozen=True)
@@ -100,6 +100,7 @@ class Study:
     quick_seeds: int | None = None  # the first N seeds make the quick run (None: the quick run is the full one)
     clearance_m: float | None = None  # planning clearance override for every scenario (None: each scenario's)
     paired_seeds: bool = False  # the k-th seed runs with the k-th world seed only
+    claims: tuple[dict[str, Any], ...] = ()  # [[claims]] tables as written (their verdicts: swarmnav report)
 
     def seed_pairs(self) -> list[tuple[int | None, int]]:
         """(world seed, seed) of every run of one setting, in the grid's order."""
@@ -344,5 +345,9 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
     if paired and len(world_seeds) != len(seeds):
         _fail(source, "paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                       f"{len(world_seeds) if 'world_seeds' in data else 'no'} world seeds")
+    claims = data.get("claims", [])
+    if not isinstance(claims, list) or not all(isinstance(c, dict) for c in claims):
+        _fail(source, "claims", "expected an array of [[claims]] tables")
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
-                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired)
+                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired,
+                 tuple(claims))
