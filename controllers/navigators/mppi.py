@@ -76,6 +76,9 @@ class MppiNavigator:
     """
 
     name: ClassVar[str] = "mppi"
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
 
     samples: int = 1000
     horizon_steps: int = 30

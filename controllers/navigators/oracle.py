@@ -49,6 +49,8 @@ class ClairvoyantOracleNavigator:
 
     name: ClassVar[str] = "oracle"
     uses_detections: ClassVar[bool] = False  # it knows the future instead
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: ClassVar[float] = 0.0     # its search runs in reset(), not in step()
     clairvoyant: ClassVar[bool] = True       # benchmarks report it as the yardstick, never as a contender
 
     cell_m: float = 0.1
