@@ -14,6 +14,13 @@ where the obstacles are put in the way.  Kinds:
   (they stop at the arena's edge).
 * ``crowd``: random walks (Hasan et al. 2023's dynamic obstacles) scattered over
   the arena, clear of the start and the goal; they depend on the run's world seed.
+* ``fast_crossing``: ``crossing`` with obstacles faster than the robot (``speed_ratio`` above 1).
+* ``dense_crowd``: ``crowd`` packed closer (0.1 m apart instead of 0.3, 0.8 m clear of the ends).
+* ``door_patrol``: a wall of static discs across the arena, half-way, with one door (1.2 m clear) near the
+  line; the cylinders patrol back and forth through the door (waypoint loops, staggered starts).
+* ``corridor``: a corridor 1.6 m wide of static discs along the line; the cylinders drive at the robot in
+  two lanes (head-on traffic).
+* ``mixed``: about a third crossing, the rest random walkers.
 
 Speeds are ``speed_ratio`` times the robot's top speed, radii are drawn in
 ``[radius_min_m, radius_max_m]``.  A request that cannot be met (more
@@ -29,7 +36,8 @@ import numpy as np
 
 from swarmnav.models.errors import ConfigError
 
-KINDS = ("crossing", "head_on", "overtake", "crowd")
+KINDS = ("crossing", "head_on", "overtake", "crowd", "fast_crossing", "dense_crowd", "door_patrol", "corridor",
+         "mixed")
 ENDPOINT_INSET_M = 1.0
 SOURCE = "scenarios generate"
 
@@ -64,6 +72,8 @@ class GeneratorOptions:
                 bad(key, f"must be positive, got {getattr(self, key)!r}")
         if self.radius_max_m < self.radius_min_m:
             bad("radius_max_m", f"must be at least --radius-min-m ({self.radius_min_m:g}), got {self.radius_max_m:g}")
+        if kind == "fast_crossing" and self.speed_ratio <= 1.0:
+            bad("speed_ratio", f"fast crossers need a ratio above 1, got {self.speed_ratio:g}")
         if kind == "overtake" and self.speed_ratio >= 1.0:
             bad("speed_ratio", f"overtaking needs slower obstacles (a ratio below 1), got {self.speed_ratio:g}")
         if self.sensor_model not in ("rangefinder", "detector"):
@@ -106,8 +116,9 @@ def generate(kind: str, seed: int, options: GeneratorOptions | None = None) -> s
     goal = (w - ENDPOINT_INSET_M, y_line)
     radii = rng.uniform(options.radius_min_m, options.radius_max_m, options.obstacles)
     speed = options.speed_ratio * options.robot_speed_m_s
-    obstacles = {"crossing": _crossing, "head_on": _head_on, "overtake": _overtake, "crowd": _crowd}[kind](
-        rng, options, radii, speed, start, goal)
+    obstacles = {"crossing": _crossing, "head_on": _head_on, "overtake": _overtake, "crowd": _crowd,
+                 "fast_crossing": _crossing, "dense_crowd": _dense_crowd, "door_patrol": _door_patrol,
+                 "corridor": _corridor, "mixed": _mixed}[kind](rng, options, radii, speed, start, goal)
     straight_s = (goal[0] - start[0]) / options.robot_speed_m_s
     time_limit = options.time_limit_s or round(3.0 * straight_s + 20.0)
     name = options.name or f"dyn-{kind.replace('_', '-')}-{seed}"
@@ -126,7 +137,9 @@ def generate(kind: str, seed: int, options: GeneratorOptions | None = None) -> s
         "sim = { cell_m = 0.1 }",
     ]
     for x, y, r, motion in obstacles:
-        lines += ["", "[[obstacles]]", f"x = {x:.4f}", f"y = {y:.4f}", f"radius_m = {r:.4f}", f"motion = {motion}"]
+        lines += ["", "[[obstacles]]", f"x = {x:.4f}", f"y = {y:.4f}", f"radius_m = {r:.4f}"]
+        if motion is not None:  # None: a static disc (the walls of doors and corridors)
+            lines.append(f"motion = {motion}")
     return "\n".join(lines) + "\n"
 
 
@@ -181,14 +194,15 @@ def _overtake(rng, options, radii, speed, start, goal):
             for x, r in zip(xs, radii)]
 
 
-def _crowd(rng, options, radii, speed, start, goal):
+def _crowd(rng, options, radii, speed, start, goal, gap_m: float = 0.3, ends_m: float = 1.0, placed=None):
     w = options.arena_m
-    placed: list[tuple[float, float, float]] = []
+    placed = list(placed or [])
+    first = len(placed)
     for r in radii:
         for _ in range(200):
             x, y = rng.uniform(r, w - r, 2)
-            clear_of_ends = all(math.hypot(x - px, y - py) > 1.0 + r for px, py in (start, goal))
-            if clear_of_ends and all(math.hypot(x - px, y - py) > r + pr + 0.3 for px, py, pr in placed):
+            clear_of_ends = all(math.hypot(x - px, y - py) > ends_m + r for px, py in (start, goal))
+            if clear_of_ends and all(math.hypot(x - px, y - py) > r + pr + gap_m for px, py, pr in placed):
                 placed.append((float(x), float(y), float(r)))
                 break
         else:
@@ -197,4 +211,63 @@ def _crowd(rng, options, radii, speed, start, goal):
     step_m = 0.5
     period_s = step_m / speed
     motion = f'{{ kind = "random_walk", step_m = {step_m:g}, period_s = {period_s:.4f} }}'
-    return [(x, y, r, motion) for x, y, r in placed]
+    return [(x, y, r, motion) for x, y, r in placed[first:]]
+
+
+def _dense_crowd(rng, options, radii, speed, start, goal):
+    return _crowd(rng, options, radii, speed, start, goal, gap_m=0.1, ends_m=0.8)
+
+
+WALL_RADIUS_M = 0.12   # the static discs of walls, WALL_SPACING_M apart (they overlap: a wall with no gap)
+WALL_SPACING_M = 0.2
+
+
+def _wall(a: tuple[float, float], b: tuple[float, float]) -> list:
+    """Static discs from a to b (centres), WALL_SPACING_M apart."""
+    length = math.hypot(b[0] - a[0], b[1] - a[1])
+    count = max(int(math.ceil(length / WALL_SPACING_M)), 1) + 1
+    return [(a[0] + (b[0] - a[0]) * k / (count - 1), a[1] + (b[1] - a[1]) * k / (count - 1), WALL_RADIUS_M, None)
+            for k in range(count)]
+
+
+def _waypoints(points: list[tuple[float, float]], speed: float, start_s: float) -> str:
+    pts = ", ".join(f"[{x:.4f}, {y:.4f}]" for x, y in points)
+    return f'{{ kind = "waypoints", points = [{pts}], speed_m_s = {speed:.4f}, start_s = {start_s:.3f} }}'
+
+
+def _door_patrol(rng, options, radii, speed, start, goal):
+    w = options.arena_m
+    x_wall = w / 2.0
+    door_y = start[1] + rng.uniform(-1.0, 1.0)
+    half = 0.6 + WALL_RADIUS_M  # 1.2 m clear between the wall discs' surfaces
+    out = _wall((x_wall, 0.0), (x_wall, door_y - half)) + _wall((x_wall, door_y + half), (x_wall, w))
+    for r in radii:
+        if r > 0.6:
+            raise ConfigError("--radius-max-m", f"a patroller must fit the 1.2 m door (radius at most 0.6), "
+                                                f"got {r:.3g}", SOURCE)
+        reach = rng.uniform(1.0, x_wall - start[0] - 0.8)
+        y = door_y + rng.uniform(-1.0, 1.0) * max(0.6 - r - 0.05, 0.0)
+        v = speed * rng.uniform(0.8, 1.0)
+        period = 4.0 * reach / v
+        out.append((x_wall - reach, y, r, _waypoints([(x_wall - reach, y), (x_wall + reach, y)], v,
+                                                     rng.uniform(0.0, 0.5 * period))))
+    return out
+
+
+def _corridor(rng, options, radii, speed, start, goal):
+    half = 0.8 + WALL_RADIUS_M  # 1.6 m clear between the walls' surfaces
+    x0, x1 = start[0] + 0.6, goal[0] - 0.6
+    out = _wall((x0, start[1] - half), (x1, start[1] - half)) + _wall((x0, start[1] + half), (x1, start[1] + half))
+    mid = 0.5 * (start[0] + goal[0])
+    xs = _spread(rng, options, radii, mid - 1.0, goal[0] - 0.6, "places in the corridor, short of the goal")
+    for k, (x, r) in enumerate(zip(xs, radii)):
+        lane = (1.0 if k % 2 == 0 else -1.0) * min(0.4, 0.8 - r - 0.02)
+        out.append((x, start[1] + lane, r, _linear(speed * rng.uniform(0.8, 1.0), 180.0, "stop")))
+    return out
+
+
+def _mixed(rng, options, radii, speed, start, goal):
+    crossers = max(1, len(radii) // 3)
+    out = _crossing(rng, options, radii[:crossers], speed, start, goal)
+    placed = [(x, y, r) for x, y, r, _ in out]
+    return out + _crowd(rng, options, radii[crossers:], speed, start, goal, placed=placed)

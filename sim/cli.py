@@ -99,6 +99,8 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
     from swarmnav.models.scenario import list_scenarios, load_scenario
     if getattr(args, "scenarios_command", None) == "generate":
         return cmd_generate(args)
+    if getattr(args, "scenarios_command", None) == "info":
+        return cmd_scenario_info(args)
     rows = []
     for name in list_scenarios():
         s = load_scenario(name)
@@ -110,6 +112,24 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
     else:
         for r in rows:
             print(f"{r['name']:<24} {r['obstacles']:>3} obstacles ({r['moving']} moving)  {r['description']}")
+    return EXIT_OK
+
+
+def cmd_scenario_info(args: argparse.Namespace) -> int:
+    """``scenarios info SCENARIO``: its difficulty metrics and the clairvoyant oracle's verdict (sim/difficulty.py)."""
+    from swarmnav.models.scenario import load_scenario
+    from swarmnav.sim.difficulty import difficulty
+    scenario = load_scenario(args.scenario)
+    if args.world_seed is not None:
+        scenario = scenario.with_world_seed(args.world_seed)
+    info = difficulty(scenario)
+    if args.json:
+        print(json.dumps(info))
+        return EXIT_OK
+    for key, value in info.items():
+        if key == "oracle":
+            value = ", ".join(f"{k} {v}" for k, v in value.items())
+        print(f"{key:<24} {value}")
     return EXIT_OK
 
 
@@ -259,9 +279,13 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("scenarios", help="list the bundled scenarios, or generate one")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_scenarios)
-    gen = p.add_subparsers(dest="scenarios_command", metavar="generate").add_parser(
-        "generate", help="write a dynamic scenario (crossing, head_on, overtake, crowd) from a seed")
+    scenario_commands = p.add_subparsers(dest="scenarios_command", metavar="generate|info")
+    gen = scenario_commands.add_parser("generate", help="write a dynamic scenario (crossing, head_on, ...) from a seed")
     _add_generate_options(gen)
+    info = scenario_commands.add_parser("info", help="difficulty metrics and the clairvoyant oracle's verdict")
+    info.add_argument("scenario", metavar="SCENARIO", help="a bundled name or a .toml path")
+    info.add_argument("--world-seed", type=int, help="seed of the random obstacle motions (default: the scenario's)")
+    info.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("plan", help="plan a path for a scenario")
     _add_run_options(p)

@@ -155,16 +155,22 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
                         "default: a temporary folder")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
-    parser.add_argument("--suite", choices=("dyn", "papers"), default="dyn",
+    parser.add_argument("--suite", choices=("dyn", "papers", "dyn300"), default="dyn",
                         help="dyn: the dyn-* suite (default); papers: the papers' strategies beside replan + iaco "
-                             "and dstar_replan, one row per run (sim/benchmarks/paper_navigation.py)")
+                             "and dstar_replan, one row per run (sim/benchmarks/paper_navigation.py); dyn300: the "
+                             "300 generated scenes of models/suites/dyn300.toml, by difficulty")
     parser.add_argument("--quick", action="store_true",
-                        help=f"1 world seed on {', '.join(BENCH_NAVIGATION_QUICK_SCENARIOS)} (under a minute)")
+                        help=f"1 world seed on {', '.join(BENCH_NAVIGATION_QUICK_SCENARIOS)} (under a minute); "
+                             "with --suite dyn300: a stratified sample, 2 scenes per group")
+    parser.add_argument("--sensor-model", choices=("detector", "rangefinder"),
+                        help="--suite dyn300 only: every scene with this sensing (rangefinder: 12 at 1 m)")
+    parser.add_argument("--workers", type=options.positive_int, default=1,
+                        help="local worker processes for the runs (default 1: in this process)")
 
 
 def run_bench_navigation(args: argparse.Namespace) -> int:
     from swarmnav.sim.benchmarks import navigation
-    if args.quick:
+    if args.quick and args.suite != "dyn300":
         args.seeds, args.scenario = 1, args.scenario or list(BENCH_NAVIGATION_QUICK_SCENARIOS)
     return navigation.run(args)
 

@@ -101,7 +101,7 @@ def test_bench_navigation_runs_the_policy_named_by_navigator_set(policy_module):
                    "--navigator", "follow", "--navigator-set", f"policy={policy_module}", "--json")
     assert out.returncode == 0, out.stderr
     rows = {row["navigator"]: row for row in json.loads(out.stdout)}
-    assert sorted(rows) == ["follow", "policy"] and rows["policy"]["runs"] == 1
+    assert sorted(rows) == ["follow", "oracle", "policy"] and rows["policy"]["runs"] == 1  # the oracle: the yardstick
     direct = run_episode(EpisodeSpec(load_scenario("dyn-crossing-3").with_world_seed(0), navigator="policy",
                                      navigator_params={"policy": policy_module}, seed=0, world_seed=0)).result
     assert rows["policy"]["success_rate"] == float(direct.success)

@@ -14,6 +14,8 @@ from swarmnav.controllers.navigators.immas_stepwise import ImmasStepwiseNavigato
 from swarmnav.controllers.navigators.policy import PolicyNavigator
 from swarmnav.controllers.navigators.dstar_replan import DStarReplanNavigator
 from swarmnav.controllers.navigators.dwa import DynamicWindowNavigator
+from swarmnav.controllers.navigators.mppi import MppiNavigator
+from swarmnav.controllers.navigators.oracle import ClairvoyantOracleNavigator
 from swarmnav.controllers.navigators.replan import ReplanNavigator
 from swarmnav.controllers.navigators.velocity_obstacle import VelocityObstacleNavigator
 from swarmnav.models.parameters import build_component, register_component
@@ -30,6 +32,8 @@ def register(cls: type) -> type:
 for _cls in (FollowNavigator, ReplanNavigator, DStarReplanNavigator, DynamicWindowNavigator, VelocityObstacleNavigator,
              IacoLocalNavigator, ImmasStepwiseNavigator, PolicyNavigator):
     register(_cls)
+register(MppiNavigator)  # Williams et al. (2017) as Nav2 adapts it (controllers/navigators/mppi.py)
+register(ClairvoyantOracleNavigator)  # the clairvoyant yardstick (controllers/navigators/oracle.py)
 
 
 def make_navigator(name: str, params: dict[str, Any] | None = None, source: str | None = None,

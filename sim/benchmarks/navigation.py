@@ -13,6 +13,21 @@ navigator).  Scenarios whose obstacles all move on fixed lines give the same run
 for every world seed; they are still counted once per seed.  ``--by-scenario``
 adds one row per navigator and scenario (the same columns plus ``scenario``), to
 see where the failures are.
+
+**Against the clairvoyant oracle** (:mod:`controllers.navigators.oracle`): every scenario and world seed is
+also run by ``oracle``, whose verdict (solvable at its lattice's resolution or not, T*) each contender's run
+is read against, so that an unsolvable scene never counts against a navigator: ``oracle_solvable_runs``,
+``solved_share`` (successes among the oracle-solvable runs), ``time_score`` (BARN's, Perille et al. 2020:
+0 on failure, else T* / T clipped to 1, averaged over the oracle-solvable runs) and ``mean_spl_solvable``.
+The ``oracle`` row itself is the yardstick's validation: ``success_on_solvable`` is its physics success on
+the runs it called solvable (target: at least 0.95), ``solvable_share`` the share it called solvable.
+
+``--suite dyn300``: the 300 generated scenes of ``models/suites/dyn300.toml`` (each with its own world
+seed, ``--seeds`` ignored), in order of difficulty; ``--quick`` a stratified sample (2 per group);
+``--sensor-model detector|rangefinder`` (12 rangefinders at 1 m) overrides their sensing; with
+``--by-scenario`` each scenario's rows carry its shipped ``difficulty`` metrics (to set success against them).  Where the
+shipped verdicts (``dyn300-verdicts.json``) disagree with this run's oracle, ``verdict_mismatches`` says how
+often (the oracle row).
 """
 
 from __future__ import annotations
@@ -27,6 +42,10 @@ from swarmnav.controllers.navigators import NAVIGATORS
 from swarmnav.models.scenario import list_scenarios, load_scenario
 
 SUITE_PREFIX = "dyn-"
+ORACLE = "oracle"  # the clairvoyant yardstick, run beside every contender
+# A generated suite's per-scenario rows carry these shipped difficulty metrics (sim/difficulty.py).
+DIFFICULTY_KEYS = ("difficulty_rank", "static_density", "dispersion", "survivability", "dynamic_traversability",
+                   "t_star_ratio")
 
 
 def default_navigators(settings: dict[str, dict[str, Any]] | None = None) -> list[str]:
@@ -65,40 +84,84 @@ def suite_names() -> list[str]:
     return [name for name in list_scenarios() if name.startswith(SUITE_PREFIX)]
 
 
-def navigation_study(seeds: int, navigators: list[str], scenarios: list[str],
+def navigation_study(seeds: int | None, navigators: list[str], scenarios: list[str],
                      navigator_params: dict[str, dict[str, Any]]) -> dict[str, Any]:
     """The benchmark as a physics study: each scenario with its own planner, every navigator, run ``k`` with
-    world seed ``k`` and planner seed ``k`` (paired)."""
+    world seed ``k`` and planner seed ``k`` (paired); ``seeds`` None: one run, the scenario's world seed."""
     planners = list(dict.fromkeys(load_scenario(name).planner_name for name in scenarios))
-    return {"name": "bench-navigation", "scenarios": scenarios, "mode": "physics", "seeds": seeds,
-            "world_seeds": list(range(seeds)), "paired_seeds": True,
+    runs = ({"seeds": seeds, "world_seeds": list(range(seeds)), "paired_seeds": True} if seeds is not None
+            else {"seeds": [0]})
+    return {"name": "bench-navigation", "scenarios": scenarios, "mode": "physics", **runs,
             "planners": [{"name": p} for p in planners],
             "navigators": [{"name": n, "params": navigator_params.get(n, {})} for n in navigators]}
 
 
+def is_clairvoyant(name: str) -> bool:
+    return bool(getattr(NAVIGATORS[name], "clairvoyant", False))
+
+
+def oracle_verdicts(rows: list[dict[str, Any]]) -> dict[tuple[str, int], dict[str, Any]]:
+    """(scenario, world seed) -> the oracle's verdict (its ``oracle`` event), from the oracle's runs."""
+    out = {}
+    for r in rows:
+        if r["navigator"] == ORACLE and r.get("run_events"):
+            verdict = json.loads(r["run_events"])["last"].get("oracle")
+            if verdict is not None:
+                out[(r["scenario"], r["world_seed"])] = verdict
+    return out
+
+
+def write_suite(suite_name: str, quick: bool, sensor_model: str | None, folder: str) -> tuple[list[str], Any]:
+    """The suite's scenes as TOML files under ``folder`` (paths, in order of difficulty) and the suite."""
+    import os
+    from swarmnav.models.suites import load_suite, stratified_sample
+    suite = load_suite(suite_name, sensor_model)
+    scenes = stratified_sample(suite) if quick else suite.scenes
+    os.makedirs(os.path.join(folder, "scenarios"), exist_ok=True)
+    paths = []
+    for scene in scenes:
+        path = os.path.join(folder, "scenarios", f"{scene.name}.toml")
+        with open(path, "w", encoding="utf-8") as out:
+            out.write(scene.text())
+        paths.append(path)
+    return paths, suite
+
+
 def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, scenarios: list[str] | None = None,
                          progress: bool = False, navigator_params: dict[str, dict[str, Any]] | None = None,
-                         by_scenario: bool = False, out_dir: str | None = None) -> list[dict[str, Any]]:
-    """One row per navigator (see the module docstring); ``navigator_params``: per navigator name.  With
-    ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key; the
-    overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given."""
+                         by_scenario: bool = False, out_dir: str | None = None, suite: str | None = None,
+                         quick: bool = False, sensor_model: str | None = None,
+                         workers: int = 1) -> list[dict[str, Any]]:
+    """One row per navigator and the oracle's (see the module docstring); ``navigator_params``: per navigator
+    name.  With ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key;
+    the overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given;
+    ``suite`` (e.g. ``dyn300``) runs a generated suite instead of ``scenarios``."""
+    if out_dir is None:
+        with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
+            return benchmark_navigation(seeds, navigators, scenarios, progress, navigator_params, by_scenario,
+                                        folder, suite, quick, sensor_model, workers)
     from swarmnav.sim.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
-    navigators = navigators or default_navigators(navigator_params)
-    names = scenarios or suite_names()
-    tables = navigation_study(seeds, navigators, names, navigator_params)
-    if out_dir is None:
-        with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
-            rows = run_study_tables(tables, folder, show_progress=progress)
+    contenders = [n for n in (navigators or default_navigators(navigator_params)) if not is_clairvoyant(n)]
+    shipped: dict[str, dict[str, Any]] = {}
+    if suite is not None:
+        names, loaded = write_suite(suite, quick, sensor_model, out_dir)
+        shipped = loaded.verdicts
+        run_seeds = None
     else:
-        rows = run_study_tables(tables, out_dir, show_progress=progress)
-    runs = {n: [r for r in rows if r["navigator"] == n] for n in navigators}
-    table = [{"scenario": None, **_row(nav, arm)} for nav, arm in runs.items()]
+        names, run_seeds = scenarios or suite_names(), seeds
+    tables = navigation_study(run_seeds, contenders + [ORACLE], names, navigator_params)
+    rows = run_study_tables(tables, out_dir, show_progress=progress, workers=workers)
+    verdicts = oracle_verdicts(rows)
+    runs = {n: [r for r in rows if r["navigator"] == n] for n in contenders + [ORACLE]}
+    table = [{"scenario": None, **_row(nav, arm, verdicts, shipped)} for nav, arm in runs.items()]
     if by_scenario:
-        for name in names:
+        for name in dict.fromkeys(r["scenario"] for r in rows):
+            extra = {"difficulty": {k: shipped[name][k] for k in DIFFICULTY_KEYS}} if name in shipped else {}
             for nav, arm in runs.items():
-                table.append({"scenario": name, **_row(nav, [r for r in arm if r["scenario"] == name])})
+                table.append({"scenario": name, **_row(nav, [r for r in arm if r["scenario"] == name], verdicts,
+                                                       shipped), **extra})
     return table
 
 
@@ -106,9 +169,31 @@ def _mean(values: list[float]) -> float | None:
     return sum(values) / len(values) if values else None
 
 
-def _row(navigator: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
+def _row(navigator: str, rows: list[dict[str, Any]], verdicts: dict[tuple[str, int], dict[str, Any]],
+         shipped: dict[str, dict[str, Any]]) -> dict[str, Any]:
     """Rates over every run (a run that raised, or found no path, counts as a failure in each rate's
-    denominator); means over the runs that drove."""
+    denominator); means over the runs that drove; the oracle's columns over the runs it called solvable."""
+    out = _plain_row(navigator, rows)
+    solvable = [r for r in rows if verdicts.get((r["scenario"], r["world_seed"]), {}).get("solvable")]
+    out["oracle_solvable_runs"] = len(solvable)
+    out["solved_share"] = (sum(bool(r["success"]) for r in solvable) / len(solvable)) if solvable else None
+    scores = []
+    for r in solvable:
+        t_star = verdicts[(r["scenario"], r["world_seed"])]["arrival_s"]
+        scores.append(min(1.0, t_star / r["time_to_goal_s"]) if r["success"] and r["time_to_goal_s"] else 0.0)
+    out["time_score"] = _mean(scores)
+    out["mean_spl_solvable"] = _mean([r["spl"] or 0.0 for r in solvable])
+    if navigator == ORACLE:
+        out["solvable_share"] = len(solvable) / len(rows) if rows else None
+        out["success_on_solvable"] = out.pop("solved_share")
+        out["verdict_mismatches"] = sum(
+            1 for r in rows if r["scenario"] in shipped and (r["scenario"], r["world_seed"]) in verdicts
+            and bool(shipped[r["scenario"]]["oracle"]["solvable"])
+            != bool(verdicts[(r["scenario"], r["world_seed"])]["solvable"]))
+    return out
+
+
+def _plain_row(navigator: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
     n = len(rows)
     drove = [r for r in rows if r["outcome"] == "ok"]
     reached = [r["time_to_goal_s"] for r in rows if r["success"]]
@@ -143,9 +228,15 @@ def run(args: argparse.Namespace) -> int:
     from swarmnav.sim.cli import parse_settings  # loaded already: the CLI is what calls this
     settings = navigator_settings(parse_settings(args.navigator_set, "--navigator-set"),
                                   args.navigator or list(NAVIGATORS))
+    suite = None if args.suite == "dyn" else args.suite
+    if suite is None and getattr(args, "sensor_model", None):
+        raise ConfigError("--sensor-model", "applies to a generated suite (--suite dyn300) only")
     rows = benchmark_navigation(args.seeds, args.navigator, args.scenario,
                                 progress=not args.json and sys.stderr.isatty(), navigator_params=settings,
-                                by_scenario=args.by_scenario, out_dir=args.out)
+                                by_scenario=args.by_scenario, out_dir=args.out, suite=suite,
+                                quick=bool(getattr(args, "quick", False)) and suite is not None,
+                                sensor_model=getattr(args, "sensor_model", None),
+                                workers=getattr(args, "workers", 1) or 1)
     if args.json:
         print(json.dumps(rows))
         return 0
@@ -162,10 +253,23 @@ def _print_table(rows: list[dict[str, Any]], title: str) -> None:
     if title:
         print(title)
     header = (f"{'navigator':<18} {'runs':>4} {'success':>7} {'collide':>7} {'timeout':>7} {'t_goal_s':>8} "
-              f"{'SPL':>5} {'danger_s':>8} {'replans':>7} {'us/step':>8} {'x_realtime':>10}")
+              f"{'SPL':>5} {'danger_s':>8} {'replans':>7} {'us/step':>8} {'x_realtime':>10} {'solvable':>8} "
+              f"{'solved':>6} {'t_score':>7}")
     print(header)
+
+    def cell(value: Any, width: int, spec: str) -> str:
+        return f"{'-' if value is None else format(value, spec):>{width}}"
+
     for r in rows:
-        t_goal = f"{r['mean_time_to_goal_s']:.1f}" if r["mean_time_to_goal_s"] is not None else "-"
+        solved = r["success_on_solvable"] if r["navigator"] == ORACLE else r["solved_share"]
         print(f"{r['navigator']:<18} {r['runs']:>4} {r['success_rate']:>7.2f} {r['collision_rate']:>7.2f} "
-              f"{r['timeout_rate']:>7.2f} {t_goal:>8} {r['mean_spl']:>5.2f} {r['mean_time_in_danger_s']:>8.2f} "
-              f"{r['mean_replans']:>7.1f} {r['navigator_us_per_step']:>8.0f} {r['realtime_factor']:>10.1f}")
+              f"{r['timeout_rate']:>7.2f} {cell(r['mean_time_to_goal_s'], 8, '.1f')} {cell(r['mean_spl'], 5, '.2f')} "
+              f"{cell(r['mean_time_in_danger_s'], 8, '.2f')} {cell(r['mean_replans'], 7, '.1f')} "
+              f"{r['navigator_us_per_step']:>8.0f} {r['realtime_factor']:>10.1f} {r['oracle_solvable_runs']:>8} "
+              f"{cell(solved, 6, '.2f')} {cell(r['time_score'], 7, '.2f')}")
+    oracle = [r for r in rows if r["navigator"] == ORACLE]
+    for r in oracle:
+        print(f"oracle (clairvoyant): called {r['oracle_solvable_runs']} of {r['runs']} runs solvable; succeeded in "
+              f"physics on {cell(r['success_on_solvable'], 4, '.2f').strip()} of them (target >= 0.95)"
+              + (f"; {r['verdict_mismatches']} verdicts differ from the shipped ones" if r["verdict_mismatches"]
+                 else ""))

@@ -1,0 +1,68 @@
+"""Generated suites (models/suites), the new generator kinds and bench navigation against the oracle."""
+
+import pytest
+
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import parse_scenario
+from swarmnav.models.scenario_generator import GeneratorOptions, generate
+from swarmnav.models.suites import load_suite, stratified_sample
+from swarmnav.sim.benchmarks.navigation import ORACLE, benchmark_navigation
+
+
+def test_dyn300_has_300_distinct_scenes_each_with_a_shipped_verdict_in_order_of_difficulty():
+    suite = load_suite("dyn300")
+    names = [s.name for s in suite.scenes]
+    assert len(names) == 300 == len(set(names))
+    assert set(names) == set(suite.verdicts)
+    ranks = [suite.verdicts[n]["difficulty_rank"] for n in names]
+    assert ranks == sorted(ranks)
+    sample = stratified_sample(suite)
+    assert len(sample) == 2 * len({s.group for s in suite.scenes})
+
+
+def test_every_group_generates_scenarios_that_load_with_the_sensing_asked_for():
+    suite = load_suite("dyn300", sensor_model="rangefinder")
+    for scene in stratified_sample(suite, per_group=1):
+        scenario = parse_scenario(scene.text(), scene.name)
+        assert scenario.name == scene.name and scenario.world_seed == scene.seed
+        assert scenario.sensor_model == "rangefinder" and scenario.sensor_range_m == 1.0
+
+
+def test_a_bad_suite_file_names_the_field(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text('name = "bad"\n[[groups]]\nkind = "crossing"\nseeds = [3, 1]\n')
+    with pytest.raises(ConfigError, match=r"groups\[0\]\.seeds"):
+        load_suite(str(path))
+    path.write_text('name = "bad"\n[[groups]]\nkind = "crossing"\nseeds = [0, 1]\noptions = { speed = 1 }\n')
+    with pytest.raises(ConfigError, match=r"groups\[0\]\.options\.speed"):
+        load_suite(str(path))
+
+
+@pytest.mark.parametrize("kind", ["fast_crossing", "dense_crowd", "door_patrol", "corridor", "mixed"])
+def test_new_kinds_are_pure_functions_of_their_options_and_load(kind):
+    options = GeneratorOptions(speed_ratio=1.5 if kind == "fast_crossing" else 0.6,
+                               obstacles=10 if kind == "dense_crowd" else 3)
+    text = generate(kind, 4, options)
+    assert text == generate(kind, 4, options)
+    scenario = parse_scenario(text)
+    walls = [ob for ob in scenario.obstacles if not ob.moving]
+    assert (len(walls) > 0) == (kind in ("door_patrol", "corridor"))
+
+
+def test_fast_crossers_must_outrun_the_robot():
+    with pytest.raises(ConfigError, match="--speed-ratio"):
+        generate("fast_crossing", 0, GeneratorOptions(speed_ratio=0.9))
+
+
+def test_bench_rows_read_each_run_against_the_oracle_verdict(tmp_path):
+    path = tmp_path / "short.toml"
+    path.write_text(generate("crossing", 5, GeneratorOptions(obstacles=2, arena_m=5.0, sensor_model="detector")))
+    rows = benchmark_navigation(1, ["follow", "velocity_obstacle"], [str(path)], out_dir=str(tmp_path / "out"))
+    by_name = {r["navigator"]: r for r in rows}
+    assert set(by_name) == {"follow", "velocity_obstacle", ORACLE}
+    oracle = by_name[ORACLE]
+    assert oracle["oracle_solvable_runs"] == 1 and oracle["success_on_solvable"] == 1.0
+    for name in ("follow", "velocity_obstacle"):
+        row = by_name[name]
+        assert row["solved_share"] == row["success_rate"]      # the one run is oracle-solvable
+        assert (row["time_score"] > 0) == (row["success_rate"] > 0) and row["time_score"] <= 1.0
