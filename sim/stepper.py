@@ -371,7 +371,8 @@ class EpisodeStepper:
         step, monitor = self.step_index, self.monitor
         self.result = RunResult(
             reached=outcome == "goal_reached", outcome=outcome, collisions=monitor.collisions,
-            first_collision_s=monitor.first_collision_s, sim_time_s=step * self.dt_s,
+            first_collision_s=monitor.first_collision_s, first_contact=monitor.first_contact,
+            sim_time_s=step * self.dt_s,
             wall_time_s=time.perf_counter() - self._wall0,
             path_length_m=self.length_m, min_clearance_m=float(self.min_clearance_m), steps=step,
             times_s=self.times_s[:step + 1].copy(), poses=self.poses[:step + 1].copy(),
