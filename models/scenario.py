@@ -492,7 +492,7 @@ def _check_grid_size(width_m: float, height_m: float, cell_m: float, field_name:
     if cells > MAX_GRID_CELLS:
         smallest = math.sqrt(width_m * height_m / MAX_GRID_CELLS)
         raise ConfigError(field_name, f"a {width_m:g} x {height_m:g} m arena at {cell_m:g} m per cell needs "
-                          f"{cells:.4g} grid cells (at most {MAX_GRID_CELLS:,}; a cell of about "
+                          f"{min(cells, 1e300):.4g} grid cells (at most {MAX_GRID_CELLS:,}; a cell of about "
                           f"{smallest:.3g} m or more fits)", source)
 
 
