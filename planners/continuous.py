@@ -294,11 +294,13 @@ class ContinuousPlanner(SwarmPlanner):
             try:
                 path = self.run_search(problem, rng, state)
                 break
-            except BudgetExceeded:
+            except BudgetExceeded as exc:
+                exc.evaluations, exc.plan_time_s = spent + state.evaluations, time.perf_counter() - t0
                 raise
-            except NoPathFound:
+            except NoPathFound as exc:
                 spent += state.evaluations
                 if attempt == settings.growth or settings.via_points >= MAX_AUTO_VIA_POINTS * 2:
+                    exc.evaluations, exc.plan_time_s = spent, time.perf_counter() - t0
                     raise
                 settings = dataclasses.replace(settings, via_points=2 * settings.via_points)
         extra = dict(path.stats.extra, mode=settings.mode, via_point_count=settings.via_points, guess=settings.guess,

@@ -227,9 +227,12 @@ class SwarmPlanner:
         try:
             waypoints, extra = self.finish(state, problem, rng)
         except NoPathFound as exc:
+            # A failed run is data too: the error carries what the search spent (a study row records it).
             if state.exhausted:
-                raise BudgetExceeded(f"{exc} (the budget of {state.max_evaluations} evaluations is spent)") from exc
-            raise
+                exc = BudgetExceeded(f"{exc} (the budget of {state.max_evaluations} evaluations is spent)")
+            exc.evaluations, exc.iterations = state.evaluations, done
+            exc.plan_time_s = time.perf_counter() - t0
+            raise exc
         # The iteration (1-based) after which the best cost no longer improved.
         extra.setdefault("convergence_iteration", converged_at)
         if self.repair_limit(state):

@@ -16,7 +16,8 @@ randomness, ``world_seed`` every random obstacle motion.  The planner draws from
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+import dataclasses
+from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
 import numpy as np
@@ -30,6 +31,7 @@ from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.grid_search import ThetaStarPlanner
 from swarmnav.planners.problem import Path, Problem, scenario_problem
+from swarmnav.planners.swarm import Budget, apply_budget
 from swarmnav.sim.recording import Recorder, RecorderGroup
 from swarmnav.sim.runner import RunResult, Simulation
 from swarmnav.sim.scene import CompiledScene
@@ -70,6 +72,7 @@ class EpisodeSpec:
     seed: int | None = None
     world_seed: int | None = None
     clearance_m: float | None = None  # the planning clearance beyond the robot radius; None = the scenario's
+    budget: Budget | None = None  # a study's budget for the planner (planners.swarm.Budget); None = none
 
     def resolved(self) -> "EpisodeSpec":
         """Every field filled in; the scenario carries the world seed."""
@@ -87,7 +90,7 @@ class EpisodeSpec:
         if self.clearance_m is not None:
             scenario = scenario.with_clearance(self.clearance_m)
         return EpisodeSpec(scenario, planner, planner_params, navigator, navigator_params, seed, world_seed,
-                           scenario.clearance_m)
+                           scenario.clearance_m, self.budget)
 
 
 @dataclass(eq=False)
@@ -98,6 +101,8 @@ class Episode:
     problem: Problem
     path: Path
     result: RunResult | None = None
+    planner_params: dict[str, Any] = field(default_factory=dict)  # every parameter of the planner, resolved
+    budgeted: bool = False  # the planner ran under ``spec.budget``
 
     def plan_summary(self) -> dict[str, Any]:
         """The object ``swarmnav plan --json`` prints."""
@@ -107,6 +112,8 @@ class Episode:
                 "length_m": stats.length_m, "plan_time_s": stats.plan_time_s,
                 "iterations": stats.iterations, "evaluations": stats.evaluations,
                 "collision_free": bool(self.problem.is_collision_free(self.path.waypoints)),
+                "planner_params": self.planner_params,
+                "budget": spec.budget.as_dict() if spec.budget is not None else None, "budgeted": self.budgeted,
                 "details": json_safe(stats.extra)}
 
     def summary(self) -> dict[str, Any]:
@@ -129,11 +136,25 @@ def plan_episode(spec: EpisodeSpec) -> Episode:
     """
     spec = spec.resolved()
     source = spec.scenario.source_path
-    planner = make_planner(spec.planner, spec.planner_params, source)
+    planner, budgeted = build_planner(spec)
     make_navigator(spec.navigator, spec.navigator_params, source)  # a bad navigator fails before planning
     problem = scenario_problem(spec.scenario)
     path = planner.plan(problem, np.random.default_rng(spec.seed))
-    return Episode(spec, problem, path)
+    return Episode(spec, problem, path, planner_params=resolved_params(planner), budgeted=budgeted)
+
+
+def build_planner(spec: EpisodeSpec) -> tuple[Any, bool]:
+    """The run's one configured planner (a resolved spec's), under its budget, and whether it honours
+    the budget: the first plan and every replan of the navigator use it."""
+    planner = make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)
+    return apply_budget(planner, spec.budget)
+
+
+def resolved_params(planner: Any) -> dict[str, Any]:
+    """Every parameter of a planner as it runs (its dataclass fields, defaults included; JSON values)."""
+    if not dataclasses.is_dataclass(planner):
+        return {}
+    return json_safe({f.name: getattr(planner, f.name) for f in dataclasses.fields(planner) if f.init})
 
 
 def static_problem(scenario: Scenario) -> Problem:
@@ -179,7 +200,7 @@ def run_episode(spec: EpisodeSpec, recorders: Sequence[Recorder] = (), *, scene:
     spec = episode.spec
     simulation = simulation or Simulation(spec.scenario, scene)
     navigator = make_navigator(spec.navigator, spec.navigator_params, spec.scenario.source_path)
-    planner = make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)
+    planner, _ = build_planner(spec)
     scenario = spec.scenario
     setup = NavigationSetup(
         path=episode.path, problem=episode.problem, planner=planner,
@@ -189,7 +210,8 @@ def run_episode(spec: EpisodeSpec, recorders: Sequence[Recorder] = (), *, scene:
         max_speed_m_s=scenario.max_speed_m_s, known_problem=static_problem(scenario),
         scenario=scenario)
     recorder = RecorderGroup(list(recorders)) if recorders else None
-    context = simulation.context(spec.planner, spec.planner_params, spec.seed, spec.navigator,
+    # The log records every resolved parameter (replaying them builds the same planner).
+    context = simulation.context(spec.planner, episode.planner_params or spec.planner_params, spec.seed, spec.navigator,
                                  spec.navigator_params) if recorder is not None else None
     episode.result = simulation.run(navigator, setup, recorder=recorder, context=context,
                                     time_limit_s=time_limit_s, stop_on_collision=stop_on_collision,

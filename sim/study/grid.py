@@ -1,8 +1,8 @@
 """A study's grid: every (scenario, planner setting, navigator setting, seed, world seed) cell.
 
 A cell's configuration hash covers what decides its result: the scenario file's
-bytes, the planner and navigator with their labels and parameters, both seeds, the mode and
-the simulated-time limit.  Resuming skips the cells whose hash is already in the
+bytes, the planner and navigator with their labels and parameters, both seeds, the mode,
+the simulated-time limit, and the clearance and budget when the study sets them.  Resuming skips the cells whose hash is already in the
 rows; an edited scenario or parameter is a new cell.
 """
 
@@ -38,6 +38,7 @@ class Cell:
     wall_limit_s: float
     config_hash: str
     clearance_m: float | None = None  # the study's planning clearance override (None: the scenario's)
+    budget: dict[str, Any] | None = None  # the planner's budget, {"evaluations": N} or {"time_s": T} (None: none)
 
     @property
     def physics(self) -> bool:
@@ -79,6 +80,9 @@ def expand(study: Study) -> list[Cell]:
                       "world_seed": world_seed, "mode": study.mode, "time_limit_s": study.time_limit_s}
             if study.clearance_m is not None:  # absent otherwise: earlier hashes hold
                 config["clearance_m"] = study.clearance_m
+            budget = study.budget_of(planner)
+            if budget is not None:  # likewise
+                config["budget"] = budget.as_dict()
             cells.append(Cell(
                 study=study.name, scenario=scenario, scenario_name=FilePath(scenario).stem,
                 planner=planner.name, label=_sweep_label(planner, planner_params),
@@ -87,5 +91,5 @@ def expand(study: Study) -> list[Cell]:
                 navigator_params=navigator_params, seed=seed, world_seed=world_seed,
                 mode=study.mode, time_limit_s=study.time_limit_s,
                 wall_limit_s=study.wall_limit_s, config_hash=config_hash(config),
-                clearance_m=study.clearance_m))
+                clearance_m=study.clearance_m, budget=None if budget is None else budget.as_dict()))
     return cells

@@ -16,11 +16,14 @@ TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) o
                                      # scenario (default: each scenario's robot.clearance_m)
     reference = "gwo"                # the planner label (or one swept arm, "maco(p0=0.9)") the statistics
                                      # compare against (default: the first)
+    budget = { evaluations = 5000 }  # optional: every planner of the study runs until it has spent this
+                                     # budget (or { time_s = 2.0 }); see planners.swarm.Budget
 
     [[planners]]
     name = "gwo"                     # a name in the planner registry
     label = "GWO"                    # optional; default: the name
     params = { population = 50, iterations = [50, 100] }   # a list sweeps that parameter
+    budget = { evaluations = 10000 } # optional: this entry's own budget (default: the study's)
 
     [[navigators]]                   # optional; default: one navigator, follow
     name = "follow"
@@ -31,6 +34,9 @@ TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) o
     metric = "plan_length_m"
     value = 14.14
     note = "Table 2"
+
+    [[claims]]                       # optional: a claim of the paper the study tests (schema: the
+    id = "gwo-shorter"               # report's claims section); kept as given here
 
 Every problem is a :class:`ConfigError` naming the field (``planners[1].params.alpha``).
 """
@@ -49,12 +55,13 @@ from swarmnav.controllers.navigators import make_navigator
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, load_scenario, resolve_scenario_path
 from swarmnav.planners.registry import make_planner
+from swarmnav.planners.swarm import Budget
 
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
 TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
             "time_limit_s", "reference", "planners", "navigators", "paper", "clearance_m",
-            "paired_seeds"}
+            "paired_seeds", "budget", "claims"}
 
 
 @dataclass(frozen=True)
@@ -65,6 +72,7 @@ class Component:
     label: str
     params: dict[str, Any]  # a list value is a sweep
     swept: tuple[str, ...]  # the keys that sweep
+    budget: Budget | None = None  # this entry's budget (None: the study's)
 
     def settings(self) -> list[dict[str, Any]]:
         """Every parameter table of the sweep (the Cartesian product of the lists), in file order."""
@@ -100,6 +108,12 @@ class Study:
     quick_seeds: int | None = None  # the first N seeds make the quick run (None: the quick run is the full one)
     clearance_m: float | None = None  # planning clearance override for every scenario (None: each scenario's)
     paired_seeds: bool = False  # the k-th seed runs with the k-th world seed only
+    budget: Budget | None = None  # every planner's budget, unless its entry names its own
+    claims: tuple[dict[str, Any], ...] = ()  # the [[claims]] tables as given (the report checks them)
+
+    def budget_of(self, planner: Component) -> Budget | None:
+        """The budget a planner entry runs under: its own, else the study's."""
+        return planner.budget or self.budget
 
     def seed_pairs(self) -> list[tuple[int | None, int]]:
         """(world seed, seed) of every run of one setting, in the grid's order."""
@@ -224,7 +238,8 @@ def _components(source: str, value: Any, key: str, kind: str, make) -> tuple[Com
         where = f"{key}[{i}]"
         if not isinstance(entry, dict):
             _fail(source, where, "expected a table")
-        for k in sorted(set(entry) - {"name", "label", "params"}):
+        allowed = {"name", "label", "params"} | ({"budget"} if kind == "planner" else set())
+        for k in sorted(set(entry) - allowed):
             _fail(source, f"{where}.{k}", "unknown key")
         name = _string(source, entry, "name", f"{where}.name")
         label = _string(source, entry, "label", f"{where}.label", name)
@@ -235,7 +250,8 @@ def _components(source: str, value: Any, key: str, kind: str, make) -> tuple[Com
         for k in swept:
             if not params[k]:
                 _fail(source, f"{where}.params.{k}", "empty grid: the sweep lists no value")
-        component = Component(name, label, dict(params), swept)
+        budget = _budget(source, entry["budget"], f"{where}.budget") if "budget" in entry else None
+        component = Component(name, label, dict(params), swept, budget)
         for setting in component.settings():  # every combination builds: names and every swept value checked
             try:
                 make(name, setting, source)
@@ -250,6 +266,37 @@ def _components(source: str, value: Any, key: str, kind: str, make) -> tuple[Com
         if label in labels[:i]:
             _fail(source, f"{key}[{i}].label", f"label {label!r} is used twice (give each entry its own label)")
     return tuple(out)
+
+
+def _budget(source: str, value: Any, field: str) -> Budget:
+    """``{ evaluations = N }`` (a positive integer) or ``{ time_s = T }`` (positive seconds)."""
+    if not isinstance(value, dict):
+        _fail(source, field, f"expected a table {{ evaluations = N }} or {{ time_s = T }}, got {value!r}")
+    for k in sorted(set(value) - {"evaluations", "time_s"}):
+        _fail(source, f"{field}.{k}", "unknown key (expected evaluations or time_s)")
+    if len(value) != 1:
+        _fail(source, field, "expected exactly one of evaluations or time_s")
+    if "evaluations" in value:
+        count = value["evaluations"]
+        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+            _fail(source, f"{field}.evaluations", f"expected a positive integer, got {count!r}")
+        return Budget(evaluations=count)
+    time_s = _number(source, value["time_s"], f"{field}.time_s")
+    if not 0 < time_s < float("inf"):
+        _fail(source, f"{field}.time_s", f"must be positive and finite, got {time_s:g}")
+    return Budget(time_s=time_s)
+
+
+def _claims(source: str, value: Any) -> tuple[dict[str, Any], ...]:
+    """The [[claims]] tables, kept as given (each needs a unique ``id``; the report checks the rest)."""
+    if not isinstance(value, list) or not all(isinstance(entry, dict) for entry in value):
+        _fail(source, "claims", "expected an array of [[claims]] tables")
+    ids = []
+    for i, entry in enumerate(value):
+        ids.append(_string(source, entry, "id", f"claims[{i}].id"))
+        if ids[-1] in ids[:-1]:
+            _fail(source, f"claims[{i}].id", f"{ids[-1]!r} is used twice")
+    return tuple(dict(entry) for entry in value)
 
 
 def _paper(source: str, value: Any, scenarios: tuple[str, ...], labels: list[str]) -> tuple[PaperValue, ...]:
@@ -344,5 +391,8 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
     if paired and len(world_seeds) != len(seeds):
         _fail(source, "paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                       f"{len(world_seeds) if 'world_seeds' in data else 'no'} world seeds")
+    budget = _budget(source, data["budget"], "budget") if "budget" in data else None
+    claims = _claims(source, data["claims"]) if "claims" in data else ()
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
-                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired)
+                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired,
+                 budget, claims)
