@@ -4,6 +4,7 @@ for every planner that honours one."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 from pathlib import Path
@@ -21,7 +22,8 @@ from swarmnav.sim.study.grid import expand
 from swarmnav.sim.study.spec import load_study, parse_study
 
 PAPER_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3", "adl-abc-path-1", "adl-abc-path-2",
-                   "adl-abc-path-3", "adl-abc-case-b-path-1", "adl-abc-case-b-path-2", "adl-abc-case-b-path-3")
+                   "adl-abc-path-3", "adl-abc-case-b-path-1", "adl-abc-case-b-path-2")
+STUDIES = Path(__file__).parents[1] / "models" / "studies"
 CONTINUOUS = ("abc", "adl_abc", "gwo", "pso")
 SMALL = {"population": 20, "iterations": 20}
 
@@ -161,3 +163,71 @@ def test_a_bad_budget_is_one_config_error_naming_the_field(budget, problem):
     with pytest.raises(ConfigError) as err:
         parse_study(f'name = "b"\nscenarios = ["gwo-scenario-1"]\nbudget = {budget}\n[[planners]]\nname = "gwo"\n')
     assert problem in str(err.value)
+
+
+@pytest.mark.parametrize("study_name", ["gwo-vs-abc", "gwo-vs-abc-scenario-2"])
+def test_the_gwo_study_compares_at_the_papers_settings_and_at_equal_evaluations(study_name):
+    """Issue 18's "done when": at equal budget GWO's and ABC's runs spend evaluations within 2 % of each
+    other and of the stated budget (the plans of one seed of each scenario, as the study's cells run them)."""
+    study = load_study(study_name)
+    cells = expand(study)
+    assert len(cells) == (len(study.scenarios) * 5 * 2 * 10)    # scenarios x planners x navigators x seeds
+    budgets = {c.label: c.budget for c in cells}
+    assert budgets["gwo"] is None and budgets["abc"] is None
+    assert budgets["gwo-equal-budget"] == budgets["abc-equal-budget"] == {"evaluations": 10000}
+    for scenario in study.scenarios:
+        spent = {}
+        for cell in cells:
+            if cell.scenario == scenario and cell.seed == 0 and cell.navigator == "follow" and cell.budget:
+                row, _ = run_cell(dataclasses.replace(cell, mode="plan"))
+                spent[cell.label] = row["plan_evaluations"]
+        assert set(spent) == {"gwo-equal-budget", "abc-equal-budget"}
+        for value in spent.values():
+            assert 0.98 * 10000 <= value <= 10000
+        assert abs(spent["gwo-equal-budget"] - spent["abc-equal-budget"]) <= 0.02 * 10000
+    via = {json.loads(json.dumps(c.planner_params)).get("via_points") for c in cells if c.planner != "optimal"}
+    assert via == ({2} if study_name.endswith("2") else {3}) and study.clearance_m == 0.0
+
+
+@pytest.mark.parametrize("name", ["adl-abc-case-b-path-1", "adl-abc-case-b-path-2"])
+def test_case_b_as_printed_has_no_path_and_names_the_chain(name, capsys):
+    """Kamil et al. (2020) Table 3 as printed: the exact planner proves no path (exit 3); the description
+    names the chain of discs that closes it, and the chain is there (each grown disc meets the next)."""
+    from swarmnav.sim.cli import main
+
+    scenario = load_scenario(name)
+    assert len(scenario.obstacles) == 24 and scenario.robot_radius_m == 0.5
+    assert main(["plan", name, "--planner", "optimal"]) == 3
+    assert "NoPathFound" in capsys.readouterr().err
+    assert "discs 7, 3, 2 and 12" in scenario.description
+    grown = [(ob.x_m, ob.y_m, ob.radius_m + scenario.robot_radius_m) for ob in scenario.obstacles]
+    chain = [grown[i - 1] for i in (7, 3, 2, 12)]
+    assert chain[0][1] < chain[0][2] and 10.0 - chain[-1][1] < chain[-1][2]      # bottom edge ... top edge
+    for (x1, y1, r1), (x2, y2, r2) in zip(chain, chain[1:]):
+        assert np.hypot(x1 - x2, y1 - y2) < r1 + r2
+
+
+@pytest.mark.parametrize("path", [1, 2, 3])
+def test_case_b_feasible_variant_plans(path):
+    from swarmnav.planners.optimal import OptimalPlanner
+
+    printed = {(ob.x_m, ob.y_m): ob.radius_m for ob in load_scenario("adl-abc-case-b-path-1").obstacles}
+    variant = load_scenario(str(STUDIES / "adl-abc-case-b-feasible" / f"adl-abc-case-b-feasible-path-{path}.toml"))
+    assert variant.robot_radius_m == 0.05
+    assert {(ob.x_m, ob.y_m): ob.radius_m for ob in variant.obstacles} == pytest.approx(
+        {k: 0.8 * r for k, r in printed.items()})
+    optimum = OptimalPlanner().plan(scenario_problem(variant), np.random.default_rng(0))
+    assert scenario_problem(variant).is_collision_free(optimum.waypoints)
+
+
+def test_the_abc_study_expands_to_the_cells_its_file_implies_and_its_claims_name_its_arms():
+    study = load_study("abc-vs-adl-abc")
+    names = {Path(s).stem for s in study.scenarios}
+    assert len(names) == 3 + 2 + 3 + 3           # case A printed and feasible, case B printed and feasible
+    labels = [p.label for p in study.planners]
+    assert len(expand(study)) == len(names) * len(labels) * 10
+    assert {c.label: c.budget for c in expand(study)}["abc-equal-budget"] == {"evaluations": 200000}
+    assert len(study.claims) >= 8
+    for claim in study.claims:
+        assert claim["scenario"] in names and claim["planner"] in labels
+        assert set(claim["than"]) <= set(labels) and claim["metric"] in ("plan_length_m", "plan_time_s", "success")
