@@ -16,7 +16,8 @@ Karaboga's ABC as Kamil et al. (2020) Algorithm 1 gives it (also Abdulla & Hadi 
   through the limit consider worst.  The worst food source is abandoned": of the sources
   whose counter has reached the limit, the worst one (highest cost; ties: the lowest index)
   is abandoned and replaced by a random one, Eq. (6) - one scout a cycle at most, as in
-  Karaboga's ABC.  ``scouts = "all"`` (a named option, not the paper's) abandons every
+  Karaboga's ABC (whose code takes the source with the largest counter; "worst" read as the
+  highest cost is our reading of the paper's word).  ``scouts = "all"`` (a named option, not the paper's) abandons every
   exhausted source, as mealpy's ``OriginalABC`` does.
 
 One iteration costs ``2 SN`` evaluations plus one per scout (``pop_size`` = food sources =
