@@ -108,8 +108,8 @@ class Study:
     quick_seeds: int | None = None  # the first N seeds make the quick run (None: the quick run is the full one)
     clearance_m: float | None = None  # planning clearance override for every scenario (None: each scenario's)
     paired_seeds: bool = False  # the k-th seed runs with the k-th world seed only
+    claims: tuple[dict[str, Any], ...] = ()  # [[claims]] tables as written (their verdicts: swarmnav report)
     budget: Budget | None = None  # every planner's budget, unless its entry names its own
-    claims: tuple[dict[str, Any], ...] = ()  # the [[claims]] tables as given (the report checks them)
 
     def budget_of(self, planner: Component) -> Budget | None:
         """The budget a planner entry runs under: its own, else the study's."""
@@ -287,18 +287,6 @@ def _budget(source: str, value: Any, field: str) -> Budget:
     return Budget(time_s=time_s)
 
 
-def _claims(source: str, value: Any) -> tuple[dict[str, Any], ...]:
-    """The [[claims]] tables, kept as given (each needs a unique ``id``; the report checks the rest)."""
-    if not isinstance(value, list) or not all(isinstance(entry, dict) for entry in value):
-        _fail(source, "claims", "expected an array of [[claims]] tables")
-    ids = []
-    for i, entry in enumerate(value):
-        ids.append(_string(source, entry, "id", f"claims[{i}].id"))
-        if ids[-1] in ids[:-1]:
-            _fail(source, f"claims[{i}].id", f"{ids[-1]!r} is used twice")
-    return tuple(dict(entry) for entry in value)
-
-
 def _paper(source: str, value: Any, scenarios: tuple[str, ...], labels: list[str]) -> tuple[PaperValue, ...]:
     if not isinstance(value, list):
         _fail(source, "paper", "expected an array of [[paper]] tables")
@@ -391,8 +379,10 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
     if paired and len(world_seeds) != len(seeds):
         _fail(source, "paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                       f"{len(world_seeds) if 'world_seeds' in data else 'no'} world seeds")
+    claims = data.get("claims", [])
+    if not isinstance(claims, list) or not all(isinstance(c, dict) for c in claims):
+        _fail(source, "claims", "expected an array of [[claims]] tables")
     budget = _budget(source, data["budget"], "budget") if "budget" in data else None
-    claims = _claims(source, data["claims"]) if "claims" in data else ()
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
                  reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired,
-                 budget, claims)
+                 tuple(claims), budget)
