@@ -12,11 +12,21 @@ Karaboga's ABC as Kamil et al. (2020) Algorithm 1 gives it (also Abdulla & Hadi 
   ``p_i = fit_i / sum fit`` (Eq. (9)) with ``fit = 1 / (1 + f)`` (Eq. (8), ``f``
   the cost :class:`planners.path_cost.PathObjective`, which is never negative)
   and try Eq. (7) around them, again greedily;
-* scout bees: every source whose counter has reached the limit is abandoned and
-  replaced by a random one, Eq. (6).
+* scout bees (Sect. 4 IV, Step 8): "The employed bees which cannot improve self-solution
+  through the limit consider worst.  The worst food source is abandoned": of the sources
+  whose counter has reached the limit, the worst one (highest cost; ties: the lowest index)
+  is abandoned and replaced by a random one, Eq. (6) - one scout a cycle at most, as in
+  Karaboga's ABC (whose code takes the source with the largest counter; "worst" read as the
+  highest cost is our reading of the paper's word).  ``scouts = "all"`` (a named option, not the paper's) abandons every
+  exhausted source, as mealpy's ``OriginalABC`` does.
 
-One iteration costs ``2 SN`` evaluations plus one per scout, as in mealpy's
-``OriginalABC`` (``pop_size`` = food sources = employed = onlookers).
+One iteration costs ``2 SN`` evaluations plus one per scout (``pop_size`` = food sources =
+employed = onlookers).
+
+Settings (Kamil et al. 2020 Sect. 6): SN = 100, limit = 5, 3 via-points, "maximum number of
+iteration equal to 1000.  MCN = 100": ``iterations`` defaults to 1000 and ``mcn`` (the cycle
+count of the adaptive limit, Eqs. (10)-(12)) to 100.  Abdulla & Hadi (2025) run their ABC
+for 100 iterations with the population of their GWO; their study sets that.
 
 Vectorisation: the employed bees all move at once (each touches only its own
 source).  The onlookers also act at once, on a snapshot of the sources: a source
@@ -44,6 +54,8 @@ from swarmnav.planners.continuous import ContinuousPlanner, ContinuousState
 from swarmnav.planners.path_cost import inverse_fitness
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.problem import Problem
+
+SCOUT_RULES = ("worst", "all")
 
 
 def adaptive_limit(iteration: int, mcn: int, dimensions: int, limit: float) -> float:
@@ -86,7 +98,9 @@ class BeeColonyPlanner(ContinuousPlanner):
 
     Attributes:
         population: food sources ``SN`` (Kamil et al. 2020: 100).
+        iterations: cycles of the loop (Kamil et al. 2020: "maximum number of iteration equal to 1000").
         limit: failures before a source is abandoned (Kamil et al. 2020: 5).
+        scouts: ``"worst"`` (the paper's: the worst exhausted source only) or ``"all"``.
         adaptive_limit: use ADL-ABC's limit, Eqs. (10)-(12), instead of ``limit``.
         mcn: ``MCN`` of Eqs. (10)-(12) (Kamil et al. 2020: 100); only with ``adaptive_limit``.
     """
@@ -95,7 +109,9 @@ class BeeColonyPlanner(ContinuousPlanner):
     parameter_ranges: ClassVar[dict[str, Range]] = {"limit": within(0, 1e9), "mcn": within(1, 1_000_000)}  # models.parameters: checked on build
 
     population: int = 100
+    iterations: int = 1000
     limit: float = 5.0
+    scouts: str = "worst"
     adaptive_limit: bool = False
     mcn: int = 100
 
@@ -103,6 +119,8 @@ class BeeColonyPlanner(ContinuousPlanner):
         super().__post_init__()
         if self.limit <= 0:
             raise ConfigError("planner.params.limit", f"must be positive, got {self.limit!r}")
+        if self.scouts not in SCOUT_RULES:
+            raise ConfigError("planner.params.scouts", f"must be one of {', '.join(SCOUT_RULES)}, got {self.scouts!r}")
         if self.mcn < 1:
             raise ConfigError("planner.params.mcn", f"must be at least 1, got {self.mcn!r}")
 
@@ -167,9 +185,11 @@ class BeeColonyPlanner(ContinuousPlanner):
         failures += visits
         failures[won] = 0
 
-        # Scout bees: abandon every source that reached the limit (Eq. (6)).
+        # Scout bees: abandon the worst source that reached the limit (or every one), Eq. (6).
         limit = self.current_limit(iteration, sources.shape[1])
         abandoned = np.flatnonzero(failures >= limit)
+        if abandoned.size and self.scouts == "worst":
+            abandoned = abandoned[[int(np.argmax(costs[abandoned]))]]
         if abandoned.size:
             fresh = self.random_solutions(state, abandoned.size, rng)
             sources[abandoned] = fresh

@@ -12,53 +12,69 @@ in :class:`planners.swarm.SwarmPlanner`:
   evaluations and keeps the best);
 * the exact feasibility check in :meth:`ContinuousPlanner.finish`.
 
-Feasibility.  The optimisers see only ``samples`` points of each curve, so the
-best candidate may cut into a disc between two samples.  To keep that rare the
-penalty uses radii grown by ``penalty_margin_m``.  ``finish`` then samples the
-spline densely (about every ``waypoint_spacing_m``), projects it onto the
-workspace bounds (a spline may overshoot an arena edge by a millimetre near a
-corner; the projection onto a box is non-expansive, so the path stays
-continuous and gets no longer), and checks that polyline,
-which is the returned path, *exactly* against the inflated discs and the bounds
-(``Problem.is_collision_free``: segment-disc distances, no sampling).  If the
-best candidate fails, the planner *repairs*: first by taking the cheapest
-candidate of the final population that passes the same check; failing that, by a
-short local search around the best candidate on a *finer* penalty (ten times the
-samples, ``repair_rounds`` batches of ``population`` Gaussian steps, shrinking),
-stopping at the first candidate that passes.  The repair runs as the loop's
-repair stage (:mod:`planners.swarm`), so its evaluations count against the same
-``max_evaluations`` budget as the search's.  ``stats.extra["repaired"]`` says
-which ("population" or "fine_penalty").  If nothing passes it raises
-:class:`planners.errors.NoPathFound` (:class:`planners.errors.BudgetExceeded`
-when the budget ran out).
+Modes.  ``mode = "paper"`` (the default) runs the algorithm as its paper writes it, on any
+scene; ``mode = "robust"`` is swarmnav's hybrid that starts from the exact tangent-graph
+route.  The table of what each mode sets, and the options that set each mechanism on its
+own, is in :mod:`planners.run_settings`.  No behaviour depends on which file a problem came
+from.  The resolved options of a run are in ``stats.extra["settings"]`` and its mode in
+``stats.extra["mode"]``.
 
-Modes: the papers' algorithms and the robust options.  ``mode = "paper"`` runs the
-algorithm as its paper writes it (3 via-points, a uniform random first population, no
-polish).  ``mode = "robust"`` adds three named options, each of which can also be set on
-its own (an explicit value always wins over the mode's):
+Feasibility.  ``finish`` samples the best candidate's spline densely (about every
+``waypoint_spacing_m``), projects it onto the workspace bounds, and checks that polyline,
+which is the returned path, *exactly* against the inflated discs and the bounds
+(``Problem.is_collision_free``: segment-disc distances, no sampling).
+
+Deviations from both papers (Kamil et al. 2020 Sect. 6; Abdulla & Hadi 2025 Sect. 6), in
+every mode:
+
+* the papers report their best candidate as the path; we check it exactly and a best that
+  cuts a disc is :class:`planners.errors.NoPathFound` (paper mode looks no further; the
+  robust mode's ``population_fallback`` and ``repair_rounds`` look for another);
+* the returned polyline is projected onto the arena (a spline may overshoot an edge near a
+  corner; the papers' arenas have no walls and they do not say what happens there; the
+  projection onto a box is non-expansive, so the path stays continuous and gets no longer);
+* a via-point coordinate that a move takes out of the search box is clipped back to it
+  (neither paper says; Karaboga's ABC and Mirjalili's GWO reference codes clip).
+
+Robust options (:mod:`planners.run_settings` has the table):
 
 * ``guess``: the geometric guess the other options start from: ``"tangent"`` (robust default
   up to 100 discs),
   the shortest route of the tangent graph around the inflated discs grown by
   ``guess_margin_m`` (default: each disc's penalty margin; :mod:`planners.tangent_guess`), or
-  ``"grid"``, a line-of-sight-shortcut A* path on the problem's grid (``guess_cell_m``);
+  ``"grid"``, a line-of-sight-shortcut A* path on the problem's grid (``guess_cell_m``), or
+  ``"none"`` (the paper mode's);
 * ``via_points``: chosen from the scene (:func:`planners.path_guess.via_points_for_turns`:
   two per turn of the tangent route plus seven; for the grid guess
   :func:`planners.path_guess.via_points_for_guess`, one per bend plus two) and *grown*
   (doubled, up to ``via_point_growth`` times, the search rerun on what is left of the
   budget) when no candidate passes the exact check;
-* ``seed_fraction``: that share of the first population is placed on the least-squares
-  fit of the guess, perturbed (:mod:`planners.path_guess`), the rest uniformly at random
-  as in the paper (later random draws, e.g. ABC's scouts, stay the paper's);
+* ``guess_fraction``: that share of the first population is placed on the least-squares
+  fit of the guess, perturbed by at most ``guess_spread_m`` (:mod:`planners.path_guess`), the
+  rest uniformly at random as in the paper (later random draws, e.g. ABC's scouts, stay the
+  paper's);
 * ``fit_push_rounds``: rounds of :func:`planners.path_guess.pushed_fit_via_points`, which
   moves the fit's curve out of the penalty's discs (a plain least-squares fit cuts the
   corners of a route that hugs them; 0: the plain fit);
+* ``penalty_margin_m`` and ``penalty_weight``: the optimisers see only ``samples`` points of
+  each curve, so the best candidate may cut into a disc between two samples; the robust
+  penalty uses radii grown by the margin, with weight 1000 (Kamil et al. 2020's weight 1 is
+  too weak to keep a spline out of a disc: a cut of a few centimetres costs less penalty
+  than the detour saves; measured on dense-field-30 and gwo-scenario-1, 100 leaves most
+  dense-field optima inside a disc, 10000 traps GWO and PSO in infeasible basins);
+* ``population_fallback``: when the best fails the exact check, the cheapest member of the
+  final population (then the seeds' fits) that passes it;
+* ``repair_rounds``: failing that, a short local search around the best candidate on a
+  *finer* penalty (ten times the samples, ``repair_rounds`` batches of ``population``
+  Gaussian steps, shrinking), stopping at the first candidate that passes.  It runs as the
+  loop's repair stage (:mod:`planners.swarm`), so its evaluations count against the same
+  budget.  ``stats.extra["repaired"]`` says which ("population" or "fine_penalty");
 * ``polish_rounds``: a compass search from the chosen candidate (:mod:`planners.polish`);
-  its result is kept only if the returned path passes the exact check.
-* ``gap_margins``: the penalty's margin (``penalty_margin_m``) shrinks, disc by disc, to
-  less than half of every narrower gap between two footprints (and less than a wall gap),
-  so that the cost does not close a gap the robot fits through
-  (:func:`planners.path_guess.gap_margins_m`; our choice);
+  its result is kept only if the returned path passes the exact check; its evaluations
+  count against the budget;
+* ``gap_margins``: the penalty's margin shrinks, disc by disc, to less than half of every
+  narrower gap between two footprints (and less than a wall gap), so that the cost does not
+  close a gap the robot fits through (:func:`planners.path_guess.gap_margins_m`; our choice);
 * ``stall_evaluations``: the search stops early once that many evaluations in a row have
   not lowered the best cost by more than ``stall_tolerance`` (relative).  Started from a
   seeded population, the swarm mostly refines the guess's fit, and on the random fields
@@ -70,12 +86,6 @@ its own (an explicit value always wins over the mode's):
   (ed.), Advances in Differential Evolution, Springer, Sect. 3.1); counting evaluations
   rather than iterations makes it the same for the algorithms that evaluate once an
   iteration (GWO, PSO) and those that evaluate two or three times (ABC, ADL-ABC).
-
-``mode = "auto"`` (the default) is ``"paper"`` on the papers' own bundled instances
-(recognised by their geometry, :mod:`planners.paper_instances`) and ``"robust"`` everywhere
-else: a user reproducing a paper gets the paper's algorithm and parameters, and a user
-planning any other scene gets the version that finds it.  The mode a run used is in
-``stats.extra["mode"]`` (``swarmnav plan --json``), so the choice is never silent.
 """
 
 from __future__ import annotations
@@ -92,61 +102,15 @@ from swarmnav.models.parameters import Range, above, within
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.errors import BudgetExceeded
-from swarmnav.planners.paper_instances import paper_instance
 from swarmnav.planners.path_cost import PathObjective
-from swarmnav.planners.path_guess import (MAX_AUTO_VIA_POINTS, MAX_TANGENT_DISCS, fit_via_points, gap_margins_m,
-                                          pushed_fit_via_points, scene_guesses, seeded_population)
+from swarmnav.planners.path_guess import MAX_AUTO_VIA_POINTS, fit_via_points, pushed_fit_via_points, seeded_population
 from swarmnav.planners.polish import compass_polish
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
+from swarmnav.planners.run_settings import (GUESSES, MODES, PAPER_VIA_POINTS, RunSettings, mode_value,
+                                            resolve_settings)
 from swarmnav.planners.segment_gaps import polyline_gap_m
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 from swarmnav.planners.via_points import ENCODINGS, ViaPointCurve
-
-MODES = ("auto", "paper", "robust")
-GUESSES = ("grid", "tangent")
-#: Via-points of both papers (Kamil et al. 2020 Sect. 3; Abdulla & Hadi 2025).
-PAPER_VIA_POINTS = 3
-#: The robust mode's defaults of the options left unset.
-ROBUST_SEED_FRACTION = 0.5
-ROBUST_POLISH_ROUNDS = 40
-ROBUST_VIA_POINT_GROWTH = 2
-ROBUST_FIT_PUSH_ROUNDS = 40
-ROBUST_GUESS = "tangent"
-#: The robust mode's ``stall_evaluations``, in populations.
-ROBUST_STALL_POPULATIONS = 10
-ROBUST_GAP_MARGINS = True
-
-
-@dataclass(frozen=True)
-class RunSettings:
-    """What one run uses once the mode is resolved (:meth:`ContinuousPlanner.settings_for`).
-
-    Attributes:
-        mode: "paper" or "robust".
-        via_points: ``k`` of this attempt.
-        seed_fraction: share of the first population seeded from ``guess``.
-        polish_rounds: compass-search rounds on the chosen candidate.
-        growth: how many more times ``k`` may double when nothing passes.
-        guesses: the geometric guesses, (N, 2) waypoints each (empty: no seeding).
-        paper: the paper scenario recognised (for ``mode = "auto"``), or None.
-        push_rounds: rounds that push the seeds' fit out of the discs.
-        stall_evaluations: evaluations without improvement that end the search (0: never).
-        margins_m: (n,) the penalty margin of each disc (None: ``penalty_margin_m`` for all).
-        guess: the kind of the guesses ("tangent" or "grid"; None: none computed).
-    """
-
-    mode: str = "paper"
-    via_points: int = PAPER_VIA_POINTS
-    seed_fraction: float = 0.0
-    polish_rounds: int = 0
-    growth: int = 0
-    guesses: tuple[np.ndarray, ...] = ()
-    paper: str | None = None
-    push_rounds: int = 0
-    stall_evaluations: int = 0
-    margins_m: np.ndarray | None = None
-    guess: str | None = None
-
 
 #: A fast gap below minus this rejects a candidate without the exact check (whose own
 #: tolerance is 1e-6 m; the two computations differ by rounding only).
@@ -196,53 +160,49 @@ class ContinuousState(SwarmState):
 class ContinuousPlanner(SwarmPlanner):
     """Common parameters of the via-point swarm planners.
 
+    Options left at ``None`` take their mode's value (:mod:`planners.run_settings`).
+
     Attributes:
         population: candidates per iteration (food sources, wolves, particles); population
             x samples may be at most :data:`MAX_POPULATION_SAMPLES` (1,000,000).
         iterations: iterations of the loop (Abdulla & Hadi 2025 uses 100).
         max_evaluations: optional cap on objective evaluations (0 or None: none).
-        via_points: free via-points ``k`` (Kamil et al. 2020 and Abdulla & Hadi (2025) use 3).
+        via_points: free via-points ``k`` (``None``: the papers' 3 in paper mode, chosen from
+            the guess in robust mode).
         samples: curve samples the cost sees (Kamil et al. 2020's ``np``; 100).
         encoding: ``"spline"`` (not-a-knot cubic) or ``"polyline"``.
         length_weight: ``w1`` of Abdulla & Hadi (2025) Eq. (6).
         smoothness_weight: ``w2`` of Abdulla & Hadi (2025) Eq. (6); 0 gives Kamil et al. 2020's objective.
             Abdulla & Hadi (2025) gives no values for w1, w2; the default 0 makes the
             objective the path length, which the benchmark compares.
-        penalty_weight: multiplier of Kamil et al. 2020's penalty, Eqs. (3)-(5).  The
-            paper adds it with weight 1; that is too weak to keep a spline out of a
-            disc (a cut of a few centimetres costs less penalty than the detour
-            saves), so the default is 1000 (measured on dense-field-30 and gwo-scenario-1:
-            100 leaves most dense-field optima inside a disc, 10000 traps GWO and PSO
-            in infeasible basins).
-        penalty_margin_m: added to the inflated radii in the penalty only, so that
-            the optimum keeps a little room for the curve between samples.
+        penalty_weight: multiplier of Kamil et al. 2020's penalty, Eqs. (3)-(5) (paper: 1).
+        penalty_margin_m: added to the inflated radii in the penalty only (paper: 0).
+        bounds_penalty: penalise curve samples outside the arena (in neither paper).
+        population_fallback: scan the final population when the best cuts a disc.
         repair_rounds: batches of the fine-penalty repair (0: no such repair).
         waypoint_spacing_m: spacing of the returned waypoints along the spline; the
             polyline through them is what the exact check verifies.
-        mode: "paper", "robust" or "auto" (see the module docstring).
-        via_points: ``None`` (default): 3 in paper mode, chosen from the scene in robust mode.
-        seed_fraction: share of the first population seeded from the geometric guess
-            (``None``: 0 in paper mode, 0.5 in robust mode).
-        seed_spread_m: largest standard deviation of the seeds' perturbation.
+        mode: "paper" (default) or "robust" (see :mod:`planners.run_settings`).
+        guess_fraction: share of the first population seeded from the geometric guess.
+        guess_spread_m: largest standard deviation of the seeds' perturbation.
         guess_cell_m: cell of the A* guess's grid (``None``: the problem's).
-        polish_rounds: compass-search rounds on the result (``None``: 0 / 40).
+        polish_rounds: compass-search rounds on the result.
         polish_step_m: the compass search's first step.
-        via_point_growth: doublings of ``k`` when nothing passes (``None``: 0 / 2).
-        guess: ``"tangent"`` or ``"grid"``: the geometric guess of the seeds and of ``k``
-            (``None``: "grid" in paper mode, where it seeds only with an explicit
-            ``seed_fraction``; in robust mode "tangent" up to
+        via_point_growth: doublings of ``k`` when nothing passes.
+        guess: ``"tangent"``, ``"grid"`` or ``"none"``: the geometric guess of the seeds and
+            of ``k`` (``None``: "none" in paper mode; in robust mode "tangent" up to
             :data:`planners.path_guess.MAX_TANGENT_DISCS` discs, "grid" above).
         guess_margin_m: how much the tangent guess grows the inflated discs (``None``: each
             disc's penalty margin, so that the guess clears the discs the penalty sees).
-        fit_push_rounds: rounds that push the seeds' fit out of the discs (``None``: 0 / 40; it stops
-            early once the fit is clear).
+        fit_push_rounds: rounds that push the seeds' fit out of the discs (it stops early
+            once the fit is clear).
         stall_evaluations: end the search once this many evaluations in a row have not
             improved the best (``None``: never in paper mode; in robust mode 10 x
             ``population`` when the first population is seeded, never otherwise; 0: never).
         stall_tolerance: the relative drop of the best cost that counts as an improvement.
         gap_margins: whether each disc's penalty margin shrinks to keep narrow gaps open
-            (:func:`planners.path_guess.gap_margins_m`; ``None``: no / yes).  The tangent
-            guess then grows each disc by its own margin (unless ``guess_margin_m`` is set).
+            (:func:`planners.path_guess.gap_margins_m`).  The tangent guess then grows each
+            disc by its own margin (unless ``guess_margin_m`` is set).
     """
 
     supports: ClassVar[frozenset[str]] = frozenset({"discs"})
@@ -265,13 +225,15 @@ class ContinuousPlanner(SwarmPlanner):
     encoding: str = "spline"
     length_weight: float = 1.0
     smoothness_weight: float = 0.0
-    penalty_weight: float = 1000.0
-    penalty_margin_m: float = 0.02
+    penalty_weight: float | None = None
+    penalty_margin_m: float | None = None
+    bounds_penalty: bool | None = None
+    population_fallback: bool | None = None
     waypoint_spacing_m: float = 0.05
-    repair_rounds: int = 10
-    mode: str = "auto"
-    seed_fraction: float | None = None
-    seed_spread_m: float = 0.2
+    repair_rounds: int | None = None
+    mode: str = "paper"
+    guess_fraction: float | None = None
+    guess_spread_m: float = 0.2
     guess_cell_m: float | None = None
     polish_rounds: int | None = None
     polish_step_m: float = 0.05
@@ -284,6 +246,7 @@ class ContinuousPlanner(SwarmPlanner):
     gap_margins: bool | None = None
 
     def __post_init__(self) -> None:
+        optional = lambda value, ok: value is None or ok(value)   # noqa: E731
         checks = (
             ("population", self.population >= 4, "must be at least 4"),
             ("iterations", self.iterations >= 0, "must not be negative"),
@@ -294,14 +257,13 @@ class ContinuousPlanner(SwarmPlanner):
             ("encoding", self.encoding in ENCODINGS, f"must be one of {', '.join(ENCODINGS)}"),
             ("length_weight", self.length_weight >= 0, "must not be negative"),
             ("smoothness_weight", self.smoothness_weight >= 0, "must not be negative"),
-            ("penalty_weight", self.penalty_weight > 0, "must be positive"),
-            ("penalty_margin_m", self.penalty_margin_m >= 0, "must not be negative"),
+            ("penalty_weight", optional(self.penalty_weight, lambda v: v > 0), "must be positive"),
+            ("penalty_margin_m", optional(self.penalty_margin_m, lambda v: v >= 0), "must not be negative"),
             ("waypoint_spacing_m", self.waypoint_spacing_m > 0, "must be positive"),
-            ("repair_rounds", self.repair_rounds >= 0, "must not be negative"),
+            ("repair_rounds", optional(self.repair_rounds, lambda v: v >= 0), "must not be negative"),
             ("mode", self.mode in MODES, f"must be one of {', '.join(MODES)}"),
-            ("seed_fraction", self.seed_fraction is None or 0.0 <= self.seed_fraction <= 1.0,
-             "must be between 0 and 1"),
-            ("seed_spread_m", self.seed_spread_m >= 0, "must not be negative"),
+            ("guess_fraction", optional(self.guess_fraction, lambda v: 0.0 <= v <= 1.0), "must be between 0 and 1"),
+            ("guess_spread_m", self.guess_spread_m >= 0, "must not be negative"),
             ("guess_cell_m", self.guess_cell_m is None or self.guess_cell_m > 0, "must be positive"),
             ("polish_rounds", self.polish_rounds is None or self.polish_rounds >= 0, "must not be negative"),
             ("polish_step_m", self.polish_step_m > 0, "must be positive"),
@@ -325,48 +287,13 @@ class ContinuousPlanner(SwarmPlanner):
     state_type = ContinuousState
 
     def settings_for(self, problem: Problem) -> RunSettings:
-        """Resolve ``mode`` and the options left at ``None`` for ``problem`` (the robust mode
-        also computes the geometric guess here)."""
-        paper = paper_instance(problem) if self.mode == "auto" else None
-        mode = self.mode if self.mode != "auto" else ("paper" if paper else "robust")
-        if mode == "paper":
-            return RunSettings(mode="paper", via_points=self.via_points or PAPER_VIA_POINTS,
-                               seed_fraction=self.seed_fraction or 0.0, polish_rounds=self.polish_rounds or 0,
-                               growth=self.via_point_growth or 0, paper=paper, push_rounds=self.fit_push_rounds or 0,
-                               stall_evaluations=self.stall_evaluations or 0,
-                               guesses=scene_guesses(problem, self.guess or "grid", self.guess_cell_m,
-                                                     self.resolved_guess_margin_m())[0] if self.seed_fraction else (),
-                               guess=(self.guess or "grid") if self.seed_fraction else None)
-        fraction = ROBUST_SEED_FRACTION if self.seed_fraction is None else self.seed_fraction
-        gap_margins = ROBUST_GAP_MARGINS if self.gap_margins is None else self.gap_margins
-        margins = gap_margins_m(problem, self.penalty_margin_m) if gap_margins else None
-        guess_margin = self.guess_margin_m if self.guess_margin_m is not None else (
-            margins if margins is not None else self.penalty_margin_m)
-        kind = self.guess or (ROBUST_GUESS if problem.disc_centres_m.shape[0] <= MAX_TANGENT_DISCS else "grid")
-        guesses, chosen_k = (scene_guesses(problem, kind, self.guess_cell_m, guess_margin)
-                             if (fraction or self.via_points is None) else ((), PAPER_VIA_POINTS))
-        if kind == "tangent" and not guesses and (fraction or self.via_points is None):
-            raise NoPathFound(f"{self.name}: no collision-free path exists: the tangent graph of the inflated "
-                              f"discs (exact, as the optimal planner's) joins no route from start to goal")
-        via_points = self.via_points or chosen_k
-        return RunSettings(
-            mode="robust", via_points=via_points, seed_fraction=fraction,
-            polish_rounds=ROBUST_POLISH_ROUNDS if self.polish_rounds is None else self.polish_rounds,
-            growth=ROBUST_VIA_POINT_GROWTH if self.via_point_growth is None else self.via_point_growth,
-            guesses=guesses, paper=paper,
-            push_rounds=ROBUST_FIT_PUSH_ROUNDS if self.fit_push_rounds is None else self.fit_push_rounds,
-            margins_m=margins, guess=kind if (fraction or self.via_points is None) else None,
-            stall_evaluations=(self.stall_evaluations if self.stall_evaluations is not None
-                               else ROBUST_STALL_POPULATIONS * self.population if (fraction and guesses) else 0))
-
-    def resolved_guess_margin_m(self) -> float:
-        """``guess_margin_m``, or by default the penalty's own margin ``penalty_margin_m`` (the
-        robust mode's gap margins replace it by each disc's own)."""
-        return self.penalty_margin_m if self.guess_margin_m is None else self.guess_margin_m
+        """Resolve ``mode`` and the options left at ``None`` for ``problem``
+        (:func:`planners.run_settings.resolve_settings`)."""
+        return resolve_settings(self, problem)
 
     def plan(self, problem: Problem, rng: np.random.Generator) -> Path:
-        """Resolve the mode, then run the search; in robust mode, rerun it with twice the
-        via-points (on what is left of the budget) while nothing passes the exact check."""
+        """Resolve the mode, then run the search; with ``via_point_growth``, rerun it with twice
+        the via-points (on what is left of the budget) while nothing passes the exact check."""
         t0 = time.perf_counter()
         check_endpoints(problem)
         check_supported(self, problem)
@@ -378,18 +305,18 @@ class ContinuousPlanner(SwarmPlanner):
             try:
                 path = self.run_search(problem, rng, state)
                 break
-            except BudgetExceeded:
+            except BudgetExceeded as exc:
+                exc.evaluations, exc.plan_time_s = spent + state.evaluations, time.perf_counter() - t0
                 raise
-            except NoPathFound:
+            except NoPathFound as exc:
                 spent += state.evaluations
                 if attempt == settings.growth or settings.via_points >= MAX_AUTO_VIA_POINTS * 2:
+                    exc.evaluations, exc.plan_time_s = spent, time.perf_counter() - t0
                     raise
                 settings = dataclasses.replace(settings, via_points=2 * settings.via_points)
         extra = dict(path.stats.extra, mode=settings.mode, via_point_count=settings.via_points, guess=settings.guess,
-                     via_point_growths=attempt, guess_lengths_m=[
+                     via_point_growths=attempt, settings=settings.summary(), guess_lengths_m=[
                          float(np.sum(np.hypot(*np.diff(g, axis=0).T))) for g in settings.guesses])
-        if settings.paper:
-            extra["paper_instance"] = settings.paper
         return Path.from_waypoints(path.waypoints, time.perf_counter() - t0, iterations=path.stats.iterations,
                                    evaluations=spent + path.stats.evaluations,
                                    cost_history=path.stats.cost_history,
@@ -399,19 +326,23 @@ class ContinuousPlanner(SwarmPlanner):
                                    extra=extra)
 
     def objective(self, problem: Problem, via_points: int | None = None,
-                  margins_m: np.ndarray | None = None) -> PathObjective:
+                  margins_m: np.ndarray | float | None = None, settings: RunSettings | None = None) -> PathObjective:
         """The cost function of ``problem`` for this planner's encoding and weights, with
-        ``via_points`` free via-points (default: the parameter, else the papers' 3) and the
-        penalty margins ``margins_m`` (one per disc; default ``penalty_margin_m`` for all)."""
+        ``via_points`` free via-points (default: the parameter, else the papers' 3), the
+        penalty margins ``margins_m`` (one per disc, or one for all) and the penalty weight and
+        bounds penalty of ``settings`` (default: this planner's mode's)."""
         k = via_points or self.via_points or PAPER_VIA_POINTS
         curve = ViaPointCurve(self.encoding, k, problem.start.xy, problem.goal.xy,
                               self.samples)
+        if margins_m is None:
+            margins_m = settings.margins_m if settings is not None else mode_value(self, "penalty_margin_m")
+        weight = settings.penalty_weight if settings is not None else mode_value(self, "penalty_weight")
+        bounds = settings.bounds_penalty if settings is not None else mode_value(self, "bounds_penalty")
         return PathObjective(curve=curve, centres_m=problem.disc_centres_m,
-                             penalty_radii_m=problem.inflated_radii_m + (
-                                 self.penalty_margin_m if margins_m is None else margins_m),
+                             penalty_radii_m=problem.inflated_radii_m + margins_m,
                              bounds=problem.bounds, length_weight=self.length_weight,
                              smoothness_weight=self.smoothness_weight,
-                             penalty_weight=self.penalty_weight)
+                             penalty_weight=weight, bounds_penalty=bounds)
 
     def search_bounds(self, problem: Problem, via_points: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(lower, upper), each (2k,): x of every via-point, then y, within the workspace."""
@@ -427,10 +358,10 @@ class ContinuousPlanner(SwarmPlanner):
 
     def initial_solutions(self, state: ContinuousState, count: int, rng: np.random.Generator) -> np.ndarray:
         """The first population: :meth:`random_solutions` (the papers'), except that with a
-        ``seed_fraction`` and guesses that share of it is seeded from the guesses (first,
+        ``guess_fraction`` and guesses that share of it is seeded from the guesses (first,
         split evenly between them)."""
         settings = state.settings
-        seeded = int(round(settings.seed_fraction * count)) if settings.guesses else 0
+        seeded = int(round(settings.guess_fraction * count)) if settings.guesses else 0
         if seeded == 0:
             return self.random_solutions(state, count, rng)
         shares = np.diff(np.linspace(0, seeded, len(settings.guesses) + 1).round().astype(int))
@@ -440,7 +371,7 @@ class ContinuousPlanner(SwarmPlanner):
                                    if settings.push_rounds else fit_via_points(objective.curve, guess),
                                    state.lower, state.upper)
                            for guess, share in zip(settings.guesses, shares) if share]
-        seeds = [seeded_population(fit, int(share), self.seed_spread_m, state.lower, state.upper, rng)
+        seeds = [seeded_population(fit, int(share), self.guess_spread_m, state.lower, state.upper, rng)
                  for fit, share in zip(state.seed_fits, [share for share in shares if share])]
         return np.vstack(seeds + [self.random_solutions(state, count - seeded, rng)])
 
@@ -486,7 +417,7 @@ class ContinuousPlanner(SwarmPlanner):
     def init_state(self, state: ContinuousState, problem: Problem, rng: np.random.Generator) -> None:
         check_supported(self, problem)
         k = state.settings.via_points
-        state.objective = self.objective(problem, k, state.settings.margins_m)
+        state.objective = self.objective(problem, k, settings=state.settings)
         state.lower, state.upper = self.search_bounds(problem, k)
         self.init_swarm(state, rng)
 
@@ -494,20 +425,22 @@ class ContinuousPlanner(SwarmPlanner):
         """Create and evaluate the first population (``state.population``, ``state.costs``)."""
         raise NotImplementedError
 
-    def repair_limit(self) -> int:
-        return self.repair_rounds
+    def repair_limit(self, state: ContinuousState) -> int:
+        return state.settings.repair_rounds
 
     def needs_repair(self, state: ContinuousState, problem: Problem) -> bool:
-        """Scan the best, then the final population (cheapest first), then the seeds' fits
-        once for a candidate that passes the exact check; repair while there is none."""
+        """Check the best once; with ``population_fallback``, then the final population (cheapest
+        first) and the seeds' fits, for a candidate that passes the exact check; repair while
+        there is none."""
         if not state.scanned:
             state.scanned = True
             candidates = [] if state.best_solution is None else [np.asarray(state.best_solution, dtype=float)]
-            if state.population is not None:
+            if state.population is not None and state.settings.population_fallback:
                 order = np.argsort(state.costs, kind="stable")
                 candidates.extend(np.asarray(state.population[i], dtype=float) for i in order
                                   if math.isfinite(state.costs[i]))
-            candidates.extend(state.seed_fits)    # a swarm that moves every member may have lost them
+            if state.settings.population_fallback:
+                candidates.extend(state.seed_fits)    # a swarm that moves every member may have lost them
             for rank, solution in enumerate(candidates):
                 if self.passes_exact_check(problem, self.dense_waypoints(state.objective, solution), state):
                     state.chosen, state.repaired = solution, ("population" if rank > 0 else None)
@@ -525,7 +458,7 @@ class ContinuousPlanner(SwarmPlanner):
             best = np.asarray(state.best_solution, dtype=float)
             state.repair_solution = best
             state.repair_cost = float(self.evaluate(state, best[None, :], state.fine, offer=False)[0])
-            state.repair_step_m = 4.0 * max(self.penalty_margin_m, 0.01)
+            state.repair_step_m = 4.0 * max(float(np.max(state.settings.margins_m)), 0.01)
         best = state.repair_solution
         trial = np.clip(best + rng.normal(0.0, state.repair_step_m, (self.population, best.size)),
                         state.lower, state.upper)
@@ -542,14 +475,17 @@ class ContinuousPlanner(SwarmPlanner):
         """Dense waypoints of the candidate that passed the exact check.
 
         Raises:
-            NoPathFound: neither the best, nor any member of the final population,
-                nor the repair is collision-free.
+            NoPathFound: the best is not collision-free, nor (with the robust options) any
+                member of the final population, nor the repair.
         """
         self.needs_repair(state, problem)          # the scan, when the loop ran no repair stage
         if state.chosen is None:
-            raise NoPathFound(f"{self.name}: no candidate of the final population is collision-free "
-                              f"(best clearance {state.best_gap_m:.4f} m), nor the fine-penalty repair; try "
-                              f"more iterations or a larger penalty_weight")
+            settings = state.settings
+            looked = ["the best candidate"] + (["the final population"] if settings.population_fallback else []) + (
+                ["the fine-penalty repair"] if settings.repair_rounds else [])
+            raise NoPathFound(f"{self.name} ({settings.mode} mode): {', '.join(looked)} cut(s) a disc "
+                              f"(best clearance {state.best_gap_m:.4f} m); the penalty weight is "
+                              f"{settings.penalty_weight:g}, see the robust options of planners.run_settings")
         objective = state.objective
         polished = 0
         if state.settings.polish_rounds and not state.exhausted:

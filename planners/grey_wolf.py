@@ -12,6 +12,20 @@ mean of three positions, one drawn towards each leader:
 * ``x(t+1) = (x_1' + x_2' + x_3') / 3`` (Eq. 25; the extraction reads ``/ 2``,
   which would not average the three moves, so we take Mirjalili's ``/ 3``).
 
+``a`` falls over the run: ``a = 2 - 2 f`` with ``f`` the share of the run done
+(:attr:`planners.swarm.SwarmState.run_fraction`: iterations / ``iterations``, or, under an
+evaluation or time budget, the share of the budget spent), so that a budgeted run ends
+with ``a`` near 0 as the paper's 100 iterations do.
+
+Deviations from Abdulla & Hadi (2025), each our reading:
+
+* Sect. 3, Eqs. (6)-(8): the paper's objective is ``w1 F1 + w2 F2`` with no obstacle term
+  and no values of ``w1``, ``w2``; we add Kamil et al.'s (2020) penalty Eqs. (3)-(5) with
+  weight 1 (the same group's ABC paper; without an obstacle term nothing keeps a path out
+  of a disc) and default to ``w1 = 1``, ``w2 = 0`` (the length its Sect. 6 compares);
+* Sect. 6: "a population size of 0.5" is read as 50 wolves;
+* Eq. (25) divides by 3, not by the extraction's 2 (see above).
+
 Choices where the paper is silent: a new position is clipped to the search box;
 the pack moves without greedy selection (Mirjalili's original; mealpy's
 ``OriginalGWO`` keeps a wolf's old position when the new one is worse); the
@@ -67,7 +81,7 @@ class GreyWolfPlanner(ContinuousPlanner):
              iteration: int) -> None:
         wolves = state.population
         leaders = state.data["leaders"]                              # (3, D)
-        a = 2.0 - 2.0 * iteration / max(self.iterations, 1)
+        a = 2.0 - 2.0 * state.run_fraction
         shape = (3,) + wolves.shape                                  # (3, P, D)
         big_a = 2.0 * a * rng.random(shape) - a                      # Eq. (17)
         big_c = 2.0 * rng.random(shape)                              # Eq. (18)

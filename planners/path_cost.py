@@ -202,7 +202,7 @@ def inverse_fitness(objective: np.ndarray, epsilon: float = 0.001) -> np.ndarray
 class PathObjective:
     """The cost every continuous planner minimises (lower is better).
 
-    ``cost = w1 * length + w2 * smoothness + penalty_weight * (obstacle_penalty + bounds_penalty)``
+    ``cost = w1 * length + w2 * smoothness + penalty_weight * (obstacle_penalty [+ bounds_penalty])``
 
     With ``w2 = 0`` this is Kamil et al. 2020's ``F + $p`` (Eqs. (1)-(5), the reciprocal
     of its fitness Eq. (2)) with the penalty scaled; with ``w2 > 0`` it is Abdulla & Hadi
@@ -217,6 +217,7 @@ class PathObjective:
         bounds: the workspace.
         length_weight, smoothness_weight: ``w1`` and ``w2`` of Eq. (6).
         penalty_weight: multiplier of the penalty (Kamil et al. 2020 uses 1).
+        bounds_penalty: add :func:`bounds_penalty` (in neither paper: swarmnav's robust mode).
     """
 
     curve: ViaPointCurve
@@ -226,6 +227,7 @@ class PathObjective:
     length_weight: float = 1.0
     smoothness_weight: float = 0.0
     penalty_weight: float = 1.0
+    bounds_penalty: bool = True
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "cells", DiscCells(self.centres_m, self.penalty_radii_m))
@@ -251,7 +253,8 @@ class PathObjective:
             smoothness = smoothness_rad(block[0].T, block[1].T) if self.smoothness_weight else 0.0
             cost = weighted_objective(cost, smoothness, self.length_weight, self.smoothness_weight)
         penalty = obstacle_penalty_of_block(block, self.cells)
-        penalty += bounds_penalty_of_block(block, *self.limits)
+        if self.bounds_penalty:
+            penalty += bounds_penalty_of_block(block, *self.limits)
         penalty *= self.penalty_weight
         cost += penalty
         return cost

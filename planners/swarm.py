@@ -26,12 +26,25 @@ colonies send out fewer ants), and the loop stops, search or repair, once
 nothing is left.  If the run then has no feasible path and the budget is what
 stopped it, the loop raises :class:`planners.errors.BudgetExceeded` instead of
 ``NoPathFound``.
+
+**Budgets** (:class:`Budget`, :func:`apply_budget`): a study compares planners at a stated
+budget, the same for every planner.  ``Budget(evaluations=N)`` sets ``max_evaluations = N`` and
+makes ``iterations`` large enough (N: every iteration evaluates at least once) that the budget,
+not the iteration count, ends the search: the run spends exactly N evaluations unless its
+algorithm ends on its own first (a walk that reached the goal, a stall rule).  Every
+evaluation counts: the continuous planners' onlookers, scouts, repair and polish, an ant
+colony's tours (one ant's tour evaluated is one evaluation).  ``Budget(time_s=T)`` ends the
+search at the first iteration boundary after T seconds of wall time.  A schedule that runs
+"over the iterations" (GWO's ``a``) follows :attr:`SwarmState.run_fraction`, the share of the
+run spent by whichever limit ends it first.  Planners outside this loop may implement
+``with_budget(budget)`` themselves; the others ignore budgets (:func:`apply_budget` says so).
 """
 
 from __future__ import annotations
 
 import math
 import time
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -57,6 +70,9 @@ class SwarmState:
         done: set by ``step`` when the run is complete before the iteration limit
             (e.g. the robot reached the goal); the loop then stops.
         data: the algorithm's own arrays (pheromone, counters, ...).
+        run_fraction: the share of the run done when the current step starts: the largest of
+            iterations / iteration limit, evaluations / ``max_evaluations`` and wall time /
+            the time budget (set by the loop).
     """
 
     max_evaluations: int | None = None
@@ -67,6 +83,7 @@ class SwarmState:
     costs: np.ndarray | None = None
     done: bool = False
     data: dict[str, Any] = field(default_factory=dict)
+    run_fraction: float = 0.0
 
     @property
     def evaluations_left(self) -> float:
@@ -91,6 +108,33 @@ class SwarmState:
             self.best_solution = np.array(solutions[i], copy=True)
 
 
+@dataclass(frozen=True)
+class Budget:
+    """A study's budget for every planner: objective evaluations or wall time (one of them).
+
+    Attributes:
+        evaluations: objective evaluations (None: no such budget).
+        time_s: wall time of the search in seconds (None: no such budget).
+    """
+
+    evaluations: int | None = None
+    time_s: float | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        return {k: v for k, v in (("evaluations", self.evaluations), ("time_s", self.time_s)) if v is not None}
+
+
+def apply_budget(planner: Any, budget: Budget | None) -> tuple[Any, bool]:
+    """``planner`` under ``budget``, and whether it honours budgets (a planner without
+    ``with_budget``, e.g. an exact one, is returned as it is, with False)."""
+    if budget is None:
+        return planner, False
+    with_budget = getattr(planner, "with_budget", None)
+    if with_budget is None:
+        return planner, False
+    return with_budget(budget), True
+
+
 class SwarmPlanner:
     """Base class owning the loop: initialise, step, track the best, repair, stop.
 
@@ -101,8 +145,19 @@ class SwarmPlanner:
 
     iterations: int
     max_evaluations: int | None = None
+    #: Wall-time budget of the search (set by :meth:`with_budget`; not a parameter).
+    time_budget_s: float | None = None
     #: The state class this planner's hooks expect.
     state_type: ClassVar[type[SwarmState]] = SwarmState
+
+    def with_budget(self, budget: Budget) -> "SwarmPlanner":
+        """A copy of this planner that runs until ``budget`` is spent (see the module docstring)."""
+        if budget.evaluations is not None:
+            return dataclasses.replace(self, max_evaluations=int(budget.evaluations),
+                                       iterations=max(int(budget.evaluations), 1))
+        planner = dataclasses.replace(self, max_evaluations=None, iterations=2**31 - 1)
+        planner.time_budget_s = float(budget.time_s)
+        return planner
 
     # --------------------------------------------------------- hooks to supply
     def init_state(self, state: SwarmState, problem: Problem, rng: np.random.Generator) -> None:
@@ -124,7 +179,7 @@ class SwarmPlanner:
         """Iterations of the search (default: ``iterations``)."""
         return self.iterations
 
-    def repair_limit(self) -> int:
+    def repair_limit(self, state: SwarmState) -> int:
         """Most repair rounds after the search (default: none)."""
         return 0
 
@@ -151,9 +206,14 @@ class SwarmPlanner:
         spent = [state.evaluations]  # cumulative evaluations at each entry of ``history``
         done = 0
         converged_at = 0
-        for iteration in range(self.iteration_limit(problem)):
-            if state.done or state.exhausted:
+        limit = self.iteration_limit(problem)
+        for iteration in range(limit):
+            elapsed_s = time.perf_counter() - t0
+            if state.done or state.exhausted or (self.time_budget_s is not None and elapsed_s >= self.time_budget_s):
                 break
+            state.run_fraction = max(iteration / max(limit, 1),
+                                     state.evaluations / state.max_evaluations if state.max_evaluations else 0.0,
+                                     elapsed_s / self.time_budget_s if self.time_budget_s else 0.0)
             self.step(state, problem, rng, iteration)
             if state.best_cost < history[-1]:
                 converged_at = iteration + 1
@@ -161,18 +221,21 @@ class SwarmPlanner:
             spent.append(state.evaluations)
             done = iteration + 1
         repairs = 0
-        while repairs < self.repair_limit() and not state.exhausted and self.needs_repair(state, problem):
+        while repairs < self.repair_limit(state) and not state.exhausted and self.needs_repair(state, problem):
             self.repair_step(state, problem, rng, repairs)
             repairs += 1
         try:
             waypoints, extra = self.finish(state, problem, rng)
         except NoPathFound as exc:
+            # A failed run is data too: the error carries what the search spent (a study row records it).
             if state.exhausted:
-                raise BudgetExceeded(f"{exc} (the budget of {state.max_evaluations} evaluations is spent)") from exc
-            raise
+                exc = BudgetExceeded(f"{exc} (the budget of {state.max_evaluations} evaluations is spent)")
+            exc.evaluations, exc.iterations = state.evaluations, done
+            exc.plan_time_s = time.perf_counter() - t0
+            raise exc
         # The iteration (1-based) after which the best cost no longer improved.
         extra.setdefault("convergence_iteration", converged_at)
-        if self.repair_limit():
+        if self.repair_limit(state):
             extra.setdefault("repair_rounds", repairs)
         return Path.from_waypoints(waypoints, time.perf_counter() - t0, iterations=done,
                                    evaluations=state.evaluations,

@@ -74,7 +74,7 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
                         help="clearance beyond the robot radius (default 0, as in the papers)")
     parser.add_argument("--peer-scenario", default="gwo-scenario-1")
     parser.add_argument("--peer-runs", type=options.non_negative_int, default=3, help="mealpy runs per peer (0: none)")
-    parser.add_argument("--modes", nargs="+", default=["paper", "robust"], choices=["paper", "robust", "auto"])
+    parser.add_argument("--modes", nargs="+", default=["paper", "robust"], choices=["paper", "robust"])
     parser.add_argument("--fields", type=options.non_negative_int, default=10,
                         help="random disc fields of 10-40 discs (default 10; 0: none)")
     parser.add_argument("--out", metavar="DIR", help="keep the quality studies' rows in DIR/scenarios and DIR/fields "

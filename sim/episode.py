@@ -22,6 +22,7 @@ episode with them, on a :class:`~sim.runner.Simulation` compiled once per episod
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
@@ -35,6 +36,7 @@ from swarmnav.models.parameters import refuse_code
 from swarmnav.models.seeds import Seeds
 from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.planners.problem import Path, Planner, Problem, scenario_problem
+from swarmnav.planners.swarm import Budget, apply_budget
 from swarmnav.sim.recording import Recorder, RecorderGroup
 from swarmnav.sim.reference import reference_length_m, static_problem
 from swarmnav.sim.runner import Simulation
@@ -81,6 +83,7 @@ class EpisodeSpec:
     seed: int | None = None
     world_seed: int | None = None
     clearance_m: float | None = None  # the planning clearance beyond the robot radius; None = the scenario's
+    budget: Budget | None = None  # a study's budget for the planner (planners.swarm.Budget); None = none
 
     def resolved(self) -> "EpisodeSpec":
         """Every field filled in; the scenario carries the world seed."""
@@ -103,7 +106,7 @@ class EpisodeSpec:
         if self.clearance_m is not None:
             scenario = scenario.with_clearance(self.clearance_m)
         return EpisodeSpec(scenario, planner, planner_params, navigator, navigator_params, seed, world_seed,
-                           scenario.clearance_m)
+                           scenario.clearance_m, self.budget)
 
     @property
     def seeds(self) -> Seeds:
@@ -125,6 +128,8 @@ class Episode:
     scene: CompiledScene | None = field(default=None, repr=False)  # the scene to run; None: the scenario's
     result: RunResult | None = None
     _simulation: Simulation | None = field(default=None, repr=False)
+    planner_params: dict[str, Any] = field(default_factory=dict)  # every parameter of the planner, resolved
+    budgeted: bool = False  # the planner runs under ``spec.budget``
 
     @property
     def simulation(self) -> Simulation:
@@ -141,6 +146,8 @@ class Episode:
                 "length_m": stats.length_m, "plan_time_s": stats.plan_time_s,
                 "iterations": stats.iterations, "evaluations": stats.evaluations,
                 "collision_free": bool(self.problem.is_collision_free(self.path.waypoints)),
+                "planner_params": self.planner_params,
+                "budget": spec.budget.as_dict() if spec.budget is not None else None, "budgeted": self.budgeted,
                 "details": json_safe(stats.extra)}
 
     def summary(self) -> dict[str, Any]:
@@ -167,11 +174,26 @@ def plan_episode(spec: EpisodeSpec, scene: CompiledScene | None = None) -> Episo
     """
     spec = spec.resolved()
     source = spec.scenario.source_path
-    planner = make_planner(spec.planner, spec.planner_params, source)
+    planner, budgeted = build_planner(spec)
     navigator = make_navigator(spec.navigator, spec.navigator_params, source)  # fails before planning
     problem = scenario_problem(spec.scenario)
     path = planner.plan(problem, np.random.default_rng(spec.seed))
-    return Episode(spec, problem, path, planner, navigator, scene)
+    return Episode(spec, problem, path, planner, navigator, scene, planner_params=resolved_params(planner),
+                   budgeted=budgeted)
+
+
+def build_planner(spec: EpisodeSpec) -> tuple[Any, bool]:
+    """The run's one configured planner (a resolved spec's), under its budget, and whether it honours
+    the budget: the first plan and every replan of the navigator use it."""
+    planner = make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)
+    return apply_budget(planner, spec.budget)
+
+
+def resolved_params(planner: Any) -> dict[str, Any]:
+    """Every parameter of a planner as it runs (its dataclass fields, defaults included; JSON values)."""
+    if not dataclasses.is_dataclass(planner):
+        return {}
+    return json_safe({f.name: getattr(planner, f.name) for f in dataclasses.fields(planner) if f.init})
 
 
 def run_episode(episode: Episode | EpisodeSpec, recorders: Sequence[Recorder] = (), *,
@@ -196,12 +218,13 @@ def run_episode(episode: Episode | EpisodeSpec, recorders: Sequence[Recorder] = 
         max_speed_m_s=scenario.max_speed_m_s, known_problem=static_problem(scenario),
         scenario=scenario)
     recorder = RecorderGroup(list(recorders)) if recorders else None
-    context = simulation.context(spec.planner, spec.planner_params, spec.seed, spec.navigator,
-                                 spec.navigator_params) if recorder is not None else None
+    # The log records every resolved parameter (replaying them builds the same planner).
+    context = simulation.context(spec.planner, planned.planner_params or spec.planner_params, spec.seed,
+                                 spec.navigator, spec.navigator_params) if recorder is not None else None
     result = simulation.run(navigator, setup, recorder=recorder, context=context,
                             time_limit_s=time_limit_s, stop_on_collision=stop_on_collision)
     return replace(planned, result=result)
 
 
-__all__ = ["Episode", "EpisodeSpec", "NAVIGATOR_STREAM", "json_safe", "plan_episode", "reference_length_m",
-           "run_episode", "static_problem"]
+__all__ = ["Episode", "EpisodeSpec", "NAVIGATOR_STREAM", "build_planner", "json_safe", "plan_episode",
+           "reference_length_m", "resolved_params", "run_episode", "static_problem"]

@@ -27,7 +27,7 @@ reference = "gwo"
 
 [[planners]]
 name = "gwo"
-params = { population = 10, iterations = 8 }
+params = { population = 10, iterations = 8, mode = "robust" }   # the paper mode ends inside a disc here
 
 [[planners]]
 name = "rrt_star"

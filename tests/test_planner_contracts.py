@@ -115,7 +115,7 @@ def test_the_repair_counts_against_the_budget():
     """Without a budget the repair would spend its own evaluations; with one it stops at it."""
     problem = scenario_problem(load_scenario("dense-field-30"))
     # the robust mode's grid guess and plain fit (its tangent guess needs no repair here)
-    params = {"population": 10, "iterations": 5, "guess": "grid", "fit_push_rounds": 0}
+    params = {"population": 10, "iterations": 5, "guess": "grid", "fit_push_rounds": 0, "mode": "robust"}
     unlimited = make_planner("abc", params)
     repaired = None
     for seed in range(20):
@@ -142,7 +142,7 @@ def test_the_repair_counts_against_the_budget():
 def test_budget_spent_without_a_path_is_budget_exceeded():
     problem = scenario_problem(load_scenario("dense-field-30"))
     with pytest.raises(BudgetExceeded):   # the robust mode's grid guess, plain fit (the tangent one finds it)
-        make_planner("gwo", {"max_evaluations": 60, "guess": "grid", "fit_push_rounds": 0}).plan(
+        make_planner("gwo", {"max_evaluations": 60, "guess": "grid", "fit_push_rounds": 0, "mode": "robust"}).plan(
             problem, np.random.default_rng(1))
     # Without a budget the same failure is NoPathFound (the paper's gwo: the robust mode's
     # seeded start would find a path even with four wolves and one iteration).
@@ -197,7 +197,7 @@ def test_evaluation_history_is_cumulative_and_matches_the_cost_history(planner_n
     problem = problems["restaurant-table-2" if "discs" in PLANNERS[planner_name].supports else "iaco-complex"]
     params = small_budget(planner_name)
     if "polish_rounds" in fields_of(planner_name):
-        params.update(polish_rounds=0, repair_rounds=0)
+        params.update(polish_rounds=0, repair_rounds=0, penalty_weight=1000.0, penalty_margin_m=0.02)
     try:
         path = make_planner(planner_name, params).plan(problem, np.random.default_rng(3))
     except PlanningError:
@@ -214,7 +214,7 @@ def test_evaluation_history_is_cumulative_and_matches_the_cost_history(planner_n
 
 def test_the_repair_and_polish_come_after_the_last_recorded_iteration():
     problem = scenario_problem(load_scenario("restaurant-table-2"))
-    params = {"population": 20, "iterations": 20}
+    params = {"population": 20, "iterations": 20, "mode": "robust"}
     bare = make_planner("gwo", dict(params, polish_rounds=0)).plan(problem, np.random.default_rng(3))
     polished = make_planner("gwo", params).plan(problem, np.random.default_rng(3))
     assert polished.stats.extra["polish_rounds"] > 0
@@ -224,22 +224,28 @@ def test_the_repair_and_polish_come_after_the_last_recorded_iteration():
 
 
 def test_bee_colony_history_counts_employed_onlookers_and_scouts():
-    """Karaboga's ABC: SN to score the first sources, then 2 SN a cycle plus one per scout, so cycles
-    differ (an even spread of the total would not)."""
+    """Karaboga's ABC: SN to score the first sources, then 2 SN a cycle plus the scout (Kamil et al. 2020
+    abandon the worst exhausted source only: at most one a cycle), so cycles differ (an even spread of the
+    total would not); ``scouts = "all"`` abandons every exhausted source."""
     problem = scenario_problem(load_scenario("restaurant-table-2"))
     sources = 20
-    path = make_planner("abc", {"population": sources, "iterations": 20, "limit": 2}).plan(
-        problem, np.random.default_rng(3))
+    params = {"population": sources, "iterations": 20, "limit": 6, "mode": "robust", "stall_evaluations": 0}
+    path = make_planner("abc", params).plan(problem, np.random.default_rng(3))
     history = np.array(path.stats.evaluation_history)
     steps = np.diff(history)
     assert history[0] == sources
-    assert np.all(steps >= 2 * sources) and np.all(steps <= 3 * sources)
+    assert np.all(steps >= 2 * sources) and np.all(steps <= 2 * sources + 1)
+    assert len(set(steps.tolist())) > 1
+    every = make_planner("abc", dict(params, scouts="all", limit=2)).plan(problem, np.random.default_rng(3))
+    steps = np.diff(every.stats.evaluation_history)
+    assert np.all(steps <= 3 * sources) and steps.max() > 2 * sources + 1
     assert len(set(steps.tolist())) > 1
 
 
 def test_pso_spends_one_swarm_an_iteration():
     problem = scenario_problem(load_scenario("restaurant-table-2"))
-    path = make_planner("pso", {"population": 12, "iterations": 8}).plan(problem, np.random.default_rng(3))
+    path = make_planner("pso", {"population": 12, "iterations": 8, "mode": "robust", "stall_evaluations": 0}).plan(
+        problem, np.random.default_rng(3))
     assert np.array_equal(np.diff(path.stats.evaluation_history), np.full(8, 12))
 
 
@@ -248,8 +254,8 @@ def test_a_via_point_growth_keeps_the_last_search_after_the_failed_ones():
     evaluation counts start after what the failed search spent, so they still end at the total."""
     problem = scenario_problem(load_scenario("restaurant-table-5"))
     population, iterations = 10, 5
-    params = dict(population=population, iterations=iterations, via_points=1, seed_fraction=0.0, polish_rounds=0,
-                  repair_rounds=0)
+    params = dict(population=population, iterations=iterations, via_points=1, guess_fraction=0.0, polish_rounds=0,
+                  repair_rounds=0, mode="robust")
     grown = None
     for seed in range(10):
         try:

@@ -1,5 +1,5 @@
-"""The continuous planners' modes: the paper's algorithm on the papers' instances, the robust
-options elsewhere (planners/continuous.py, path_guess.py, polish.py, paper_instances.py)."""
+"""The continuous planners' robust mode and its options (planners/continuous.py, run_settings.py,
+path_guess.py, polish.py); the paper mode's independence of the scene's file is in test_fair_comparison.py."""
 
 from __future__ import annotations
 
@@ -24,18 +24,6 @@ def _optimum(problem) -> float:
 
 
 @pytest.mark.parametrize("planner", CONTINUOUS)
-def test_auto_is_the_paper_on_the_papers_instances_and_robust_elsewhere(planner):
-    paper_scene = scenario_problem(load_scenario("gwo-scenario-1"), clearance_m=0.0)
-    auto = make_planner(planner, SMALL).plan(paper_scene, np.random.default_rng(2))
-    paper = make_planner(planner, dict(SMALL, mode="paper")).plan(paper_scene, np.random.default_rng(2))
-    assert auto.stats.extra["mode"] == "paper" and auto.stats.extra["paper_instance"] == "gwo-scenario-1"
-    assert auto.same_as(paper)
-    assert auto.stats.extra["via_point_count"] == 3
-    other = scenario_problem(load_scenario("restaurant-table-5"))
-    assert make_planner(planner, SMALL).plan(other, np.random.default_rng(2)).stats.extra["mode"] == "robust"
-
-
-@pytest.mark.parametrize("planner", CONTINUOUS)
 @pytest.mark.parametrize("field", [(15, 3), (30, 5), (40, 9)])
 def test_robust_on_random_fields_is_feasible_and_near_the_optimum(planner, field):
     problem = random_disc_field(*field)
@@ -56,7 +44,7 @@ def test_robust_same_seed_same_path(planner):
     again = make_planner(planner, dict(SMALL, mode="robust")).plan(problem, np.random.default_rng(4))
     assert first.same_as(again)
     # The seeded fit may win whatever the seed; without seeds the draws show.
-    unseeded = dict(SMALL, mode="robust", seed_fraction=0.0, via_points=5)
+    unseeded = dict(SMALL, mode="robust", guess_fraction=0.0, via_points=5)
     first = make_planner(planner, unseeded).plan(problem, np.random.default_rng(4))
     other = make_planner(planner, unseeded).plan(problem, np.random.default_rng(5))
     assert not first.same_as(other)
@@ -144,15 +132,17 @@ def test_pushed_fit_clears_the_discs_the_plain_fit_cuts():
 @pytest.mark.parametrize("planner", CONTINUOUS)
 def test_the_robust_search_stops_on_stall_and_the_paper_runs_every_iteration(planner):
     problem = random_disc_field(20, 1)
-    stalled = make_planner(planner, {"mode": "robust"}).plan(problem, np.random.default_rng(3))
-    full = make_planner(planner, {"mode": "robust", "stall_evaluations": 0}).plan(problem, np.random.default_rng(3))
+    stalled = make_planner(planner, {"mode": "robust", "iterations": 100}).plan(problem, np.random.default_rng(3))
+    full = make_planner(planner, {"mode": "robust", "iterations": 100, "stall_evaluations": 0}).plan(
+        problem, np.random.default_rng(3))
     assert stalled.stats.extra["stopped_on_stall"] and not full.stats.extra["stopped_on_stall"]
     assert stalled.stats.iterations < full.stats.iterations == 100
     assert stalled.stats.evaluations < full.stats.evaluations
     # the last improvement of the best by more than the tolerance is at least 10 populations back
     history = np.asarray(stalled.stats.cost_history)
     assert history[-1] >= history[-2] * (1.0 - 1e-4)
-    paper = make_planner(planner, dict(SMALL, mode="paper")).plan(
+    paper = make_planner(planner, dict(SMALL, mode="paper", penalty_weight=1000.0, penalty_margin_m=0.02,
+                                       population_fallback=True)).plan(
         scenario_problem(load_scenario("gwo-scenario-1"), clearance_m=0.0), np.random.default_rng(3))
     assert paper.stats.iterations == SMALL["iterations"] and not paper.stats.extra["stopped_on_stall"]
 
@@ -223,8 +213,7 @@ def test_robust_guess_is_the_tangent_graph_up_to_its_disc_limit_then_the_grid():
     large = make_planner("gwo", dict(SMALL, mode="robust")).plan(lattice(MAX_TANGENT_DISCS + 1),
                                                                 np.random.default_rng(0))
     assert small.stats.extra["guess"] == "tangent" and large.stats.extra["guess"] == "grid"
-    paper = make_planner("gwo", dict(SMALL, mode="paper")).plan(lattice(16), np.random.default_rng(0))
-    assert paper.stats.extra["guess"] is None
+    assert make_planner("gwo", dict(SMALL, mode="paper")).settings_for(lattice(16)).guess == "none"
 
 
 @pytest.mark.parametrize("scenario", ["adl-abc-path-1", "adl-abc-path-2"])

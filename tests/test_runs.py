@@ -57,8 +57,11 @@ def test_an_empty_arena_reports_no_clearance_rather_than_infinity():
 
 
 @pytest.mark.parametrize("scenario_name, planner_name, params", [
-    ("gwo-scenario-1", "gwo", {"population": 30, "iterations": 60}),
-    ("gwo-scenario-1", "adl_abc", {"population": 30, "iterations": 60}),
+    # The paper mode with the gwo-vs-abc study's penalty (weight 1 ends inside a disc: NoPathFound).
+    ("gwo-scenario-1", "gwo", {"population": 30, "iterations": 60, "penalty_weight": 1000.0, "penalty_margin_m": 0.02,
+                               "population_fallback": True}),
+    ("gwo-scenario-1", "adl_abc", {"population": 30, "iterations": 60, "penalty_weight": 1000.0,
+                                   "penalty_margin_m": 0.02, "population_fallback": True}),
     ("gwo-scenario-1", "optimal", {}),
     ("immas-env1-scattered", "immas", {}),
 ])

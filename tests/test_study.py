@@ -31,7 +31,7 @@ seeds = 3
 name = "astar"
 [[planners]]
 name = "gwo"
-params = {{ population = 10, iterations = 10 }}
+params = {{ population = 10, iterations = 10, mode = "robust" }}   # the paper mode ends inside a disc here
 """
 TINY_TIME_LIMIT_S = 4.0
 
@@ -409,7 +409,8 @@ def test_an_unreachable_ray_address_is_one_line_naming_the_option(tmp_path):
 
 
 ABC_PLAN_ONLY = ('name = "abc-progress"\nscenarios = ["restaurant-table-2"]\nseeds = 2\n'
-                 '[[planners]]\nname = "abc"\nparams = { population = 10, iterations = 12, limit = 2 }\n')
+                 '[[planners]]\nname = "abc"\nparams = { population = 10, iterations = 12, limit = 6, mode = "robust", '
+                 'stall_evaluations = 0 }\n')
 
 
 def test_progress_rows_are_the_planners_own_evaluation_history():

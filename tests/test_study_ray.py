@@ -30,7 +30,7 @@ seeds = [0, 1]
 name = "astar"
 [[planners]]
 name = "gwo"
-params = { population = 10, iterations = 10 }
+params = { population = 10, iterations = 10, mode = "robust" }   # the paper mode ends inside a disc here
 """
 
 

@@ -37,6 +37,14 @@ at reset, and at every control step:
    step (the repair is incremental, so retrying is cheap); one
    ``replan_failed`` event per blocked spell.
 
+**Its own planner.**  Every path this navigator follows, the first one included, is D* Lite's
+on its grid: the run's planner plans the episode's first path (``plan --json``, the row's
+``plan_*`` columns), but this navigator does not follow it.  Its ``planner`` parameter names
+that (``"dstar_lite"``, the only value: an incremental repair needs D* Lite's cost-to-goal
+field, which no swarm planner keeps), so a row of "gwo + dstar_replan" says in its
+navigator parameters that the robot drove D* Lite's paths; the ``replan`` navigator is the
+one that replans with the run's own planner and parameters.
+
 ``cell_m`` = 0 uses the scenario's ``sim.cell_m`` (a map scenario's own cells
 always).  The optional safety filter is the one every navigator shares.
 Planning wall time (``replan_wall_s``) counts the D* Lite repairs only.
@@ -57,6 +65,7 @@ from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationSt
 from swarmnav.controllers.navigators.replan import check_positive, keep_outside
 from swarmnav.controllers.prediction import swept_discs
 from swarmnav.controllers.safety_filter import SafetyFilter
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import rasterise
 from swarmnav.planners.dstar_lite import DStarLite
 from swarmnav.planners.errors import NoPathFound
@@ -77,6 +86,7 @@ class DStarReplanNavigator:
         improvement_m: a new path replaces a still-free one only when shorter by more than this.
         update_period_s: the sweeps are marked (and D* Lite repaired) at most this often.
         safety_filter, time_before_collision_s: the optional Nav2-style filter.
+        planner: the planner of every path followed: ``"dstar_lite"`` (the only one; see the module docstring).
     """
 
     name: ClassVar[str] = "dstar_replan"
@@ -94,10 +104,14 @@ class DStarReplanNavigator:
     update_period_s: float = 0.2
     safety_filter: bool = False
     time_before_collision_s: float = 1.0
+    planner: str = "dstar_lite"
 
     def __post_init__(self) -> None:
         check_positive(self, ("horizon_s", "time_before_collision_s"),
                        ("margin_m", "cell_m", "improvement_m", "update_period_s"))
+        if self.planner != "dstar_lite":
+            raise ConfigError("navigator.params.planner",
+                              f"must be 'dstar_lite' (this navigator repairs D* Lite's own paths), got {self.planner!r}")
 
     def reset(self, setup: NavigationSetup) -> None:
         known = setup.map_problem

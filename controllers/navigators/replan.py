@@ -12,9 +12,11 @@ are used; our choices:
   over ``horizon_s`` (:func:`~controllers.prediction.swept_discs`) and grown by
   the robot radius plus ``margin_m``, comes within reach of the path ahead of
   the robot (the next ``lookahead_m`` of it).  Velocities are used.
-* **Replanning**: with the scenario's own planner (any registered planner, the
-  run's generator), from the current pose to the goal, on the known map (the
-  static obstacles only: ``NavigationSetup.map_problem``) plus the swept discs
+* **Replanning**: with the run's one configured planner (any registered planner, with the
+  parameters and mode the run names, under the run's budget if a study set one, built from
+  the same spec as the first plan's planner; the run's generator), from the current pose
+  to the goal, on the known map (the static obstacles only: ``NavigationSetup.map_problem``)
+  plus the swept discs
   of every sensed obstacle.  A swept disc that would contain the robot's
   current position (an obstacle already close) is shrunk to leave it outside,
   or dropped; likewise for the goal's future sweeps.  But while a sensed
@@ -99,7 +101,7 @@ def sensed_problem(known: Problem, pose: Pose2D, sensed: list[Disc]) -> Problem:
 
 @dataclass
 class ReplanNavigator:
-    """Follow, and replan with the scenario's planner when a sensed sweep blocks the path ahead.
+    """Follow, and replan with the run's planner when a sensed sweep blocks the path ahead.
 
     Args:
         lookahead_m: how much of the path ahead is checked.

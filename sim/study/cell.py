@@ -24,7 +24,8 @@ from typing import Any
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.planners.errors import PlanningError
-from swarmnav.sim.episode import EpisodeSpec, json_safe, plan_episode, run_episode
+from swarmnav.planners.swarm import Budget
+from swarmnav.sim.episode import EpisodeSpec, build_planner, json_safe, plan_episode, resolved_params, run_episode
 from swarmnav.sim.study.grid import Cell
 from swarmnav.sim.trajectory_metrics import bends, count_turns
 from swarmnav.sim.versions import software_versions
@@ -113,7 +114,10 @@ def base_row(cell: Cell) -> dict[str, Any]:
             "planner_params": json.dumps(cell.planner_params, sort_keys=True), "navigator": cell.navigator,
             "navigator_label": cell.navigator_label,
             "navigator_params": json.dumps(cell.navigator_params, sort_keys=True), "seed": cell.seed,
-            "world_seed": cell.world_seed, "mode": cell.mode}
+            "world_seed": cell.world_seed, "mode": cell.mode,
+            "budget": None if cell.budget is None else json.dumps(cell.budget, sort_keys=True),
+            "budget_evaluations": (cell.budget or {}).get("evaluations"),
+            "budget_time_s": (cell.budget or {}).get("time_s")}
 
 
 def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], list[dict[str, Any]]]:
@@ -128,8 +132,12 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
             row["straight_line_m"] = math.hypot(scenario.goal.x_m - scenario.start.x_m,
                                                 scenario.goal.y_m - scenario.start.y_m)
             spec = EpisodeSpec(scenario, cell.planner, cell.planner_params, cell.navigator, cell.navigator_params,
-                               seed=cell.seed, world_seed=cell.world_seed, clearance_m=cell.clearance_m)
+                               seed=cell.seed, world_seed=cell.world_seed, clearance_m=cell.clearance_m,
+                               budget=None if cell.budget is None else Budget(**cell.budget))
             row["clearance_m"] = scenario.clearance_m if cell.clearance_m is None else cell.clearance_m
+            planner, budgeted = build_planner(spec.resolved())   # recorded for every row, failed ones too
+            row.update(planner_resolved=json.dumps(resolved_params(planner), sort_keys=True), budgeted=budgeted,
+                       plan_mode=getattr(planner, "mode", None))
             episode = plan_episode(spec)
             if cell.physics:
                 tally = EventTally()
@@ -146,7 +154,9 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
         row.update(outcome="timeout", error=f"exceeded the wall limit of {cell.wall_limit_s:g} s")
         episode = None
     except PlanningError as exc:
-        row.update(outcome="no_path", error=f"{type(exc).__name__}: {exc}")
+        # What the failed search spent, when the planner says (the swarm loop does).
+        row.update(outcome="no_path", error=f"{type(exc).__name__}: {exc}",
+                   plan_evaluations=getattr(exc, "evaluations", None), plan_time_s=getattr(exc, "plan_time_s", None))
         episode = None
     except Exception as exc:  # noqa: BLE001 - a failing run is a row, never the end of the study
         row.update(outcome="error", error=f"{type(exc).__name__}: {exc}")

@@ -1,8 +1,8 @@
 """A study's grid: every (scenario, planner setting, navigator setting, seed, world seed) cell.
 
 A cell's configuration hash covers what decides its result: the scenario file's
-bytes, the planner and navigator with their labels and parameters, both seeds, the mode and
-the simulated-time limit.  Resuming skips the cells whose hash is already in the
+bytes, the planner and navigator with their labels and parameters, both seeds, the mode,
+the simulated-time limit, and the clearance and budget when the study sets them.  Resuming skips the cells whose hash is already in the
 rows; an edited scenario or parameter is a new cell.
 """
 
@@ -39,6 +39,7 @@ class Cell:
     config_hash: str
     clearance_m: float | None = None  # the study's planning clearance override (None: the scenario's)
     trust_code: bool = False  # the study's --trust-code (not part of the hash: it decides no result)
+    budget: dict[str, Any] | None = None  # the planner's budget, {"evaluations": N} or {"time_s": T} (None: none)
 
     @property
     def physics(self) -> bool:
@@ -83,6 +84,9 @@ def iter_cells(study: Study) -> Iterator[Cell]:
                       "world_seed": world_seed, "mode": study.mode, "time_limit_s": study.time_limit_s}
             if study.clearance_m is not None:  # absent otherwise: earlier hashes hold
                 config["clearance_m"] = study.clearance_m
+            budget = study.budget_of(planner)
+            if budget is not None:  # likewise
+                config["budget"] = budget.as_dict()
             yield Cell(
                 study=study.name, scenario=scenario, scenario_name=FilePath(scenario).stem,
                 planner=planner.name, label=label,
@@ -91,7 +95,8 @@ def iter_cells(study: Study) -> Iterator[Cell]:
                 navigator_params=navigator_params, seed=seed, world_seed=world_seed,
                 mode=study.mode, time_limit_s=study.time_limit_s,
                 wall_limit_s=study.wall_limit_s, config_hash=config_hash(config),
-                clearance_m=study.clearance_m, trust_code=study.trust_code)
+                clearance_m=study.clearance_m, trust_code=study.trust_code,
+                budget=None if budget is None else budget.as_dict())
 
 
 def count_cells(study: Study) -> int:

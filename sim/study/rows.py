@@ -56,6 +56,8 @@ RUN_SCHEMA = pa.schema([
     ("replans", pa.int64()), ("replan_wall_s", pa.float64()), ("stopped_s", pa.float64()),
     ("safety_triggers", pa.int64()), ("control_steps", pa.int64()), ("navigator_wall_s", pa.float64()),
     ("driven_turns", pa.int64()), ("run_events", pa.string()),
+    ("budget", pa.string()), ("budget_evaluations", pa.int64()), ("budget_time_s", pa.float64()),
+    ("budgeted", pa.bool_()), ("plan_mode", pa.string()), ("planner_resolved", pa.string()),
 ])
 PROGRESS_SCHEMA = pa.schema([
     ("config_hash", pa.string()), ("iteration", pa.int64()), ("best_cost", pa.float64()),

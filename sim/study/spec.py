@@ -16,11 +16,14 @@ TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) o
                                      # scenario (default: each scenario's robot.clearance_m)
     reference = "gwo"                # the planner label (or one swept arm, "maco(p0=0.9)") the statistics
                                      # compare against (default: the first)
+    budget = { evaluations = 5000 }  # optional: every planner of the study runs until it has spent this
+                                     # budget (or { time_s = 2.0 }); see planners.swarm.Budget
 
     [[planners]]
     name = "gwo"                     # a name in the planner registry
     label = "GWO"                    # optional; default: the name
     params = { population = 50, iterations = [50, 100] }   # a list sweeps that parameter
+    budget = { evaluations = 10000 } # optional: this entry's own budget (default: the study's)
 
     [[navigators]]                   # optional; default: one navigator, follow
     name = "follow"
@@ -31,6 +34,9 @@ TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) o
     metric = "plan_length_m"
     value = 14.14
     note = "Table 2"
+
+    [[claims]]                       # optional: a claim of the paper the study tests (schema: the
+    id = "gwo-shorter"               # report's claims section); kept as given here
 
 Every problem is a :class:`ConfigError` naming the field (``planners[1].params.alpha``).
 """
@@ -51,6 +57,7 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, load_scenario, resolve_scenario_path
 from swarmnav.models.parameters import refuse_code
 from swarmnav.planners.registry import PLANNERS, make_planner
+from swarmnav.planners.swarm import Budget
 
 MAX_SEEDS = 100_000  # seeds (or world seeds) of one study
 MAX_SEED = 2**63 - 1  # as --seed and a scenario's seed (a TOML integer; NumPy's seeds take it)
@@ -60,7 +67,7 @@ STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bu
 MODES = ("plan", "physics")
 TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
             "time_limit_s", "reference", "planners", "navigators", "paper", "clearance_m",
-            "paired_seeds", "claims"}
+            "paired_seeds", "budget", "claims"}
 
 
 @dataclass(frozen=True)
@@ -71,6 +78,7 @@ class Component:
     label: str
     params: dict[str, Any]  # a list value is a sweep
     swept: tuple[str, ...]  # the keys that sweep
+    budget: Budget | None = None  # this entry's budget (None: the study's)
 
     def settings(self) -> list[dict[str, Any]]:
         """Every parameter table of the sweep (the Cartesian product of the lists), in file order."""
@@ -108,6 +116,11 @@ class Study:
     paired_seeds: bool = False  # the k-th seed runs with the k-th world seed only
     claims: tuple[dict[str, Any], ...] = ()  # [[claims]] tables as written (their verdicts: swarmnav report)
     trust_code: bool = False  # --trust-code: its files (study, scenarios) may name code to run
+    budget: Budget | None = None  # every planner's budget, unless its entry names its own
+
+    def budget_of(self, planner: Component) -> Budget | None:
+        """The budget a planner entry runs under: its own, else the study's."""
+        return planner.budget or self.budget
 
     def seed_pairs(self) -> list[tuple[int | None, int]]:
         """(world seed, seed) of every run of one setting, in the grid's order."""
@@ -235,7 +248,8 @@ def _components(source: str, value: Any, key: str, kind: str, make, trust_code: 
         where = f"{key}[{i}]"
         if not isinstance(entry, dict):
             _fail(source, where, "expected a table")
-        for k in sorted(set(entry) - {"name", "label", "params"}):
+        allowed = {"name", "label", "params"} | ({"budget"} if kind == "planner" else set())
+        for k in sorted(set(entry) - allowed):
             _fail(source, f"{where}.{k}", "unknown key")
         name = _string(source, entry, "name", f"{where}.name")
         label = _string(source, entry, "label", f"{where}.label", name)
@@ -246,7 +260,8 @@ def _components(source: str, value: Any, key: str, kind: str, make, trust_code: 
         for k in swept:
             if not params[k]:
                 _fail(source, f"{where}.params.{k}", "empty grid: the sweep lists no value")
-        component = Component(name, label, dict(params), swept)
+        budget = _budget(source, entry["budget"], f"{where}.budget") if "budget" in entry else None
+        component = Component(name, label, dict(params), swept, budget)
         for setting in component.settings():  # every combination builds: names and every swept value checked
             try:
                 make(name, setting, source, trust_code=trust_code)
@@ -276,6 +291,23 @@ def _refuse_scenario_code(scenarios: tuple[str, ...], planners: tuple[Component,
                 if component.name == own:
                     unset = {k: v for k, v in params.items() if k not in component.params}
                     refuse_code(registry, kind, own, unset, scenario.source_path)
+def _budget(source: str, value: Any, field: str) -> Budget:
+    """``{ evaluations = N }`` (a positive integer) or ``{ time_s = T }`` (positive seconds)."""
+    if not isinstance(value, dict):
+        _fail(source, field, f"expected a table {{ evaluations = N }} or {{ time_s = T }}, got {value!r}")
+    for k in sorted(set(value) - {"evaluations", "time_s"}):
+        _fail(source, f"{field}.{k}", "unknown key (expected evaluations or time_s)")
+    if len(value) != 1:
+        _fail(source, field, "expected exactly one of evaluations or time_s")
+    if "evaluations" in value:
+        count = value["evaluations"]
+        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+            _fail(source, f"{field}.evaluations", f"expected a positive integer, got {count!r}")
+        return Budget(evaluations=count)
+    time_s = _number(source, value["time_s"], f"{field}.time_s")
+    if not 0 < time_s < float("inf"):
+        _fail(source, f"{field}.time_s", f"must be positive and finite, got {time_s:g}")
+    return Budget(time_s=time_s)
 
 
 def _paper(source: str, value: Any, scenarios: tuple[str, ...], labels: list[str]) -> tuple[PaperValue, ...]:
@@ -380,6 +412,7 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
     claims = data.get("claims", [])
     if not isinstance(claims, list) or not all(isinstance(c, dict) for c in claims):
         _fail(source, "claims", "expected an array of [[claims]] tables")
+    budget = _budget(source, data["budget"], "budget") if "budget" in data else None
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
                  reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired,
-                 tuple(claims), bool(trust_code))
+                 tuple(claims), bool(trust_code), budget)
