@@ -212,7 +212,7 @@ class ContinuousPlanner(SwarmPlanner):
         "via_points": within(1, 1000), "samples": within(2, 1e9), "length_weight": within(0, 1e6),
         "smoothness_weight": within(0, 1e6), "penalty_weight": above(0, 1e12), "penalty_margin_m": within(0, 100),
         "waypoint_spacing_m": within(0.001, 100), "repair_rounds": within(0, 100_000),
-        "seed_fraction": within(0, 1), "seed_spread_m": within(0, 100), "guess_cell_m": within(0.01, 100),
+        "guess_fraction": within(0, 1), "guess_spread_m": within(0, 100), "guess_cell_m": within(0.01, 100),
         "polish_rounds": within(0, 100_000), "polish_step_m": above(0, 100), "via_point_growth": within(0, 10),
         "guess_margin_m": within(0, 100), "fit_push_rounds": within(0, 100_000),
         "stall_evaluations": within(0, 1e9), "stall_tolerance": within(0, 1)}  # models.parameters: checked on build

@@ -56,12 +56,14 @@ import functools
 import math
 import threading
 import time
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
 
 from swarmnav.models.geometry import segment_disc_distance
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
 
@@ -171,6 +173,17 @@ class OmplPlanner:
     max_evaluations: int | None = 5000
     time_s: float | None = None
     round_evaluations: int = 100
+    # models.parameters checks these on build: collision checks are a few microseconds each, so 10^8 is minutes.
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "max_evaluations": within(0, 100_000_000), "time_s": within(0, 86_400),
+        "round_evaluations": within(1, 100_000_000)}
+
+    def with_budget(self, budget) -> "OmplPlanner":
+        """A copy that runs to a study's budget: ``evaluations`` as collision checks (this planner's own unit
+        of work, which its rows count as evaluations), or ``time_s`` of wall-clock time with no check limit."""
+        if budget.evaluations is not None:
+            return dataclasses.replace(self, max_evaluations=int(budget.evaluations), time_s=None)
+        return dataclasses.replace(self, max_evaluations=None, time_s=float(budget.time_s))
 
     def __post_init__(self) -> None:
         check_parameters(self, (
@@ -306,6 +319,8 @@ class RRTStarPlanner(_TreePlanner):
     range_m: float = 0.0
     goal_bias: float = 0.05
     rewire_factor: float = 1.1
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "range_m": within(0, 1e6), "goal_bias": within(0, 1), "rewire_factor": above(0, 1e3)}
 
     def check_own_parameters(self) -> None:
         check_parameters(self, (
@@ -349,6 +364,8 @@ class BITStarPlanner(_TreePlanner):
 
     samples_per_batch: int = 100
     rewire_factor: float = 1.1
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "samples_per_batch": within(1, 1_000_000), "rewire_factor": above(0, 1e3)}
 
     def check_own_parameters(self) -> None:
         check_parameters(self, (

@@ -40,6 +40,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.kinematics import wheel_speeds
@@ -79,6 +80,15 @@ class MppiNavigator:
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
+    # noise_bank x samples x horizon_steps x 2 float32 are drawn at reset: at most 16 x 20,000 x 100 x 2 (256 MB)
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "samples": within(1, 20_000), "horizon_steps": within(1, 100), "model_dt_s": above(0, 10),
+        "linear_std_m_s": within(0, 100), "angular_std_rad_s": within(0, 100), "temperature": above(0, 1e6),
+        "control_cost": within(0, 1e6), "margin_m": within(0, 100), "repulsion_m": within(0, 100),
+        "repulsion_weight": within(0, 1e6), "collision_cost": within(0, 1e9), "lookahead_m": above(0, 1000),
+        "follow_weight": within(0, 1e6), "path_weight": within(0, 1e6), "goal_radius_m": within(0, 1000),
+        "goal_weight": within(0, 1e6), "max_angular_rad_s": above(0, 100), "noise_bank": within(1, 16),
+        "optimise_period_s": within(0, 10), "time_before_collision_s": within(0, 600)}
 
     samples: int = 1000
     horizon_steps: int = 30

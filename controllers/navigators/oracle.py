@@ -28,6 +28,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
@@ -52,6 +53,11 @@ class ClairvoyantOracleNavigator:
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0     # its search runs in reset(), not in step()
     clairvoyant: ClassVar[bool] = True       # benchmarks report it as the yardstick, never as a contender
+    # the lattice coarsens itself past 10^8 state-ticks, so a fine cell costs time, not memory (models.parameters)
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "cell_m": within(0.01, 10), "speed_fraction": above(0, 1), "turn_rate_rad_s": above(0, 100),
+        "margin_m": within(0, 10), "gain_x": within(0, 1e4), "gain_y": within(0, 1e6), "gain_theta": within(0, 1e4),
+        "max_angular_rad_s": above(0, 100)}
 
     cell_m: float = 0.1
     speed_fraction: float = 0.9
