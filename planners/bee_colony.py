@@ -1,5 +1,11 @@
 """Artificial Bee Colony over spline via-points: ``abc`` and ``adl_abc`` (Kamil et al. 2020).
 
+The paper's instances (Kamil et al. 2020, Tables 1-4) report paths for a 0.5 m robot, but as printed no path
+exists for it (``optimal`` exits 3: case A's discs close the arena, case B's discs 7, 3, 2 and 12 chain from its
+bottom edge to its top, and case B path 3's start lies on disc 12). swarmnav bundles the printed instances and
+feasible variants that state what they change (``models/studies/adl-abc-feasible/``,
+``models/studies/adl-abc-case-b-feasible/``); case B path 3 exists only as a feasible variant.
+
 Karaboga's ABC as Kamil et al. (2020) Algorithm 1 gives it (also Abdulla & Hadi (2025) Sect. 4.1):
 
 * ``population`` food sources ``SN``, placed by Eq. (6) ``x = x_min + rand (x_max - x_min)``;
