@@ -68,7 +68,8 @@ def run_studies(args: argparse.Namespace) -> int:
         study = load_study(name)
         rows.append({"name": name, "mode": study.mode, "cells": len(expand(study)),
                      "scenarios": [FilePath(s).stem for s in study.scenarios],
-                     "planners": [p.label for p in study.planners], "description": study.description})
+                     "planners": [p.label for p in study.planners], "claims": len(study.claims),
+                     "description": study.description})
     if args.json:
         print(json.dumps(rows))
     else:
@@ -78,17 +79,46 @@ def run_studies(args: argparse.Namespace) -> int:
 
 
 def add_report_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("dir", help="a study's output directory (holding runs.parquet)")
-    p.add_argument("--out", help="HTML report path (default: DIR/report.html); the Markdown twin goes beside it")
+    p.add_argument("dir", nargs="+", help="a study's output directory (holding runs.parquet); with --readme-table, "
+                                          "claims.json files or folders holding one")
+    p.add_argument("--out", help="HTML report path (default: DIR/report.html); the Markdown twin and claims.json "
+                                 "go beside it")
+    p.add_argument("--json", action="store_true", help="print the claims' verdicts (claims.json) instead")
+    p.add_argument("--readme-table", action="store_true",
+                   help="print the README's table of claims from the claims.json verdicts of each DIR")
+    p.add_argument("--readme", help="with --readme-table: replace the table in this README file instead")
+
+
+def _readme_table(args: argparse.Namespace) -> int:
+    from swarmnav.sim.study.readme_table import block, read_documents, replace_block
+    text = block(read_documents(args.dir))
+    if args.readme:
+        path = FilePath(args.readme)
+        path.write_text(replace_block(path.read_text(encoding="utf-8"), text, str(path)), encoding="utf-8")
+        print(f"claims table: {path}")
+    else:
+        print(text)
+    return 0
 
 
 def run_report(args: argparse.Namespace) -> int:
     from swarmnav.models.errors import ConfigError
+    if args.readme_table:
+        return _readme_table(args)
+    if args.readme:
+        raise ConfigError("--readme", "needs --readme-table")
+    if len(args.dir) != 1:
+        raise ConfigError("dir", f"expected one study directory, got {len(args.dir)} (several only with "
+                                 "--readme-table)")
     from swarmnav.sim.study.report import write_report
-    directory = FilePath(args.dir)
+    directory = FilePath(args.dir[0])
     if not (directory / "runs.parquet").is_dir():
         raise ConfigError("dir", "holds no runs.parquet (run `swarmnav study` first)", str(directory))
     html_path = FilePath(args.out) if args.out else directory / "report.html"
     markdown_path = write_report(directory, html_path)
-    print(f"report: {html_path}  markdown: {markdown_path}")
+    claims_path = html_path.parent / "claims.json"
+    if args.json:
+        print(claims_path.read_text(encoding="utf-8"), end="")
+    else:
+        print(f"report: {html_path}  markdown: {markdown_path}  claims: {claims_path}")
     return 0

@@ -25,6 +25,17 @@ TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) o
     [[navigators]]                   # optional; default: one navigator, follow
     name = "follow"
 
+    [[claims]]                       # optional: a claim of the paper the rows test (see claim_spec.py)
+    id = "gwo-shorter-than-abc-sc1"
+    statement = "GWO's mean path is shorter than ABC's on scenario 1"
+    source = "Abdulla & Hadi (2025), Sect. 6.1"
+    scenario = "gwo-scenario-1"
+    metric = "plan_length_m"         # or "success"
+    better = "lower"
+    planner = "gwo"
+    than = ["abc"]
+    test = "rank_sum"                # or "signed_rank", "fisher" (success)
+
     [[paper]]                        # optional: a paper's value to print beside ours
     scenario = "gwo-scenario-1"
     planner = "GWO"                  # a planner label
@@ -49,12 +60,13 @@ from swarmnav.controllers.navigators import make_navigator
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, load_scenario, resolve_scenario_path
 from swarmnav.planners.registry import make_planner
+from swarmnav.sim.study.claim_spec import Claim, parse_claims
 
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
 TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
             "time_limit_s", "reference", "planners", "navigators", "paper", "clearance_m",
-            "paired_seeds"}
+            "paired_seeds", "claims"}
 
 
 @dataclass(frozen=True)
@@ -100,6 +112,7 @@ class Study:
     quick_seeds: int | None = None  # the first N seeds make the quick run (None: the quick run is the full one)
     clearance_m: float | None = None  # planning clearance override for every scenario (None: each scenario's)
     paired_seeds: bool = False  # the k-th seed runs with the k-th world seed only
+    claims: tuple[Claim, ...] = ()  # the paper's claims the rows test (the report's verdicts)
 
     def seed_pairs(self) -> list[tuple[int | None, int]]:
         """(world seed, seed) of every run of one setting, in the grid's order."""
@@ -344,5 +357,7 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
     if paired and len(world_seeds) != len(seeds):
         _fail(source, "paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                       f"{len(world_seeds) if 'world_seeds' in data else 'no'} world seeds")
+    claims = parse_claims(source, data.get("claims", []), scenarios, planners, navigators)
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
-                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired)
+                 reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired,
+                 claims)
