@@ -18,6 +18,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection, PatchCollection  # noqa: E402
+from matplotlib.ticker import NullFormatter  # noqa: E402
 
 from swarmnav.sim import palette  # noqa: E402
 from swarmnav.sim.study import anytime  # noqa: E402
@@ -107,10 +108,13 @@ def anytime_figure(arms: dict[str, list[dict[str, Any]]], history: dict[str, any
     runs = {name: [history[r["config_hash"]] for r in rows if r["config_hash"] in history]
             for name, rows in arms.items()}
     recorded = {name: h for name, h in runs.items() if any(x.cost.size > 1 for x in h)}
-    silent = [name for name in arms if name not in recorded]
+    failed = [name for name in arms if name not in recorded and all(r["outcome"] != "ok" for r in arms[name])]
+    silent = [name for name in arms if name not in recorded and name not in failed]
+    absent = "; ".join(part for part in (
+        "no best-cost history recorded: " + ", ".join(silent) if silent else "",
+        "every run failed (no history): " + ", ".join(failed) if failed else "") if part)
     if not recorded:
-        return None, ("No planner of this scenario records a best-cost history" + (f" ({', '.join(silent)})"
-                                                                                    if silent else "") + ".")
+        return None, f"No anytime figure for this scenario ({absent})."
     reference, said = anytime.reference_cost(optimum_m, [h for hs in recorded.values() for h in hs])
     fig, axes = plt.subplots(2, 2, figsize=(MAX_WIDTH_IN, 7.2))
     colour = colours(list(arms))
@@ -130,6 +134,7 @@ def anytime_figure(arms: dict[str, list[dict[str, Any]]], history: dict[str, any
         for row in (0, 1):
             ax = axes[row, column]
             ax.set_xscale("log")
+            ax.xaxis.set_minor_formatter(NullFormatter())
             ax.set_xlabel(what)
             ax.grid(alpha=0.3, which="both")
             if not ax.lines:
@@ -137,7 +142,8 @@ def anytime_figure(arms: dict[str, list[dict[str, Any]]], history: dict[str, any
                         transform=ax.transAxes, ha="center", va="center")
         axes[0, column].set_ylabel("best cost (median, IQR)")
         if optimum_m is not None:
-            axes[0, column].axhline(optimum_m, color=palette.DRIVEN, linewidth=0.8, linestyle=":")
+            axes[0, column].axhline(optimum_m, color=palette.DRIVEN, linewidth=0.8, linestyle=":",
+                                    label="exact optimum")
         axes[1, column].set_ylabel("share of (run, target) pairs reached")
         axes[1, column].set_ylim(-0.02, 1.02)
     axes[0, 0].set_title("fixed budget")
@@ -146,7 +152,7 @@ def anytime_figure(arms: dict[str, list[dict[str, Any]]], history: dict[str, any
         estimated = sorted(n for n, hs in recorded.items() if any(x.estimated for x in hs))
         axes[0, 0].set_xlabel(f"objective evaluations (spread evenly for {', '.join(estimated)})")
     handles, labels = axes[0, 0].get_legend_handles_labels()
-    footer = "" if not silent else "no best-cost history recorded: " + ", ".join(silent)
+    footer = absent
     fig.legend(handles, labels, loc="lower center", ncol=min(4, len(labels)), frameon=False,
                bbox_to_anchor=(0.5, -0.02 - 0.03 * math.ceil(len(labels) / 4)))
     if footer:

@@ -33,7 +33,7 @@ STYLE = ("body{font-family:sans-serif;max-width:1200px;margin:auto;padding:0 12p
          ".table{overflow-x:auto;max-width:100%}table{border-collapse:collapse;margin:8px 0}"
          "td,th{border:1px solid #bbb;padding:3px 6px;font-size:13px;text-align:right;white-space:nowrap}"
          "th{background:#eee}td:first-child,th:first-child{text-align:left}"
-         ".reproduces{color:#096}.contradicted{color:#b00}")
+         "td.t{text-align:left;white-space:normal;min-width:8em}")
 
 
 def load_rows(directory: FilePath) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
@@ -211,7 +211,12 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
         if errors:
             doc.paragraph("Failures: " + "; ".join(errors[:5]) + (" …" if len(errors) > 5 else ""))
         for item in statistics_section(scenario, arms, meta.get("reference")):
-            doc.paragraph(item) if isinstance(item, str) else doc.table(item)
+            if isinstance(item, str):
+                doc.paragraph(item)
+            elif item.rows:
+                doc.table(item)
+            else:
+                doc.paragraph(f"({item.caption}: no completed runs to test.)")
         paper = paper_values_table(scenario, arms, scenario_rows, meta.get("paper", []))
         if paper is not None:
             doc.paragraph("The paper's values beside ours (mean ± std over our completed runs).")

@@ -110,7 +110,7 @@ def statistics_section(scenario: str, arms: dict[str, list[dict[str, Any]]], ref
                        c.fisher_p, c.fisher_p_holm] for c in success], kinds={3: "p", 4: "p"}))
     if any(r.get("plan_length_m") is not None for r in scenario_rows):
         result = friedman(arms, "plan_length_m")
-        if result is not None:
+        if result is not None and result["blocks"] >= 2:
             from swarmnav.sim.study.tables import number, p_value
             out.append(f"Friedman test of the plan length across all {len(arms)} planners on {result['blocks']} "
                        f"seeds every planner completed: chi² = {number(result['statistic'])}, "

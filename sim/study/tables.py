@@ -13,6 +13,7 @@ import csv
 import html
 import io
 import math
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -86,8 +87,9 @@ class Table:
 
     def html(self) -> str:
         head = "".join(f"<th>{html.escape(h)}</th>" for h in self.header)
-        body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
-                       for row in self.text_rows())
+        body = "".join("<tr>" + "".join(f"<td{' class=t' if _is_text(v) else ''}>{html.escape(c)}</td>"
+                                        for v, c in zip(raw, row)) + "</tr>"
+                       for raw, row in zip(self.rows, self.text_rows()))
         return f"<div class='table'><table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table></div>"
 
     def markdown(self) -> list[str]:
@@ -123,6 +125,11 @@ class Table:
         lines += [" & ".join(latex_escape(c) for c in row) + r" \\" for row in self.text_rows()]
         lines += [r"\bottomrule", r"\end{tabular}", r"\end{table}", ""]
         return "\n".join(lines)
+
+
+def _is_text(value: Any) -> bool:
+    """A cell set left (text), as opposed to a number or a count like "3/10" (right)."""
+    return isinstance(value, str) and not re.fullmatch(r"[\d/.% -]*", value)
 
 
 def _raw(value: Any) -> Any:
