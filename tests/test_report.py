@@ -5,6 +5,8 @@ import csv
 import io
 import json
 import re
+import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -238,3 +240,42 @@ def test_the_readme_claims_table_is_the_one_generated_from_the_committed_verdict
         for claim in document["claims"]:
             fields = {k: claim[k] for k in written.get(claim["id"], {})}
             assert fields == written[claim["id"]], f"{path}: claim {claim['id']} changed; run `make readme-table`"
+
+
+@pytest.mark.skipif(shutil.which("pdflatex") is None, reason="pdflatex not installed (the LaTeX is checked "
+                                                              "structurally above)")
+def test_the_latex_tables_compile_with_pdflatex(shorter, tmp_path):
+    html_path = tmp_path / "r.html"
+    assert main(["report", str(shorter), "--out", str(html_path)]) == 0
+    done = subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "tables.tex"],
+                          cwd=tmp_path / "r_files", capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stdout[-2000:]
+
+
+PHYSICS = """
+name = "collide"
+scenarios = ["gwo-scenario-2"]
+mode = "physics"
+time_limit_s = 35
+seeds = 1
+[[planners]]
+name = "optimal"
+"""
+
+
+def test_physics_paths_show_the_driven_trajectory_from_logs_and_say_so_without(tmp_path):
+    """On gwo-scenario-2 the straight optimal plan driven by follow collides with a moving disc: the outcome
+    is a collision, study.json has the moving discs' tracks, and the path figure draws the driven trajectory
+    from the kept log (without --logs the report says there is none)."""
+    path = tmp_path / "collide.toml"
+    path.write_text(PHYSICS)
+    for folder, logs in (("with", ["--logs"]), ("without", [])):
+        assert main(["study", str(path), "--out", str(tmp_path / folder), "--json", *logs]) == 0
+        assert main(["report", str(tmp_path / folder)]) == 0
+    geometry = json.loads((tmp_path / "with" / "study.json").read_text())["scenarios"]["gwo-scenario-2"]
+    assert len(geometry["disc_tracks"]) == 3 and geometry["optimum_m"] == pytest.approx(np.hypot(10, 10))
+    with_logs = (tmp_path / "with" / "report.md").read_text()
+    without = (tmp_path / "without" / "report.md").read_text()
+    assert "| optimal | 1 | 0 | 1 | 0 | 0 | 0 | 0 |" in with_logs  # runs, success, collision, ...
+    assert "the trajectory it drove" in with_logs and "No driven trajectory" not in with_logs
+    assert "No driven trajectory for optimal" in without and "--logs" in without
