@@ -79,19 +79,19 @@ def run_studies(args: argparse.Namespace) -> int:
 
 
 def add_report_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("dir", nargs="+", help="a study's output directory (holding runs.parquet); with --readme-table, "
-                                          "claims.json files or folders holding one")
+    p.add_argument("dir", nargs="?", help="a study's output directory (holding runs.parquet)")
     p.add_argument("--out", help="HTML report path (default: DIR/report.html); the Markdown twin and claims.json "
                                  "go beside it")
     p.add_argument("--json", action="store_true", help="print the claims' verdicts (claims.json) instead")
-    p.add_argument("--readme-table", action="store_true",
-                   help="print the README's table of claims from the claims.json verdicts of each DIR")
+    p.add_argument("--readme-table", nargs="+", metavar="PATH",
+                   help="print the README's table of claims from these claims.json files (or folders holding them, "
+                        "e.g. models/studies/results) instead of a report")
     p.add_argument("--readme", help="with --readme-table: replace the table in this README file instead")
 
 
 def _readme_table(args: argparse.Namespace) -> int:
     from swarmnav.sim.study.readme_table import block, read_documents, replace_block
-    text = block(read_documents(args.dir))
+    text = block(read_documents(args.readme_table))
     if args.readme:
         path = FilePath(args.readme)
         path.write_text(replace_block(path.read_text(encoding="utf-8"), text, str(path)), encoding="utf-8")
@@ -107,11 +107,10 @@ def run_report(args: argparse.Namespace) -> int:
         return _readme_table(args)
     if args.readme:
         raise ConfigError("--readme", "needs --readme-table")
-    if len(args.dir) != 1:
-        raise ConfigError("dir", f"expected one study directory, got {len(args.dir)} (several only with "
-                                 "--readme-table)")
+    if args.dir is None:
+        raise ConfigError("dir", "is required (a study's output directory), unless --readme-table")
     from swarmnav.sim.study.report import write_report
-    directory = FilePath(args.dir[0])
+    directory = FilePath(args.dir)
     if not (directory / "runs.parquet").is_dir():
         raise ConfigError("dir", "holds no runs.parquet (run `swarmnav study` first)", str(directory))
     html_path = FilePath(args.out) if args.out else directory / "report.html"

@@ -128,15 +128,6 @@ def ordered_runs(runs: list[dict[str, Any]], meta: dict[str, Any]) -> list[dict[
     return sorted(runs, key=key)
 
 
-def study_claims(directory: FilePath) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """(the study's metadata, the ``claims.json`` document of its rows)."""
-    meta_path = directory / "study.json"
-    meta = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
-    runs, _ = load_rows(directory)
-    claims = [Claim.from_dict(c) for c in meta.get("claims", [])]
-    return meta, claims_document(meta.get("name", directory.name), claims, runs)
-
-
 def _driven(arms: dict[str, list[dict[str, Any]]]) -> tuple[dict[str, tuple], str]:
     """The driven trajectory and collision points of each arm's path-figure run, read from its MCAP log
     (kept by ``swarmnav study --logs``); and a sentence saying where there were none."""
