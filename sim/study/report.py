@@ -31,7 +31,7 @@ CLAIMS_FILE = "claims.json"
 STYLE = ("body{font-family:sans-serif;max-width:1200px;margin:auto;padding:0 12px}"
          "img{max-width:100%;height:auto;display:block}figure{margin:12px 0}"
          ".table{overflow-x:auto;max-width:100%}table{border-collapse:collapse;margin:8px 0}"
-         "td,th{border:1px solid #bbb;padding:3px 6px;font-size:13px;text-align:right;white-space:nowrap}"
+         "td,th{border:1px solid #bbb;padding:3px 5px;font-size:13px;text-align:right;white-space:nowrap}th{white-space:normal}"
          "th{background:#eee}td:first-child,th:first-child{text-align:left}"
          "td.t{text-align:left;white-space:normal;min-width:8em}")
 
