@@ -167,8 +167,9 @@ def anytime_figure(arms: dict[str, list[dict[str, Any]]], history: dict[str, any
     return fig, sentence
 
 
-def _obstacles(ax, geometry: dict[str, Any]) -> bool:
-    """Arena, static obstacles, moving obstacles' tracks coloured by time; True if a track was drawn."""
+def _obstacles(ax, geometry: dict[str, Any], end_s: float | None):
+    """Arena, static obstacles, moving obstacles' tracks coloured by time up to ``end_s`` (None: as recorded);
+    the tracks' collection if one was drawn."""
     width_m, height_m = geometry["arena_m"]
     ax.add_patch(plt.Rectangle((0, 0), width_m, height_m, fill=False, edgecolor=palette.ARENA, linewidth=1.0))
     tracks = geometry.get("disc_tracks", [])
@@ -181,9 +182,10 @@ def _obstacles(ax, geometry: dict[str, Any]) -> bool:
     ax.add_collection(PatchCollection([plt.Rectangle((x0, y0), x1 - x0, y1 - y0)
                                        for x0, y0, x1, y1 in geometry.get("boxes", [])], color=palette.OBSTACLE))
     drawn = None
-    end_s = max((t["t_x_y"][-1][0] for t in tracks if t["t_x_y"]), default=1.0) or 1.0
+    end_s = end_s or max((t["t_x_y"][-1][0] for t in tracks if t["t_x_y"]), default=1.0) or 1.0
     for track in tracks:
         txy = np.array(track["t_x_y"], dtype=float)
+        txy = txy[txy[:, 0] <= end_s + 1e-9] if len(txy) else txy
         if len(txy) < 2:
             continue
         segments = np.stack([txy[:-1, 1:], txy[1:, 1:]], axis=1)
@@ -205,7 +207,9 @@ def paths(arms: dict[str, list[dict[str, Any]]], geometry: dict[str, Any] | None
     trajectory that run drove with the points where collisions began (``driven``: arm -> (xy, collisions))."""
     driven = driven or {}
     fig, ax = plt.subplots(figsize=(7.0, 6.0))
-    tracks = _obstacles(ax, geometry) if geometry else None
+    times = [r["sim_time_s"] for rows in arms.values() for r in rows if r.get("sim_time_s") is not None]
+    tracks = _obstacles(ax, geometry, max(times) if times else None) if geometry else None
+    collision_label = "collision began"
     colour = colours(list(arms))
     drawn = False
     for name, rows in arms.items():
@@ -222,7 +226,8 @@ def paths(arms: dict[str, list[dict[str, Any]]], geometry: dict[str, Any] | None
                     label=f"{name} driven")
             if len(collisions):
                 ax.plot(collisions[:, 0], collisions[:, 1], "x", color=palette.COLLISION, markersize=9, mew=2,
-                        zorder=7, label=f"{name} collision")
+                        zorder=7, label=collision_label)
+                collision_label = "_nolegend_"
     if not drawn:
         plt.close(fig)
         return None
