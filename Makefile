@@ -1,5 +1,5 @@
 # Two commands do all set-up on a fresh machine:
-#   make demo   seed 004's moving obstacles, planned by GWO, driven with replan (log, video, plot)
+#   make demo   Abdulla & Hadi (2025) scenario 2, its moving obstacles, planned by GWO, driven with replan (log, video, plot)
 #   make test   run the test suite
 # Each creates .venv and installs swarmnav into it on first use.
 
@@ -18,20 +18,19 @@ STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c
 
 $(STAMP): pyproject.toml planners/_colony_walk.c planners/_grid_search.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test,bench]'
-	touch $(STAMP)
+	@echo "installing swarmnav into $(VENV) (pip's output: $(VENV)/install.log)"
+	@$(BIN)/python -m pip install --quiet --upgrade pip > $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
+	@$(BIN)/python -m pip install --quiet -e '.[test,bench]' >> $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
+	@touch $(STAMP)
 
 install: $(STAMP)
 
 demo: $(STAMP)
-	mkdir -p logs
+	@mkdir -p logs
 	$(BIN)/swarmnav run $(DEMO_SCENARIO) --planner $(DEMO_PLANNER) --navigator $(DEMO_NAVIGATOR) --seed 0 \
-		--out logs/demo.mcap --overwrite --video logs/demo.mp4 --json > logs/demo.json
-	$(BIN)/swarmnav log info logs/demo.mcap
-	$(BIN)/swarmnav plot logs/demo.mcap -o logs/demo.png
-	@echo "summary: logs/demo.json  log: logs/demo.mcap  video: logs/demo.mp4  plot: logs/demo.png"
-	@cat logs/demo.json; echo
+		--out logs/demo.mcap --overwrite --video logs/demo.mp4 --json-out logs/demo.json
+	@$(BIN)/swarmnav plot logs/demo.mcap -o logs/demo.png > /dev/null
+	@echo "plot: logs/demo.png   (inspect the log: swarmnav log info logs/demo.mcap; open it in Foxglove)"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

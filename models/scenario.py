@@ -20,6 +20,9 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem
 
 SCENARIO_DIR = FilePath(__file__).resolve().parent / "scenarios"
+#: Folders of scenario files that installed packages declare (entry-point group ``swarmnav.scenarios``, added by
+#: ``swarmnav.sim.plugins``): their names resolve after the bundled ones.
+EXTRA_SCENARIO_DIRS: list[FilePath] = []
 MOTION_KINDS = ("linear", "random_walk", "waypoints")
 
 # Stated maxima (README "Limits"), each checked before anything of that size is
@@ -231,8 +234,11 @@ class _Table:
 
 
 def list_scenarios() -> list[str]:
-    """Names of the bundled scenarios (file stems under models/scenarios/)."""
-    return sorted(p.stem for p in SCENARIO_DIR.glob("*.toml"))
+    """Names of the bundled scenarios (file stems under models/scenarios/), then those of installed packages."""
+    names = {p.stem for p in SCENARIO_DIR.glob("*.toml")}
+    for folder in EXTRA_SCENARIO_DIRS:
+        names.update(p.stem for p in folder.glob("*.toml"))
+    return sorted(names)
 
 
 def resolve_scenario_path(name_or_path: str) -> FilePath:
@@ -242,7 +248,8 @@ def resolve_scenario_path(name_or_path: str) -> FilePath:
         if not candidate.is_file():
             raise ConfigError("scenario", "file does not exist", str(candidate))
         return candidate
-    bundled = SCENARIO_DIR / f"{name_or_path}.toml"
+    bundled = next((folder / f"{name_or_path}.toml" for folder in (SCENARIO_DIR, *EXTRA_SCENARIO_DIRS)
+                    if (folder / f"{name_or_path}.toml").is_file()), SCENARIO_DIR / f"{name_or_path}.toml")
     if not bundled.is_file():
         raise ConfigError("scenario", f"no bundled scenario named {name_or_path!r} "
                           f"(see `swarmnav scenarios`)", name_or_path)

@@ -3,7 +3,8 @@
 Exit codes: 0 the command ran (whether or not the goal was reached); 1 a bug
 (an exception nothing anticipated: one line saying so and where the full
 traceback was saved); 2 bad input (one line on stderr naming the file, the
-field and the problem); 3 the planner found no path.
+field and the problem); 3 the planner found no path; 4 ``replay --verify`` found a
+difference; 5 a CI check fell short (``run --expect``, ``study --min-success``).
 """
 
 from __future__ import annotations
@@ -32,6 +33,12 @@ for _name, _value in SINGLE_THREAD_ENVIRONMENT.items():  # before any subcommand
     os.environ.setdefault(_name, _value)
 
 EXIT_OK, EXIT_BUG, EXIT_BAD_INPUT, EXIT_NO_PATH = 0, 1, 2, 3
+# 4 is replay --verify's difference; 5: a run or study fell short of --expect / --min-success (a CI check).
+EXIT_EXPECTATION = 5
+
+
+# The commands that name planners, navigators or scenarios: they load the installed plugins first.
+PLUGIN_COMMANDS = {"plan", "run", "study", "bench", "scenarios", "planners", "navigators", "replay"}
 
 
 class UserError(Exception):
@@ -105,6 +112,22 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def cmd_components(args: argparse.Namespace) -> int:
+    """``swarmnav planners`` / ``swarmnav navigators``: names, parameters and defaults, description, package."""
+    from swarmnav.sim.plugins import describe_components
+    rows = describe_components(args.kind)
+    if args.json:
+        print(json.dumps(rows))
+        return EXIT_OK
+    for row in rows:
+        origin = "" if row["package"] == "swarmnav" else f"  [{row['package']}]"
+        print(f"{row['name']:<20} {row['description']}{origin}")
+        for param in row["parameters"]:
+            bounds = f" in {param['range']}" if "range" in param else ""
+            print(f"    {param['name']} = {param['default']!r} ({param['type']}{bounds})")
+    return EXIT_OK
+
+
 def cmd_generate(args: argparse.Namespace) -> int:
     """``scenarios generate KIND --seed N``: write (or print) a generated scenario; it must load back."""
     from dataclasses import fields
@@ -158,36 +181,22 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from swarmnav.sim.episode import plan_episode, run_episode
-    spec = _episode_spec(args)
+    from swarmnav.calls import run
     try:
-        planned = plan_episode(spec)  # bad input or no path fails before any file is made
+        outcome = run(args.scenario, args.planner, parse_settings(args.set, "--set"), args.navigator,
+                      parse_settings(args.navigator_set, "--navigator-set"), args.seed, args.world_seed,
+                      waypoints=args.waypoints, log=False if args.no_log else (args.out or True),
+                      overwrite=args.overwrite, video=args.video, camera=args.camera, width=args.width,
+                      height=args.height, fps=args.fps, stop_on_collision=True if args.stop_on_collision else None,
+                      live=args.live,
+                      on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove WebSocket)",
+                                                file=sys.stderr))
     except ConfigError as exc:
         raise _blame_options(args, exc) from None
-    recorders = []
-    log_path = None
-    if not args.no_log:
-        from swarmnav.sim.mcap_log import McapRecorder, default_log_path
-        log_path = FilePath(args.out) if args.out else default_log_path(
-            planned.spec.scenario.name, planned.spec.planner, planned.spec.seed, time.strftime("%Y%m%d-%H%M%S"))
-        if log_path.is_dir():
-            raise UserError(f"{log_path}: --out: Is a directory (give a file path)")
-        if log_path.exists() and not args.overwrite:
-            raise UserError(f"{log_path}: --out: file exists (use --overwrite)")
-        recorders.append(McapRecorder(
-            log_path, live=args.live, overwrite=True,
-            on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove WebSocket)",
-                                      file=sys.stderr)))
-    elif args.live:
-        raise UserError("--live: needs the log (drop --no-log)")
-    if args.video:
-        from swarmnav.sim.render import VideoRecorder
-        recorders.append(VideoRecorder(args.video, camera=args.camera, width=args.width,
-                                       height=args.height, fps=args.fps))
-    episode = run_episode(spec, recorders, stop_on_collision=True if args.stop_on_collision else None,
-                          planned=planned)
-    result, path = episode.result, episode.path
-    out = {**episode.summary(), "log": str(log_path) if log_path else None, "video": args.video}
+    out = outcome.to_dict()
+    result, path = outcome.result, outcome.path
+    if args.json_out:
+        FilePath(args.json_out).write_text(json.dumps(out) + "\n", encoding="utf-8")
     if args.json:
         print(json.dumps(out))
     else:
@@ -197,12 +206,30 @@ def cmd_run(args: argparse.Namespace) -> int:
               f"({result.wall_time_s:.2f} s wall); driven {result.path_length_m:.3f} m "
               f"(planned {path.stats.length_m:.3f} m); collisions {result.collisions}"
               + (f", first at {result.first_collision_s:.2f} s" if result.first_collision_s is not None else "")
-              + f"; min clearance {result.min_clearance_m:.3f} m")
-        if log_path:
-            print(f"log: {log_path}")
+              + f"; min clearance {result.min_clearance_m:.3f} m"
+              + (f"; SPL {out['spl']:.3f}" if out.get("spl") is not None else ""))
+        if outcome.log:
+            print(f"log: {outcome.log}")
         if args.video:
             print(f"video: {args.video}")
-    return EXIT_OK
+        if args.json_out:
+            print(f"summary (run --json): {args.json_out}")
+    return expectation_exit(args.expect, outcome)
+
+
+def expectation_exit(expect: str | None, outcome) -> int:
+    """``--expect success|reached``: EXIT_EXPECTATION and one line on stderr when the run falls short."""
+    if expect is None:
+        return EXIT_OK
+    met = outcome.success if expect == "success" else outcome.reached
+    if met:
+        return EXIT_OK
+    result = outcome.result
+    print(f"swarmnav: expectation not met: --expect {expect}: {outcome.episode.spec.scenario.name}: "
+          f"{result.outcome}, {result.collisions} collision(s), {result.sim_time_s:.2f} s sim"
+          + (f", first collision at {result.first_collision_s:.2f} s" if result.first_collision_s is not None else "")
+          + f"; log: {outcome.log or 'none'}", file=sys.stderr)
+    return EXIT_EXPECTATION
 
 
 def _add_run_options(p: argparse.ArgumentParser) -> None:
@@ -244,7 +271,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--height", type=int, default=480)
     p.add_argument("--fps", type=float, default=DEFAULT_FPS)
     p.add_argument("--stop-on-collision", action="store_true", help="stop at the first collision")
+    p.add_argument("--waypoints", metavar="FILE", help="drive this path instead of planning: CSV with x,y columns, "
+                   "a JSON list of [x, y] pairs, or the output of `plan --json`")
+    p.add_argument("--json-out", metavar="FILE", help="also write the `--json` object to FILE")
+    p.add_argument("--expect", choices=("success", "reached"),
+                   help=f"exit {EXIT_EXPECTATION} unless the goal is reached with no collision (success) or reached "
+                   "at all (reached): a CI smoke check")
     p.set_defaults(func=cmd_run)
+
+    for kind in ("planners", "navigators"):
+        p = sub.add_parser(kind, help=f"list every {kind[:-1]} (bundled and installed plugins) with its parameters")
+        p.add_argument("--json", action="store_true")
+        p.set_defaults(func=cmd_components, kind=kind[:-1])
 
     groups: dict[str, argparse._SubParsersAction] = {}
     bench = sub.add_parser("bench", help="benchmarks that print figures")
@@ -271,6 +309,9 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGTERM, _exit_on_sigterm)
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.command in PLUGIN_COMMANDS:
+        from swarmnav.sim.plugins import load_plugins
+        load_plugins()
     func: Callable[[argparse.Namespace], int] = args.func
     try:
         return int(func(args) or 0)

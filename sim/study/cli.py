@@ -23,6 +23,20 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quick", action="store_true",
                    help="only the study's first quick_seeds seeds (a later full run into the same --out resumes)")
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
+    p.add_argument("--junit", metavar="FILE", help="write the study's rows as JUnit XML (one test suite per scenario, "
+                   "a failure per row that is not a success)")
+    p.add_argument("--min-success", type=_rate, metavar="RATE",
+                   help="exit 5 when a configuration's (scenario, planner, navigator) success rate is below RATE")
+
+
+def _rate(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a rate in [0, 1], got {text!r}") from None
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"expected a rate in [0, 1], got {text!r}")
+    return value
 
 
 def run_study(args: argparse.Namespace) -> int:
@@ -53,6 +67,25 @@ def run_study(args: argparse.Namespace) -> int:
               + (f"({', '.join(f'{k} {v}' for k, v in sorted(summary['outcomes'].items()) if k != 'ok')})"
                  if summary["failed"] else ""))
         print(f"rows: {FilePath(out) / 'runs.parquet'}  report: swarmnav report {out}")
+    return _ci_checks(args, study.name, out)
+
+
+def _ci_checks(args: argparse.Namespace, study: str, out: str) -> int:
+    """``--junit`` and ``--min-success`` over every row of the folder (this run's and earlier ones')."""
+    if not args.junit and args.min_success is None:
+        return 0
+    from swarmnav.sim.study.junit import success_shortfalls, write_junit
+    from swarmnav.sim.study.rows import read_table
+    rows = read_table(out).to_pylist()
+    if args.junit:
+        write_junit(study, rows, args.junit)
+        print(f"junit: {args.junit}", file=sys.stderr if args.json else sys.stdout)
+    if args.min_success is not None:
+        shortfalls = success_shortfalls(rows, args.min_success)
+        for line in shortfalls:
+            print(f"swarmnav: expectation not met: --min-success: {line}", file=sys.stderr)
+        if shortfalls:
+            return 5
     return 0
 
 

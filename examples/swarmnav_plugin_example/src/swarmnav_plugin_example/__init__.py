@@ -1,0 +1,1 @@
+"""An example swarmnav plugin (see its pyproject.toml for the entry points)."""

@@ -1,0 +1,166 @@
+"""The API's calls: each composes a run the one way the command line does (``sim.episode``), so
+``swarmnav.run(...).to_dict()`` is what ``swarmnav run --json`` prints for the same arguments.
+
+Heavy modules (MuJoCo, SciPy, the planners) are imported inside the calls, on first use.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path as FilePath
+from typing import TYPE_CHECKING, Any, Callable, Sequence
+
+from swarmnav.results import PlanResult, RunOutcome
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from swarmnav.models.scenario import Scenario
+
+ScenarioLike = "str | os.PathLike | Scenario"
+
+
+def load_scenario(name_or_path: str | os.PathLike) -> "Scenario":
+    """A bundled scenario by name (``swarmnav scenarios``), an installed package's, or a ``.toml`` path.
+
+    Raises:
+        ConfigError: missing file, malformed TOML or a field that breaks the schema (naming it).
+    """
+    from swarmnav.models.scenario import load_scenario as load
+    from swarmnav.sim.plugins import load_plugins
+    load_plugins()
+    return load(str(name_or_path))
+
+
+def _scenario(scenario: Any) -> "Scenario":
+    from swarmnav.models.scenario import Scenario
+    return scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+
+
+def episode_spec(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
+                 navigator: str | None = None, navigator_params: dict[str, Any] | None = None,
+                 seed: int | None = None, world_seed: int | None = None, clearance_m: float | None = None):
+    """The :class:`swarmnav.sim.episode.EpisodeSpec` of these arguments (``None``: the scenario's)."""
+    from swarmnav.sim.episode import EpisodeSpec
+    from swarmnav.sim.plugins import load_plugins
+    load_plugins()
+    return EpisodeSpec(_scenario(scenario), planner=planner, planner_params=dict(params or {}),
+                       navigator=navigator, navigator_params=dict(navigator_params or {}),
+                       seed=seed, world_seed=world_seed, clearance_m=clearance_m)
+
+
+def plan(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
+         seed: int | None = None, clearance_m: float | None = None) -> PlanResult:
+    """Plan the scenario (its obstacles at t = 0) with a registered planner.
+
+    Raises:
+        ConfigError: unknown planner or a bad parameter.
+        PlanningError: no path (``NoPathFound``, ``StartBlocked``, ...).
+    """
+    from swarmnav.sim.episode import plan_episode
+    return PlanResult(plan_episode(episode_spec(scenario, planner, params, seed=seed, clearance_m=clearance_m)))
+
+
+def given_episode(spec, waypoints: "np.ndarray", source: str):
+    """An episode whose path is the given waypoints instead of a plan (``run --waypoints``): the spec's planner
+    still serves a navigator that replans."""
+    from swarmnav.controllers.navigators import make_navigator
+    from swarmnav.planners.registry import make_planner
+    from swarmnav.sim.episode import Episode
+    from swarmnav.sim.given_path import given_path
+    spec = spec.resolved()
+    make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)  # bad names fail before the run
+    make_navigator(spec.navigator, spec.navigator_params, spec.scenario.source_path)
+    problem, path = given_path(spec.scenario, waypoints, source)
+    return Episode(spec, problem, path)
+
+
+def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
+        navigator: str | None = None, navigator_params: dict[str, Any] | None = None,
+        seed: int | None = None, world_seed: int | None = None, clearance_m: float | None = None, *,
+        waypoints: "Sequence[Sequence[float]] | np.ndarray | str | os.PathLike | None" = None,
+        log: "str | os.PathLike | bool | None" = None, overwrite: bool = False,
+        video: "str | os.PathLike | None" = None, camera: str = "top", width: int = 640, height: int = 480,
+        fps: float | None = None, stop_on_collision: bool | None = None, live: bool = False,
+        on_live: Callable[[str], None] | None = None) -> RunOutcome:
+    """Plan (or take ``waypoints``) and drive the scenario in MuJoCo.
+
+    Args:
+        waypoints: a path to drive instead of planning: ``(N, 2)`` metres, or a CSV/JSON file
+            (:mod:`swarmnav.sim.given_path`).
+        log: an MCAP path, ``True`` for ``logs/<scenario>_<planner>_seed<N>_<stamp>.mcap``, or ``None``/``False``
+            for no log.
+        video: an MP4 path rendered offscreen while running.
+
+    Raises:
+        ConfigError: bad input (naming the field); the log or video file exists without ``overwrite``.
+        PlanningError: no path.
+    """
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.sim.episode import plan_episode, run_episode
+    spec = episode_spec(scenario, planner, params, navigator, navigator_params, seed, world_seed, clearance_m)
+    if waypoints is not None:
+        from swarmnav.sim.given_path import as_waypoints, read_waypoints
+        if isinstance(waypoints, (str, os.PathLike)):
+            planned = given_episode(spec, read_waypoints(waypoints), str(waypoints))
+        else:
+            planned = given_episode(spec, as_waypoints(waypoints, "waypoints"), "waypoints")
+    else:
+        planned = plan_episode(spec)  # bad input or no path fails before any file is made
+    recorders: list[Any] = []
+    log_path = None
+    if log:
+        from swarmnav.sim.mcap_log import McapRecorder, default_log_path
+        log_path = FilePath(log) if log is not True else default_log_path(
+            planned.spec.scenario.name, planned.spec.planner, planned.spec.seed, time.strftime("%Y%m%d-%H%M%S"))
+        if log_path.is_dir():
+            raise ConfigError("--out", "Is a directory (give a file path)", str(log_path))
+        if log_path.exists() and not overwrite:
+            raise ConfigError("--out", "file exists (use --overwrite)", str(log_path))
+        recorders.append(McapRecorder(log_path, live=live, overwrite=True, on_live=on_live))
+    elif live:
+        raise ConfigError("--live", "needs the log (drop --no-log)")
+    if video:
+        from swarmnav.sim.commands import DEFAULT_FPS
+        from swarmnav.sim.render import VideoRecorder
+        recorders.append(VideoRecorder(str(video), camera=camera, width=width, height=height,
+                                       fps=DEFAULT_FPS if fps is None else fps))
+    episode = run_episode(spec, recorders, stop_on_collision=stop_on_collision, planned=planned)
+    return RunOutcome(episode, str(log_path) if log_path else None, str(video) if video else None)
+
+
+def run_study(file_or_spec: Any, out: str | os.PathLike | None = None, *, workers: int | None = None,
+              engine: str = "local", address: str | None = None, logs: bool = False,
+              quick: bool = False) -> dict[str, Any]:
+    """Run a study (a bundled name, a ``.toml`` path, or the tables of a study file as a dict) into ``out``
+    (default ``studies/<name>``); a folder that holds some of its rows resumes.  Returns the summary that
+    ``swarmnav study --json`` prints."""
+    from swarmnav.sim.plugins import load_plugins
+    from swarmnav.sim.study.execute import run_study as execute
+    from swarmnav.sim.study.spec import Study, load_study, study_from_tables
+    load_plugins()
+    if isinstance(file_or_spec, Study):
+        study = file_or_spec
+    elif isinstance(file_or_spec, dict):
+        study = study_from_tables(file_or_spec, "<tables>", str(file_or_spec.get("name", "study")))
+    else:
+        study = load_study(str(file_or_spec))
+    if quick:
+        study = study.quick()
+    target = FilePath(out) if out is not None else FilePath("studies") / study.name
+    return execute(study, target, engine=engine, workers=workers, address=address, logs=logs)
+
+
+def register_planner(cls: type) -> type:
+    """Register a planner class in this process (a decorator, too); every command run from this process, and
+    this API, then knows it by ``cls.name``.  To make it known to the ``swarmnav`` command and to study
+    workers, declare it as an entry point (``swarmnav.planners``) of an installed package instead."""
+    from swarmnav.planners.registry import register
+    return register(cls)
+
+
+def register_navigator(cls: type) -> type:
+    """Register a navigator class in this process (see :func:`register_planner`; group ``swarmnav.navigators``)."""
+    from swarmnav.controllers.navigators import register
+    return register(cls)

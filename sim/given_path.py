@@ -1,0 +1,119 @@
+"""A path someone else planned, read from a file and driven instead of a plan (``swarmnav run --waypoints``).
+
+Three formats, told apart by their content (not their name):
+
+* CSV with a header naming ``x`` and ``y`` columns (other columns are ignored), one waypoint a row;
+* a JSON list of ``[x, y]`` pairs;
+* a JSON object with a ``waypoints`` list (what ``swarmnav plan --json`` prints).
+
+Every problem is one :class:`ConfigError` naming the file, the row (or JSON index) and what is wrong.  The
+path is data: nothing in the file is run.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from pathlib import Path as FilePath
+from typing import Any, Sequence
+
+import numpy as np
+
+from swarmnav.models.errors import ConfigError
+from swarmnav.planners.problem import Path, scenario_problem
+
+FIELD = "--waypoints"
+MAX_WAYPOINTS = 1_000_000  # a path longer than this is not a path a controller follows; it is refused by size
+
+
+def _finite_pair(value: Any, where: str, source: str) -> tuple[float, float]:
+    if (not isinstance(value, (list, tuple)) or len(value) != 2
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
+        raise ConfigError(where, f"expected an [x, y] pair of numbers, got {value!r}"[:200], source)
+    x, y = float(value[0]), float(value[1])
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise ConfigError(where, f"must be finite, got [{x}, {y}]", source)
+    return x, y
+
+
+def _from_json(data: Any, source: str) -> list[tuple[float, float]]:
+    key = ""
+    if isinstance(data, dict):
+        if "waypoints" not in data:
+            raise ConfigError(FIELD, "a JSON object needs a 'waypoints' list (as `swarmnav plan --json` prints)",
+                              source)
+        data, key = data["waypoints"], "waypoints"
+    if not isinstance(data, list):
+        raise ConfigError(FIELD, "expected a JSON list of [x, y] pairs", source)
+    if len(data) > MAX_WAYPOINTS:
+        raise ConfigError(FIELD, f"{len(data)} waypoints (at most {MAX_WAYPOINTS:,})", source)
+    return [_finite_pair(v, f"{key}[{i}]", source) for i, v in enumerate(data)]
+
+
+def _from_csv(text: str, source: str) -> list[tuple[float, float]]:
+    reader = csv.reader(io.StringIO(text))
+    header = next(reader, None)
+    columns = [c.strip().lower() for c in header or []]
+    if "x" not in columns or "y" not in columns:
+        raise ConfigError("row 1", "a CSV file needs a header naming its x and y columns", source)
+    ix, iy = columns.index("x"), columns.index("y")
+    out = []
+    for number, row in enumerate(reader, start=2):
+        if not row or all(not cell.strip() for cell in row):
+            continue
+        if len(out) >= MAX_WAYPOINTS:
+            raise ConfigError(f"row {number}", f"more than {MAX_WAYPOINTS:,} waypoints", source)
+        try:
+            x, y = float(row[ix]), float(row[iy])
+        except (IndexError, ValueError):
+            raise ConfigError(f"row {number}", f"expected numbers in columns x and y, got {row!r}"[:200],
+                              source) from None
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise ConfigError(f"row {number}", f"must be finite, got {x}, {y}", source)
+        out.append((x, y))
+    return out
+
+
+def read_waypoints(file: str | FilePath) -> np.ndarray:
+    """The ``(N, 2)`` waypoints in metres of a CSV or JSON file (see the module's docstring).
+
+    Raises:
+        ConfigError: unreadable file, unknown format, a bad row, or fewer than two waypoints.
+    """
+    source = str(file)
+    try:
+        text = FilePath(file).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(FIELD, f"cannot be read ({getattr(exc, 'strerror', None) or exc})", source) from None
+    stripped = text.lstrip()
+    if stripped.startswith(("[", "{")):
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise ConfigError(f"line {exc.lineno}", f"malformed JSON ({exc.msg})", source) from None
+        points = _from_json(data, source)
+    else:
+        points = _from_csv(text, source)
+    return as_waypoints(points, source)
+
+
+def as_waypoints(points: Sequence[Sequence[float]] | np.ndarray, source: str = FIELD) -> np.ndarray:
+    """Waypoints given in code or read from a file, checked: at least two finite ``[x, y]`` pairs."""
+    array = np.asarray(points, dtype=float)
+    if array.ndim != 2 or array.shape[1] != 2:
+        raise ConfigError(FIELD, f"expected (N, 2) waypoints, got shape {array.shape}", source)
+    if len(array) < 2:
+        raise ConfigError(FIELD, f"a path needs at least two waypoints, got {len(array)}", source)
+    if not np.all(np.isfinite(array)):
+        raise ConfigError(FIELD, "every waypoint must be finite", source)
+    return np.ascontiguousarray(array)
+
+
+def given_path(scenario, waypoints: np.ndarray, source: str) -> tuple[Any, Path]:
+    """The scenario's problem and the given waypoints as a :class:`Path` (no planning time, no search),
+    ``stats.extra`` saying where the path came from."""
+    problem = scenario_problem(scenario)
+    path = Path.from_waypoints(waypoints, 0.0, extra={"given": source})
+    return problem, path

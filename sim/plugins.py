@@ -1,0 +1,156 @@
+"""Planners, navigators and scenario folders from installed packages, by entry points.
+
+An installed distribution declares, in its ``pyproject.toml``::
+
+    [project.entry-points."swarmnav.planners"]
+    my_planner = "my_lab.planning:MyPlanner"        # a planner class (the seam of swarmnav.planners.problem)
+
+    [project.entry-points."swarmnav.navigators"]
+    my_navigator = "my_lab.driving:MyNavigator"     # a navigator class (swarmnav.controllers.navigator)
+
+    [project.entry-points."swarmnav.scenarios"]
+    my_scenarios = "my_lab.scenarios"               # a package whose folder holds scenario .toml files
+
+and every command then knows those names as it knows the bundled ones (``run --planner``, studies,
+``bench planners``).  Only what the user installed is loaded, and only by the group's name: a scenario or
+study file that names a plugin selects an installed class by its registered name, never a module of the
+file's choosing.
+
+A plugin that fails to import, is not a class, or takes a name already registered (a bundled one or another
+plugin's) is one warning line on stderr naming the distribution, and is skipped; the rest works.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import importlib.resources
+import sys
+from pathlib import Path as FilePath
+from typing import Any, Callable
+
+GROUPS = ("swarmnav.planners", "swarmnav.navigators", "swarmnav.scenarios")
+
+#: ``(kind, name) -> "distribution version"`` of every component a plugin registered.
+ORIGINS: dict[tuple[str, str], str] = {}
+_loaded = False
+
+
+def _distribution(entry: importlib.metadata.EntryPoint) -> str:
+    dist = getattr(entry, "dist", None)
+    return f"{dist.name} {dist.version}" if dist is not None else "an unknown distribution"
+
+
+def _warn(entry: importlib.metadata.EntryPoint, problem: str) -> None:
+    print(f"swarmnav: warning: plugin {entry.name!r} of {_distribution(entry)} ({entry.group}): {problem}; "
+          "skipped", file=sys.stderr)
+
+
+def _register(entry: importlib.metadata.EntryPoint, kind: str, registry: dict[str, type],
+              register: Callable[[type], type]) -> None:
+    try:
+        cls = entry.load()
+    except Exception as exc:  # a broken plugin must not stop the bundled components
+        _warn(entry, f"cannot be imported ({type(exc).__name__}: {exc})".replace("\n", " "))
+        return
+    name = getattr(cls, "name", None)
+    if not isinstance(cls, type):
+        _warn(entry, f"{entry.value} is not a class")
+    elif name != entry.name:
+        _warn(entry, f"the class's name is {name!r}, not the entry point's {entry.name!r}")
+    elif name in registry:
+        owner = ORIGINS.get((kind, name), "swarmnav")
+        _warn(entry, f"the {kind} name {name!r} is taken by {owner}")
+    else:
+        try:
+            register(cls)
+        except (TypeError, ValueError) as exc:
+            _warn(entry, str(exc))
+            return
+        ORIGINS[(kind, cls.name)] = _distribution(entry)
+
+
+def _scenario_folder(entry: importlib.metadata.EntryPoint) -> FilePath | None:
+    try:
+        folder = importlib.resources.files(entry.value)
+    except Exception as exc:
+        _warn(entry, f"cannot be found ({type(exc).__name__}: {exc})".replace("\n", " "))
+        return None
+    path = FilePath(str(folder))
+    if not path.is_dir():
+        _warn(entry, f"{entry.value} is not a folder")
+        return None
+    return path
+
+
+def load_plugins() -> None:
+    """Register every installed plugin once per process (later calls do nothing)."""
+    global _loaded
+    if _loaded:
+        return
+    _loaded = True
+    from swarmnav.controllers import navigators
+    from swarmnav.models import scenario
+    from swarmnav.planners import registry
+
+    for entry in importlib.metadata.entry_points(group="swarmnav.planners"):
+        _register(entry, "planner", registry.PLANNERS, registry.register)
+    for entry in importlib.metadata.entry_points(group="swarmnav.navigators"):
+        _register(entry, "navigator", navigators.NAVIGATORS, navigators.register)
+    for entry in importlib.metadata.entry_points(group="swarmnav.scenarios"):
+        folder = _scenario_folder(entry)
+        if folder is not None and folder not in scenario.EXTRA_SCENARIO_DIRS:
+            scenario.EXTRA_SCENARIO_DIRS.append(folder)
+
+
+def origin(kind: str, name: str) -> str:
+    """The distribution a component comes from (``swarmnav`` for the bundled ones)."""
+    return ORIGINS.get((kind, name), "swarmnav")
+
+
+def describe_components(kind: str) -> list[dict[str, Any]]:
+    """Every registered planner or navigator with its parameters (name, type, default, documented range if the
+    component declares one), its one-line description and its package: what ``swarmnav planners`` lists."""
+    import dataclasses
+    import typing
+
+    load_plugins()
+    if kind == "planner":
+        from swarmnav.planners.registry import PLANNERS as registry_map
+    else:
+        from swarmnav.controllers.navigators import NAVIGATORS as registry_map
+    out = []
+    for name in sorted(registry_map):
+        cls = registry_map[name]
+        doc = (cls.__doc__ or "").strip().splitlines()
+        try:
+            hints = typing.get_type_hints(cls)
+        except Exception:
+            hints = {}
+        ranges = getattr(cls, "parameter_ranges", None) or {}
+        params = []
+        for f in (dataclasses.fields(cls) if dataclasses.is_dataclass(cls) else ()):
+            if not f.init:
+                continue
+            default = f.default if f.default is not dataclasses.MISSING else (
+                f.default_factory() if f.default_factory is not dataclasses.MISSING else None)
+            annotation = hints.get(f.name, f.type)
+            entry = {"name": f.name, "type": getattr(annotation, "__name__", str(annotation)),
+                     "default": _json_value(default)}
+            if f.name in ranges:
+                entry["range"] = _json_value(ranges[f.name])
+            params.append(entry)
+        out.append({"name": name, "description": doc[0] if doc else "", "package": origin(kind, name),
+                    "parameters": params})
+    return out
+
+
+def _json_value(value: Any) -> Any:
+    if isinstance(value, (bool, int, str)) or value is None:
+        return value
+    if isinstance(value, float):
+        return value if value == value and abs(value) != float("inf") else str(value)
+    if isinstance(value, (list, tuple)):
+        return [_json_value(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): _json_value(v) for k, v in value.items()}
+    return repr(value)

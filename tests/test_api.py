@@ -1,0 +1,178 @@
+"""The Python API (``import swarmnav``), plugins by entry points, given paths and the CI checks."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tomllib
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+import pytest
+
+import swarmnav
+from swarmnav.sim.cli import EXIT_EXPECTATION, main
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLE = ROOT / "examples" / "swarmnav_plugin_example"
+WALL_CLOCK = {"wall_time_s", "replan_wall_s", "plan_time_s"}
+
+
+def _swarmnav(*args: str, env: dict[str, str] | None = None, cwd: Path | None = None):
+    return subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", *args], capture_output=True, text=True,
+                          env={**os.environ, **(env or {})}, cwd=cwd, timeout=600)
+
+
+def _without_wall_clock(value):
+    if isinstance(value, dict):
+        return {k: _without_wall_clock(v) for k, v in value.items() if k not in WALL_CLOCK}
+    return value
+
+
+def test_import_swarmnav_is_light_and_public():
+    code = ("import sys, swarmnav; "
+            "print(sorted(m for m in ('mujoco', 'scipy', 'dm_control') if m in sys.modules)); "
+            "print(callable(swarmnav.run), callable(swarmnav.plan), swarmnav.Problem.__name__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
+    assert out[0] == "[]"
+    assert out[1] == "True True Problem"
+
+
+def test_run_to_dict_is_what_run_json_prints(capsys):
+    result = swarmnav.run("gwo-scenario-1", planner="astar", seed=0)
+    assert result.outcome == result.to_dict()["outcome"] == "goal_reached"
+    assert main(["run", "gwo-scenario-1", "--planner", "astar", "--seed", "0", "--no-log", "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert _without_wall_clock(printed) == _without_wall_clock(result.to_dict())
+    figure = result.plot()
+    labels = {line.get_label() for line in figure.axes[0].get_lines()}
+    assert {"planned path", "driven"} <= labels
+
+
+def test_plan_returns_the_path_plan_json_prints(capsys):
+    planned = swarmnav.plan("gwo-scenario-3", planner="astar", seed=1)
+    assert main(["plan", "gwo-scenario-3", "--planner", "astar", "--seed", "1", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["waypoints"] == planned.to_dict()["waypoints"]
+
+
+def test_given_waypoints_reproduce_the_planned_run(tmp_path, capsys):
+    assert main(["plan", "gwo-scenario-3", "--planner", "astar", "--seed", "0", "--json"]) == 0
+    plan_file = tmp_path / "plan.json"
+    plan_file.write_text(capsys.readouterr().out)
+    assert main(["run", "gwo-scenario-3", "--planner", "astar", "--seed", "0", "--no-log", "--json"]) == 0
+    planned_run = json.loads(capsys.readouterr().out)
+    assert main(["run", "gwo-scenario-3", "--waypoints", str(plan_file), "--no-log", "--json"]) == 0
+    given_run = json.loads(capsys.readouterr().out)
+    for key in ("outcome", "collisions", "sim_time_s", "path_length_m", "min_clearance_m"):
+        assert given_run[key] == planned_run[key], key
+    assert given_run["plan"]["details"]["given"] == str(plan_file)
+    # The same path as a CSV file drives the same run.
+    csv_file = tmp_path / "plan.csv"
+    csv_file.write_text("x,y\n" + "\n".join(f"{x!r},{y!r}" for x, y in planned_run["plan"]["waypoints"]) + "\n")
+    assert swarmnav.run("gwo-scenario-3", waypoints=csv_file).result.path_length_m == given_run["path_length_m"]
+
+
+def test_a_path_through_an_obstacle_reports_the_collision_and_fails_expect(tmp_path, capsys):
+    path = tmp_path / "through.json"
+    path.write_text("[[0, 0], [10, 10]]")  # gwo-scenario-1 has a disc at (1, 1)
+    code = main(["run", "gwo-scenario-1", "--waypoints", str(path), "--no-log", "--json", "--stop-on-collision",
+                 "--expect", "success"])
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert code == EXIT_EXPECTATION
+    assert out["plan"]["collision_free"] is False
+    assert out["collisions"] >= 1 and out["first_collision_s"] is not None
+    assert captured.err.count("\n") == 1 and "--expect success" in captured.err
+    # reached-with-contacts passes --expect reached but not --expect success
+    assert main(["run", "gwo-scenario-2", "--planner", "astar", "--no-log", "--expect", "reached"]) == 0
+    assert main(["run", "gwo-scenario-2", "--planner", "astar", "--no-log", "--expect", "success"]) == EXIT_EXPECTATION
+
+
+@pytest.mark.parametrize("text,where", [("x,y\n0,0\nfoo,1\n", "row 3"), ("a,b\n0,0\n", "row 1"),
+                                        ("[[0, 0], [1]]", "[1]"), ('{"path": []}', "--waypoints"),
+                                        ("[[0, 0]]", "at least two"), ("[[0, 0], [NaN, 1]]", "must be finite")])
+def test_bad_waypoint_files_are_one_line(tmp_path, capsys, text, where):
+    path = tmp_path / "w.txt"
+    path.write_text(text)
+    assert main(["run", "gwo-scenario-1", "--waypoints", str(path), "--no-log"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(path) in err and where in err
+
+
+def _plugin_path(tmp_path: Path, broken: bool = False) -> dict[str, str]:
+    """The example package importable and its distribution metadata (entry points) on the path, as an
+    installed distribution would have them, without a build."""
+    info = tmp_path / "swarmnav_plugin_example-0.1.0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: swarmnav-plugin-example\nVersion: 0.1.0\n")
+    groups = tomllib.loads((EXAMPLE / "pyproject.toml").read_text())["project"]["entry-points"]
+    (info / "entry_points.txt").write_text("".join(
+        f"[{group}]\n" + "".join(f"{name} = {value}\n" for name, value in entries.items())
+        for group, entries in groups.items()))
+    if broken:
+        broken_info = tmp_path / "broken_plugin-1.0.dist-info"
+        broken_info.mkdir()
+        (broken_info / "METADATA").write_text("Metadata-Version: 2.1\nName: broken-plugin\nVersion: 1.0\n")
+        (broken_info / "entry_points.txt").write_text("[swarmnav.planners]\nbroken = no_such_module_here:Planner\n"
+                                                      "[swarmnav.navigators]\nfollow = clashing_plugin:Follow\n")
+        (tmp_path / "clashing_plugin.py").write_text(
+            "from swarmnav.controllers.navigators.follow import FollowNavigator\n\n"
+            "class Follow(FollowNavigator):\n    pass\n")
+    return {"PYTHONPATH": os.pathsep.join([str(tmp_path), str(EXAMPLE / "src"), os.environ.get("PYTHONPATH", "")])}
+
+
+def test_an_installed_plugin_is_listed_and_runs(tmp_path):
+    env = _plugin_path(tmp_path)
+    listed = json.loads(_swarmnav("planners", "--json", env=env).stdout)
+    mine = next(row for row in listed if row["name"] == "random_detour")
+    assert mine["package"] == "swarmnav-plugin-example 0.1.0"
+    assert {"name": "samples", "type": "int", "default": 2000} in mine["parameters"]
+    assert next(row for row in listed if row["name"] == "astar")["package"] == "swarmnav"
+    navigators = json.loads(_swarmnav("navigators", "--json", env=env).stdout)
+    assert "slow_follow" in {row["name"] for row in navigators}
+    run = _swarmnav("run", "plugin-corridor", "--navigator", "slow_follow", "--no-log", "--json",
+                    "--expect", "success", env=env)
+    assert run.returncode == 0, run.stderr
+    out = json.loads(run.stdout)
+    assert out["planner"] == "random_detour" and out["success"] is True and out["plan"]["collision_free"]
+    study = tmp_path / "plugin-study.toml"
+    study.write_text('name = "plugin-study"\nscenarios = ["gwo-scenario-3", "plugin-corridor"]\nmode = "plan"\n'
+                     'seeds = 2\n[[planners]]\nname = "random_detour"\n[[planners]]\nname = "astar"\n')
+    done = _swarmnav("study", str(study), "--out", str(tmp_path / "rows"), "--workers", "1", "--json",
+                     "--junit", str(tmp_path / "junit.xml"), env=env)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["ran"] == 8
+    cases = ElementTree.parse(tmp_path / "junit.xml").getroot().iter("testcase")
+    assert sum("random_detour" in case.get("name") for case in cases) == 4
+
+
+def test_a_broken_plugin_is_one_warning_and_the_rest_works(tmp_path):
+    env = _plugin_path(tmp_path, broken=True)
+    run = _swarmnav("run", "gwo-scenario-1", "--planner", "astar", "--no-log", env=env)
+    assert run.returncode == 0
+    warnings = [line for line in run.stderr.splitlines() if "warning" in line]
+    assert len(warnings) == 2, run.stderr
+    assert any("broken-plugin 1.0" in w and "cannot be imported" in w for w in warnings)
+    assert any("'follow' is taken by swarmnav" in w for w in warnings)  # a clash keeps the bundled one
+    assert "random_detour" in _swarmnav("planners", env=env).stdout
+
+
+def test_study_junit_and_min_success(tmp_path):
+    study = tmp_path / "smoke.toml"
+    study.write_text('name = "smoke"\nscenarios = ["gwo-scenario-1"]\nmode = "physics"\nseeds = 2\n'
+                     '[[planners]]\nname = "astar"\n[[planners]]\nname = "straight"\n')
+    junit = tmp_path / "ci" / "smoke.xml"
+    done = _swarmnav("study", str(study), "--out", str(tmp_path / "rows"), "--workers", "2", "--junit", str(junit),
+                     "--min-success", "0.5")
+    assert done.returncode == EXIT_EXPECTATION, done.stderr
+    assert "straight + follow: success 0/2" in done.stderr and "astar" not in done.stderr
+    root = ElementTree.parse(junit).getroot()
+    cases = list(root.iter("testcase"))
+    failed = [case for case in cases if case.find("failure") is not None]
+    assert len(cases) == 4 and root.get("tests") == "4"
+    assert {case.get("name").split(" +")[0] for case in failed} == {"straight"} and root.get("failures") == "2"
+    # astar succeeds on scenario 1: the same study passes a lower bar
+    again = _swarmnav("study", str(study), "--out", str(tmp_path / "rows"), "--min-success", "0")
+    assert again.returncode == 0
