@@ -279,3 +279,13 @@ def test_physics_paths_show_the_driven_trajectory_from_logs_and_say_so_without(t
     assert "| optimal | 1 | 0 | 1 | 0 | 0 | 0 | 0 |" in with_logs  # runs, success, collision, ...
     assert "the trajectory it drove" in with_logs and "No driven trajectory" not in with_logs
     assert "No driven trajectory for optimal" in without and "--logs" in without
+
+
+def test_identical_lengths_up_to_rounding_have_no_spread_in_the_paper_table():
+    from swarmnav.sim.study.statistics import paper_table
+    rows = [{"outcome": "ok", "success": True, "plan_length_m": x} for x in (31.7, 31.700000000000003, 31.7)]
+    header, [line] = paper_table({"a": rows})
+    assert line[header.index("mean - best (m)")] == 0.0 and line[header.index("std (m)")] == 0.0
+    rows[0]["plan_length_m"] = 32.0
+    header, [line] = paper_table({"a": rows})
+    assert line[header.index("mean - best (m)")] == pytest.approx(0.1)

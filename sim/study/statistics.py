@@ -268,8 +268,9 @@ def paper_table(arms: dict[str, list[dict[str, Any]]]) -> tuple[list[str], list[
             summary = summarise(rows, metric)
             if summary is None:
                 line.append(None)
-            elif statistic == "spread":
-                line.append(summary.mean - summary.best)
+            elif statistic == "spread":  # rounding noise of identical runs (1e-15 m) is no spread
+                spread = summary.mean - summary.best
+                line.append(0.0 if abs(spread) <= 1e-12 * max(1.0, abs(summary.best)) else spread)
             else:
                 line.append(getattr(summary, statistic))
         table.append(line)
