@@ -237,8 +237,10 @@ def test_the_readme_claims_table_is_the_one_generated_from_the_committed_verdict
         document = json.loads(path.read_text())
         assert document["study"] == path.parent.name and path.parent.name in list_studies()
         written = {c.id: c.as_dict() for c in load_study(path.parent.name).claims}
+        assert sorted(c["id"] for c in document["claims"]) == sorted(written), \
+            f"{path}: the study's claims changed; run `make readme-table`"
         for claim in document["claims"]:
-            fields = {k: claim[k] for k in written.get(claim["id"], {})}
+            fields = {k: claim[k] for k in written[claim["id"]]}
             assert fields == written[claim["id"]], f"{path}: claim {claim['id']} changed; run `make readme-table`"
 
 
