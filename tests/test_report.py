@@ -233,6 +233,9 @@ def test_the_readme_claims_table_is_the_one_generated_from_the_committed_verdict
     generated = capsys.readouterr().out.strip()
     readme = (REPO / "README.md").read_text()
     assert current_block(readme) == generated, "run `make readme-table` (README and verdicts differ)"
+    with_claims = [name for name in list_studies() if load_study(name).claims]
+    assert sorted(p.parent.name for p in committed) == with_claims, \
+        "a bundled study's claims have no committed verdicts (or a study lost its claims); run `make readme-table`"
     for path in committed:  # each committed verdict file is of a bundled study, with its claims as written now
         document = json.loads(path.read_text())
         assert document["study"] == path.parent.name and path.parent.name in list_studies()
