@@ -294,3 +294,10 @@ def test_identical_lengths_up_to_rounding_have_no_spread_in_the_paper_table():
     rows[0]["plan_length_m"] = 32.0
     header, [line] = paper_table({"a": rows})
     assert line[header.index("mean - best (m)")] == pytest.approx(0.1)
+
+
+def test_a12_counts_every_pair_with_ties_half():
+    rng = np.random.default_rng(3)
+    x, y = rng.integers(0, 5, 40).astype(float), rng.integers(0, 5, 33).astype(float)
+    pairs = [(1.0 if a > b else 0.5 if a == b else 0.0) for a in x for b in y]
+    assert a12(x, y) == pytest.approx(np.mean(pairs)) and a12(x, y) + a12(y, x) == pytest.approx(1.0)
