@@ -46,7 +46,7 @@ class DetectedObstacle:
     track_id: int = -1
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class Observation:
     """What the robot senses at one control step.
 
@@ -73,6 +73,16 @@ class Observation:
     detections: tuple[DetectedObstacle, ...] = ()
     range_cutoff_m: float = math.inf
 
+    def __init__(self, time_s: float, pose: Pose2D, twist: Twist, ranges_m: np.ndarray,
+                 range_angles_rad: np.ndarray, range_offset_m: float, detections: tuple[DetectedObstacle, ...] = (),
+                 range_cutoff_m: float = math.inf):
+        # One built every control step: the fields go straight into the instance's dict, once (the
+        # generated frozen __init__ sets each through object.__setattr__, four times the cost).
+        # Still frozen: assigning a field afterwards raises FrozenInstanceError.
+        self.__dict__.update(time_s=time_s, pose=pose, twist=twist, ranges_m=ranges_m,
+                             range_angles_rad=range_angles_rad, range_offset_m=range_offset_m,
+                             detections=detections, range_cutoff_m=range_cutoff_m)
+
 
 @dataclass(frozen=True, eq=False)
 class NavigationSetup:
@@ -81,7 +91,8 @@ class NavigationSetup:
     Attributes:
         path: the path planned at t = 0 on ``problem``.
         problem: the planning problem the first path was planned on.
-        planner: the scenario's planner, for navigators that replan.
+        planner: the run's planner (the one that planned ``path``), for navigators that declare
+            ``uses_planner``; None for the others.
         rng: the generator of the run's ``seed`` (planner and navigator randomness).
         controller: turns a path into wheel speeds.
         goal: the goal checker.
@@ -95,7 +106,7 @@ class NavigationSetup:
 
     path: Path
     problem: Problem
-    planner: Planner
+    planner: Planner | None
     rng: np.random.Generator
     controller: Controller
     goal: GoalChecker
@@ -142,10 +153,37 @@ class NavigationStep:
 
 
 class Navigator(Protocol):
-    """``uses_detections`` (optional, default True): False for a navigator that never reads
-    ``Observation.detections``, which then stays empty and costs nothing."""
+    """What a navigator is, and what it declares it uses (every navigator states all three).
+
+    Attributes:
+        name: the registry name.
+        uses_detections: whether :meth:`step` reads ``Observation.detections``; when False
+            they stay empty and the sensing model's work is spared.  Read after :meth:`reset`
+            (a navigator may decide per run, e.g. from the scenario).
+        uses_planner: whether :meth:`step` may call ``NavigationSetup.planner`` (replanning
+            with the run's planner); when False the setup's ``planner`` is None.
+        replan_wall_s: wall time spent planning inside :meth:`step` since :meth:`reset`
+            (0 for a navigator that never plans); reported as the run's ``replan_wall_s``.
+    """
 
     name: ClassVar[str]
+    uses_detections: bool
+    uses_planner: ClassVar[bool]
+    replan_wall_s: float
 
     def reset(self, setup: NavigationSetup) -> None: ...
     def step(self, observation: Observation) -> NavigationStep: ...
+
+
+DECLARATIONS = ("uses_detections", "uses_planner", "replan_wall_s")  # what every navigator class states
+
+
+def check_declarations(cls: type) -> type:
+    """``cls`` if it declares what it uses (:class:`Navigator`'s ``uses_detections``, ``uses_planner`` as
+    booleans and ``replan_wall_s`` as a number, on the class); TypeError naming what is missing."""
+    missing = [name for name, kind in zip(DECLARATIONS, (bool, bool, (int, float)))
+               if not isinstance(getattr(cls, name, None), kind)]
+    if missing:
+        raise TypeError(f"navigator {cls.__name__} does not declare {', '.join(missing)} "
+                        "(controllers.navigator.Navigator)")
+    return cls

@@ -17,6 +17,7 @@ import numpy as np
 
 from swarmnav.models.obstacle_motion import WALK_STEPS, LinearMotion, RandomWalkMotion, Stationary, WaypointMotion
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.seeds import Seeds
 from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem
 
 SCENARIO_DIR = FilePath(__file__).resolve().parent / "scenarios"
@@ -116,6 +117,11 @@ class Scenario:
             return self.bounds
         return Rect(inflation_m, inflation_m, self.arena_width_m - inflation_m,
                     self.arena_height_m - inflation_m)
+
+    @property
+    def seeds(self) -> Seeds:
+        """The scenario's seeds: the file's ``seed`` for the planner, ``world_seed`` for the world."""
+        return Seeds(self.seed, self.world_seed)
 
     def with_world_seed(self, world_seed: int) -> "Scenario":
         """This scenario with every random obstacle motion drawn from ``world_seed``."""

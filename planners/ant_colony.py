@@ -25,7 +25,8 @@ import numpy as np
 
 from swarmnav.planners._colony_walk import walk_block
 from swarmnav.planners.errors import NoPathFound
-from swarmnav.planners.grid_graph import DIRECTIONS, STEP_COSTS, cells_to_waypoints, count_bends, neighbour_table
+from swarmnav.planners.grid_graph import (DIRECTIONS, STEP_COSTS, cell_clearance_m, cells_to_waypoints, count_bends,
+                                          neighbour_table)
 from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmState
@@ -339,7 +340,11 @@ def best_tour_result(state: SwarmState, problem: Problem, shortcut: bool,
     raw = cells_to_waypoints(problem, grid, cells)
     waypoints = exact_shortcut(problem, raw) if shortcut else raw
     lengths_m = data["last_lengths"] * grid.cell_m
+    clearance = cell_clearance_m(grid)
+    idx = np.array(cells)
     return waypoints, {
+        "moves": len(cells) - 1,
+        "mean_cell_clearance_m": float(np.mean(clearance[idx[:, 0], idx[:, 1]])),
         "raw_cells": [list(c) for c in cells],
         "raw_length_m": state.best_cost,
         "mean_length_m": float(np.mean(lengths_m)) if lengths_m.size else math.nan,

@@ -288,3 +288,10 @@ def count_bends(cells: list[Cell] | np.ndarray) -> int:
     steps = np.diff(arr, axis=0)
     return int(np.count_nonzero(np.any(steps[1:] != steps[:-1], axis=1)))
 
+
+
+def cell_clearance_m(grid: OccupancyGrid) -> np.ndarray:
+    """(rows, cols) Euclidean distance in metres from each cell centre to the nearest occupied cell centre
+    (of the inflated grid): the "wide free space" Hasan et al. (2023) seek, as one number per cell."""
+    from scipy import ndimage  # SciPy only where a clearance is asked for
+    return ndimage.distance_transform_edt(~grid.occupied) * grid.cell_m

@@ -1,8 +1,10 @@
 """IMMAS: the improved MAX-MIN ant system of Hasan, Abdullah & Saleh (2023).
 
-A wide-free-space planner in two stages, on the inflated occupancy grid:
+A wide-free-space planner in two stages, on the inflated occupancy grid, with the MAX-MIN
+machinery of the paper's base (its Sect. 2, Stützle & Hoos 2000: :mod:`planners.max_min_trails`)
+under its own modifications:
 
-1. **Environment analysis** (Algorithm 1).  Pheromone propagates from the goal
+1. **Environment analysis** (Algorithm 1, §3.2).  Pheromone propagates from the goal
    (the food) over the free cells in order of route cost, D*-style, until the
    start (the nest) is reached.  While expanding a cell X:
 
@@ -12,26 +14,52 @@ A wide-free-space planner in two stages, on the inflated occupancy grid:
    * CheckTightTunnelState (Algorithm 2, line 19): each horizontal or vertical
      neighbour Y of X whose two flanking cells (the diagonal neighbours of X on
      either side of Y) are both obstacles is a tight-tunnel entrance and is closed;
-   * PheromoneTrails (line 17): each free neighbour Y gets route cost
-     ``k(Y) = k(X) + c`` and pheromone ``tau(Y) = rho * tau(X) + c`` (Eq. 2 with the
-     arc cost as deposit), ``c`` = 1 for a horizontal or vertical move and the
-     diagonal factor 1.4 for a diagonal one; rho = 0.98.
+   * PheromoneTrails (line 17): each free neighbour Y gets the route cost
+     ``k(Y) = k(X) + c`` (``c`` = 1 horizontally or vertically, 1.4 diagonally; Table 1's
+     "Total Arc Cost" sums these, so its values are multiples of 0.2) and the trail of
+     ``propagation = "mmas"`` (the default):
+
+     - every trail starts at ``tau_max`` (Sect. 2, item 3: "the intentional setup of the
+       pheromone to max at the start"), the goal at ``goal_pher = 0`` (Algorithm 1 line 6);
+     - the iteration-best ant deposits (Sect. 2, item 1, and Eq. 2): the open list is sorted
+       (line 20), so the ant dequeued, X, is the best of its iteration, and it alone updates
+       its neighbours, ``rho tau(X) + 1`` (Eq. 2 with a unit deposit);
+     - "multiply the value of tau by 1.4 [diagonally], and by 1 [horizontally or vertically]"
+       (§3.2) is applied to that value: ``tau(Y) = c (rho tau(X) + 1)``;
+     - every written trail is clamped to ``[tau_min, tau_max]`` at once (Sect. 2.1: "the limits
+       ... will be checked after each iteration"), with ``tau_max = 1 / (1 - rho)`` (Stützle &
+       Hoos Eq. 7 for the unit deposit) and ``tau_min`` from ``p_best = 0.05`` (their Eq. 11,
+       ``n`` = the free cells, ``avg`` = 4); see :func:`mmas_limits`.
+
+     ``propagation = "route_cost"`` keeps swarmnav's earlier reading, ``tau(Y) = rho tau(X) + c``
+     without bounds (for comparison; it is not MMAS).
 
 2. **Tour construction** (Algorithm 3, Eq. 3).  From the start, each iteration
    moves the robot (the ant) to the neighbour with the best value of
    ``(tau + clean)^alpha * eta^beta``, with ``eta`` the distance to the goal, and adds
    the new cell's route cost ``k`` to the total arc cost (line 25).
 
+Where the paper's prose and its algorithms disagree (our choices):
+
+* **Evaporation rate.**  §3.2's prose says "the evaporation rate doubles for each instance";
+  Algorithm 1 line 4 sets rho = 0.98 once and §4.2 runs every experiment at "the same
+  evaporation rate rho value of 0.98".  We follow Algorithm 1 and §4.2 by default; the prose is
+  the named option ``evaporation_doubling`` (rho, which the paper calls the evaporation rate,
+  doubles after every expansion: from the second ring out every trail sits at ``tau_max`` and
+  the tour runs on clean and eta alone).
+* **Deposit.**  Eq. (2)'s ``1 / f(s_best)`` has no solution cost in a propagation that has not
+  reached the start yet; we deposit 1 per step (the "1" that §3.2 multiplies by 1.4 or 1).
+
 Readings of the paper where its text is ambiguous (our choices):
 
 * Algorithm 3 lines 14-20 keep the neighbour with the *smallest* value of Eq. (3):
-  tau is read as the propagated route cost (it grows away from the goal), clean
+  tau grows away from the goal (under either propagation), clean
   penalises obstacle neighbours and eta is a distance, so the smallest value is
   the cell nearest the goal away from walls.  ``selection="roulette"`` instead
   draws the neighbour with probability proportional to 1 / Eq. (3) with the
   shared roulette wheel.
 * The robot never re-enters a cell; with no unvisited candidate it follows the
-  propagation tree one step towards the goal (tau strictly decreases along it),
+  propagation tree one step towards the goal (k strictly decreases along it),
   so every tour ends at the goal.
 * Clean values for the tour are counted on the final grid (after all closings).
 * The start and goal cells are never closed.  If closing disconnects them, the
@@ -39,158 +67,41 @@ Readings of the paper where its text is ambiguous (our choices):
 * Cells closed by Algorithms 1-2 are grid cells of *our* inflated grid: with a
   robot one cell wide (the papers' setting, see ``planners.movingai.inflated_map_grid``)
   they are the map's one-cell gates and tunnels.
+
+Deviations that remain (each also a row of the README's "Deviations from the papers"):
+
+* **Maps** (Sect. 4, Fig. 4): the six 50 x 50 environments and the 10 x 10 one are in the paper's
+  figures, not its text; ours (``models/maps/``) follow its descriptions, and the ``immas-*``
+  scenarios and ``models/studies/immas-pairs/`` place Table 1's 30 start/goal pairs on them.  On
+  our 10 x 10 map IMMAS takes the paper's 14 moves with alpha = 2 (§4.1) at an arc cost of
+  95.8, not 106.2; gates, tunnels and costs of Table 1 depend on the map and are not reproduced.
+* **Baseline** (Table 1): the paper compares with its own improved MMAS [9] and a D*/PSO hybrid
+  [8], whose texts it does not give; swarmnav's baseline is the plain MMAS of Stützle & Hoos
+  (``mmas``, :mod:`planners.max_min_colony`) and A*.
 """
 
 from __future__ import annotations
 
-import heapq
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
-from scipy import ndimage
 
 from swarmnav.planners.ant_colony import roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
-from swarmnav.planners.grid_graph import DIRECTIONS, Cell, cells_to_waypoints, count_bends, grid_endpoints, grid_problem
+from swarmnav.planners.grid_graph import (DIRECTIONS, Cell, cell_clearance_m, cells_to_waypoints, count_bends,
+                                          grid_endpoints, grid_problem)
 from swarmnav.planners.grid_shortcut import exact_shortcut
+from swarmnav.planners.max_min_trails import P_BEST
+from swarmnav.planners.pheromone_propagation import (PROPAGATIONS, EnvironmentAnalysis, analyse_environment,
+                                                     is_gate, is_tight_tunnel, mmas_limits)
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 
-INF = math.inf
-ORTHOGONAL = ((-1, 0), (1, 0), (0, -1), (0, 1))
-
-
-@dataclass
-class EnvironmentAnalysis:
-    """Result of Algorithms 1-2.
-
-    Attributes:
-        blocked: (rows, cols) obstacles after closing gates and tunnels.
-        route_cost: (rows, cols) k, the route cost to the goal (inf where not propagated).
-        pheromone: (rows, cols) tau (inf where not propagated).
-        clean: (rows, cols) clean weight times the number of obstacle neighbours.
-        parent: (rows, cols, 2) the next cell towards the goal in the propagation tree (-1 if none).
-        gates: cells closed by GateRaiseState.
-        tunnels: cells closed by CheckTightTunnelState.
-        expansions: cells expanded by the propagation.
-        closing_reverted: closing disconnected start from goal, so nothing was closed.
-    """
-
-    blocked: np.ndarray
-    route_cost: np.ndarray
-    pheromone: np.ndarray
-    clean: np.ndarray
-    parent: np.ndarray
-    gates: list[Cell] = field(default_factory=list)
-    tunnels: list[Cell] = field(default_factory=list)
-    expansions: int = 0
-    closing_reverted: bool = False
-
-
-def is_gate(blocked: list[list[bool]], r: int, c: int) -> bool:
-    """GateRaiseState: both cells of a diagonally opposite pair of neighbours are obstacles."""
-    rows, cols = len(blocked), len(blocked[0])
-
-    def occ(rr: int, cc: int) -> bool:
-        return 0 <= rr < rows and 0 <= cc < cols and blocked[rr][cc]
-
-    return (occ(r + 1, c + 1) and occ(r - 1, c - 1)) or (occ(r + 1, c - 1) and occ(r - 1, c + 1))
-
-
-def is_tight_tunnel(blocked: list[list[bool]], r: int, c: int, dr: int, dc: int) -> bool:
-    """Algorithm 2 for the horizontal or vertical neighbour Y = (r + dr, c + dc) of X = (r, c).
-
-    Y is a tight-tunnel entrance when the two diagonal neighbours of X that
-    flank it are both obstacles.
-    """
-    rows, cols = len(blocked), len(blocked[0])
-
-    def occ(rr: int, cc: int) -> bool:
-        return 0 <= rr < rows and 0 <= cc < cols and blocked[rr][cc]
-
-    if dr:
-        return occ(r + dr, c - 1) and occ(r + dr, c + 1)
-    return occ(r - 1, c + dc) and occ(r + 1, c + dc)
-
-
-def analyse_environment(occupied: np.ndarray, start: Cell, goal: Cell, rho: float = 0.98,
-                        clean_weight: float = 0.5, diagonal_factor: float = 1.4,
-                        close: bool = True) -> EnvironmentAnalysis:
-    """Algorithms 1-2: propagate pheromone from the goal, closing gates and tight tunnels.
-
-    Raises:
-        NoPathFound: the start is unreachable from the goal even without closing.
-    """
-    occ = np.asarray(occupied, dtype=bool)
-    rows, cols = occ.shape
-    blocked = occ.tolist()
-    k = [[INF] * cols for _ in range(rows)]
-    tau = [[INF] * cols for _ in range(rows)]
-    parent = [[None] * cols for _ in range(rows)]
-    closed_set = [[False] * cols for _ in range(rows)]
-    keep = {start, goal}
-    gates: list[Cell] = []
-    tunnels: list[Cell] = []
-    gr, gc = goal
-    k[gr][gc] = 0.0
-    tau[gr][gc] = 0.0
-    heap = [(0.0, gr, gc)]
-    expansions = 0
-    reached = False
-    moves = [(dr, dc, diagonal_factor if dr and dc else 1.0) for dr, dc in DIRECTIONS]
-    while heap:
-        kx, r, c = heapq.heappop(heap)
-        if closed_set[r][c] or blocked[r][c] or kx > k[r][c]:
-            continue
-        closed_set[r][c] = True
-        if (r, c) == start:
-            reached = True
-            break
-        if close and (r, c) not in keep and is_gate(blocked, r, c):
-            blocked[r][c] = True
-            gates.append((r, c))
-            continue
-        expansions += 1
-        if close:
-            for dr, dc in ORTHOGONAL:
-                yr, yc = r + dr, c + dc
-                if (0 <= yr < rows and 0 <= yc < cols and not blocked[yr][yc] and (yr, yc) not in keep
-                        and not closed_set[yr][yc] and is_tight_tunnel(blocked, r, c, dr, dc)):
-                    blocked[yr][yc] = True
-                    tunnels.append((yr, yc))
-        tx = tau[r][c]
-        for dr, dc, cost in moves:
-            yr, yc = r + dr, c + dc
-            if not (0 <= yr < rows and 0 <= yc < cols) or blocked[yr][yc] or closed_set[yr][yc]:
-                continue
-            if dr and dc and (blocked[r][yc] or blocked[yr][c]):
-                continue
-            ky = kx + cost
-            if ky < k[yr][yc]:
-                k[yr][yc] = ky
-                tau[yr][yc] = rho * tx + cost
-                parent[yr][yc] = (r, c)
-                heapq.heappush(heap, (ky, yr, yc))
-    if not reached:
-        if close:
-            result = analyse_environment(occ, start, goal, rho, clean_weight, diagonal_factor, close=False)
-            result.closing_reverted = True
-            return result
-        raise NoPathFound(f"goal cell {goal} is unreachable from start cell {start}")
-    blocked_arr = np.array(blocked, dtype=bool)
-    neighbours = ndimage.convolve(blocked_arr.astype(np.int64), np.array([[1, 1, 1], [1, 0, 1], [1, 1, 1]]),
-                                  mode="constant", cval=0)
-    parent_arr = np.full((rows, cols, 2), -1, dtype=np.int64)
-    for r in range(rows):
-        for c in range(cols):
-            if parent[r][c] is not None:
-                parent_arr[r, c] = parent[r][c]
-    return EnvironmentAnalysis(blocked=blocked_arr, route_cost=np.array(k), pheromone=np.array(tau),
-                               clean=clean_weight * neighbours * ~blocked_arr, parent=parent_arr,
-                               gates=gates, tunnels=tunnels, expansions=expansions)
+__all__ = ["MaxMinAntSystemPlanner", "EnvironmentAnalysis", "analyse_environment", "is_gate", "is_tight_tunnel",
+           "mmas_limits", "tour_scores", "PROPAGATIONS"]
 
 
 def tour_scores(tau: np.ndarray, clean: np.ndarray, eta: np.ndarray, alpha: float, beta: float) -> np.ndarray:
@@ -212,6 +123,11 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
         clean_weight: added per obstacle neighbour (0.5).
         diagonal_factor: arc cost of a diagonal move (1.4).
         close_gates_and_tunnels: apply GateRaiseState and Algorithm 2.
+        propagation: ``"mmas"`` (the MAX-MIN trails, see the module docstring) or ``"route_cost"``
+            (swarmnav's earlier reading: the trail is the unbounded route cost ``rho tau(X) + c``).
+        evaporation_doubling: §3.2's prose, "the evaporation rate doubles for each instance"
+            (off: Algorithm 1 line 4 and §4.2 keep rho = 0.98).
+        p_best: Stützle & Hoos (2000)'s p_best of ``tau_min`` (0.05).
         selection: "best" (Algorithm 3: the smallest Eq. (3) value) or "roulette".
         iterations: max_itr, the move budget; 0 means the number of cells.
         cell_m: grid resolution; ``None`` keeps the problem's.  The grid may have at most
@@ -227,6 +143,9 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
     clean_weight: float = 0.5
     diagonal_factor: float = 1.4
     close_gates_and_tunnels: bool = True
+    propagation: str = "mmas"
+    evaporation_doubling: bool = False
+    p_best: float = P_BEST
     selection: str = "best"
     iterations: int = 0
     cell_m: float | None = None
@@ -236,6 +155,8 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
     def __post_init__(self) -> None:
         check_parameters(self, (
             ("selection", self.selection in ("best", "roulette"), "must be 'best' or 'roulette'"),
+            ("propagation", self.propagation in PROPAGATIONS, f"must be one of {', '.join(PROPAGATIONS)}"),
+            ("p_best", 0.0 < self.p_best < 1.0, "must lie in (0, 1)"),
             ("rho", 0.0 < self.rho <= 1.0, "must lie in (0, 1]"),
             ("iterations", self.iterations >= 0, "must not be negative"),
             ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
@@ -243,6 +164,12 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
 
     def prepare(self, problem: Problem) -> Problem:
         return grid_problem(problem, self.cell_m)
+
+    def analyse(self, occupied: np.ndarray, start: Cell, goal: Cell) -> EnvironmentAnalysis:
+        """Algorithms 1-2 with this planner's settings (the ``immas_stepwise`` navigator's too)."""
+        return analyse_environment(occupied, start, goal, self.rho, self.clean_weight, self.diagonal_factor,
+                                   self.close_gates_and_tunnels, self.propagation, self.evaporation_doubling,
+                                   self.p_best)
 
     def iteration_limit(self, problem: Problem) -> int:
         """max_itr: ``iterations``, or the number of cells when it is 0."""
@@ -253,8 +180,7 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
         t0 = time.perf_counter()
         grid = problem.grid
         start, goal = grid_endpoints(problem, grid)
-        analysis = analyse_environment(grid.occupied, start, goal, self.rho, self.clean_weight,
-                                       self.diagonal_factor, self.close_gates_and_tunnels)
+        analysis = self.analyse(grid.occupied, start, goal)
         rows, cols = grid.shape
         rr, cc = np.mgrid[0:rows, 0:cols]
         eta = np.hypot(rr - goal[0], cc - goal[1])
@@ -321,7 +247,7 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
         raw = cells_to_waypoints(problem, grid, cells)
         waypoints = exact_shortcut(problem, raw) if self.shortcut else raw
         a: EnvironmentAnalysis = data["analysis"]
-        clearance = ndimage.distance_transform_edt(~grid.occupied) * grid.cell_m
+        clearance = cell_clearance_m(grid)
         idx = np.array(cells)
         extra = {
             "raw_cells": [list(cell) for cell in cells],
@@ -338,6 +264,8 @@ class MaxMinAntSystemPlanner(SwarmPlanner):
             "mean_cell_clearance_m": float(np.mean(clearance[idx[:, 0], idx[:, 1]])),
             "analysis_time_s": data["analysis_time_s"],
         }
+        if a.limits is not None:
+            extra.update({"tau_min": a.limits.tau_min, "tau_max": a.limits.tau_max})
         return waypoints, extra
 
 

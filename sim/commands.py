@@ -167,6 +167,11 @@ def add_bench_study_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--quick", action="store_true",
                         help="%d seeds per scenario, %d GWO iterations, no Ray (under a minute)" % BENCH_STUDY_QUICK)
+    parser.add_argument("--cells", type=options.positive_int, nargs="+", metavar="N",
+                        help="instead: how the driver scales, plan-only studies of about N cells each (astar and "
+                             "straight on four scenarios, 2 workers), local and on Ray (unless --no-ray): cells/s, "
+                             "the driver's peak memory, the ratio of each rate to the smallest study's; "
+                             "e.g. --cells 10000 100000")
 
 
 def run_bench_study(args: argparse.Namespace) -> int:

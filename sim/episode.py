@@ -8,31 +8,37 @@ Parameters resolve in one place (:meth:`EpisodeSpec.resolved`): a scenario's own
 planner (navigator) parameters apply when the spec names the same planner
 (navigator) as the scenario or none; the spec's parameters override them.
 
-Two seeds say what they seed: ``seed`` the planner's and the navigator's
-randomness, ``world_seed`` every random obstacle motion.  The planner draws from
+Two seeds say what they seed (:class:`models.scenario.Seeds`): ``seed`` the
+planner's and the navigator's randomness, ``world_seed`` every random obstacle
+motion; each falls back to the scenario's (``Scenario.seeds``: the file's ``seed``,
+or the world seed :meth:`Scenario.with_world_seed` set).  The planner draws from
 ``default_rng(seed)``; the navigator from its own stream,
 ``SeedSequence(seed, spawn_key=(1,))``, so a navigator's draws never shift the plan.
+
+:func:`plan_episode` builds the planner and the navigator once (a bad parameter of
+either fails before planning) and plans; :func:`run_episode` runs that planned
+episode with them, on a :class:`~sim.runner.Simulation` compiled once per episode.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
 import numpy as np
 
-from swarmnav.controllers.navigator import NavigationSetup
+from swarmnav.controllers.navigator import NavigationSetup, Navigator
 from swarmnav.controllers.navigators import make_navigator
 from swarmnav.controllers.point_to_point import PointToPointController
 from swarmnav.models.scenario import Scenario
+from swarmnav.models.seeds import Seeds
 from swarmnav.planners.registry import make_planner
-from swarmnav.planners.errors import PlanningError
-from swarmnav.planners.optimal import OptimalPlanner
-from swarmnav.planners.grid_search import ThetaStarPlanner
-from swarmnav.planners.problem import Path, Problem, scenario_problem
+from swarmnav.planners.problem import Path, Planner, Problem, scenario_problem
 from swarmnav.sim.recording import Recorder, RecorderGroup
-from swarmnav.sim.runner import RunResult, Simulation
+from swarmnav.sim.reference import reference_length_m, static_problem
+from swarmnav.sim.runner import Simulation
 from swarmnav.sim.scene import CompiledScene
+from swarmnav.sim.run_result import RunResult
 
 def json_safe(value: Any) -> Any:
     """A planner's extra statistics as JSON values (NumPy scalars and arrays to numbers and lists)."""
@@ -58,7 +64,7 @@ NAVIGATOR_STREAM = 1  # spawn key of the navigator's generator under the run's s
 class EpisodeSpec:
     """What to run: a scenario, a planner and a navigator with their parameters, and two seeds.
 
-    ``None`` means "the scenario's": its planner, navigator, ``seed`` (for both seeds), ``robot.clearance_m``.
+    ``None`` means "the scenario's": its planner, navigator, seeds (``Scenario.seeds``), ``robot.clearance_m``.
     Parameters given here override the scenario's own for the same planner or navigator.
     """
 
@@ -80,8 +86,9 @@ class EpisodeSpec:
                           **(self.planner_params or {})}
         navigator_params = {**(scenario.navigator_params if navigator == scenario.navigator_name else {}),
                             **(self.navigator_params or {})}
-        seed = scenario.seed if self.seed is None else int(self.seed)
-        world_seed = scenario.seed if self.world_seed is None else int(self.world_seed)
+        fallback = scenario.seeds
+        seed = fallback.planner if self.seed is None else int(self.seed)
+        world_seed = fallback.world if self.world_seed is None else int(self.world_seed)
         if world_seed != scenario.world_seed:
             scenario = scenario.with_world_seed(world_seed)
         if self.clearance_m is not None:
@@ -89,15 +96,33 @@ class EpisodeSpec:
         return EpisodeSpec(scenario, planner, planner_params, navigator, navigator_params, seed, world_seed,
                            scenario.clearance_m)
 
+    @property
+    def seeds(self) -> Seeds:
+        """The run's seeds, the scenario's where this spec names none."""
+        spec = self if self.seed is not None and self.world_seed is not None else self.resolved()
+        return Seeds(spec.seed, spec.world_seed)
+
 
 @dataclass(eq=False)
 class Episode:
-    """A planned (and, unless plan-only, simulated) episode."""
+    """A planned (and, once run, simulated) episode: the resolved spec, its problem and path, and the
+    planner and navigator built for it (once: :func:`run_episode` uses these)."""
 
     spec: EpisodeSpec  # resolved
     problem: Problem
     path: Path
+    planner: Planner
+    navigator: Navigator
+    scene: CompiledScene | None = field(default=None, repr=False)  # the scene to run; None: the scenario's
     result: RunResult | None = None
+    _simulation: Simulation | None = field(default=None, repr=False)
+
+    @property
+    def simulation(self) -> Simulation:
+        """The compiled scene the episode runs on, built on first use and kept (runs of it reuse it)."""
+        if self._simulation is None:
+            self._simulation = Simulation(self.spec.scenario, self.scene)
+        return self._simulation
 
     def plan_summary(self) -> dict[str, Any]:
         """The object ``swarmnav plan --json`` prints."""
@@ -120,8 +145,12 @@ class Episode:
         return out
 
 
-def plan_episode(spec: EpisodeSpec) -> Episode:
-    """Resolve the spec and plan on the scenario's obstacles at t = 0.
+def plan_episode(spec: EpisodeSpec, scene: CompiledScene | None = None) -> Episode:
+    """Resolve the spec, build its planner and navigator, and plan on the scenario's obstacles at t = 0.
+
+    Args:
+        scene: a compiled scene to run instead of compiling the scenario (replay runs the MJCF
+            its log carries).
 
     Raises:
         ConfigError: unknown planner or navigator, or a bad parameter (naming the field).
@@ -130,59 +159,28 @@ def plan_episode(spec: EpisodeSpec) -> Episode:
     spec = spec.resolved()
     source = spec.scenario.source_path
     planner = make_planner(spec.planner, spec.planner_params, source)
-    make_navigator(spec.navigator, spec.navigator_params, source)  # a bad navigator fails before planning
+    navigator = make_navigator(spec.navigator, spec.navigator_params, source)  # fails before planning
     problem = scenario_problem(spec.scenario)
     path = planner.plan(problem, np.random.default_rng(spec.seed))
-    return Episode(spec, problem, path)
+    return Episode(spec, problem, path, planner, navigator, scene)
 
 
-def static_problem(scenario: Scenario) -> Problem:
-    """The scenario's problem with its moving obstacles left out: what the robot knows in advance (the map)."""
-    return scenario_problem(replace(scenario, obstacles=tuple(ob for ob in scenario.obstacles if not ob.moving)))
+def run_episode(episode: Episode | EpisodeSpec, recorders: Sequence[Recorder] = (), *,
+                time_limit_s: float | None = None, stop_on_collision: bool | None = None) -> Episode:
+    """Run a planned episode's closed loop with the given recorders (a spec is planned first).
 
-
-_REFERENCE_LENGTHS: dict[str, float | None] = {}
-
-
-def reference_length_m(scenario: Scenario) -> float | None:
-    """L* for SPL: the exact shortest length among the static discs (``optimal``'s ``optimum_length_m``, not its
-    polygon's slightly longer length), or Theta*'s path length on a map.
-
-    None when there is no path among the static obstacles.  Cached by the
-    scenario's text (the static geometry does not depend on the world seed).
-    """
-    key = scenario.source_text or scenario.name
-    if key not in _REFERENCE_LENGTHS:
-        problem = static_problem(scenario)
-        planner = ThetaStarPlanner() if problem.boxes or problem.grid_override is not None else OptimalPlanner()
-        try:
-            stats = planner.plan(problem, np.random.default_rng(0)).stats
-            _REFERENCE_LENGTHS[key] = float(stats.extra.get("optimum_length_m", stats.length_m))
-        except PlanningError:
-            _REFERENCE_LENGTHS[key] = None
-    return _REFERENCE_LENGTHS[key]
-
-
-def run_episode(spec: EpisodeSpec, recorders: Sequence[Recorder] = (), *, scene: CompiledScene | None = None,
-                time_limit_s: float | None = None, stop_on_collision: bool | None = None,
-                simulation: Simulation | None = None, planned: Episode | None = None) -> Episode:
-    """Plan, build the simulation and run the closed loop with the given recorders.
+    Returns the episode with its ``result`` (the planned episode passed in is left as it was,
+    so a benchmark may run it again: the navigator is reset at the start of every run).
 
     Args:
-        scene: a compiled scene to run instead of compiling the scenario (replay
-            runs the MJCF its log carries).
-        simulation: a ready :class:`Simulation` of the same scenario (benchmarks reuse one).
-        planned: the result of :func:`plan_episode` on this spec, when it was planned already.
         time_limit_s, stop_on_collision: override the scenario's.
     """
-    episode = planned if planned is not None else plan_episode(spec)
-    spec = episode.spec
-    simulation = simulation or Simulation(spec.scenario, scene)
-    navigator = make_navigator(spec.navigator, spec.navigator_params, spec.scenario.source_path)
-    planner = make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)
+    planned = episode if isinstance(episode, Episode) else plan_episode(episode)
+    spec, simulation = planned.spec, planned.simulation
     scenario = spec.scenario
+    navigator = planned.navigator
     setup = NavigationSetup(
-        path=episode.path, problem=episode.problem, planner=planner,
+        path=planned.path, problem=planned.problem, planner=planned.planner if navigator.uses_planner else None,
         rng=np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(NAVIGATOR_STREAM,))),
         controller=PointToPointController(simulation.scene.drive, max_speed_m_s=scenario.max_speed_m_s),
         goal=simulation.goal_checker(), control_dt_s=simulation.control_dt_s,
@@ -191,7 +189,10 @@ def run_episode(spec: EpisodeSpec, recorders: Sequence[Recorder] = (), *, scene:
     recorder = RecorderGroup(list(recorders)) if recorders else None
     context = simulation.context(spec.planner, spec.planner_params, spec.seed, spec.navigator,
                                  spec.navigator_params) if recorder is not None else None
-    episode.result = simulation.run(navigator, setup, recorder=recorder, context=context,
-                                    time_limit_s=time_limit_s, stop_on_collision=stop_on_collision,
-                                    reference_length_m=reference_length_m(scenario))
-    return episode
+    result = simulation.run(navigator, setup, recorder=recorder, context=context,
+                            time_limit_s=time_limit_s, stop_on_collision=stop_on_collision)
+    return replace(planned, result=result)
+
+
+__all__ = ["Episode", "EpisodeSpec", "NAVIGATOR_STREAM", "json_safe", "plan_episode", "reference_length_m",
+           "run_episode", "static_problem"]

@@ -136,7 +136,7 @@ def verify_log(log: RunLog) -> VerifyReport:
     import mujoco
 
     from swarmnav.models.scenario import parse_scenario
-    from swarmnav.sim.episode import EpisodeSpec, run_episode
+    from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
     from swarmnav.sim.scene import index_scene
 
     context = context_from_log(log)
@@ -152,7 +152,7 @@ def verify_log(log: RunLog) -> VerifyReport:
     if "stopped_on_collision" in kinds:
         options["stop_on_collision"] = True
     capture = TrajectoryCapture()
-    episode = run_episode(spec, [capture], scene=index_scene(model, context.mjcf_xml), **options)
+    episode = run_episode(plan_episode(spec, scene=index_scene(model, context.mjcf_xml)), [capture], **options)
     path, result = episode.path, episode.result
     return compare_with_log(log, capture, np.asarray(path.waypoints, dtype=float)[:, :2], result.outcome)
 

@@ -8,7 +8,7 @@ import pytest
 from absl.testing import absltest
 from dm_env import test_utils
 
-from swarmnav.models.scenario import load_scenario, parse_scenario
+from swarmnav.models.scenario import Seeds, load_scenario, parse_scenario
 from swarmnav.models.world import Pose2D
 from swarmnav.sim.env import RewardWeights, make_environment
 from swarmnav.sim.env.task import same_model
@@ -53,9 +53,9 @@ def test_the_physics_carries_the_model_runs_and_logs_use():
 def test_env_and_run_agree_bit_for_bit_on_the_same_wheel_commands(follow_run):
     env = make_environment("gwo-scenario-2", action="wheels")
     timesteps = replay_commands(env, follow_run.wheel_command_rad_s)
-    loop = env.task.loop
-    assert loop.step == follow_run.steps
-    assert np.array_equal(loop.poses[:loop.step + 1], follow_run.poses)
+    stepper = env.task.stepper
+    assert stepper.step_index == follow_run.steps
+    assert np.array_equal(stepper.poses[:stepper.step_index + 1], follow_run.poses)
     assert sum(ts.reward is not None for ts in timesteps) == follow_run.steps
     metrics = env.task.info()["metrics"]
     assert metrics["collisions"] == follow_run.collisions
@@ -104,7 +104,7 @@ def test_time_limit_is_a_truncation_with_discount_one_like_the_runs_timeout():
     timesteps = replay_commands(env, run.wheel_command_rad_s)
     assert timesteps[-1].last() and timesteps[-1].discount == 1.0
     assert len(timesteps) - 1 == run.steps
-    assert np.array_equal(env.task.loop.poses[:run.steps + 1], run.poses)
+    assert np.array_equal(env.task.stepper.poses[:run.steps + 1], run.poses)
 
 
 def test_stop_on_collision_is_a_termination_at_the_runs_collision(follow_run):
@@ -123,7 +123,7 @@ def _rollout(env, seed, steps=150):
     out = [env.reset()]
     for _ in range(steps):
         out.append(env.step(rng.uniform(-1.0, 1.0, 2)))
-    return out, env.task.loop.poses[:steps + 1].copy()
+    return out, env.task.stepper.poses[:steps + 1].copy()
 
 
 @pytest.mark.parametrize("detector", [False, True])
@@ -149,11 +149,11 @@ def test_same_seeds_and_actions_give_the_same_observations_rewards_and_costs(det
     assert np.array_equal(poses_again, poses_a)
     assert [t.reward for t in run_again] == [t.reward for t in run_a]
     # Another world seed moves the random-walk obstacle elsewhere.
-    a.task.set_world_seed(8)
+    a.task.set_seeds(Seeds(a.task.seeds.planner, 8))
     a.reset()
-    moved = a.task.loop.obstacle_track_m
+    moved = a.task.stepper.obstacle_track_m
     b.reset()
-    assert not np.array_equal(moved, b.task.loop.obstacle_track_m)
+    assert not np.array_equal(moved, b.task.stepper.obstacle_track_m)
 
 
 def test_observations_follow_the_documented_conventions():
@@ -198,7 +198,7 @@ def test_the_detector_model_observes_the_moving_obstacles_in_the_robot_frame_nea
         obs = timestep.observation
         for key, value in obs.items():
             spec[key].validate(value)
-        x, y, heading = env.task.loop.poses[step]
+        x, y, heading = env.task.stepper.poses[step]
         t = step * env.control_timestep()
         expected = []
         for ob in moving:  # the true state, from the scenario's own motions
@@ -254,7 +254,7 @@ def test_a_start_at_the_goal_ends_on_the_first_step_with_discount_zero_and_no_mo
     assert first.first() and not first.last()
     assert last.last() and last.discount == 0.0 and last.reward == 0.0
     assert env.task.info()["outcome"] == "goal_reached" and env.task.info()["metrics"]["sim_time_s"] == 0.0
-    assert np.array_equal(env.task.loop.poses[:1], run.poses)  # the action was not applied
+    assert np.array_equal(env.task.stepper.poses[:1], run.poses)  # the action was not applied
     assert env.physics.data.time == 0.0
     assert env.step(np.array([5.0, 5.0])).first()  # dm_env: a step after LAST starts a new episode
 
@@ -284,3 +284,23 @@ def test_gymnasium_reset_reports_an_episode_over_at_its_start_and_the_first_step
     assert info["outcome"] == "goal_reached" and info["metrics"]["reached"]
     _, reward, terminated, truncated, info = env.step(env.action_space.sample())
     assert terminated and not truncated and reward == 0.0
+
+
+@pytest.mark.parametrize("name, spl", [("restaurant-table-5", "positive"), ("gwo-scenario-2", "zero"),
+                                       ("dyn-crossing-3", "zero")])  # success; collisions (rangefinder, detector)
+def test_the_environments_final_metrics_are_run_jsons_for_the_same_wheel_commands(name, spl, capsys):
+    """SPL included: the environment's episode is the same stepper's, with the same L*.  (``follow``
+    runs: the environment has no navigator to replan or trigger a safety filter.)"""
+    import json
+
+    from swarmnav.sim.cli import main
+    assert main(["run", name, "--navigator", "follow", "--json", "--no-log"]) == 0
+    run = json.loads(capsys.readouterr().out)
+    commands = run_episode(EpisodeSpec(load_scenario(name), navigator="follow")).result.wheel_command_rad_s
+    env = make_environment(name, action="wheels")
+    replay_commands(env, commands)
+    metrics = env.task.info()["metrics"]
+    assert (run["spl"] > 0.0) if spl == "positive" else (run["spl"] == 0.0 and run["collisions"] > 0)
+    wall = {"wall_time_s"}
+    assert {k: v for k, v in metrics.items() if k not in wall} == \
+        {k: run[k] for k in metrics if k not in wall}

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from swarmnav.models.scenario import load_scenario
+from swarmnav.models.scenario import Seeds, load_scenario
 from swarmnav.sim.env import ENV_ID, NavigateEnv
 from swarmnav.sim.log_reader import read_log
 
@@ -94,6 +94,7 @@ def test_reset_options_switch_scenario_and_world_seed():
     assert env.task.scenario.name == "gwo-scenario-2"
     env.reset(seed=1, options={"scenario": "dense-field-30", "world_seed": 5})
     assert env.task.scenario.name == "dense-field-30" and env.task.scenario.world_seed == 5
+    assert env.task.seeds.planner == Seeds.derived(1).planner
     assert env.unwrapped.dm_env.physics.model.ngeom != NavigateEnv("gwo-scenario-2").dm_env.physics.model.ngeom
     with pytest.raises(ValueError, match="unknown"):
         env.reset(options={"sceanrio": "x"})
@@ -119,7 +120,7 @@ def test_an_episode_records_to_mcap_like_a_run(tmp_path):
     while not truncated:
         _, _, _, truncated, info = env.step(np.array([0.5, 0.2]))
         steps += 1
-    poses = env.task.loop.poses[:steps + 1].copy()
+    poses = env.task.stepper.poses[:steps + 1].copy()
     env.reset(seed=0)  # the second episode is closed before its end
     for _ in range(5):
         env.step(np.array([0.5, 0.2]))
@@ -145,3 +146,27 @@ def test_bench_env_quick_prints_the_three_rates_and_their_ratios_as_json():
     bad = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "bench", "env", "--repeats", "0"],
                          capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "--repeats" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def _walker_tracks(env, **reset):
+    env.reset(**reset)
+    return env.task.stepper.obstacle_track_m.copy()
+
+
+def test_reset_seed_derives_the_world_too_and_options_override_it():
+    from swarmnav.models.scenario import Seeds, parse_scenario
+    text = load_scenario("gwo-scenario-2").source_text.replace(
+        'kind = "linear", speed_m_s = 0.05, heading_deg = 150.0, at_edge = "reflect"',
+        'kind = "random_walk", step_m = 0.3, period_s = 1.0')
+    env = NavigateEnv(parse_scenario(text, "random-walk.toml"), time_limit_s=5.0)
+    one, again, two = (_walker_tracks(env, seed=s) for s in (1, 1, 2))
+    assert np.array_equal(one, again) and not np.array_equal(one, two)
+    assert env.task.seeds == Seeds.derived(2)
+    pinned = _walker_tracks(env, seed=2, options={"world_seed": 1, "planner_seed": 9})
+    assert env.task.seeds == Seeds(9, 1)
+    assert np.array_equal(pinned, _walker_tracks(env, seed=5, options={"world_seed": 1}))
+    # After a seeded reset, unseeded resets draw new worlds, the same sequence for the same first seed.
+    sequence = [_walker_tracks(env, seed=3)] + [_walker_tracks(env) for _ in range(2)]
+    assert not np.array_equal(sequence[1], sequence[2]) and not np.array_equal(sequence[0], sequence[1])
+    replayed = [_walker_tracks(env, seed=3)] + [_walker_tracks(env) for _ in range(2)]
+    assert all(np.array_equal(a, b) for a, b in zip(sequence, replayed))

@@ -60,10 +60,10 @@ def test_the_policy_navigator_and_the_environment_drive_the_same_trajectory(poli
     while not timestep.last():
         observations.append(timestep.observation)
         timestep = env.step(reactive_policy.act(timestep.observation))
-    loop = env.task.loop
-    assert loop.step == run.steps
-    assert np.array_equal(loop.poses[:loop.step + 1], run.poses)
-    assert np.array_equal(loop.wheel_cmd[:loop.step], run.wheel_command_rad_s[:-1])
+    stepper = env.task.stepper
+    assert stepper.step_index == run.steps
+    assert np.array_equal(stepper.poses[:stepper.step_index + 1], run.poses)
+    assert np.array_equal(stepper.wheel_cmd[:stepper.step_index], run.wheel_command_rad_s[:-1])
     # The navigator's policy saw exactly the environment's observations, entry by entry.
     assert len(seen) == len(observations)
     for a, b in zip(seen, observations):

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from swarmnav.controllers.navigators import NAVIGATORS
-from swarmnav.models.scenario import parse_scenario
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import Seeds, parse_scenario
 from swarmnav.sim.cli import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
 
@@ -98,12 +99,65 @@ def test_scenario_parameters_apply_only_to_the_scenario_s_own_planner():
     assert EpisodeSpec(scenario, "theta_star").resolved().planner_params == {}
 
 
-def test_the_navigator_draws_from_its_own_stream():
-    scenario = parse_scenario(RANDOM_WALKS)
-    first = run_episode(EpisodeSpec(scenario, "straight", seed=3), time_limit_s=1.0)
-    second = run_episode(EpisodeSpec(scenario, "straight", seed=3), time_limit_s=1.0)
+def crossing_case():
+    """A 5 m arena that one obstacle crosses: ``replan`` replans in it."""
+    from swarmnav.models.scenario_generator import GeneratorOptions, generate
+    return parse_scenario(generate("crossing", 7, GeneratorOptions(obstacles=1, arena_m=5.0, speed_ratio=0.5,
+                                                                    range_m=1.0)))
+
+
+def test_the_navigator_draws_from_its_own_stream(monkeypatch):
+    """``replan`` replans with ABC, which draws from the navigator's generator: the same seed gives the same
+    run, and another navigator stream under the same seed leaves the plan but changes the replanned drive."""
+    from swarmnav.sim import episode as episode_module
+
+    spec = EpisodeSpec(crossing_case(), "abc", navigator="replan", seed=3)
+    first = run_episode(spec)
+    second = run_episode(spec)
+    assert first.result.replans >= 1
     assert np.array_equal(first.result.poses, second.result.poses)
-    assert plan_episode(EpisodeSpec(scenario, "straight", seed=3)).path.same_as(first.path)
+    monkeypatch.setattr(episode_module, "NAVIGATOR_STREAM", episode_module.NAVIGATOR_STREAM + 1)
+    other = run_episode(spec)
+    assert other.path.same_as(first.path)  # the planner's stream is untouched
+    assert plan_episode(spec).path.same_as(first.path)
+    assert other.result.poses.shape != first.result.poses.shape or \
+        not np.array_equal(other.result.poses, first.result.poses)
+
+
+def test_a_world_seed_set_on_the_scenario_is_kept_and_an_explicit_one_wins():
+    scenario = parse_scenario(RANDOM_WALKS).with_world_seed(7)
+    spec = EpisodeSpec(scenario, "straight").resolved()
+    assert spec.world_seed == 7 and spec.seeds == Seeds(planner=4, world=7)
+    times = np.arange(0.0, 6.0, 0.02)
+    assert np.array_equal(np.stack([ob.trajectory().positions_at(times) for ob in spec.scenario.obstacles]),
+                          tracks(7))
+    assert EpisodeSpec(scenario, "straight", seed=1, world_seed=2).seeds == Seeds(planner=1, world=2)
+    assert EpisodeSpec(parse_scenario(RANDOM_WALKS)).seeds == parse_scenario(RANDOM_WALKS).seeds == Seeds(4, 4)
+
+
+def test_one_seed_derives_two_distinct_reproducible_seeds():
+    derived = [Seeds.derived(s) for s in range(50)]
+    assert derived == [Seeds.derived(s) for s in range(50)]
+    assert len({d.planner for d in derived} | {d.world for d in derived}) == 100
+    for bad in (-1, 1.5, True):
+        with pytest.raises(ConfigError) as info:
+            Seeds(0, bad)
+        assert info.value.field == "seeds.world"
+
+
+@pytest.mark.parametrize("name", sorted(NAVIGATORS))
+def test_every_navigator_declares_what_it_uses(name, contract_policy):
+    """The seam's declarations (controllers.navigator.Navigator) are there, typed, and honest about the
+    planner: one that declares it never uses the planner runs with ``setup.planner`` None."""
+    from swarmnav.models.scenario import load_scenario
+
+    navigator = NAVIGATORS[name](**NEEDS_PARAMS.get(name, {}))
+    assert isinstance(navigator.uses_detections, bool) and isinstance(type(navigator).uses_planner, bool)
+    assert navigator.replan_wall_s == 0.0
+    spec = EpisodeSpec(load_scenario("gwo-scenario-2"), "astar", navigator=name,
+                       navigator_params=NEEDS_PARAMS.get(name))
+    result = run_episode(spec, time_limit_s=2.0).result
+    assert result.steps > 0 and result.replan_wall_s >= 0.0
 
 
 def test_the_wheel_installs_one_namespace_and_nothing_named_models(tmp_path):
@@ -115,11 +169,26 @@ def test_the_wheel_installs_one_namespace_and_nothing_named_models(tmp_path):
     names = zipfile.ZipFile(wheel).namelist()
     tops = {name.split("/")[0] for name in names}
     assert {top for top in tops if not top.endswith(".dist-info")} == {"swarmnav"}
-    for package in ("models", "planners", "controllers", "sim"):
-        assert f"swarmnav/{package}/__init__.py" in names
-    assert "swarmnav/models/scenarios/gwo-scenario-1.toml" in names
-    assert "swarmnav/sim/benchmarks/sim.py" in names
-    assert "swarmnav/controllers/navigators/follow.py" in names
+    # Every module and bundled data file (scenarios, maps, studies, MJCF) of a mapped folder ships, at the
+    # place pyproject's package-dir gives it (the deepest mapped folder holding it decides).
+    import tomllib
+    mapping = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-dir"]
+    folders = sorted(((ROOT / folder, package) for package, folder in mapping.items()),
+                     key=lambda item: len(item[0].parts), reverse=True)
+    missing, shipped = [], 0
+    for folder, _ in folders:
+        for source in folder.rglob("*"):
+            if not source.is_file() or "__pycache__" in source.parts or \
+                    source.suffix not in (".py", ".toml", ".xml", ".map", ".scen", ".md"):
+                continue
+            owner, package = next((f, p) for f, p in folders if source.is_relative_to(f))
+            if owner != folder:
+                continue
+            expected = "/".join([*package.split("."), *source.relative_to(folder).parts])
+            shipped += expected in names
+            if expected not in names:
+                missing.append(str(source.relative_to(ROOT)))
+    assert shipped > 100 and not missing
 
 
 NEEDS_PARAMS = {"policy": {"policy": "contract_policy:act"}}
@@ -138,10 +207,32 @@ def test_every_navigator_is_deterministic_and_names_a_bad_parameter(name, contra
 
     scenario = load_scenario("gwo-scenario-2")
     spec = EpisodeSpec(scenario, "astar", navigator=name, navigator_params=NEEDS_PARAMS.get(name))
-    first = run_episode(spec, time_limit_s=3.0).result
-    second = run_episode(spec, time_limit_s=3.0).result
-    assert first.steps > 0 and np.array_equal(first.poses, second.poses)
+    planned = plan_episode(spec)
+    first = run_episode(planned, time_limit_s=3.0).result
+    again = run_episode(planned, time_limit_s=3.0).result  # the same navigator, reset for its second run
+    fresh = run_episode(spec, time_limit_s=3.0).result
+    assert first.steps > 0 and np.array_equal(first.poses, again.poses) and np.array_equal(first.poses, fresh.poses)
     with pytest.raises(ConfigError) as info:
         plan_episode(EpisodeSpec(scenario, "astar", navigator=name,
                                  navigator_params={**NEEDS_PARAMS.get(name, {}), "no_such_knob": 1}))
     assert info.value.field == "navigator.params.no_such_knob"
+
+
+def test_a_navigator_that_does_not_declare_what_it_uses_is_refused_at_registration():
+    from swarmnav.controllers.navigators import register
+    from swarmnav.controllers.navigators.follow import FollowNavigator
+
+    class Undeclared:
+        name = "undeclared"
+        uses_detections = False
+
+    with pytest.raises(TypeError, match="uses_planner, replan_wall_s"):
+        register(Undeclared)
+    assert "undeclared" not in NAVIGATORS
+
+    class HalfDeclared(FollowNavigator):
+        name = "half_declared"
+        uses_planner = "no"
+
+    with pytest.raises(TypeError, match="does not declare uses_planner"):
+        register(HalfDeclared)

@@ -118,9 +118,9 @@ def test_skipping_clearance_measurements_changes_nothing(monkeypatch, name, navi
                                              ("immas-env1-dynamic", None)])
 def test_the_runners_bound_is_below_the_clearance_at_every_step_among_moving_obstacles(monkeypatch, name, navigator):
     """The bound the loop acts on (its obstacle-shift bookkeeping included) against a fresh probe's measure."""
-    from swarmnav.sim import runner
+    from swarmnav.sim import stepper
 
-    original = runner.StepLoop.observe
+    original = stepper.EpisodeStepper._observe
     checked = []
 
     def checking_observe(self):
@@ -132,7 +132,7 @@ def test_the_runners_bound_is_below_the_clearance_at_every_step_among_moving_obs
         checked.append(bound > 0.0)
         return original(self)
 
-    monkeypatch.setattr(runner.StepLoop, "observe", checking_observe)
+    monkeypatch.setattr(stepper.EpisodeStepper, "_observe", checking_observe)
     run_episode(EpisodeSpec(load_scenario(name), navigator=navigator), time_limit_s=40.0)
     assert sum(checked) >= 200
 
@@ -204,3 +204,30 @@ def test_rangefinder_sensing_hands_the_tracker_what_hit_points_and_the_map_give(
         world = pose.heading_rad + scene.range_angles_rad
         assert directions.tobytes() == np.column_stack([np.cos(world), np.sin(world)]).tobytes()
         assert beam_ranges.tobytes() == ranges.tobytes() and beam_origins.shape == (len(ranges), 2)
+
+
+@pytest.mark.parametrize("name", ["dyn-crowd-1", "dyn-crossing-3"])  # rangefinder tracker, detector
+def test_skipping_the_sensing_model_for_a_navigator_that_never_reads_it_changes_nothing(monkeypatch, name):
+    """``follow`` declares ``uses_detections = False``: its observations carry no detections and the
+    sensing model does no work; sensing anyway gives the same run, bit for bit (and does sense)."""
+    from swarmnav.controllers.navigators.follow import FollowNavigator
+    from swarmnav.sim.detector import ObstacleSensing
+
+    spec = EpisodeSpec(load_scenario(name), navigator="follow")
+    sensed = []
+    original = ObstacleSensing.sense
+
+    def counting_sense(self, *args):
+        detections = original(self, *args)
+        sensed.append(len(detections))
+        return detections
+
+    monkeypatch.setattr(ObstacleSensing, "sense", counting_sense)
+    fast = run_episode(spec, time_limit_s=30.0).result
+    assert not sensed
+    monkeypatch.setattr(FollowNavigator, "uses_detections", True)
+    slow = run_episode(spec, time_limit_s=30.0).result
+    assert len(sensed) == slow.steps + 1 and sum(sensed) > 0
+    assert np.array_equal(fast.poses, slow.poses)
+    assert np.array_equal(fast.wheel_command_rad_s, slow.wheel_command_rad_s)
+    assert fast.summary() | {"wall_time_s": 0} == slow.summary() | {"wall_time_s": 0}

@@ -87,17 +87,17 @@ def test_collisions_are_detected_at_the_physics_rate_where_the_bodies_touch():
 
 
 def test_stepping_k_physics_steps_at_once_away_from_obstacles_changes_nothing(monkeypatch):
-    from swarmnav.sim import runner
+    from swarmnav.sim import stepper
 
     scenario = load_scenario("gwo-scenario-2")  # the straight line meets a moving obstacle
     fast = simulate(scenario, "straight", {}, 0, time_limit_s=40.0).result
-    original = runner.StepLoop.__init__
+    original = stepper.EpisodeStepper.__init__
 
     def always_check_every_physics_step(self, *args, **kwargs):
         original(self, *args, **kwargs)
         self.contact_free_gap_m = float("inf")
 
-    monkeypatch.setattr(runner.StepLoop, "__init__", always_check_every_physics_step)
+    monkeypatch.setattr(stepper.EpisodeStepper, "__init__", always_check_every_physics_step)
     slow = simulate(scenario, "straight", {}, 0, time_limit_s=40.0).result
     assert fast.collisions == slow.collisions >= 1
     assert fast.first_collision_s == slow.first_collision_s

@@ -63,7 +63,7 @@ def test_tiny_study_rows_equal_the_same_episodes(tiny):
         except PlanningError as exc:
             assert row["outcome"] == "no_path" and type(exc).__name__ in row["error"]
             continue
-        summary = run_episode(spec, planned=planned, time_limit_s=TINY_TIME_LIMIT_S).summary()
+        summary = run_episode(planned, time_limit_s=TINY_TIME_LIMIT_S).summary()
         assert row["outcome"] == "ok"
         for key in ("reached", "collisions", "sim_time_s", "path_length_m", "min_clearance_m"):
             assert row[key] == summary[key], key
@@ -400,7 +400,7 @@ def test_an_unreachable_ray_address_is_one_line_naming_the_option(tmp_path):
     import socket
 
     from swarmnav.models.errors import ConfigError
-    from swarmnav.sim.study.engines import check_reachable
+    from swarmnav.sim.study.ray_engine import check_reachable
 
     with socket.socket() as listener:  # a port that surely refuses: bound, never listening
         listener.bind(("127.0.0.1", 0))

@@ -1,14 +1,21 @@
 """The Ray engine on a real local instance (2 CPUs): the local engine's rows, timings aside; the wall limit
-enforced inside a task; no token-authentication warning at start-up."""
+enforced inside a task; no token-authentication warning at start-up; a task whose worker dies (by its own
+hand or killed from outside) is an error row and the study goes on."""
 
+import dataclasses
 import logging
+import os
+import signal
+import threading
+import time
+from pathlib import Path
 
 import pandas as pd
 import pytest
 
-from swarmnav.sim.study.engines import RAY_AUTH_LOGGER, start_ray
+from swarmnav.sim.study.ray_engine import RAY_AUTH_LOGGER, start_ray
 from swarmnav.sim.study.execute import run_study
-from swarmnav.sim.study.rows import TIMING_COLUMNS
+from swarmnav.sim.study.rows import PROGRESS_TIMING_COLUMNS, TIMING_COLUMNS
 from swarmnav.sim.study.spec import parse_study
 
 ray = pytest.importorskip("ray", reason="the ray extra is not installed (pip install 'swarmnav[ray]')")
@@ -44,10 +51,17 @@ def ray_start_log():
     records = _Records()
     logger = logging.getLogger(RAY_AUTH_LOGGER)
     logger.addHandler(records)
+    saved = os.environ.get("PYTHONPATH")
+    # the instance's workers inherit this environment: they can import the tests' dying policy
+    os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(Path(__file__).parent), saved) if p)
     try:
         start_ray(None, 2)
     finally:
         logger.removeHandler(records)
+        if saved is None:
+            os.environ.pop("PYTHONPATH")
+        else:
+            os.environ["PYTHONPATH"] = saved
     yield records.messages
     ray.shutdown()
 
@@ -65,8 +79,8 @@ def test_ray_rows_equal_local_rows(ray_start_log, tmp_path):
     frames = [pd.read_parquet(tmp_path / d / "runs.parquet").drop(columns=list(TIMING_COLUMNS))
               .sort_values("config_hash").reset_index(drop=True) for d in ("local", "ray")]
     pd.testing.assert_frame_equal(frames[0], frames[1])
-    progress = [pd.read_parquet(tmp_path / d / "progress.parquet").sort_values(["config_hash", "iteration"])
-                .reset_index(drop=True) for d in ("local", "ray")]
+    progress = [pd.read_parquet(tmp_path / d / "progress.parquet").drop(columns=list(PROGRESS_TIMING_COLUMNS))
+                .sort_values(["config_hash", "iteration"]).reset_index(drop=True) for d in ("local", "ray")]
     pd.testing.assert_frame_equal(progress[0], progress[1])
 
 
@@ -77,3 +91,82 @@ def test_the_wall_limit_interrupts_a_ray_task(ray_start_log, tmp_path):
     assert run_study(study, tmp_path, engine="ray", workers=2)["outcomes"] == {"timeout": 1}
     row = pd.read_parquet(tmp_path / "runs.parquet").iloc[0]
     assert row.error == "exceeded the wall limit of 1 s" and row.cell_wall_s < 5
+
+
+def test_ray_tasks_that_kill_their_worker_are_error_rows(ray_start_log, tmp_path):
+    from swarmnav.sim.study.spec import Component
+    study = parse_study(STUDY.replace('seeds = [0, 1]', 'seeds = [0]'))
+    dying = Component(name="policy", label="dying", params={"policy": "dying_policy:act"}, swept=())
+    study = dataclasses.replace(study, navigators=(study.navigators[0], dying))
+    summary = run_study(study, tmp_path, engine="ray", workers=2)
+    assert summary["ran"] == 8 and summary["outcomes"] == {"ok": 4, "error": 4}, summary
+    rows = pd.read_parquet(tmp_path / "runs.parquet")
+    dead = rows[rows.navigator_label == "dying"]
+    assert (dead.outcome == "error").all()
+    assert dead.error.str.endswith("1 try, Ray's own retries are off)").all()
+    assert (rows[rows.navigator_label != "dying"].outcome == "ok").all()
+    assert run_study(study, tmp_path, engine="ray", workers=2)["ran"] == 0
+
+
+def processes_with(text: str) -> list[int]:
+    """PIDs of this machine's processes whose command line contains ``text`` (from /proc)."""
+    pids = []
+    for entry in Path("/proc").iterdir():
+        try:
+            if entry.name.isdigit() and text.encode() in (entry / "cmdline").read_bytes():
+                pids.append(int(entry.name))
+        except OSError:  # ended meanwhile
+            continue
+    return pids
+
+
+def test_a_ray_worker_killed_from_outside_is_one_error_row(ray_start_log, tmp_path):
+    study = parse_study(STUDY.replace("time_limit_s = 3.0", "time_limit_s = 6.0"))
+    killed: list[int] = []
+
+    def kill_one_task() -> None:
+        deadline = time.monotonic() + 120
+        while not killed and time.monotonic() < deadline:
+            for pid in processes_with("ray::run_batch"):
+                time.sleep(0.5)  # inside its cell by now
+                os.kill(pid, signal.SIGKILL)
+                killed.append(pid)
+                return
+            time.sleep(0.05)
+    killer = threading.Thread(target=kill_one_task)
+    killer.start()
+    summary = run_study(study, tmp_path, engine="ray", workers=2)
+    killer.join()
+    assert killed and summary["ran"] == 8 and summary["outcomes"] == {"ok": 7, "error": 1}, summary
+    rows = pd.read_parquet(tmp_path / "runs.parquet")
+    assert len(rows) == 8 and rows.config_hash.is_unique
+    error = rows[rows.outcome == "error"].error.iloc[0]
+    assert error.startswith("the worker running this cell died (WorkerCrashedError")
+    assert error.endswith("1 try, Ray's own retries are off)")
+
+
+def test_sigterm_ends_a_ray_study_with_one_line_and_keeps_its_rows(tmp_path):
+    import subprocess
+    import sys
+    path = tmp_path / "study.toml"
+    path.write_text('name = "terminated"\nscenarios = ["gwo-scenario-1", "gwo-scenario-2"]\nseeds = 1500\n'
+                    '[[planners]]\nname = "astar"\n')
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out)]
+    process = subprocess.Popen(command + ["--engine", "ray", "--workers", "2"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not list((out / "runs.parquet").glob("part-*.parquet")) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 128 + signal.SIGTERM
+    assert "SIGTERM received" not in err and "PC: @" not in err and "Traceback" not in err
+    assert [line for line in err.splitlines() if line.startswith("swarmnav:")] == [
+        f"swarmnav: study stopped (SIGTERM); the rows of the finished cells are kept in {out}: run the same command "
+        "to resume"]
+    kept = len(pd.read_parquet(out / "runs.parquet"))
+    assert 0 < kept < 3000
+    subprocess.run(command + ["--workers", "2"], check=True, capture_output=True, timeout=300)
+    rows = pd.read_parquet(out / "runs.parquet")
+    assert len(rows) == 3000 and rows.config_hash.is_unique

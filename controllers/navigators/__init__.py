@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from swarmnav.controllers.navigator import check_declarations
 from swarmnav.controllers.navigators.follow import FollowNavigator
 from swarmnav.controllers.navigators.iaco_local import IacoLocalNavigator
 from swarmnav.controllers.navigators.immas_stepwise import ImmasStepwiseNavigator
@@ -21,8 +22,9 @@ NAVIGATORS: dict[str, type] = {}
 
 
 def register(cls: type) -> type:
-    """Add a navigator class to :data:`NAVIGATORS`; a missing or taken name is an error."""
-    return register_component(NAVIGATORS, "navigator", cls)
+    """Add a navigator class to :data:`NAVIGATORS`; a missing or taken name, or a missing declaration of what
+    it uses (:func:`controllers.navigator.check_declarations`), is an error."""
+    return register_component(NAVIGATORS, "navigator", check_declarations(cls))
 
 
 for _cls in (FollowNavigator, ReplanNavigator, DStarReplanNavigator, DynamicWindowNavigator, VelocityObstacleNavigator,

@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -79,6 +79,9 @@ class DStarReplanNavigator:
     """
 
     name: ClassVar[str] = "dstar_replan"
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: float = field(default=0.0, init=False, repr=False)
 
     horizon_s: float = 3.0
     margin_m: float = 0.1

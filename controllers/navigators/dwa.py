@@ -78,6 +78,9 @@ class DynamicWindowNavigator:
     """
 
     name: ClassVar[str] = "dwa"
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
 
     alpha: float = 1.0
     beta: float = 1.2

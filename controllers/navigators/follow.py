@@ -18,6 +18,8 @@ class FollowNavigator:
 
     name: ClassVar[str] = "follow"
     uses_detections: ClassVar[bool] = False  # follows the first path whatever the sensors say
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
 
     def reset(self, setup: NavigationSetup) -> None:
         self._controller = setup.controller

@@ -79,6 +79,9 @@ class IacoLocalNavigator:
     """
 
     name: ClassVar[str] = "iaco_local"
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = True
+    replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured
     strategy: str = "paper"
     same_line_deg: float = 15.0
     margin_m: float = 0.05

@@ -210,6 +210,9 @@ class ImmasStepwiseNavigator:
     """
 
     name: ClassVar[str] = "immas_stepwise"
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = True
+    replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured
     alpha: float | None = None
     beta: float | None = None
     reach_m: float = 0.1
@@ -232,8 +235,7 @@ class ImmasStepwiseNavigator:
         start = grid.cell_of(problem.start.x_m, problem.start.y_m)
         goal = grid.cell_of(problem.goal.x_m, problem.goal.y_m)
         t0 = time.perf_counter()
-        analysis = analyse_environment(grid.occupied, start, goal, planner.rho, planner.clean_weight,
-                                       planner.diagonal_factor, planner.close_gates_and_tunnels)
+        analysis = planner.analyse(grid.occupied, start, goal)
         self.analysis_time_s = time.perf_counter() - t0
         self.walk = StepwiseWalk(analysis, goal, alpha, beta)
         self.walker = CellWalker(setup.controller, grid, self.reach_m)

@@ -15,7 +15,7 @@ policy, never project code (the registry of navigators stays explicit);
 from __future__ import annotations
 
 import pkgutil
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, ClassVar
 
 import numpy as np
@@ -58,7 +58,9 @@ class PolicyNavigator:
     """
 
     name: ClassVar[str] = "policy"
-    uses_detections: ClassVar[bool] = True  # per run after reset: only when the observation has obstacles
+    uses_detections: bool = field(default=True, init=False, repr=False)  # per run: set by reset
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
     policy: str = ""
     action: str = "twist"
     path_waypoints: int = 0

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, replace, field
 from typing import Any, ClassVar
 
 from swarmnav.controllers.controller import ControlCommand
@@ -112,6 +112,9 @@ class ReplanNavigator:
     """
 
     name: ClassVar[str] = "replan"
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = True
+    replan_wall_s: float = field(default=0.0, init=False, repr=False)
 
     lookahead_m: float = 2.5
     horizon_s: float = 6.0

@@ -65,6 +65,9 @@ class VelocityObstacleNavigator:
     """
 
     name: ClassVar[str] = "velocity_obstacle"
+    uses_detections: ClassVar[bool] = True
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
 
     time_horizon_s: float = 4.0
     speed_samples: int = 5

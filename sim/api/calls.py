@@ -70,10 +70,10 @@ def given_episode(spec, waypoints: "np.ndarray", source: str):
     from swarmnav.sim.episode import Episode
     from swarmnav.sim.given_path import given_path
     spec = spec.resolved()
-    make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)  # bad names fail before the run
-    make_navigator(spec.navigator, spec.navigator_params, spec.scenario.source_path)
+    planner = make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)  # bad names fail early
+    navigator = make_navigator(spec.navigator, spec.navigator_params, spec.scenario.source_path)
     problem, path = given_path(spec.scenario, waypoints, source)
-    return Episode(spec, problem, path)
+    return Episode(spec, problem, path, planner, navigator)
 
 
 def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
@@ -126,7 +126,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
         from swarmnav.sim.render import VideoRecorder
         recorders.append(VideoRecorder(str(video), camera=camera, width=width, height=height,
                                        fps=DEFAULT_FPS if fps is None else fps))
-    episode = run_episode(spec, recorders, stop_on_collision=stop_on_collision, planned=planned)
+    episode = run_episode(planned, recorders, stop_on_collision=stop_on_collision)
     return RunOutcome(episode, str(log_path) if log_path else None, str(video) if video else None)
 
 

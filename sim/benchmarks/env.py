@@ -43,7 +43,7 @@ def _env_steps_per_s(env, steps: int, rng: np.random.Generator) -> float:
 
 def _runner_steps_per_s(simulation: Simulation, planned, duration_s: float):
     """The runner's rate and its wheel commands (for the replay)."""
-    result = run_episode(planned.spec, simulation=simulation, planned=planned, time_limit_s=duration_s).result
+    result = run_episode(planned, time_limit_s=duration_s).result
     return result.steps / result.wall_time_s, result.wheel_command_rad_s[:-1]
 
 
@@ -71,7 +71,7 @@ def benchmark_env(scenario_name: str = "dense-field-30", duration_s: float = 20.
     env = NavigateEnv(scenario_name)
     replay_env = NavigateEnv(scenario_name, action="wheels")
     planned = plan_episode(EpisodeSpec(env.task.scenario))
-    simulation = Simulation(planned.spec.scenario)
+    simulation = planned.simulation
     control_steps = int(round(duration_s / simulation.control_dt_s))
     rng = np.random.default_rng(0)
     envs, runners, bares, ratios, replays, replay_ratios = [], [], [], [], [], []

@@ -45,8 +45,7 @@ def _bare_steps_per_s(simulation: Simulation, wheel_commands_rad_s: list[tuple[f
 
 def _closed_loop(simulation: Simulation, planned: Episode, duration_s: float, recorders=()):
     """(physics steps per second, realtime factor, the wheel commands it sent) of one closed-loop run."""
-    result = run_episode(planned.spec, recorders, simulation=simulation, planned=planned,
-                         time_limit_s=duration_s).result
+    result = run_episode(planned, recorders, time_limit_s=duration_s).result
     steps = result.steps * simulation.steps_per_control
     commands = [(float(left), float(right)) for left, right in result.wheel_command_rad_s]
     return steps / result.wall_time_s, result.sim_time_s / result.wall_time_s, commands
@@ -66,7 +65,7 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
         raise ConfigError("--duration", f"{duration_s:g} s at {scenario.sim.control_hz:g} Hz needs "
                           f"{duration_s * scenario.sim.control_hz:.4g} control steps (at most {MAX_CONTROL_STEPS:,})")
     planned = plan_episode(EpisodeSpec(scenario))
-    simulation = Simulation(planned.spec.scenario)
+    simulation = planned.simulation
     bare, closed, ratios, realtime, logging, logging_ratios = [], [], [], [], [], []
     commands = _closed_loop(simulation, planned, duration_s)[2]  # untimed: the trajectory both replay
     recorder_cls = None

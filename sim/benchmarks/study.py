@@ -8,6 +8,14 @@
 * Ray against the local engine: the same study as Ray tasks on a local instance with
   2 CPUs (after a warm-up round) against 2 local worker processes, both in the steady state.
 
+With ``--cells N ...`` it measures instead how the driver scales: plan-only studies
+of about N cells each (A* and the straight line on four bundled scenarios, cells of
+a few milliseconds, so the driver's bookkeeping is what grows), each run by
+``swarmnav study --workers 2 --json`` in a process of its own on the local engine and
+on a local Ray instance: cells per second (rows written and parts compacted, worker
+and Ray start-up included), the driver's peak resident memory (the study's own
+summary), and each rate over the smallest study's of the same engine.
+
 The cells are GWO plans of ``--iterations`` (default 600, about 75 ms each here): with
 the planners as fast as they are now, a 60-iteration cell takes 8 ms and the workers'
 start-up (about a second) would be most of what the wall-time speed-up measures.
@@ -32,6 +40,66 @@ params = {{ iterations = {iterations} }}
 
 
 
+SCALE_STUDY = """
+name = "bench-study-scale"
+scenarios = ["gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3", "restaurant-table-2"]
+mode = "plan"
+seeds = {seeds}
+[[planners]]
+name = "astar"
+[[planners]]
+name = "straight"
+"""
+SCALE_CELLS_PER_SEED = 8  # four scenarios, two planners
+MAX_SCALE_CELLS = 10_000_000
+
+
+def run_scale(args: argparse.Namespace) -> int:
+    """``bench study --cells N ...``: cells/s and the driver's peak memory per study size and engine."""
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    from swarmnav.models.errors import ConfigError
+    if max(args.cells) > MAX_SCALE_CELLS:
+        raise ConfigError("--cells", f"at most {MAX_SCALE_CELLS:,} cells, got {max(args.cells):,}")
+    engines = ["local"] if args.no_ray else ["local", "ray"]
+    results = []
+    with tempfile.TemporaryDirectory(prefix="swarmnav-bench-study-") as folder:
+        for engine in engines:
+            for cells in sorted(set(args.cells)):
+                seeds = -(-cells // SCALE_CELLS_PER_SEED)
+                path = Path(folder) / f"scale-{seeds}.toml"
+                path.write_text(SCALE_STUDY.format(seeds=seeds), encoding="utf-8")
+                out = Path(folder) / f"out-{engine}-{seeds}"
+                done = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out),
+                                       "--engine", engine, "--workers", "2", "--json"],
+                                      capture_output=True, text=True)
+                if done.returncode != 0:
+                    raise RuntimeError(f"bench study --cells: the {engine} study of {seeds * 8} cells failed: "
+                                       + (done.stderr.strip().splitlines() or ["?"])[-1])
+                summary = json.loads(done.stdout)
+                parts = len(list((out / "runs.parquet").glob("*.parquet")))
+                results.append({"engine": engine, "cells": summary["ran"], "wall_s": summary["wall_s"],
+                                "cells_per_s": round(summary["ran"] / summary["wall_s"], 1),
+                                "driver_peak_mb": summary["driver_peak_mb"], "parts": parts,
+                                "failed": summary["failed"]})
+    for row in results:
+        base = next(r for r in results if r["engine"] == row["engine"])
+        row["rate_ratio"] = round(row["cells_per_s"] / base["cells_per_s"], 3)
+    if args.json:
+        print(json.dumps(results))
+        return 0
+    print(f"plan-only studies (astar and straight on four scenarios), 2 workers; rate: cells/s over the study's "
+          f"run (start-up included); ratio: over the smallest study of the same engine")
+    print(f"  {'engine':<6} {'cells':>9} {'wall s':>8} {'cells/s':>8} {'ratio':>6} {'driver MB':>10} {'parts':>6}")
+    for r in results:
+        print(f"  {r['engine']:<6} {r['cells']:>9,} {r['wall_s']:>8.1f} {r['cells_per_s']:>8.1f} "
+              f"{r['rate_ratio']:>6.3f} {r['driver_peak_mb']:>10.0f} {r['parts']:>6}")
+    return 0
+
+
 def _arrivals(results) -> list[float]:
     """Seconds from the engine's start to each result's arrival."""
     t0 = time.perf_counter()
@@ -48,10 +116,13 @@ def steady_rate(arrivals: list[float], workers: int) -> float:
 
 
 def run(args: argparse.Namespace) -> int:
+    if getattr(args, "cells", None):
+        return run_scale(args)
     from swarmnav.models.scenario import load_scenario
     from swarmnav.sim.episode import EpisodeSpec, plan_episode
     from swarmnav.sim.study.cell import run_cell
-    from swarmnav.sim.study.engines import run_local, run_ray, start_ray
+    from swarmnav.sim.study.engines import run_local
+    from swarmnav.sim.study.ray_engine import run_ray, start_ray
     from swarmnav.sim.study.grid import expand
     from swarmnav.sim.study.spec import parse_study
     study = parse_study(BENCH_STUDY.format(seeds=args.seeds, iterations=args.iterations))

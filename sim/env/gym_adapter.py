@@ -5,10 +5,16 @@ Importing :mod:`swarmnav.sim.env` registers the id, so in a fresh interpreter::
     env = gymnasium.make("swarmnav.sim.env:swarmnav/Navigate-v0", scenario="gwo-scenario-2")
 
 (Gymnasium 1.x imports the module before the colon; it does not load plugin
-entry points.)  ``reset(seed=..., options={"scenario": ..., "world_seed": ...})``:
-``seed`` seeds the path planner (and ``np_random``), ``world_seed`` the
-obstacles' random walks, ``scenario`` switches to another scenario (a new
-model).  ``step`` returns ``(obs, reward, terminated, truncated, info)`` with
+entry points.)  ``reset(seed=..., options={"scenario": ..., "planner_seed": ..., "world_seed": ...})``:
+``seed`` seeds ``np_random`` and derives the episode's two seeds
+(:meth:`models.scenario.Seeds.derived`: ``SeedSequence(seed).spawn(2)``, the path
+planner's from the first child, the obstacles' random walks from the second), so
+another ``seed`` gives another world; ``planner_seed`` and ``world_seed`` in
+``options`` override the derived ones.  ``reset()`` with no seed after a seeded
+one derives the next episode's seeds from ``np_random`` (so an RL loop that seeds
+once meets a new world every episode, the same sequence for the same first seed);
+before any seeded reset it keeps the seeds of the environment's options (the
+scenario's by default).  ``scenario`` switches to another scenario (a new model).  ``step`` returns ``(obs, reward, terminated, truncated, info)`` with
 ``terminated`` on the goal (or a collision when the scenario stops on one),
 ``truncated`` at the time limit, and ``info`` from :meth:`NavigationTask.info`
 (``cost``, ``collisions``, ``clearance_m``, ``time_s``, ``outcome``, and
@@ -25,9 +31,11 @@ import numpy as np
 from dm_env import specs
 from gymnasium import spaces
 
+from swarmnav.models.seeds import Seeds
 from swarmnav.sim.env.task import EnvOptions, NavigationTask, make_environment
 
 ENV_ID = "swarmnav/Navigate-v0"
+RESET_OPTIONS = ("scenario", "planner_seed", "world_seed")
 
 
 def _box(spec: specs.Array) -> spaces.Box:
@@ -58,6 +66,7 @@ class NavigateEnv(gymnasium.Env):
         self._size = (width, height, camera)
         self._options = EnvOptions(**options)
         self._renderer = None
+        self._seeded = False  # whether a reset had a seed: then reset() derives new seeds from np_random
         self._build(scenario)
 
     def _build(self, scenario: Any) -> None:
@@ -74,15 +83,21 @@ class NavigateEnv(gymnasium.Env):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
         options = dict(options or {})
-        unknown = set(options) - {"scenario", "world_seed"}
+        unknown = set(options) - set(RESET_OPTIONS)
         if unknown:
-            raise ValueError(f"reset options: unknown {sorted(unknown)} (known: scenario, world_seed)")
+            raise ValueError(f"reset options: unknown {sorted(unknown)} (known: {', '.join(RESET_OPTIONS)})")
         if "scenario" in options:
             self._build(options["scenario"])
-        if options.get("world_seed") is not None:
-            self.task.set_world_seed(int(options["world_seed"]))
+        seeds = self.task.seeds
         if seed is not None:
-            self.task.set_seed(seed)
+            seeds = Seeds.derived(seed)
+            self._seeded = True
+        elif self._seeded:
+            seeds = Seeds.derived(int(self.np_random.integers(2**63)))
+        planner = options.get("planner_seed")
+        world = options.get("world_seed")
+        self.task.set_seeds(Seeds(seeds.planner if planner is None else int(planner),
+                                  seeds.world if world is None else int(world)))
         timestep = self.dm_env.reset()
         return timestep.observation, self.task.info()
 
@@ -97,13 +112,13 @@ class NavigateEnv(gymnasium.Env):
         if self.render_mode != "rgb_array":
             return None
         from swarmnav.sim.render import SceneRenderer
-        loop = self.task.loop
+        stepper = self.task.stepper
         if self._renderer is None:
             width, height, camera = self._size
             self._renderer = SceneRenderer(self.dm_env.physics.model.ptr, width, height, camera)
         planned = self.task.planned_path()
-        return self._renderer.render(loop.data, path_m=None if planned is None else planned.path.waypoints,
-                                     trail_m=loop.poses[:loop.step + 1, :2])
+        return self._renderer.render(stepper.data, path_m=None if planned is None else planned.path.waypoints,
+                                     trail_m=stepper.poses[:stepper.step_index + 1, :2])
 
     def close(self) -> None:
         if getattr(self, "dm_env", None) is not None:

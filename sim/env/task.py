@@ -1,20 +1,19 @@
-"""A scenario as a dm_control task: the ``dm_env`` API over the runner's own steps.
+"""A scenario as a dm_control task: the ``dm_env`` API over the runner's own episode stepper.
 
 The physics is a :class:`dm_control.mujoco.Physics` built from the MJCF text
 that runs and logs use (``compile_scene(scenario).xml``); :func:`same_model`
 checks that it compiled to the same model, byte for byte.  The task drives a
-:class:`sim.runner.StepLoop` on that physics' ``MjData``:
+:class:`sim.stepper.EpisodeStepper` on that physics' ``MjData``, as
+``swarmnav run``'s navigator does, and calls none of the loop's steps itself:
 
-* ``initialize_episode``: a new ``StepLoop`` (start pose, obstacles at t = 0),
-  the initial contact check, the first observation;
-* ``before_step``: the action becomes a wheel command (:func:`action_command`)
-  and ``StepLoop.apply`` writes it;
-* ``physics.step``: ``StepLoop.advance`` (``mj_step`` k times with the
-  collision check after each, exactly as ``swarmnav run``);
-* ``after_step``: ``StepLoop.move_obstacles``, ``observe`` and ``outcome``.
+* ``initialize_episode``: a new stepper and its ``reset()`` (start pose, obstacles
+  at t = 0, the recorder started, the initial contact check, the first observation);
+* ``before_step``: the action becomes a wheel command (:func:`action_command`);
+* ``physics.step``: ``EpisodeStepper.step(command)``, one control period;
+* ``after_step``: the reward and cost of the stepper's new observation.
 
-So the environment and ``swarmnav run`` share the code that moves obstacles,
-reads sensors and counts collisions.  ``discount`` is 0 when the goal is
+So the environment and ``swarmnav run`` share every step of the loop, the metrics
+(SPL included) and what a recording holds.  ``discount`` is 0 when the goal is
 reached (termination) or, when the scenario stops on collision, at the first
 collision; it is 1 at the time limit (truncation), as dm_env defines them.
 The step's collision count (the Safety-Gymnasium ``cost``) and the run's
@@ -38,7 +37,6 @@ end an episode either: ``reset`` returns ``info["outcome"]`` already set (and
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 from pathlib import Path as FilePath
 from typing import Any
@@ -48,14 +46,17 @@ import numpy as np
 from dm_control import mujoco as dm_mujoco
 from dm_control.rl import control
 
+from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command, observation_layout
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario, load_scenario
+from swarmnav.models.seeds import Seeds
 from swarmnav.sim.episode import EpisodeSpec, plan_episode
 from swarmnav.sim.env.observations import action_spec, observation_specs
 from swarmnav.sim.env.reward import RewardWeights
-from swarmnav.sim.runner import RunResult, Simulation, StepLoop
+from swarmnav.sim.runner import Simulation
 from swarmnav.sim.scene import compile_scene, index_scene
+from swarmnav.sim.stepper import EpisodeStepper
 
 NAVIGATOR_NAME = "env"  # what a recorded episode names as its navigator
 
@@ -74,7 +75,7 @@ class EnvOptions:
             as ``obstacles`` (the ``detector`` model always gives ``obstacles``).
         reward: the reward's weights.
         time_limit_s, stop_on_collision: override the scenario's.
-        seed: the planner's seed (None: the scenario's).
+        seed: the planner's seed (None: the scenario's, ``Scenario.seeds``).
         world_seed: the obstacles' random walks (None: the scenario's).
         record_to: an ``.mcap`` path to record each episode to with the recorder of
             ``swarmnav run``; ``{episode}`` in it is replaced by the episode number.
@@ -115,19 +116,23 @@ def same_model(a: mujoco.MjModel, b: mujoco.MjModel) -> bool:
 
 
 class SwarmnavPhysics(dm_mujoco.Physics):
-    """dm_control physics whose control step is the runner's ``StepLoop.advance``."""
+    """dm_control physics whose control step is one :meth:`EpisodeStepper.step` with the task's command."""
 
-    loop: StepLoop | None = None
+    stepper: EpisodeStepper | None = None
+    command: ControlCommand | None = None  # set by the task's before_step
     frozen: bool = False  # the episode ended at its start: its one step advances nothing
 
     def step(self, nstep: int = 1) -> None:
-        if self.loop is None or nstep != self.loop.k:
-            raise RuntimeError(f"step {nstep} physics steps: the environment steps {getattr(self.loop, 'k', '?')} "
-                               "at a time, through its task")
+        if self.stepper is None or nstep != self.stepper.k:
+            raise RuntimeError(f"step {nstep} physics steps: the environment steps "
+                               f"{getattr(self.stepper, 'k', '?')} at a time, through its task")
         if self.frozen:
             return
+        command, self.command = self.command, None
+        if command is None:
+            raise RuntimeError("no command for this step: the task's before_step sets it")
         with self.check_invalid_state():
-            self.loop.advance()
+            self.stepper.step(command)
 
 
 class NavigationTask(control.Task):
@@ -136,44 +141,39 @@ class NavigationTask(control.Task):
     def __init__(self, scenario: Scenario, physics: SwarmnavPhysics, xml: str, options: EnvOptions):
         self.options = options
         self.scene = index_scene(physics.model.ptr, xml)  # the indices, on the physics' own model
-        if options.world_seed is not None and options.world_seed != scenario.world_seed:
-            scenario = scenario.with_world_seed(int(options.world_seed))
         self.simulation = Simulation(scenario, self.scene)
-        self.seed = scenario.seed if options.seed is None else int(options.seed)
+        fallback = scenario.seeds
+        self.set_seeds(Seeds(fallback.planner if options.seed is None else int(options.seed),
+                             fallback.world if options.world_seed is None else int(options.world_seed)))
         self.layout = observation_layout(scenario, self.scene.drive,
                                          options.path_waypoints if options.path_planner else 0,
                                          options.obstacle_slots, options.tracked_obstacles)
         self.episode = -1
-        self.loop: StepLoop | None = None
-        self.result: RunResult | None = None
-        self._recorder = None
+        self.stepper: EpisodeStepper | None = None
         self.over_at_start = False
-        self._planned: tuple[int, int, Any] | None = None  # (seed, world seed, episode) of the path
+        self._planned: tuple[Seeds, Any] | None = None  # (seeds, episode) of the path
 
     # --- set-up between episodes -------------------------------------------------------------
     @property
     def scenario(self) -> Scenario:
         return self.simulation.scenario
 
-    def set_world_seed(self, world_seed: int) -> None:
-        """Obstacle random walks of this world seed from the next episode on (the model is unchanged)."""
-        if int(world_seed) != self.scenario.world_seed:
-            self.simulation = Simulation(self.scenario.with_world_seed(int(world_seed)), self.scene)
-
-    def set_seed(self, seed: int) -> None:
-        """The planner's seed (for the ``path`` observation) from the next episode on."""
-        self.seed = int(seed)
+    def set_seeds(self, seeds: Seeds) -> None:
+        """The planner's seed (for the ``path`` observation) and the obstacles' random walks, from the next
+        episode on (the model is unchanged)."""
+        self.seeds = seeds
+        if seeds.world != self.scenario.world_seed:
+            self.simulation = Simulation(self.scenario.with_world_seed(seeds.world), self.scene)
 
     def planned_path(self):
         """The path planner's episode for the current seeds, planned once and kept (None without a planner)."""
         if self.options.path_planner is None:
             return None
-        key = (self.seed, self.scenario.world_seed)
-        if self._planned is None or self._planned[:2] != key:
-            spec = EpisodeSpec(self.scenario, planner=self.options.path_planner, seed=self.seed,
-                               world_seed=self.scenario.world_seed)
-            self._planned = (*key, plan_episode(spec))
-        return self._planned[2]
+        if self._planned is None or self._planned[0] != self.seeds:
+            spec = EpisodeSpec(self.scenario, planner=self.options.path_planner, seed=self.seeds.planner,
+                               world_seed=self.seeds.world)
+            self._planned = (self.seeds, plan_episode(spec))
+        return self._planned[1]
 
     # --- dm_control.rl.control.Task ---------------------------------------------------------------
     def initialize_episode(self, physics: SwarmnavPhysics) -> None:
@@ -183,50 +183,41 @@ class NavigationTask(control.Task):
         planned = self.planned_path()
         waypoints = planned.path.waypoints if planned is not None else None
         goal = scenario.goal
-        self.goal = self.simulation.goal_checker()
         self.observer = PolicyObserver(self.layout, (goal.x_m, goal.y_m), waypoints)
-        self.stop_on_collision = (scenario.sim.stop_on_collision if options.stop_on_collision is None
-                                  else options.stop_on_collision)
-        recorder = self._open_recorder(planned)
-        time_limit_s = scenario.time_limit_s if options.time_limit_s is None else options.time_limit_s
-        self.loop = loop = StepLoop(self.simulation, recorder, time_limit_s, data=physics.data.ptr)
-        physics.loop = loop
-        loop.sense_obstacles = bool(self.layout.obstacle_slots)  # the sensing model only when observed
-        if recorder is not None:
-            recorder.start(self.simulation.context(
-                options.path_planner or "none", {}, self.seed, NAVIGATOR_NAME,
-                {"action": options.action}))
-            if waypoints is not None:
-                recorder.path(0.0, waypoints)
-        self.result = None
+        recorder = self._open_recorder()
+        context = None if recorder is None else self.simulation.context(
+            options.path_planner or "none", {}, self.seeds.planner, NAVIGATOR_NAME, {"action": options.action})
+        self.stepper = physics.stepper = self.simulation.stepper(
+            time_limit_s=options.time_limit_s, stop_on_collision=options.stop_on_collision, recorder=recorder,
+            context=context, path_m=waypoints, sense_obstacles=bool(self.layout.obstacle_slots),  # only when observed
+            data=physics.data.ptr)
+        physics.command = None
         self.return_, self.cost, self.reward_value = 0.0, 0.0, 0.0
-        self._wall0 = time.perf_counter()
         self._collisions = 0  # collisions at the start go into the first step's cost
-        loop.check_initial_contacts()
-        self._sense()
+        self._observed(self.stepper.reset())
         physics.frozen = self.over_at_start = bool(self.outcome)
 
     def before_step(self, action: np.ndarray, physics: SwarmnavPhysics) -> None:
-        if self.over_at_start:
-            return
-        command = action_command(action, self.options.action, self.scene.drive, self.scenario.max_speed_m_s)
-        self.loop.apply(self.observation, command)
+        if not self.over_at_start:
+            physics.command = action_command(action, self.options.action, self.scene.drive,
+                                             self.scenario.max_speed_m_s)
 
     def after_step(self, physics: SwarmnavPhysics) -> None:
+        stepper = self.stepper
         if self.over_at_start:
             self.reward_value = 0.0
         else:
             distance_before_m = self.distance_m
-            self._sense()
+            self._observed(stepper.observation)
             self.reward_value = self.options.reward.reward(distance_before_m, self.distance_m,
-                                                           self.outcome == "goal_reached", self.loop.dt_s)
+                                                           self.outcome == "goal_reached", stepper.dt_s)
         self.return_ += self.reward_value
-        collisions = self.loop.monitor.collisions
+        collisions = stepper.collisions
         self.cost = float(collisions - self._collisions)
         self._collisions = collisions
 
     def get_observation(self, physics: SwarmnavPhysics) -> dict[str, np.ndarray]:
-        return {key: value.copy() for key, value in self.obs.items()}
+        return dict(self.obs)  # the observer builds fresh arrays at every observation: nothing to copy
 
     def get_reward(self, physics: SwarmnavPhysics) -> float:
         return self.reward_value
@@ -245,44 +236,41 @@ class NavigationTask(control.Task):
         return observation_specs(self.layout)
 
     # --- the step's side information -------------------------------------------------------------
+    @property
+    def outcome(self) -> str:
+        return self.stepper.outcome
+
+    @property
+    def observation(self):
+        """The stepper's last :class:`~controllers.navigator.Observation`."""
+        return self.stepper.observation
+
     def info(self) -> dict[str, Any]:
-        """The step's ``cost``, the collisions so far, the clearance now and, at the end, the run's metrics."""
-        loop = self.loop
-        out: dict[str, Any] = {"cost": self.cost, "collisions": loop.monitor.collisions,
-                               "clearance_m": loop.clearance_m, "time_s": self.observation.time_s,
-                               "outcome": self.outcome}
-        if self.result is not None:
-            out["metrics"] = self.result.summary()
+        """The step's ``cost``, the collisions so far, the clearance now and, at the end, the run's metrics
+        (``RunResult.summary()``, as ``swarmnav run --json`` reports them)."""
+        stepper = self.stepper
+        out: dict[str, Any] = {"cost": self.cost, "collisions": stepper.collisions,
+                               "clearance_m": stepper.clearance_m, "time_s": stepper.observation.time_s,
+                               "outcome": stepper.outcome}
+        if stepper.result is not None:
+            out["metrics"] = stepper.result.summary()
         return out
 
     def close_recording(self, outcome: str) -> None:
         """Finish a recording still open (an episode reset or closed before its end)."""
-        if self._recorder is not None:
-            recorder, self._recorder = self._recorder, None
-            recorder.finish({"outcome": outcome, "sim_time_s": self.loop.time_s if self.loop else 0.0})
+        if self.stepper is not None:
+            self.stepper.close(outcome)
 
-    def _sense(self) -> None:
-        """The runner's steps between two commands: obstacles, sensors, outcome; stop at the end."""
-        loop = self.loop
-        loop.move_obstacles()
-        self.observation = observation = loop.observe()
-        self.outcome = loop.outcome(observation.pose, self.goal, self.stop_on_collision)
+    def _observed(self, observation) -> None:
+        """The policy's view of a new observation, and the goal distance the reward needs."""
         self.obs = self.observer(observation)
         self.distance_m = self.observer.goal_distance_m(observation.pose.x_m, observation.pose.y_m)
-        if self.outcome:
-            loop.stop(observation, self.outcome)
-            self.result = loop.result(self.outcome, time.perf_counter() - self._wall0)
-            if self._recorder is not None:
-                recorder, self._recorder = self._recorder, None
-                recorder.finish(self.result.summary())
 
-    def _open_recorder(self, planned):
+    def _open_recorder(self):
         if self.options.record_to is None:
             return None
         from swarmnav.sim.mcap_log import McapRecorder
-        path = FilePath(self.options.record_to.replace("{episode}", str(self.episode)))
-        self._recorder = McapRecorder(path, overwrite=True)
-        return self._recorder
+        return McapRecorder(FilePath(self.options.record_to.replace("{episode}", str(self.episode))), overwrite=True)
 
 
 def make_environment(scenario: Scenario | str, options: EnvOptions | None = None, **kwargs: Any

@@ -33,7 +33,10 @@ from swarmnav.sim.versions import software_versions
 EXTRA_COLUMNS = {"raw_length_m": "plan_raw_length_m",  # the tour before shortcutting (grid and ant planners)
                  "gates_raised": "plan_gates_raised",  # IMMAS (Hasan et al. 2023), GateRaiseState
                  "tunnels_closed": "plan_tunnels_closed",  # IMMAS, Algorithm 2 (tight tunnels)
-                 "total_arc_cost": "plan_arc_cost"}  # IMMAS, the arc cost of its tour
+                 "total_arc_cost": "plan_arc_cost",  # IMMAS, the arc cost of its tour
+                 "moves": "plan_moves",  # grid planners: cell moves of the raw tour (IMMAS's Table 1 iterations)
+                 "mean_cell_clearance_m": "plan_cell_clearance_m",  # grid planners: mean obstacle distance of the cells
+                 "nodes_visited": "plan_nodes_visited"}  # M-ACO (Habib et al. 2021): random nodes on the route
 
 
 class EventTally:
@@ -136,7 +139,7 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
                     log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
                     recorders.append(McapRecorder(log_path, overwrite=True))
                     row["log"] = str(log_path)
-                episode = run_episode(spec, recorders, planned=episode, time_limit_s=cell.time_limit_s)
+                episode = run_episode(episode, recorders, time_limit_s=cell.time_limit_s)
                 row["run_events"] = tally.as_json()
         row["outcome"] = "ok"
     except WallLimitExceeded:

@@ -22,6 +22,8 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--logs", action="store_true", help="keep the MCAP log of every physics run in DIR/logs/")
     p.add_argument("--quick", action="store_true",
                    help="only the study's first quick_seeds seeds (a later full run into the same --out resumes)")
+    p.add_argument("--retry-errors", action="store_true",
+                   help="run again the cells whose row is an error (by default a resume runs only cells without a row)")
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
     p.add_argument("--junit", metavar="FILE", help="write the study's rows as JUnit XML (one test suite per scenario, "
                    "a failure per row that is not a success)")
@@ -56,8 +58,16 @@ def run_study(args: argparse.Namespace) -> int:
         study = study.quick()
     from swarmnav.sim.study.execute import run_study as execute
     out = args.out or str(FilePath("studies") / study.name)
-    summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,
-                      show_progress=not args.json and sys.stderr.isatty())
+    try:
+        summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,
+                          show_progress=not args.json and sys.stderr.isatty(), retry_errors=args.retry_errors)
+    except (KeyboardInterrupt, SystemExit) as exc:  # Ctrl-C, or SIGTERM (the CLI's handler raises SystemExit)
+        how = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else "SIGTERM" if exc.code == 143 else f"exit {exc.code}"
+        print(f"swarmnav: study stopped ({how}); the rows of the finished cells are kept in {out}: run the same "
+              "command to resume", file=sys.stderr)
+        if isinstance(exc, KeyboardInterrupt):
+            return 130
+        raise
     if args.json:
         print(json.dumps(summary))
     else:

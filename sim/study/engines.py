@@ -1,30 +1,45 @@
-"""Engines that run study cells: separate local processes, or Ray tasks (or, for the benchmarks, this process).
+"""Engines that run study cells: separate local processes, or Ray tasks (``ray_engine``), or, for the
+benchmarks, this process.
 
-Both call the same :func:`swarmnav.sim.study.cell.run_cell` and yield each
-cell's ``(row, progress)`` as it finishes (in finishing order).  Workers run with
-one thread for NumPy's BLAS and OpenMP and ``MUJOCO_GL`` set (no rendering
+Every engine calls the same :func:`swarmnav.sim.study.cell.run_cell` and yields
+each cell's ``(row, progress)`` as it finishes (in finishing order).  Workers run
+with one thread for NumPy's BLAS and OpenMP and ``MUJOCO_GL`` set (no rendering
 happens in workers), set in the environment the workers start with, so it holds
 before anything in them imports NumPy or MuJoCo.
+
+The local driver is linear in the number of cells: it takes cells from a lazy
+iterator, keeps at most a couple of batches per worker in flight, and waits on
+one pipe and one process sentinel per worker (``multiprocessing.connection.wait``),
+so each completion costs the same whatever the size of the study.  Short cells
+travel in batches sized from the measured cell time (:class:`BatchSizer`); every
+cell's result comes back on its own, so the driver always knows which cell a
+worker is running.  A worker that dies (killed, a segfault, ``os._exit``) turns
+that cell into an ``error`` row naming the signal or exit code; the rest of its
+queue goes to a fresh worker.
 """
 
 from __future__ import annotations
 
 import contextlib
-import logging
 import multiprocessing
 import os
-import socket
+import queue
+import signal
 import threading
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from typing import Any, Iterator, Sequence
+import time
+from collections import deque
+from multiprocessing.connection import wait as wait_any
+from typing import Any, Iterable, Iterator
 
-from swarmnav.models.errors import ConfigError
 from swarmnav.sim.commands import SINGLE_THREAD_ENVIRONMENT
-from swarmnav.sim.study.cell import run_cell
+from swarmnav.sim.study.cell import _versions_json, base_row, run_cell
 from swarmnav.sim.study.grid import Cell
 
 PARENT_POLL_S = 0.5
-RAY_AUTH_LOGGER = "ray._private.authentication.authentication_token_setup"
+BATCH_TARGET_S = 0.25  # a batch of short cells takes about this long on a worker
+MAX_BATCH = 256  # cells per batch at most
+BATCHES_IN_FLIGHT = 2  # per worker: one running, one waiting, so a worker never idles for the driver
+STOP_WAIT_S = 5.0  # a finished worker's time to exit before it is terminated
 
 Result = tuple[dict[str, Any], list[dict[str, Any]]]
 
@@ -47,97 +62,171 @@ def _environment(values: dict[str, str]):
                 os.environ[key] = value
 
 
+class BatchSizer:
+    """Cells per batch: as many as take about ``target_s`` at the mean measured cell time (an exponential
+    mean of the rows' ``cell_wall_s``); one cell until the first is measured, and for every long cell."""
+
+    def __init__(self, target_s: float = BATCH_TARGET_S, limit: int = MAX_BATCH):
+        self.target_s, self.limit = target_s, limit
+        self.mean_s: float | None = None
+
+    def observe(self, row: dict[str, Any]) -> None:
+        seconds = row.get("cell_wall_s")
+        if seconds is not None:
+            self.mean_s = seconds if self.mean_s is None else 0.8 * self.mean_s + 0.2 * seconds
+
+    def size(self) -> int:
+        if self.mean_s is None:
+            return 1
+        return max(1, min(self.limit, int(self.target_s / max(self.mean_s, 1e-6))))
+
+
+def died_row(cell: Cell, how: str) -> Result:
+    """The ``error`` row of a cell whose worker died while running it."""
+    row = base_row(cell)
+    row.update(versions=_versions_json(), outcome="error", success=False,
+               error=f"the worker running this cell died ({how})")
+    return row, []
+
+
+def exit_description(exitcode: int | None) -> str:
+    if exitcode is not None and exitcode < 0:
+        try:
+            return f"killed by signal {signal.Signals(-exitcode).name}"
+        except ValueError:
+            return f"killed by signal {-exitcode}"
+    return f"exit code {exitcode}"
+
+
 def _exit_with_parent(parent_pid: int) -> None:
-    """Worker initializer: end this worker when the study's process is gone (killed, not just stopped)."""
+    """End this worker when the study's process is gone (killed, not just stopped)."""
     def watch() -> None:
-        import time
         while os.getppid() == parent_pid:
             time.sleep(PARENT_POLL_S)
         os._exit(1)
     threading.Thread(target=watch, daemon=True).start()
 
 
-def run_local(cells: Sequence[Cell], workers: int, logs_dir: str | None = None) -> Iterator[Result]:
+def _worker_main(conn, parent_pid: int, logs_dir: str | None) -> None:
+    """A local worker: batches arrive on ``conn`` (read by a thread, so the driver's sends never wait on a
+    running cell), each cell runs on this process's main thread (where the wall limit's timer works) and its
+    result goes back at once.  Ctrl-C is the driver's to handle: it terminates its workers."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _exit_with_parent(parent_pid)
+    inbox: queue.SimpleQueue = queue.SimpleQueue()
+
+    def receive() -> None:
+        try:
+            while True:
+                inbox.put(conn.recv())
+        except (EOFError, OSError):
+            inbox.put(None)
+    threading.Thread(target=receive, daemon=True).start()
+    while (batch := inbox.get()) is not None:
+        for cell in batch:
+            conn.send(run_cell(cell, logs_dir))
+
+
+class _LocalWorker:
+    def __init__(self, context, logs_dir: str | None):
+        self.conn, child = context.Pipe()
+        self.process = context.Process(target=_worker_main, args=(child, os.getpid(), logs_dir), daemon=True)
+        self.process.start()
+        child.close()
+        self.queued: deque[Cell] = deque()  # sent, not yet returned, in the order the worker runs them
+
+    def send(self, batch: list[Cell]) -> None:
+        self.queued.extend(batch)
+        self.conn.send(batch)
+
+    def receive(self) -> tuple[list[Result], bool]:
+        """The results waiting on the pipe, and whether the worker is gone (its pipe closed)."""
+        results = []
+        try:
+            while self.conn.poll():
+                results.append(self.conn.recv())
+        except (EOFError, OSError):
+            return results, True
+        return results, False
+
+    def stop(self, terminate: bool) -> None:
+        if terminate:
+            self.process.kill()
+        else:
+            with contextlib.suppress(OSError):
+                self.conn.send(None)
+        self.process.join(0.0 if terminate else STOP_WAIT_S)
+        if self.process.is_alive():
+            self.process.kill()
+            self.process.join()
+        self.conn.close()
+
+
+def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None) -> Iterator[Result]:
     """Run the cells on ``workers`` spawned processes; on an early exit (Ctrl-C, SIGTERM) the workers
     this engine started are terminated."""
-    if not cells:
-        return
-    before = set(multiprocessing.active_children())
+    source = iter(cells)
+    retry: deque[Cell] = deque()  # the queue of a worker that died, for the next workers
+    sizer = BatchSizer()
     context = multiprocessing.get_context("spawn")
-    with _environment(worker_environment()):
-        executor = ProcessPoolExecutor(max_workers=workers, mp_context=context,
-                                       initializer=_exit_with_parent, initargs=(os.getpid(),))
-        pending = {executor.submit(run_cell, cell, logs_dir) for cell in cells}
+    pool: list[_LocalWorker | None] = [None] * workers
     finished = False
+
     try:
-        while pending:
-            done, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for future in done:
-                yield future.result()
+        exhausted = False
+        while True:
+            for slot, worker in enumerate(pool):
+                while not exhausted or retry:
+                    size = sizer.size()
+                    if worker is not None and len(worker.queued) >= BATCHES_IN_FLIGHT * size:
+                        break
+                    batch = []
+                    while retry and len(batch) < size:
+                        batch.append(retry.popleft())
+                    while len(batch) < size and not exhausted:
+                        cell = next(source, None)
+                        if cell is None:
+                            exhausted = True
+                        else:
+                            batch.append(cell)
+                    if not batch:
+                        break
+                    if worker is None:
+                        with _environment(worker_environment()):
+                            worker = pool[slot] = _LocalWorker(context, logs_dir)
+                    worker.send(batch)
+            busy = [w for w in pool if w is not None and w.queued]
+            if not busy:
+                break
+            ready = set(wait_any([w.conn for w in busy] + [w.process.sentinel for w in busy]))
+            for worker in busy:
+                if worker.conn not in ready and worker.process.sentinel not in ready:
+                    continue
+                results, gone = worker.receive()
+                for row, progress in results:
+                    worker.queued.popleft()
+                    sizer.observe(row)
+                    yield row, progress
+                if gone or not worker.process.is_alive():
+                    worker.process.join()
+                    for row, progress in worker.receive()[0]:  # what it sent before it died
+                        worker.queued.popleft()
+                        yield row, progress
+                    if worker.queued:
+                        yield died_row(worker.queued.popleft(), exit_description(worker.process.exitcode))
+                        retry.extendleft(reversed(worker.queued))
+                    worker.queued.clear()
+                    worker.conn.close()
+                    pool[pool.index(worker)] = None
         finished = True
     finally:
-        if finished:
-            executor.shutdown(wait=True)
-        else:
-            executor.shutdown(wait=False, cancel_futures=True)
-            for process in set(multiprocessing.active_children()) - before:
-                process.terminate()
+        for worker in pool:
+            if worker is not None:
+                worker.stop(terminate=not finished)
 
 
-def run_inline(cells: Sequence[Cell], logs_dir: str | None = None) -> Iterator[Result]:
+def run_inline(cells: Iterable[Cell], logs_dir: str | None = None) -> Iterator[Result]:
     """Run the cells one after another in this process (the benchmarks' engine: plan times are measured
     alone and warm, as their own timing loops measure them; no worker start-up)."""
     for cell in cells:
         yield run_cell(cell, logs_dir)
-
-
-def _drop_token_notice(record: logging.LogRecord) -> bool:
-    """Logging filter: drop Ray's notice that a new local instance enabled token authentication."""
-    return not record.getMessage().startswith("Token authentication is enabled")
-
-
-def check_reachable(address: str, timeout_s: float = 5.0) -> None:
-    """Fail at once, naming ``--address``, when a ``host:port`` (or ``ray://host:port``) cluster address does not
-    answer a TCP connection (Ray itself would retry for minutes); other forms (``auto``) go to Ray as given."""
-    host, sep, port = address.removeprefix("ray://").rpartition(":")
-    if not sep or not port.isdigit():
-        return
-    try:
-        socket.create_connection((host, int(port)), timeout=timeout_s).close()
-    except OSError as exc:
-        raise ConfigError("--address", f"cannot reach {address} ({exc.strerror or exc})") from None
-
-
-def start_ray(address: str | None, workers: int | None) -> None:
-    """Connect to the cluster at ``address``, or start a local instance with ``workers`` CPUs."""
-    import ray
-    if ray.is_initialized():
-        return
-    runtime_env = {"env_vars": worker_environment()}
-    if address:
-        check_reachable(address)
-        ray.init(address=address, runtime_env=runtime_env, log_to_driver=False)
-    else:
-        # A new local instance turns token authentication on by default and logs a warning that it did;
-        # the default stays (setting RAY_AUTH_MODE after Ray's import would break its client), the notice goes.
-        logging.getLogger(RAY_AUTH_LOGGER).addFilter(_drop_token_notice)
-        ray.init(num_cpus=workers, runtime_env=runtime_env, include_dashboard=False, log_to_driver=False)
-
-
-def run_ray(cells: Sequence[Cell], address: str | None = None, workers: int | None = None,
-            logs_dir: str | None = None) -> Iterator[Result]:
-    """Run the cells as Ray tasks (one CPU each) on a local instance or the cluster at ``address``."""
-    if not cells:
-        return
-    import ray
-    start_ray(address, workers)
-    task = ray.remote(num_cpus=1, max_retries=0)(run_cell)
-    pending = [task.remote(cell, logs_dir) for cell in cells]
-    try:
-        while pending:
-            done, pending = ray.wait(pending, num_returns=1)
-            for ref in done:
-                yield ray.get(ref)
-    finally:
-        for ref in pending:
-            ray.cancel(ref, force=True)

@@ -19,9 +19,10 @@ from typing import Any, Iterator, TextIO
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.study.engines import check_reachable, run_inline, run_local, run_ray
-from swarmnav.sim.study.grid import Cell, expand
-from swarmnav.sim.study.rows import RowWriter, done_hashes, read_table
+from swarmnav.sim.study.engines import run_inline, run_local
+from swarmnav.sim.study.grid import Cell, count_cells, iter_cells
+from swarmnav.sim.study.lock import FolderLock
+from swarmnav.sim.study.rows import RowWriter, compact, done_hashes, read_table
 from swarmnav.sim.study.spec import Study, study_from_tables
 
 METADATA = "study.json"
@@ -100,31 +101,45 @@ class ProgressBar:
         self.stream.flush()
 
 
-def pending_cells(study: Study, out_dir: FilePath) -> tuple[list[Cell], int]:
-    """The cells without a row yet, and how many the study has in all."""
-    cells = expand(study)
-    done = done_hashes(out_dir)
-    return [c for c in cells if c.config_hash not in done], len(cells)
+def pending_cells(study: Study, out_dir: FilePath, retry_errors: bool = False) -> tuple[Iterator[Cell], int, int]:
+    """The cells without a row yet (lazily), how many they are, and how many the study has in all.  A cell whose
+    row is an ``error`` counts as done, unless ``retry_errors``."""
+    done = done_hashes(out_dir, ("error",) if retry_errors else ())
+    pending = sum(1 for c in iter_cells(study) if c.config_hash not in done) if done else count_cells(study)
+    return (c for c in iter_cells(study) if c.config_hash not in done), pending, count_cells(study)
 
 
 def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local", workers: int | None = None,
-              address: str | None = None, logs: bool = False, show_progress: bool = False) -> dict[str, Any]:
-    """Run every cell of ``study`` that ``out_dir`` does not hold yet; return a summary of this invocation."""
+              address: str | None = None, logs: bool = False, show_progress: bool = False,
+              retry_errors: bool = False) -> dict[str, Any]:
+    """Run every cell of ``study`` that ``out_dir`` does not hold yet; return a summary of this invocation.
+
+    The folder is locked while the study runs (a second study into it is refused, naming this one's PID);
+    when every cell has a row, the parts are compacted."""
     out_dir = FilePath(out_dir)
     if engine == "ray" and address:
+        from swarmnav.sim.study.ray_engine import check_reachable
         check_reachable(address)  # before anything is written
+    with FolderLock(out_dir):
+        return _run_locked(study, out_dir, engine, workers, address, logs, show_progress, retry_errors)
+
+
+def _run_locked(study: Study, out_dir: FilePath, engine: str, workers: int | None, address: str | None,
+                logs: bool, show_progress: bool, retry_errors: bool) -> dict[str, Any]:
     _write_metadata(study, out_dir)
-    todo, total = pending_cells(study, out_dir)
+    todo, pending, total = pending_cells(study, out_dir, retry_errors)
     workers = workers or os.cpu_count() or 1
     logs_dir = str((out_dir / "logs").resolve()) if logs else None
+    nodes: set[str] = set()
     if engine == "ray":
-        results: Iterator = run_ray(todo, address, None if address else workers, logs_dir)
+        from swarmnav.sim.study.ray_engine import run_ray
+        results: Iterator = run_ray(todo, address, None if address else workers, logs_dir, nodes)
     elif engine == "inline":
         results = run_inline(todo, logs_dir)
     else:
         results = run_local(todo, workers, logs_dir)
     writer = RowWriter(out_dir)
-    bar = ProgressBar(len(todo), sys.stderr) if show_progress and todo else None
+    bar = ProgressBar(pending, sys.stderr) if show_progress and pending else None
     counts: dict[str, int] = {}
     started = time.perf_counter()
     try:
@@ -139,10 +154,18 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
             bar.close()
         if hasattr(results, "close"):
             results.close()
+    wall_s = time.perf_counter() - started
+    parts = compact(out_dir)  # reached only when every cell has run: an interrupted study keeps its parts
     ran = sum(counts.values())
-    return {"study": study.name, "out": str(out_dir), "cells": total, "skipped": total - len(todo), "ran": ran,
+    return {"study": study.name, "out": str(out_dir), "cells": total, "skipped": total - pending, "ran": ran,
             "failed": ran - counts.get("ok", 0), "outcomes": counts, "engine": engine, "workers": workers,
-            "wall_s": round(time.perf_counter() - started, 3)}
+            "wall_s": round(wall_s, 3), "parts_compacted": parts, "driver_peak_mb": round(_peak_rss_mb(), 1), **({"ray_nodes": len(nodes)} if nodes else {})}
+
+
+def _peak_rss_mb() -> float:
+    """This process's peak resident memory so far (the driver's; workers are processes of their own)."""
+    import resource
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # KiB on Linux
 
 
 def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, workers: int = 1,

@@ -12,7 +12,7 @@ import hashlib
 import json
 from dataclasses import dataclass
 from pathlib import Path as FilePath
-from typing import Any
+from typing import Any, Iterator
 
 from swarmnav.models.scenario import resolve_scenario_path
 from swarmnav.sim.study.spec import Component, Study
@@ -66,12 +66,15 @@ def _settings(study: Study):
                         yield scenario, planner, planner_params, navigator, navigator_params
 
 
-def expand(study: Study) -> list[Cell]:
-    """Every cell of the study, in a fixed order (scenario, planner, setting, navigator, world seed, seed)."""
-    cells: list[Cell] = []
+def iter_cells(study: Study) -> Iterator[Cell]:
+    """Every cell of the study, lazily, in a fixed order (scenario, planner, setting, navigator, world seed,
+    seed): a driver holds only the cells in flight, whatever the size of the grid."""
     scenario_digest = {s: hashlib.sha256(resolve_scenario_path(s).read_bytes()).hexdigest() for s in study.scenarios}
+    pairs = study.seed_pairs()
     for scenario, planner, planner_params, navigator, navigator_params in _settings(study):
-        for world_seed, seed in study.seed_pairs():
+        label = _sweep_label(planner, planner_params)
+        navigator_label = _sweep_label(navigator, navigator_params)
+        for world_seed, seed in pairs:
             config = {"scenario_sha256": scenario_digest[scenario], "planner": planner.name,
                       "label": planner.label, "navigator_label": navigator.label,
                       "planner_params": planner_params, "navigator": navigator.name,
@@ -79,13 +82,23 @@ def expand(study: Study) -> list[Cell]:
                       "world_seed": world_seed, "mode": study.mode, "time_limit_s": study.time_limit_s}
             if study.clearance_m is not None:  # absent otherwise: earlier hashes hold
                 config["clearance_m"] = study.clearance_m
-            cells.append(Cell(
+            yield Cell(
                 study=study.name, scenario=scenario, scenario_name=FilePath(scenario).stem,
-                planner=planner.name, label=_sweep_label(planner, planner_params),
+                planner=planner.name, label=label,
                 planner_params=planner_params, navigator=navigator.name,
-                navigator_label=_sweep_label(navigator, navigator_params),
+                navigator_label=navigator_label,
                 navigator_params=navigator_params, seed=seed, world_seed=world_seed,
                 mode=study.mode, time_limit_s=study.time_limit_s,
                 wall_limit_s=study.wall_limit_s, config_hash=config_hash(config),
-                clearance_m=study.clearance_m))
-    return cells
+                clearance_m=study.clearance_m)
+
+
+def count_cells(study: Study) -> int:
+    """How many cells :func:`iter_cells` yields, without building them."""
+    settings = sum(len(p.settings()) for p in study.planners) * sum(len(n.settings()) for n in study.navigators)
+    return len(study.scenarios) * settings * len(study.seed_pairs())
+
+
+def expand(study: Study) -> list[Cell]:
+    """Every cell of the study as a list (for small grids and tests; drivers use :func:`iter_cells`)."""
+    return list(iter_cells(study))

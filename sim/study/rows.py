@@ -2,23 +2,35 @@
 (best cost per iteration of each run, with the evaluations and wall seconds spent by then).
 
 Each is a *directory* of Parquet part files (a Parquet dataset), one part per
-flushed batch, so rows are written as cells finish and a study stopped by
+flush (every ``flush_s`` seconds while cells finish), so a study stopped by
 Ctrl-C, SIGTERM or a crash keeps every row it flushed.  A part is written under a
 dot-name and renamed into place, so a reader never sees half a file (readers skip
-names starting with ``.``).  Read them with ``pandas.read_parquet("DIR/runs.parquet")``,
+names starting with ``.``).  When a study finishes, :func:`compact` rewrites the
+parts into a few large ones.  Read them with ``pandas.read_parquet("DIR/runs.parquet")``,
 ``pyarrow.parquet.read_table`` or ``pyarrow.dataset.dataset`` as one table.
 Every part has the same fixed schema (below), so parts always concatenate.
+
+Rows are keyed by their cell (``config_hash``; progress rows by cell and
+iteration).  Part names sort in writing order, and where a key appears twice (a
+folder written by two studies at once before folders were locked, a retried
+``error`` cell, a crash during compaction) the readers keep the last row and say
+so on stderr.  A part that cannot be read (truncated, empty, not this table's) is
+moved to ``DIR/damaged/`` with one warning naming it; its cells have no row, so
+a resume runs them again.
 """
 
 from __future__ import annotations
 
+import math
 import os
+import sys
 import time
 import uuid
 from pathlib import Path as FilePath
 from typing import Any
 
 import pyarrow as pa
+import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 RUNS = "runs.parquet"
@@ -35,7 +47,8 @@ RUN_SCHEMA = pa.schema([
     ("plan_evaluations", pa.int64()), ("plan_collision_free", pa.bool_()), ("plan_waypoints", pa.string()),
     ("plan_bends", pa.int64()), ("plan_convergence_iteration", pa.int64()), ("plan_extra", pa.string()),
     ("plan_raw_length_m", pa.float64()), ("plan_gates_raised", pa.int64()), ("plan_tunnels_closed", pa.int64()),
-    ("plan_arc_cost", pa.float64()),
+    ("plan_arc_cost", pa.float64()), ("plan_moves", pa.int64()), ("plan_cell_clearance_m", pa.float64()),
+    ("plan_nodes_visited", pa.int64()),
     ("reached", pa.bool_()), ("run_outcome", pa.string()), ("collisions", pa.int64()),
     ("first_collision_s", pa.float64()), ("sim_time_s", pa.float64()), ("wall_time_s", pa.float64()),
     ("path_length_m", pa.float64()), ("min_clearance_m", pa.float64()), ("log", pa.string()),
@@ -50,6 +63,27 @@ PROGRESS_SCHEMA = pa.schema([
 ])
 # Columns that measure time on the wall clock: they differ between two runs of the same cell.
 TIMING_COLUMNS = ("cell_wall_s", "plan_time_s", "wall_time_s", "replan_wall_s", "navigator_wall_s")
+PROGRESS_TIMING_COLUMNS = ("wall_s",)  # the same, of progress.parquet
+
+
+DAMAGED = "damaged"
+KEYS = {RUNS: ("config_hash",), PROGRESS: ("config_hash", "iteration")}
+COMPACT_FILE_ROWS = 1_000_000  # rows per compacted part: a million-cell study ends with one or two files
+COMPACT_GROUP_ROWS = 16_384  # rows per Parquet row group of a compacted part
+
+
+def warn(message: str) -> None:
+    print(f"swarmnav: warning: {message}", file=sys.stderr)
+
+
+def _schema(name: str) -> pa.Schema:
+    return RUN_SCHEMA if name == RUNS else PROGRESS_SCHEMA
+
+
+def part_name(token: str, index: int) -> str:
+    """A part's file name; names sort in writing order (nanoseconds, then the writer's counter)."""
+    now = time.time_ns()
+    return f"part-{time.strftime('%Y%m%d%H%M%S', time.gmtime(now // 10**9))}{now % 10**9:09d}-{token}-{index:05d}.parquet"
 
 
 def _part_names(directory: FilePath) -> list[FilePath]:
@@ -58,37 +92,106 @@ def _part_names(directory: FilePath) -> list[FilePath]:
     return sorted(p for p in directory.glob("*.parquet") if not p.name.startswith((".", "_")))
 
 
-def _read_part(path: FilePath, schema: pa.Schema) -> pa.Table:
-    """One part in ``schema``: a column an older part lacks is null (rows written before it existed)."""
-    table = pq.read_table(path)
-    columns = [table.column(f.name).cast(f.type) if f.name in table.column_names
-               else pa.nulls(len(table), f.type) for f in schema]
-    return pa.Table.from_arrays(columns, schema=schema)
+class DamagedPart(Exception):
+    """A part file that is not a readable part of its table."""
 
 
-def read_table(out_dir: str | os.PathLike, name: str = RUNS) -> pa.Table:
-    """All parts of one table (an empty table with the schema when there is none)."""
-    schema = RUN_SCHEMA if name == RUNS else PROGRESS_SCHEMA
-    parts = [_read_part(p, schema) for p in _part_names(FilePath(out_dir) / name)]
-    return pa.concat_tables(parts) if parts else schema.empty_table()
+def _read_part(path: FilePath, schema: pa.Schema, columns: list[str] | None = None) -> pa.Table:
+    """One part in ``schema`` (or its ``columns``): a column an older part lacks is null (rows written before it
+    existed).  Raises ``DamagedPart`` for a file that is no Parquet or holds another table."""
+    wanted = [f for f in schema if columns is None or f.name in columns]
+    try:
+        present = set(pq.read_schema(path).names)
+        if "config_hash" not in present:
+            raise DamagedPart("it holds no config_hash column (not a part of this table)")
+        table = pq.read_table(path, columns=[f.name for f in wanted if f.name in present])
+        arrays = [table.column(f.name).cast(f.type) if f.name in present else pa.nulls(len(table), f.type)
+                  for f in wanted]
+    except FileNotFoundError:
+        raise
+    except (pa.ArrowException, OSError, ValueError) as exc:
+        raise DamagedPart(f"{type(exc).__name__}: {exc}".splitlines()[0]) from None
+    return pa.Table.from_arrays(arrays, schema=pa.schema(wanted))
 
 
-def done_hashes(out_dir: str | os.PathLike) -> set[str]:
-    """Configuration hashes of the cells that already have a row."""
-    parts = _part_names(FilePath(out_dir) / RUNS)
-    return {h for p in parts for h in pq.read_table(p, columns=["config_hash"]).column(0).to_pylist()}
+def set_aside(path: FilePath, reason: str) -> None:
+    """Move a damaged part to ``DIR/damaged/`` (``DIR`` the study folder), with one warning naming it."""
+    folder = path.parent.parent / DAMAGED
+    target = folder / f"{path.parent.name}-{path.name}"
+    try:
+        folder.mkdir(exist_ok=True)
+        os.replace(path, target)
+        where = f"moved to {target}"
+    except OSError as exc:  # a read-only copy of a results folder: skipped, left in place
+        where = f"skipped (could not move it aside: {exc.strerror or exc})"
+    warn(f"{path}: unreadable part ({reason}); {where}; its cells have no row (a resume runs them again)")
+
+
+def _readable_parts(paths: list[FilePath], schema: pa.Schema, columns: list[str] | None):
+    """``(path, table)`` of each readable part of ``paths``; damaged parts are set aside on the way."""
+    for path in paths:
+        try:
+            yield path, _read_part(path, schema, columns)
+        except FileNotFoundError:  # removed by a compaction meanwhile: its rows are in the compacted part
+            continue
+        except DamagedPart as exc:
+            set_aside(path, str(exc))
+
+
+def _last_of_each(table: pa.Table, keys: tuple[str, ...]) -> pa.Table:
+    """The table with one row per key, the last one (later parts supersede earlier ones)."""
+    if table.num_rows == 0:
+        return table
+    indexed = table.select(list(keys)).append_column("_row", pa.array(range(table.num_rows), pa.int64()))
+    last = indexed.group_by(list(keys), use_threads=False).aggregate([("_row", "max")]).column("_row_max")
+    if len(last) == table.num_rows:
+        return table
+    return table.take(pc.take(last, pc.sort_indices(last)))
+
+
+def read_table(out_dir: str | os.PathLike, name: str = RUNS, columns: list[str] | None = None) -> pa.Table:
+    """All parts of one table, each key once (an empty table with the schema when there is none);
+    ``columns`` reads only those (the key columns are always read)."""
+    schema = _schema(name)
+    keys = KEYS[name]
+    if columns is not None:
+        columns = list(dict.fromkeys([*keys, *columns]))
+    directory = FilePath(out_dir) / name
+    names = _part_names(directory)
+    parts = [table for _, table in _readable_parts(names, schema, columns)]
+    if any(not p.exists() for p in names):  # a compaction replaced parts meanwhile: read the new ones
+        parts = [table for _, table in _readable_parts(_part_names(directory), schema, columns)]
+    if not parts:
+        wanted = [f for f in schema if columns is None or f.name in columns]
+        return pa.schema(wanted).empty_table()
+    table = pa.concat_tables(parts)
+    unique = _last_of_each(table, keys)
+    if unique.num_rows < table.num_rows:
+        warn(f"{directory}: {table.num_rows - unique.num_rows} duplicate rows of {table.num_rows} "
+             f"(the same {'cell' if name == RUNS else 'cell and iteration'} written twice); each key counted once, "
+             "the last written kept")
+    return unique
+
+
+def done_hashes(out_dir: str | os.PathLike, except_outcomes: tuple[str, ...] = ()) -> set[str]:
+    """Configuration hashes of the cells that already have a row (the last row of each cell, when a cell was
+    written twice), leaving out the cells whose row has an outcome in ``except_outcomes``."""
+    table = read_table(out_dir, RUNS, ["outcome"])
+    if except_outcomes:
+        table = table.filter(pc.invert(pc.is_in(table.column("outcome"), pa.array(except_outcomes, pa.string()))))
+    return set(table.column("config_hash").to_pylist())
 
 
 class RowWriter:
-    """Buffers finished cells and writes them as part files, at least every ``flush_s`` seconds
-    or ``batch`` runs, and on :meth:`flush`."""
+    """Buffers finished cells and writes them as part files: the first row at once, then at most every
+    ``flush_s`` seconds (or ``max_rows`` runs), and on :meth:`flush`."""
 
-    def __init__(self, out_dir: str | os.PathLike, batch: int = 16, flush_s: float = 2.0):
+    def __init__(self, out_dir: str | os.PathLike, flush_s: float = 2.0, max_rows: int = 65_536):
         self.out_dir = FilePath(out_dir)
-        self.batch, self.flush_s = batch, flush_s
+        self.flush_s, self.max_rows = flush_s, max_rows
         self.runs: list[dict[str, Any]] = []
         self.progress: list[dict[str, Any]] = []
-        self.last_flush = time.monotonic()
+        self.last_flush = -math.inf  # the first row is written at once: a study shows its first row early
         self.token = uuid.uuid4().hex[:8]
         self.parts = 0
         for name in (RUNS, PROGRESS):
@@ -97,11 +200,11 @@ class RowWriter:
     def add(self, row: dict[str, Any], progress: list[dict[str, Any]]) -> None:
         self.runs.append(row)
         self.progress.extend(progress)
-        if len(self.runs) >= self.batch or time.monotonic() - self.last_flush >= self.flush_s:
+        if len(self.runs) >= self.max_rows or time.monotonic() - self.last_flush >= self.flush_s:
             self.flush()
 
     def _write(self, name: str, rows: list[dict[str, Any]], schema: pa.Schema) -> None:
-        final = self.out_dir / name / f"part-{time.strftime('%Y%m%d%H%M%S')}-{self.token}-{self.parts:05d}.parquet"
+        final = self.out_dir / name / part_name(self.token, self.parts)
         temporary = final.with_name("." + final.name)
         pq.write_table(pa.Table.from_pylist(rows, schema=schema), temporary)
         os.replace(temporary, final)
@@ -116,3 +219,64 @@ class RowWriter:
         self._write(RUNS, self.runs, RUN_SCHEMA)
         self.parts += 1
         self.runs, self.progress = [], []
+
+
+def compact(out_dir: str | os.PathLike) -> dict[str, int]:
+    """Rewrite each table's parts as a few large parts, each key once; return the parts before, per table.
+
+    Streamed part by part (memory stays that of one row group).  The new parts are written under dot-names,
+    renamed into place when all are complete, and only then are the old parts removed: a crash in between
+    leaves each row twice, never lost, and the readers keep one of each."""
+    before = {}
+    for name in (PROGRESS, RUNS):  # progress first: a crash in between never leaves a run without its history
+        directory = FilePath(out_dir) / name
+        parts = _part_names(directory)
+        before[name] = len(parts)
+        if len(parts) > 1:
+            _compact_table(directory, name, parts)
+    return before
+
+
+def _compact_table(directory: FilePath, name: str, parts: list[FilePath]) -> None:
+    schema, token = _schema(name), uuid.uuid4().hex[:8]
+    owner: set[str] = set()  # cells already taken from a later part (the last written row wins)
+    finished: list[FilePath] = []
+    writer: pq.ParquetWriter | None = None
+    rows_in_file, pending_rows = 0, 0
+
+    def write(tables: list[pa.Table]) -> None:
+        nonlocal writer, rows_in_file
+        table = pa.concat_tables(tables)
+        if writer is None or rows_in_file + table.num_rows > COMPACT_FILE_ROWS:
+            if writer is not None:
+                writer.close()
+            final = directory / part_name(token, len(finished))
+            finished.append(final)
+            writer, rows_in_file = pq.ParquetWriter(directory / ("." + final.name), schema), 0
+        writer.write_table(table, row_group_size=COMPACT_GROUP_ROWS)
+        rows_in_file += table.num_rows
+
+    kept: list[pa.Table] = []
+    seen: set[str] = set()  # cells already taken from a newer part: the last written row of a cell wins
+    readable = []
+    for path, table in _readable_parts(list(reversed(parts)), schema, None):
+        readable.append(path)
+        hashes = pc.unique(table.column("config_hash")).to_pylist()
+        new = [h for h in hashes if h not in seen]
+        seen.update(new)
+        if len(new) < len(hashes):
+            table = table.filter(pc.is_in(table.column("config_hash"), pa.array(new, pa.string())))
+        table = _last_of_each(table, KEYS[name])
+        if table.num_rows:
+            kept.append(table)
+            pending_rows += table.num_rows
+        if pending_rows >= COMPACT_GROUP_ROWS:
+            write(kept)
+            kept, pending_rows = [], 0
+    if kept or writer is None:
+        write(kept or [schema.empty_table()])
+    writer.close()
+    for final in finished:
+        os.replace(final.with_name("." + final.name), final)
+    for path in readable:
+        path.unlink(missing_ok=True)

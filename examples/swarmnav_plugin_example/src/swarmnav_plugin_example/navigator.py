@@ -16,6 +16,8 @@ class SlowFollowNavigator:
 
     name: ClassVar[str] = "slow_follow"
     uses_detections: ClassVar[bool] = False
+    uses_planner: ClassVar[bool] = False
+    replan_wall_s: ClassVar[float] = 0.0
     speed_fraction: float = 0.5
 
     def __post_init__(self) -> None:

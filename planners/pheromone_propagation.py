@@ -1,0 +1,202 @@
+"""Algorithms 1-2 of Hasan, Abdullah & Saleh (2023): the goal-to-start pheromone propagation of IMMAS.
+
+The environment-analysis stage of :mod:`planners.max_min_ant_system` (whose docstring gives the
+equations, the MAX-MIN layering and the choices made): the D*-style propagation from the goal
+with the clean weights, GateRaiseState and CheckTightTunnelState (Algorithm 2), and the trails'
+MAX-MIN bounds (:mod:`planners.max_min_trails`).  The ``immas_stepwise`` navigator runs it too.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import ndimage
+
+from swarmnav.planners.errors import NoPathFound
+from swarmnav.planners.grid_graph import DIRECTIONS, Cell
+from swarmnav.planners.max_min_trails import P_BEST, TrailLimits, unit_limits
+
+INF = math.inf
+ORTHOGONAL = ((-1, 0), (1, 0), (0, -1), (0, 1))
+
+
+@dataclass
+class EnvironmentAnalysis:
+    """Result of Algorithms 1-2.
+
+    Attributes:
+        blocked: (rows, cols) obstacles after closing gates and tunnels.
+        route_cost: (rows, cols) k, the route cost to the goal (inf where not propagated).
+        pheromone: (rows, cols) tau (inf where not propagated).
+        clean: (rows, cols) clean weight times the number of obstacle neighbours.
+        parent: (rows, cols, 2) the next cell towards the goal in the propagation tree (-1 if none).
+        gates: cells closed by GateRaiseState.
+        tunnels: cells closed by CheckTightTunnelState.
+        expansions: cells expanded by the propagation.
+        closing_reverted: closing disconnected start from goal, so nothing was closed.
+        limits: the MAX-MIN bounds of the trails (``None`` for ``propagation="route_cost"``).
+    """
+
+    blocked: np.ndarray
+    route_cost: np.ndarray
+    pheromone: np.ndarray
+    clean: np.ndarray
+    parent: np.ndarray
+    gates: list[Cell] = field(default_factory=list)
+    tunnels: list[Cell] = field(default_factory=list)
+    expansions: int = 0
+    closing_reverted: bool = False
+    limits: TrailLimits | None = None
+
+
+def is_gate(blocked: list[list[bool]], r: int, c: int) -> bool:
+    """GateRaiseState: both cells of a diagonally opposite pair of neighbours are obstacles."""
+    rows, cols = len(blocked), len(blocked[0])
+
+    def occ(rr: int, cc: int) -> bool:
+        return 0 <= rr < rows and 0 <= cc < cols and blocked[rr][cc]
+
+    return (occ(r + 1, c + 1) and occ(r - 1, c - 1)) or (occ(r + 1, c - 1) and occ(r - 1, c + 1))
+
+
+def is_tight_tunnel(blocked: list[list[bool]], r: int, c: int, dr: int, dc: int) -> bool:
+    """Algorithm 2 for the horizontal or vertical neighbour Y = (r + dr, c + dc) of X = (r, c).
+
+    Y is a tight-tunnel entrance when the two diagonal neighbours of X that
+    flank it are both obstacles.
+    """
+    rows, cols = len(blocked), len(blocked[0])
+
+    def occ(rr: int, cc: int) -> bool:
+        return 0 <= rr < rows and 0 <= cc < cols and blocked[rr][cc]
+
+    if dr:
+        return occ(r + dr, c - 1) and occ(r + dr, c + 1)
+    return occ(r - 1, c + dc) and occ(r + 1, c + dc)
+
+
+PROPAGATIONS = ("mmas", "route_cost")
+
+
+def analyse_environment(occupied: np.ndarray, start: Cell, goal: Cell, rho: float = 0.98,
+                        clean_weight: float = 0.5, diagonal_factor: float = 1.4,
+                        close: bool = True, propagation: str = "mmas", evaporation_doubling: bool = False,
+                        p_best: float = P_BEST, trace: list[tuple[Cell, float]] | None = None
+                        ) -> EnvironmentAnalysis:
+    """Algorithms 1-2: propagate pheromone from the goal, closing gates and tight tunnels.
+
+    Args:
+        propagation: ``"mmas"`` (the MAX-MIN trails of the module docstring) or ``"route_cost"``
+            (the trail is the route cost, ``tau(Y) = rho tau(X) + c``, unbounded).
+        evaporation_doubling: §3.2's prose: the evaporation rate rho doubles with each expansion
+            (``"mmas"`` only; Algorithm 1 and §4.2 keep rho = 0.98).
+        trace: if given, every ``(cell, tau)`` written, in order (tests check the bounds after
+            every update).
+
+    Raises:
+        NoPathFound: the start is unreachable from the goal even without closing.
+    """
+    occ = np.asarray(occupied, dtype=bool)
+    rows, cols = occ.shape
+    blocked = occ.tolist()
+    bounded = propagation == "mmas"
+    limits = mmas_limits(occ, rho, diagonal_factor, p_best) if bounded else None
+    k = [[INF] * cols for _ in range(rows)]
+    # MMAS: every trail starts at tau_max (§2 item 3); the goal's goal_pher = 0 (Algorithm 1 line 6), clamped.
+    tau = [[limits.tau_max if bounded else INF] * cols for _ in range(rows)]
+    parent = [[None] * cols for _ in range(rows)]
+    closed_set = [[False] * cols for _ in range(rows)]
+    keep = {start, goal}
+    gates: list[Cell] = []
+    tunnels: list[Cell] = []
+    gr, gc = goal
+    k[gr][gc] = 0.0
+    tau[gr][gc] = limits.clamp_value(0.0) if bounded else 0.0
+    if trace is not None:
+        trace.append((goal, tau[gr][gc]))
+    heap = [(0.0, gr, gc)]
+    expansions = 0
+    reached = False
+    moves = [(dr, dc, diagonal_factor if dr and dc else 1.0) for dr, dc in DIRECTIONS]
+    persistence = rho
+    while heap:
+        kx, r, c = heapq.heappop(heap)
+        if closed_set[r][c] or blocked[r][c] or kx > k[r][c]:
+            continue
+        closed_set[r][c] = True
+        if (r, c) == start:
+            reached = True
+            break
+        if close and (r, c) not in keep and is_gate(blocked, r, c):
+            blocked[r][c] = True
+            gates.append((r, c))
+            continue
+        expansions += 1
+        if close:
+            for dr, dc in ORTHOGONAL:
+                yr, yc = r + dr, c + dc
+                if (0 <= yr < rows and 0 <= yc < cols and not blocked[yr][yc] and (yr, yc) not in keep
+                        and not closed_set[yr][yc] and is_tight_tunnel(blocked, r, c, dr, dc)):
+                    blocked[yr][yc] = True
+                    tunnels.append((yr, yc))
+        tx = tau[r][c]
+        for dr, dc, cost in moves:
+            yr, yc = r + dr, c + dc
+            if not (0 <= yr < rows and 0 <= yc < cols) or blocked[yr][yc] or closed_set[yr][yc]:
+                continue
+            if dr and dc and (blocked[r][yc] or blocked[yr][c]):
+                continue
+            ky = kx + cost
+            if ky < k[yr][yc]:
+                k[yr][yc] = ky
+                if bounded:
+                    # Eq. (2) by the iteration-best ant X (unit deposit), then "multiply by 1.4 or 1"
+                    # (§3.2), then the MMAS bounds (§2.1).
+                    tau[yr][yc] = limits.clamp_value(cost * (persistence * tx + 1.0))
+                else:
+                    tau[yr][yc] = rho * tx + cost
+                if trace is not None:
+                    trace.append(((yr, yc), tau[yr][yc]))
+                parent[yr][yc] = (r, c)
+                heapq.heappush(heap, (ky, yr, yc))
+        if bounded and evaporation_doubling:
+            persistence *= 2.0                                   # §3.2: "the evaporation rate doubles"
+    if not reached:
+        if close:
+            result = analyse_environment(occ, start, goal, rho, clean_weight, diagonal_factor, close=False,
+                                         propagation=propagation, evaporation_doubling=evaporation_doubling,
+                                         p_best=p_best, trace=trace)
+            result.closing_reverted = True
+            return result
+        raise NoPathFound(f"goal cell {goal} is unreachable from start cell {start}")
+    blocked_arr = np.array(blocked, dtype=bool)
+    neighbours = ndimage.convolve(blocked_arr.astype(np.int64), np.array([[1, 1, 1], [1, 0, 1], [1, 1, 1]]),
+                                  mode="constant", cval=0)
+    parent_arr = np.full((rows, cols, 2), -1, dtype=np.int64)
+    for r in range(rows):
+        for c in range(cols):
+            if parent[r][c] is not None:
+                parent_arr[r, c] = parent[r][c]
+    tau_arr = np.array(tau)
+    if bounded:
+        tau_arr[~np.isfinite(np.array(k))] = INF   # never propagated: no trail (Algorithm 3 skips them)
+    return EnvironmentAnalysis(blocked=blocked_arr, route_cost=np.array(k), pheromone=tau_arr,
+                               clean=clean_weight * neighbours * ~blocked_arr, parent=parent_arr,
+                               gates=gates, tunnels=tunnels, expansions=expansions, limits=limits)
+
+
+def mmas_limits(occupied: np.ndarray, rho: float, diagonal_factor: float, p_best: float = P_BEST) -> TrailLimits:
+    """The propagation's ``[tau_min, tau_max]`` (Stützle & Hoos 2000 Eqs. 7 and 11, :mod:`planners.max_min_trails`).
+
+    ``tau_max = 1 / (1 - rho)``: Eq. (7) for the unit deposit of Eq. (2) (the fixed point of
+    ``tau <- rho tau + 1``); ``n`` of Eq. (11) is the number of free cells (each a decision
+    point of the tour) and ``avg`` half the eight moves, 4.  With the persistence at 1 or more
+    (no evaporation, or §3.2's doubling) the bound is ``diagonal_factor / (1 - 0.98)`` instead
+    (the default rho's limit), so that it stays finite.
+    """
+    free = int(np.count_nonzero(~np.asarray(occupied, dtype=bool)))
+    persistence = rho if rho < 1.0 else 0.98
+    return unit_limits(persistence, 1.0 if rho < 1.0 else diagonal_factor, max(free, 1), 4.0, p_best)

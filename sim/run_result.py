@@ -1,0 +1,69 @@
+"""What one closed-loop run gives: the outcome, the trajectory and the navigation metrics."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class RunResult:
+    """What happened in one closed-loop run (arrays have one row per control step)."""
+
+    reached: bool
+    outcome: str  # "goal_reached" | "timeout" | "collision"
+    collisions: int
+    first_collision_s: float | None
+    sim_time_s: float
+    wall_time_s: float
+    path_length_m: float
+    min_clearance_m: float
+    steps: int
+    times_s: np.ndarray = field(repr=False)
+    poses: np.ndarray = field(repr=False)  # (T, 3) x, y, heading
+    wheel_command_rad_s: np.ndarray = field(repr=False)  # (T, 2)
+    collision_points_m: np.ndarray = field(repr=False)  # (C, 2) base position at each collision start
+    # Navigation metrics (Le et al. 2022's dynamic runs; see summary()).
+    time_in_danger_s: float = 0.0
+    stopped_s: float = 0.0
+    replans: int = 0
+    replan_wall_s: float = 0.0
+    safety_triggers: int = 0
+    reference_length_m: float | None = None  # L*: the shortest path among the static obstacles
+    navigator_wall_s: float = 0.0  # wall time spent in navigator.step (not in summary(): benchmarks read it)
+
+    @property
+    def success(self) -> bool:
+        """Reached the goal before the time limit with no collision."""
+        return self.reached and self.collisions == 0
+
+    @property
+    def spl(self) -> float | None:
+        """Success weighted by path length (Anderson et al. 2018, Eq. 1 for one episode): S L* / max(L, L*).
+
+        A start within the goal's tolerance, with L = L* = 0, has 1 (the paper leaves 0/0 undefined).
+        """
+        if self.reference_length_m is None:
+            return None
+        if not self.success:
+            return 0.0
+        longest_m = max(self.path_length_m, self.reference_length_m)
+        return self.reference_length_m / longest_m if longest_m > 0.0 else 1.0
+
+    def summary(self) -> dict[str, Any]:
+        return {"reached": self.reached, "outcome": self.outcome, "collisions": self.collisions,
+                "first_collision_s": self.first_collision_s, "sim_time_s": round(self.sim_time_s, 6),
+                "wall_time_s": round(self.wall_time_s, 4), "path_length_m": self.path_length_m,
+                # None when the scene has no obstacle (JSON has no infinity).
+                "min_clearance_m": self.min_clearance_m if math.isfinite(self.min_clearance_m) else None,
+                "success": self.success, "time_to_goal_s": round(self.sim_time_s, 6) if self.reached else None,
+                "spl": self.spl, "time_in_danger_s": round(self.time_in_danger_s, 6), "replans": self.replans,
+                "replan_wall_s": round(self.replan_wall_s, 4), "stopped_s": round(self.stopped_s, 6),
+                "safety_triggers": self.safety_triggers}
+
+    def log_summary(self) -> dict[str, Any]:
+        """:meth:`summary` without wall-clock figures other than ``wall_*`` (which the log writer drops)."""
+        return {k: v for k, v in self.summary().items() if k != "replan_wall_s"}

@@ -1,0 +1,389 @@
+"""One episode, one control period at a time: the only place that orders the steps of the closed loop.
+
+:class:`EpisodeStepper` owns an episode on a compiled scene: the ``MjData``, the
+obstacle motion, sensing, the contact check, the recorders' ``start`` and
+``finish``, the reference length L* and the metrics.  Whoever chooses the wheel
+commands drives it: a navigator (:meth:`sim.runner.Simulation.run`) or a policy
+(the dm_control task of :mod:`sim.env.task`)::
+
+    observation = stepper.reset()
+    while not stepper.outcome:
+        observation = stepper.step(command_for(observation))
+    result = stepper.result
+
+:meth:`~EpisodeStepper.reset` puts the robot at the start and the obstacles at
+t = 0, starts the recorder, counts contacts present at the start and senses.
+Each :meth:`~EpisodeStepper.step` then
+
+1. records the driver's new path and events, and the step (pose, ranges, command, belief);
+2. writes ``data.ctrl`` and runs ``mj_step`` k times, checking for a collision (a MuJoCo
+   contact between a robot geom and an obstacle geom) after every physics step, or all
+   k in one call when the clearance rules out any contact within the period;
+3. moves the mocap obstacles to their positions at the new time;
+4. observes: pose, twist and rangefinders as an :class:`~controllers.navigator.Observation`
+   (plain arrays, ``inf`` = nothing in range; detections only when asked for), the driven
+   length and the clearance (``mj_geomDistance``, skipped when a bound shows it cannot matter);
+5. stops on goal, timeout or (optionally) the first collision: the wheels are zeroed, the last
+   step and the outcome recorded, the :class:`RunResult` built and the recorder finished.
+
+The clearance is sampled at the control rate; collisions at the physics rate.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from swarmnav.controllers.controller import ControlCommand, Twist
+from swarmnav.controllers.goal import GoalChecker
+from swarmnav.controllers.navigator import Belief, Observation
+from swarmnav.models.scenario import Scenario
+from swarmnav.models.world import Pose2D
+from swarmnav.planners.problem import Path
+from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
+from swarmnav.sim.contact import ContactMonitor
+from swarmnav.sim.detector import ObstacleSensing
+from swarmnav.sim.recording import Recorder, RunContext, StepFrame
+from swarmnav.sim.reference import reference_length_m as shortest_static_length_m
+from swarmnav.sim.run_result import RunResult
+from swarmnav.sim.scene import CompiledScene
+from swarmnav.sim.sensing import base_twist, ranges_from_sensors, yaw_from_quaternion
+
+
+def steps_per_control(scenario: Scenario, model: mujoco.MjModel) -> int:
+    """Physics steps per control period."""
+    return int(round(1.0 / (scenario.sim.control_hz * model.opt.timestep)))
+
+
+def moving_obstacles(scene: CompiledScene) -> list:
+    """The scene's mocap obstacles (:class:`~sim.scene.ObstacleGeom`), in scene order."""
+    return [ob for ob in scene.obstacles if ob.mocap_index >= 0]
+
+
+def obstacle_positions(scenario: Scenario, scene: CompiledScene, times_s: np.ndarray) -> np.ndarray:
+    """(T, M, 2) positions of the moving obstacles at the given times."""
+    moving = moving_obstacles(scene)
+    if not moving:
+        return np.zeros((len(times_s), 0, 2))
+    return np.stack([scenario.obstacles[ob.scenario_index].trajectory().positions_at(times_s) for ob in moving],
+                    axis=1)
+
+
+def reset_data(scenario: Scenario, scene: CompiledScene, data: mujoco.MjData | None = None) -> mujoco.MjData:
+    """New MjData (or ``data`` reset in place) with the robot at the start pose and obstacles at t = 0."""
+    model = scene.model
+    if data is None:
+        data = mujoco.MjData(model)
+    else:
+        mujoco.mj_resetData(model, data)
+    start = scenario.start
+    adr = scene.free_qpos_adr
+    data.qpos[adr:adr + 3] = [start.x_m, start.y_m, 0.0]
+    data.qpos[adr + 3:adr + 7] = [math.cos(start.heading_rad / 2), 0.0, 0.0, math.sin(start.heading_rad / 2)]
+    moving = moving_obstacles(scene)
+    if moving:
+        index = np.array([ob.mocap_index for ob in moving], dtype=np.int64)
+        data.mocap_pos[index, :2] = obstacle_positions(scenario, scene, np.zeros(1))[0]
+    mujoco.mj_forward(model, data)
+    return data
+
+
+def goal_checker(scenario: Scenario) -> GoalChecker:
+    goal = scenario.goal
+    return GoalChecker(goal.x_m, goal.y_m, scenario.goal_tolerance_m)
+
+
+class EpisodeStepper:
+    """One episode on a compiled scene of ``scenario``; see the module docstring.
+
+    Args:
+        time_limit_s, stop_on_collision: None = the scenario's.
+        recorder: gets ``start(context)`` at :meth:`reset`, every step, and ``finish`` once
+            (:meth:`close` finishes it early, e.g. after an exception).
+        path_m: the path planned at t = 0, recorded at time 0 (None: no path).
+        sense_obstacles: whether observations carry detections (the sensing model's work is
+            spared for a driver that never reads them).
+        data: an ``MjData`` of ``scene.model`` to run in (the environment's physics owns one);
+            by default a new one at every :meth:`reset`.
+
+    After :meth:`reset`: ``observation`` (the last one), ``outcome`` ("" while running),
+    ``result`` (once over), ``step_index``, ``poses``, ``wheel_cmd``, ``obstacle_track_m``
+    and ``clearance_m``.
+    """
+
+    def __init__(self, scenario: Scenario, scene: CompiledScene, *, time_limit_s: float | None = None,
+                 stop_on_collision: bool | None = None, recorder: Recorder | None = None,
+                 context: RunContext | None = None, path_m: np.ndarray | None = None, sense_obstacles: bool = True,
+                 data: mujoco.MjData | None = None):
+        self.scenario = scenario
+        self.scene = scene
+        self.model = model = scene.model
+        self.recorder = recorder
+        self.context = context
+        self.path_m = path_m
+        self.sense_obstacles = bool(sense_obstacles)
+        # L* of the SPL: the shortest path among the static obstacles (sim.reference).
+        self.reference_length_m = shortest_static_length_m(scenario)
+        self.stop_on_collision = scenario.sim.stop_on_collision if stop_on_collision is None else stop_on_collision
+        self.k = steps_per_control(scenario, model)
+        self.physics_dt_s = float(model.opt.timestep)
+        self.dt_s = self.k * self.physics_dt_s
+        limit_s = scenario.time_limit_s if time_limit_s is None else time_limit_s
+        self.n_max = int(math.floor(limit_s / self.dt_s + 1e-9))
+        self.times_s = np.arange(self.n_max + 1) * self.dt_s
+        self.goal = goal_checker(scenario)
+        moving = moving_obstacles(scene)
+        self.mocap_index = np.array([ob.mocap_index for ob in moving], dtype=np.int64)
+        self.obstacle_track_m = obstacle_positions(scenario, scene, self.times_s)  # (T, M, 2)
+        self._radii_m = np.array([scenario.obstacles[ob.scenario_index].radius_m for ob in moving])
+        # How far the moving obstacles can have moved: obstacle_shift_m[j] - obstacle_shift_m[i]
+        # bounds every obstacle's displacement between control steps i and j (for clearance skips).
+        track = self.obstacle_track_m
+        hops = np.hypot(*np.moveaxis(np.diff(track, axis=0), 2, 0)).max(axis=1) if track.shape[1] else \
+            np.zeros(max(len(track) - 1, 0))
+        self.obstacle_shift_m = np.concatenate([[0.0], np.cumsum(hops)]).tolist()
+        # Farther than this from every obstacle, no contact can begin within one control period:
+        # twice the distance the base covers at full wheel speed, plus a centimetre.
+        top_speed_m_s = scene.drive.max_wheel_speed_rad_s * scene.drive.wheel_radius_m
+        self.contact_free_gap_m = 2.0 * top_speed_m_s * self.dt_s + 0.01
+        self.danger_m = scenario.sim.danger_m
+        self.qadr = scene.free_qpos_adr
+        self._wheel_qvel_adr = np.array(scene.wheel_qvel_adr)
+        self._data = data
+        self._unfinished = recorder is not None  # the recorder is owed its finish()
+        self.outcome = ""
+        self.result: RunResult | None = None
+        self.observation: Observation | None = None
+        self.step_index = 0
+
+    # --- the episode ------------------------------------------------------------------------------
+    def reset(self) -> Observation:
+        """Start pose, obstacles at t = 0, recorder started, contacts at the start counted; the first observation."""
+        self._wall0 = time.perf_counter()
+        self._start_state()
+        if self.recorder is not None:
+            self.recorder.start(self.context)
+            if self.path_m is not None:
+                self.recorder.path(0.0, self.path_m)
+        qpos = self.data.qpos
+        if self.data.ncon > self.resting_contacts:
+            self.monitor.update(self.data, 0.0, float(qpos[self.qadr]), float(qpos[self.qadr + 1]))
+        return self._sense()
+
+    def step(self, command: ControlCommand, belief: Belief | None = None, new_path: Path | None = None,
+             events: tuple[tuple[str, dict[str, Any]], ...] = ()) -> Observation:
+        """One control period with ``command`` (and what the driver decided with it: a new path, events,
+        its belief, all recorded); the next observation."""
+        if self.outcome:
+            raise RuntimeError(f"the episode is over ({self.outcome}): reset() starts another")
+        recorder = self.recorder
+        time_s = self.observation.time_s
+        if recorder is not None:
+            if new_path is not None:
+                recorder.path(time_s, new_path.waypoints)
+            for kind, details in events:
+                recorder.event(time_s, kind, details)
+        if events:
+            for kind, _ in events:
+                if kind == "replan":
+                    self.replans += 1
+                elif kind == "safety_trigger":
+                    self.safety_triggers += 1
+        wheels = command.wheels
+        left, right = wheels.left_rad_s, wheels.right_rad_s
+        data = self.data
+        data.ctrl[0] = left
+        data.ctrl[1] = right
+        self.wheel_cmd[self.step_index] = (left, right)
+        self.waypoint_index = command.waypoint_index
+        self.danger_steps += self.in_danger
+        self.stopped_steps += left == 0.0 and right == 0.0
+        if recorder is not None:
+            recorder.step(self._frame(self.observation, command, belief))
+        self._advance()
+        return self._sense()
+
+    def close(self, outcome: str) -> None:
+        """Finish a recording still open (the episode interrupted, failed or abandoned before its end)."""
+        if self._unfinished:
+            self._unfinished = False
+            self.recorder.finish({"outcome": outcome, "sim_time_s": self.time_s})
+
+    @property
+    def time_s(self) -> float:
+        return self.step_index * self.dt_s
+
+    @property
+    def collisions(self) -> int:
+        return self.monitor.collisions
+
+    @property
+    def clearance_m(self) -> float:
+        """The clearance at the last observation (measured on demand if the observation could skip it)."""
+        if self._clearance_m is None:
+            if self._observed_step != self.step_index:
+                raise RuntimeError("the clearance of an observation is only available until the next step()")
+            x, y = self.poses[self.step_index, :2].tolist()
+            self._clearance_m = self.clearance.measure(self.data, x, y)
+            self._shift_at_measure_m = self.obstacle_shift_m[max(self.step_index - 1, 0)]
+        return self._clearance_m
+
+    def clearance_bound_m(self) -> float:
+        """A value the clearance now certainly exceeds (:meth:`ClearanceProbe.lower_bound_m`)."""
+        return self.clearance.lower_bound_m(self.obstacle_shift_m[self.step_index] - self._shift_at_measure_m)
+
+    # --- the steps of a control period --------------------------------------------------------------
+    def _start_state(self) -> None:
+        scene = self.scene
+        self.data = data = reset_data(self.scenario, scene, self._data)
+        self.monitor = ContactMonitor(self.model, scene.is_robot_geom, scene.is_obstacle_geom, self.recorder,
+                                      release_s=self.dt_s)
+        # Contacts that are not collisions (wheels and casters on the floor), counted at the
+        # start: a substep with no more contacts than these and no ongoing collision is skipped.
+        self.resting_contacts = data.ncon - self.monitor.robot_obstacle_contacts(data)
+        self.clearance = ClearanceProbe(scene, data)
+        qadr = self.qadr
+        # Views into data, made once: the base's position and quaternion, its velocity, the rangefinders.
+        self._base_qpos = data.qpos[qadr:qadr + 7]
+        self._base_qvel = data.qvel[scene.free_qvel_adr:scene.free_qvel_adr + 6]
+        adr = np.asarray(scene.range_sensor_adr)
+        contiguous = len(adr) > 0 and np.array_equal(adr, np.arange(adr[0], adr[0] + len(adr)))
+        self._range_raw = data.sensordata[adr[0]:adr[0] + len(adr)] if contiguous else None
+        self.sensing = ObstacleSensing(self.scenario, self.obstacle_track_m, self._radii_m, self.dt_s,
+                                       scene.range_angles_rad, scene.range_offset_m)
+        self._shift_at_measure_m = 0.0
+        self._observed_step = -1
+        self.poses = np.zeros((self.n_max + 1, 3))
+        self.wheel_cmd = np.zeros((self.n_max + 1, 2))
+        self.min_clearance_m = math.inf
+        self._clearance_m: float | None = math.inf  # at the last observation; None: not measured (see clearance_m)
+        self._contact_free = True  # the last observation's clearance rules out a contact (none yet: inf, as ever)
+        self.length_m = 0.0
+        self.waypoint_index = 0  # of the last command, recorded with the final step
+        self.in_danger = False
+        self.step_index = 0
+        self.danger_steps = self.stopped_steps = self.replans = self.safety_triggers = 0
+        self.outcome = ""
+        self.result = None
+
+    def _advance(self) -> None:
+        """``mj_step`` k times, checking for a collision after every physics step.
+
+        When the clearance measured at the start of the step exceeds what the
+        robot can travel in one control period (obstacles move only between
+        control steps), no contact can begin, and the k steps run in one call.
+        """
+        model, data, monitor, qpos, qadr = self.model, self.data, self.monitor, self.data.qpos, self.qadr
+        if self._contact_free and not monitor.in_contact:
+            mujoco.mj_step(model, data, self.k)
+            self.step_index += 1
+            return
+        base = self.step_index * self.k
+        for substep in range(self.k):
+            mujoco.mj_step(model, data)
+            if data.ncon > self.resting_contacts or monitor.in_contact:
+                monitor.update(data, (base + substep) * self.physics_dt_s, float(qpos[qadr]), float(qpos[qadr + 1]))
+        self.step_index += 1
+
+    def _sense(self) -> Observation:
+        """Obstacles to the new time, the observation, the outcome; the end of the episode when there is one."""
+        step = self.step_index
+        if len(self.mocap_index):
+            self.data.mocap_pos[self.mocap_index, :2] = self.obstacle_track_m[step]
+        self.observation = observation = self._observe()
+        pose = observation.pose
+        if self.goal.reached(pose):
+            outcome = "goal_reached"
+        elif self.stop_on_collision and self.monitor.collisions:
+            outcome = "collision"
+        elif step >= self.n_max:
+            outcome = "timeout"
+        else:
+            return observation
+        self._stop(observation, outcome)
+        return observation
+
+    def _observe(self) -> Observation:
+        """Pose, twist and ranges now; also tracks the driven length and the clearance.
+
+        The clearance is measured only when it could matter: when
+        :meth:`ClearanceProbe.lower_bound_m` shows it above the minimum so far, the
+        danger distance and the contact-free gap, none of the minimum, the time in
+        danger or the batching of :meth:`_advance` depends on its value (and beyond
+        the probe's horizon the value is the horizon).
+        """
+        data, scene, step = self.data, self.scene, self.step_index
+        x, y, _, w, qx, qy, qz = self._base_qpos.tolist()
+        heading = yaw_from_quaternion(w, qx, qy, qz)
+        if step:
+            last_x, last_y, _ = self.poses[step - 1].tolist()
+            self.length_m += math.hypot(x - last_x, y - last_y)
+        self.poses[step] = (x, y, heading)
+        self._observed_step = step
+        bound_m = self.clearance_bound_m()
+        if bound_m > CLEARANCE_HORIZON_M:
+            gap: float | None = CLEARANCE_HORIZON_M  # what measure() returns beyond its horizon
+        elif bound_m > max(self.min_clearance_m, self.danger_m, self.contact_free_gap_m):
+            gap = None  # not a new minimum, not in danger, no contact possible: the value is not needed
+        else:
+            gap = self.clearance.measure(data, x, y)
+            # The obstacles the probe saw are where the last mj_step put them (the previous step's).
+            self._shift_at_measure_m = self.obstacle_shift_m[max(step - 1, 0)]
+        self._clearance_m = gap
+        if gap is None:
+            self.in_danger = False
+            self._contact_free = True
+        else:
+            if gap < self.min_clearance_m:
+                self.min_clearance_m = gap
+            self.in_danger = gap < self.danger_m
+            self._contact_free = gap > self.contact_free_gap_m
+        v, omega = base_twist(self._base_qvel.tolist(), 0, heading)
+        pose = Pose2D(x, y, heading)
+        raw = self._range_raw if self._range_raw is not None else data.sensordata[scene.range_sensor_adr]
+        ranges = ranges_from_sensors(raw, scene.range_cutoff_m)
+        time_s = step * self.dt_s
+        return Observation(time_s=time_s, pose=pose, twist=Twist(v, omega), ranges_m=ranges,
+                           range_angles_rad=scene.range_angles_rad, range_offset_m=scene.range_offset_m,
+                           range_cutoff_m=scene.range_cutoff_m,
+                           detections=self.sensing.sense(step, time_s, pose, ranges) if self.sense_obstacles else ())
+
+    def _stop(self, observation: Observation, outcome: str) -> None:
+        """End the episode: zero the wheels, record the last step and the outcome, build the result."""
+        self.outcome = outcome
+        self.data.ctrl[:] = 0.0
+        recorder = self.recorder
+        if recorder is not None:
+            recorder.step(self._frame(observation, ControlCommand.stop(self.waypoint_index)))
+            pose = observation.pose
+            recorder.event(observation.time_s, outcome if outcome != "collision" else "stopped_on_collision",
+                           {"x_m": pose.x_m, "y_m": pose.y_m})
+        step, monitor = self.step_index, self.monitor
+        self.result = RunResult(
+            reached=outcome == "goal_reached", outcome=outcome, collisions=monitor.collisions,
+            first_collision_s=monitor.first_collision_s, sim_time_s=step * self.dt_s,
+            wall_time_s=time.perf_counter() - self._wall0,
+            path_length_m=self.length_m, min_clearance_m=float(self.min_clearance_m), steps=step,
+            times_s=self.times_s[:step + 1].copy(), poses=self.poses[:step + 1].copy(),
+            wheel_command_rad_s=self.wheel_cmd[:step + 1].copy(),
+            collision_points_m=np.array(monitor.points, dtype=float).reshape(-1, 2),
+            time_in_danger_s=self.danger_steps * self.dt_s, stopped_s=self.stopped_steps * self.dt_s,
+            replans=self.replans, safety_triggers=self.safety_triggers, reference_length_m=self.reference_length_m)
+        if self._unfinished:
+            self._unfinished = False
+            recorder.finish(self.result.log_summary())
+
+    def _frame(self, observation: Observation, command: ControlCommand, belief: Belief | None = None) -> StepFrame:
+        base_qpos = self._base_qpos.copy()  # one fresh copy; position and quaternion are views of it
+        return StepFrame(
+            time_s=observation.time_s, position_m=base_qpos[:3], quaternion_wxyz=base_qpos[3:],
+            heading_rad=observation.pose.heading_rad, range_m=observation.ranges_m,
+            wheel_command_rad_s=np.array([command.wheels.left_rad_s, command.wheels.right_rad_s]),
+            wheel_measured_rad_s=self.data.qvel[self._wheel_qvel_adr],
+            linear_m_s=command.linear_m_s, angular_rad_s=command.angular_rad_s,
+            waypoint_index=command.waypoint_index, moving_obstacles_m=self.obstacle_track_m[self.step_index].copy(),
+            belief=belief)

@@ -1,0 +1,165 @@
+"""The Ray engine: study cells as Ray tasks on a local instance or a cluster.
+
+Linear like the local driver: a bounded number of batches in flight (a couple per
+CPU of the cluster), ``ray.wait`` over those references only, cells taken from a
+lazy iterator, batches sized from the measured cell time.
+
+On a cluster (``--address``) every node must have the driver's swarmnav (and its
+MuJoCo, NumPy, SciPy and Python) installed: each task answers with the node's
+address and versions, and a node whose versions differ fails the study at once,
+naming the node (its rows are not kept).  Logs (``--logs``) are written by the
+task to a temporary folder on its node and travel back with the row; the driver
+writes them under its own ``--out``, so no log depends on a worker's disk.
+
+Ray's own retries are off (``max_retries=0``): a task whose worker dies (killed,
+a segfault, ``os._exit``) fails once; a batch that failed runs again one cell per
+task, and a single cell whose task fails is an ``error`` row saying so.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import signal
+import socket
+import tempfile
+from collections import deque
+from itertools import islice
+from pathlib import Path as FilePath
+from typing import Any, Iterable, Iterator
+
+from swarmnav.models.errors import ConfigError
+from swarmnav.sim.study.cell import _versions_json, run_cell
+from swarmnav.sim.study.engines import BATCHES_IN_FLIGHT, BatchSizer, Result, died_row, worker_environment
+from swarmnav.sim.study.grid import Cell
+
+RAY_AUTH_LOGGER = "ray._private.authentication.authentication_token_setup"
+TRIES = 1  # Ray's max_retries = 0: one try per task
+
+
+def _drop_token_notice(record: logging.LogRecord) -> bool:
+    """Logging filter: drop Ray's notice that a new local instance enabled token authentication."""
+    return not record.getMessage().startswith("Token authentication is enabled")
+
+
+def check_reachable(address: str, timeout_s: float = 5.0) -> None:
+    """Fail at once, naming ``--address``, when a ``host:port`` (or ``ray://host:port``) cluster address does not
+    answer a TCP connection (Ray itself would retry for minutes); other forms (``auto``) go to Ray as given."""
+    host, sep, port = address.removeprefix("ray://").rpartition(":")
+    if not sep or not port.isdigit():
+        return
+    try:
+        socket.create_connection((host, int(port)), timeout=timeout_s).close()
+    except OSError as exc:
+        raise ConfigError("--address", f"cannot reach {address} ({exc.strerror or exc})") from None
+
+
+def start_ray(address: str | None, workers: int | None) -> None:
+    """Connect to the cluster at ``address``, or start a local instance with ``workers`` CPUs.
+
+    Ray's core worker installs a native handler for SIGTERM that prints a stack trace and dies by the signal;
+    the handler this process had before (the CLI's: exit with one line, the rows kept) is put back."""
+    import ray
+    if ray.is_initialized():
+        return
+    runtime_env = {"env_vars": worker_environment()}
+    previous = signal.getsignal(signal.SIGTERM)
+    if address:
+        check_reachable(address)
+        ray.init(address=address, runtime_env=runtime_env, log_to_driver=False)
+    else:
+        # A new local instance turns token authentication on by default and logs a warning that it did;
+        # the default stays (setting RAY_AUTH_MODE after Ray's import would break its client), the notice goes.
+        logging.getLogger(RAY_AUTH_LOGGER).addFilter(_drop_token_notice)
+        ray.init(num_cpus=workers, runtime_env=runtime_env, include_dashboard=False, log_to_driver=False)
+    if previous is not None:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def run_batch(cells: list[Cell], keep_logs: bool) -> dict[str, Any]:
+    """A task: run the cells in order; return the node, its versions, and each cell's row, progress and log
+    bytes (``None`` without ``--logs`` or in plan-only mode)."""
+    import ray
+    results = []
+    for cell in cells:
+        if keep_logs and cell.physics:
+            with tempfile.TemporaryDirectory(prefix="swarmnav-log-") as folder:
+                row, progress = run_cell(cell, folder)
+                log = FilePath(folder) / f"{cell.config_hash}.mcap"
+                data = log.read_bytes() if log.exists() else None
+        else:
+            (row, progress), data = run_cell(cell), None
+        results.append((row, progress, data))
+    context = ray.get_runtime_context()
+    return {"node": ray.util.get_node_ip_address(), "node_id": context.get_node_id(), "versions": _versions_json(),
+            "results": results}
+
+
+def _check_versions(answer: dict[str, Any], driver: str) -> None:
+    if answer["versions"] == driver:
+        return
+    theirs, ours = json.loads(answer["versions"]), json.loads(driver)
+    differ = ", ".join(f"{k} {theirs.get(k)} (driver {ours.get(k)})" for k in sorted(set(theirs) | set(ours))
+                       if theirs.get(k) != ours.get(k))
+    raise ConfigError("--address", f"node {answer['node']} (id {answer.get('node_id', '?')[:12]}) runs {differ}; install the driver's versions on "
+                                   "every node of the cluster")
+
+
+def _save_log(logs_dir: str, config_hash: str, data: bytes) -> str:
+    final = FilePath(logs_dir) / f"{config_hash}.mcap"
+    final.parent.mkdir(parents=True, exist_ok=True)
+    temporary = final.with_name(f".{final.name}.tmp")
+    temporary.write_bytes(data)
+    os.replace(temporary, final)
+    return str(final)
+
+
+def _failure(exc: Exception) -> str:
+    first = (str(exc).strip().splitlines() or [""])[0][:200]
+    what = f"{type(exc).__name__}: {first}" if first else type(exc).__name__
+    return f"{what}; {TRIES} try, Ray's own retries are off"
+
+
+def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | None = None,
+            logs_dir: str | None = None, nodes: set[str] | None = None) -> Iterator[Result]:
+    """Run the cells as Ray tasks (one CPU each) on a local instance or the cluster at ``address``; the ids of
+    the nodes that ran them are added to ``nodes``."""
+    import ray
+    start_ray(address, workers)
+    task = ray.remote(num_cpus=1, max_retries=0)(run_batch)
+    slots = BATCHES_IN_FLIGHT * max(1, int(ray.cluster_resources().get("CPU", 1)))
+    driver_versions = _versions_json()
+    source, solo, sizer = iter(cells), deque(), BatchSizer()
+    inflight: dict[Any, list[Cell]] = {}
+    try:
+        while True:
+            while len(inflight) < slots:
+                batch = [solo.popleft()] if solo else list(islice(source, sizer.size()))
+                if not batch:
+                    break
+                inflight[task.remote(batch, logs_dir is not None)] = batch
+            if not inflight:
+                break
+            done, _ = ray.wait(list(inflight), num_returns=1)
+            for ref in done:
+                batch = inflight.pop(ref)
+                try:
+                    answer = ray.get(ref)
+                except ray.exceptions.RayError as exc:  # the task's worker or node died
+                    if len(batch) == 1:
+                        yield died_row(batch[0], _failure(exc))
+                    else:
+                        solo.extend(batch)  # again one cell per task: only the cell that fails is an error row
+                    continue
+                _check_versions(answer, driver_versions)
+                if nodes is not None:
+                    nodes.add(answer["node_id"])
+                for row, progress, log in answer["results"]:
+                    if log is not None:
+                        row["log"] = _save_log(logs_dir, row["config_hash"], log)
+                    sizer.observe(row)
+                    yield row, progress
+    finally:
+        for ref in inflight:
+            ray.cancel(ref, force=True)
