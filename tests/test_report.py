@@ -301,3 +301,9 @@ def test_a12_counts_every_pair_with_ties_half():
     x, y = rng.integers(0, 5, 40).astype(float), rng.integers(0, 5, 33).astype(float)
     pairs = [(1.0 if a > b else 0.5 if a == b else 0.0) for a in x for b in y]
     assert a12(x, y) == pytest.approx(np.mean(pairs)) and a12(x, y) + a12(y, x) == pytest.approx(1.0)
+
+
+def test_identical_samples_give_a_rank_sum_p_of_one_and_an_inconclusive_claim(recwarn):
+    [claim] = verdicts([_claim()], _rows("A", [3.0] * 5) + _rows("B", [3.0] * 5))
+    assert claim["pairs"][0]["p"] == 1.0 and claim["verdict"] == INCONCLUSIVE and claim["a12"] == 0.5
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]

@@ -32,7 +32,7 @@ import numpy as np
 from scipy import stats
 
 from swarmnav.sim.study.claim_spec import SUCCESS, Claim
-from swarmnav.sim.study.statistics import holm
+from swarmnav.sim.study.statistics import holm, ranksum_p
 
 ALPHA = 0.05
 REPRODUCES, CONTRADICTED, INCONCLUSIVE = "reproduces", "contradicted", "inconclusive"
@@ -87,8 +87,7 @@ def pair_result(claim: Claim, rows: list[dict[str, Any]], other: str) -> dict[st
             p = float(stats.fisher_exact([[sa, len(mine) - sa], [sb, len(theirs) - sb]]).pvalue)
             pair["successes"] = [sa, sb]
     elif claim.test == "rank_sum":
-        if a.size and b.size:
-            p = float(stats.ranksums(a, b).pvalue)
+        p = ranksum_p(a, b)
     else:  # signed_rank
         pa, pb = _paired(mine, theirs, claim.metric)
         pa, pb = sign * pa, sign * pb

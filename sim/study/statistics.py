@@ -98,6 +98,16 @@ def arm_counts(rows: list[dict[str, Any]]) -> dict[str, Any]:
             "classes": {c: sum(outcome_class(r) == c for r in rows) for c in OUTCOME_CLASSES}}
 
 
+def ranksum_p(a: np.ndarray, b: np.ndarray) -> float:
+    """Two-sided p of the Wilcoxon rank-sum test (``scipy.stats.ranksums``); NaN without values on a side, and
+    1 when every value of both sides is the same (scipy's statistic is then 0 / 0: no difference at all)."""
+    if a.size == 0 or b.size == 0:
+        return float("nan")
+    if np.all(a == a[0]) and np.all(b == a[0]):
+        return 1.0
+    return float(stats.ranksums(a, b).pvalue)
+
+
 def cliffs_delta(a: np.ndarray, b: np.ndarray) -> float:
     """P(a > b) - P(a < b) over all pairs (Cliff 1993)."""
     diff = a[:, None] - b[None, :]
@@ -162,7 +172,7 @@ def compare(arms: dict[str, list[dict[str, Any]]], reference: str, metric: str) 
         if name == reference:
             continue
         other = values(rows, metric)
-        p = float(stats.ranksums(ref, other).pvalue) if ref.size and other.size else float("nan")
+        p = ranksum_p(ref, other)
         delta = cliffs_delta(ref, other) if ref.size and other.size else float("nan")
         a, b = paired(arms[reference], rows, metric)
         if a.size and np.any(a != b):
