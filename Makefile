@@ -56,14 +56,16 @@ studies: $(STAMP)
 		$(BIN)/swarmnav study $$s $(STUDY_RUN) --out studies/$$s && $(BIN)/swarmnav report studies/$$s || exit 1; \
 	done
 
-# The README's claims table: each bundled study with [[claims]] run on its quick seeds into a fresh
+# The README's claims table: each bundled study with [[claims]] run on its quick seeds (`make readme-table
+# CLAIMS_RUN=` in full) into a fresh
 # studies/readme-table/<name>/, its verdicts copied to models/studies/results/<name>/claims.json (committed),
 # and the table between the README's claims-table markers regenerated from them.
 CLAIM_STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin) if s['claims']))")
+CLAIMS_RUN ?= --quick
 readme-table: $(STAMP)
 	for s in $(CLAIM_STUDIES); do \
 		rm -rf studies/readme-table/$$s; \
-		$(BIN)/swarmnav study $$s --quick --out studies/readme-table/$$s && \
+		$(BIN)/swarmnav study $$s $(CLAIMS_RUN) --out studies/readme-table/$$s && \
 		$(BIN)/swarmnav report studies/readme-table/$$s && mkdir -p models/studies/results/$$s && \
 		cp studies/readme-table/$$s/claims.json models/studies/results/$$s/claims.json || exit 1; \
 	done

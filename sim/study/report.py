@@ -80,7 +80,7 @@ class _Document:
         self.images += 1
         stem = f"figure-{self.images:03d}"
         self.files_dir.mkdir(parents=True, exist_ok=True)
-        svg, png = figures.encode(fig, "svg"), figures.encode(fig, "png")
+        svg, png = figures.encode(fig)
         figures.close(fig)
         (self.files_dir / f"{stem}.svg").write_bytes(svg)
         (self.files_dir / f"{stem}.png").write_bytes(png)

@@ -198,7 +198,8 @@ def friedman(arms: dict[str, list[dict[str, Any]]], metric: str) -> dict[str, An
         return {"blocks": len(blocks), "statistic": float("nan"), "p": float("nan"), "kendall_w": float("nan")}
     samples = [np.array([k[b] for b in blocks], dtype=float) for k in keyed]
     try:
-        result = stats.friedmanchisquare(*samples)
+        with np.errstate(invalid="ignore", divide="ignore"):  # every block tied: scipy's 0 / 0 is NaN
+            result = stats.friedmanchisquare(*samples)
         statistic, p = float(result.statistic), float(result.pvalue)
     except ValueError:
         statistic, p = float("nan"), float("nan")
