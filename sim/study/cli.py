@@ -130,6 +130,8 @@ def add_report_arguments(p: argparse.ArgumentParser) -> None:
                    help="print the README's table of claims from these claims.json files (or folders holding them, "
                         "e.g. models/studies/results) instead of a report")
     p.add_argument("--readme", help="with --readme-table: replace the table in this README file instead")
+    p.add_argument("--ompl-log", metavar="OUT", help="also write the rows as OMPL benchmark logs, OUT/<scenario>.log "
+                   "(one experiment each), for `ompl_benchmark_statistics OUT/*.log -d bench.db` and Planner Arena")
 
 
 def _readme_table(args: argparse.Namespace) -> int:
@@ -163,4 +165,9 @@ def run_report(args: argparse.Namespace) -> int:
         print(claims_path.read_text(encoding="utf-8"), end="")
     else:
         print(f"report: {html_path}  markdown: {markdown_path}  claims: {claims_path}")
+    if args.ompl_log:
+        from swarmnav.sim.study.ompl_log import write_ompl_logs
+        logs = write_ompl_logs(directory, args.ompl_log)
+        print(f"OMPL logs: {len(logs)} in {args.ompl_log}  (ompl_benchmark_statistics {args.ompl_log}/*.log -d bench.db)",
+              file=sys.stderr if args.json else sys.stdout)
     return 0
