@@ -14,7 +14,7 @@ export MUJOCO_GL ?= egl
 
 STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin)))")
 
-.PHONY: demo test bench install clean studies
+.PHONY: demo test bench install clean studies readme-table
 
 $(STAMP): pyproject.toml planners/_colony_walk.c planners/_grid_search.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -55,6 +55,21 @@ studies: $(STAMP)
 	for s in $(STUDIES); do \
 		$(BIN)/swarmnav study $$s $(STUDY_RUN) --out studies/$$s && $(BIN)/swarmnav report studies/$$s || exit 1; \
 	done
+
+# The README's claims table: each bundled study with [[claims]] run on its quick seeds (`make readme-table
+# CLAIMS_RUN=` in full) into a fresh
+# studies/readme-table/<name>/, its verdicts copied to models/studies/results/<name>/claims.json (committed),
+# and the table between the README's claims-table markers regenerated from them.
+CLAIM_STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin) if s['claims']))")
+CLAIMS_RUN ?= --quick
+readme-table: $(STAMP)
+	for s in $(CLAIM_STUDIES); do \
+		rm -rf studies/readme-table/$$s; \
+		$(BIN)/swarmnav study $$s $(CLAIMS_RUN) --out studies/readme-table/$$s && \
+		$(BIN)/swarmnav report studies/readme-table/$$s && mkdir -p models/studies/results/$$s && \
+		cp studies/readme-table/$$s/claims.json models/studies/results/$$s/claims.json || exit 1; \
+	done
+	$(BIN)/swarmnav report --readme-table models/studies/results --readme README.md
 
 clean:
 	rm -rf $(VENV) build *.egg-info

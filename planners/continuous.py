@@ -302,6 +302,7 @@ class ContinuousPlanner(SwarmPlanner):
         for attempt in range(settings.growth + 1):
             budget = None if not self.max_evaluations else self.max_evaluations - spent
             state = self.state_type(max_evaluations=budget, settings=settings)
+            search_started_s = time.perf_counter() - t0
             try:
                 path = self.run_search(problem, rng, state)
                 break
@@ -323,6 +324,7 @@ class ContinuousPlanner(SwarmPlanner):
                                    # The last search's histories (a failed search raised, and its best costs
                                    # had fewer via-points); its evaluation counts start after the failed ones'.
                                    evaluation_history=tuple(spent + e for e in path.stats.evaluation_history),
+                                   time_history=tuple(search_started_s + t for t in path.stats.time_history),
                                    extra=extra)
 
     def objective(self, problem: Problem, via_points: int | None = None,

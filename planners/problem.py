@@ -158,7 +158,10 @@ class PlanStats:
     (what ``evaluations`` counts for that planner) spent by then, cumulatively.  Its
     last entry is the end of the search: evaluations spent after it (the swarm loop's
     repair rounds, the continuous robust mode's final polish) are
-    ``evaluations - evaluation_history[-1]``.
+    ``evaluations - evaluation_history[-1]``.  ``time_history`` (same length, or empty
+    for a planner that does not record it) holds the wall seconds since the plan
+    started at each entry: the anytime curves against time (never compared for
+    determinism).
     """
 
     length_m: float
@@ -167,6 +170,7 @@ class PlanStats:
     evaluations: int = 0
     cost_history: tuple[float, ...] = ()
     evaluation_history: tuple[int, ...] = ()
+    time_history: tuple[float, ...] = ()
     extra: dict[str, Any] = field(default_factory=dict)
 
 

@@ -204,6 +204,7 @@ class SwarmPlanner:
         self.init_state(state, problem, rng)
         history = [state.best_cost]
         spent = [state.evaluations]  # cumulative evaluations at each entry of ``history``
+        elapsed = [time.perf_counter() - t0]  # wall seconds at each entry of ``history``
         done = 0
         converged_at = 0
         limit = self.iteration_limit(problem)
@@ -219,6 +220,7 @@ class SwarmPlanner:
                 converged_at = iteration + 1
             history.append(state.best_cost)
             spent.append(state.evaluations)
+            elapsed.append(time.perf_counter() - t0)
             done = iteration + 1
         repairs = 0
         while repairs < self.repair_limit(state) and not state.exhausted and self.needs_repair(state, problem):
@@ -240,4 +242,5 @@ class SwarmPlanner:
         return Path.from_waypoints(waypoints, time.perf_counter() - t0, iterations=done,
                                    evaluations=state.evaluations,
                                    cost_history=tuple(float(c) for c in history),
-                                   evaluation_history=tuple(int(e) for e in spent), extra=extra)
+                                   evaluation_history=tuple(int(e) for e in spent),
+                                   time_history=tuple(elapsed), extra=extra)

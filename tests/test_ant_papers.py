@@ -197,12 +197,12 @@ def test_claims_name_the_studys_arms_scenarios_and_columns(name):
     labels = {cell.label for cell in expand(study)}
     scenarios = {Path(s).stem for s in study.scenarios}
     columns = set(RUN_SCHEMA.names) | {"success"}
-    ids = [c["id"] for c in study.claims]
+    ids = [c.id for c in study.claims]
     assert len(ids) == len(set(ids))
     for claim in study.claims:
-        assert claim["planner"] in labels and set(claim["than"]) <= labels, claim["id"]
-        assert claim["scenario"] in scenarios and claim["metric"] in columns, claim["id"]
-        assert claim["better"] in ("lower", "higher") and claim["test"] in ("rank_sum", "signed_rank", "fisher")
+        assert claim.planner in labels and set(claim.than) <= labels, claim.id
+        assert claim.scenario in scenarios and claim.metric in columns, claim.id
+        assert claim.better in ("lower", "higher") and claim.test in ("rank_sum", "signed_rank", "fisher")
 
 
 def test_the_ant_papers_studies_hold_at_least_seven_claims():

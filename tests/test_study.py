@@ -123,7 +123,8 @@ def test_a_raising_planner_and_a_run_past_the_wall_limit_are_rows(tmp_path, caps
     assert not rows.success.any()
     assert main(["report", str(tmp_path / "out")]) == 0  # a report of failures only still counts them
     report = (tmp_path / "out" / "report.md").read_text()
-    assert "| gwo | 1 | 1 | error 1 | 0 |" in report and "| gwo | 1 | 1 | timeout 1 | 0 |" in report
+    # runs, success, collision, timeout, no path, error, success %
+    assert "| gwo | 1 | 0 | 0 | 0 | 0 | 1 | 0 |" in report and "| gwo | 1 | 0 | 0 | 1 | 0 | 0 | 0 |" in report
 
 
 def _markdown_table(text: str, first_header: str) -> list[list[str]]:
@@ -169,44 +170,49 @@ def test_report_tables_and_wilcoxon_agree_with_the_rows(tiny, tmp_path):
     html = tmp_path / "r.html"
     assert main(["report", str(out), "--out", str(html)]) == 0
     text = (tmp_path / "r.md").read_text()
-    assert "data:image/png;base64," in html.read_text() and "src='http" not in html.read_text()
+    assert "data:image/svg+xml;base64," in html.read_text() and "src='http" not in html.read_text()
     rows = pd.read_parquet(out / "runs.parquet")
-    metric_table = _markdown_table(text, "planner | metric")
     checked = 0
     for scenario, group in rows.groupby("scenario"):
         section = text.split(f"## Scenario {scenario}")[1].split("## Scenario")[0]
-        counts = {r[0]: r for r in _markdown_table(section, "planner | runs | failed")}
+        counts = {r[0]: r for r in _markdown_table(section, "planner | runs | success")}
+        means = _markdown_table(section, "planner | n | plan length (m)")
+        mean_header = next(line for line in section.splitlines() if line.startswith("| planner | n | plan length"))
+        columns = [c.strip() for c in mean_header.strip("|").split(" | ")]
+        mean_rows, median_rows = ({r[0]: dict(zip(columns, r)) for r in means[:2]},
+                                  {r[0]: dict(zip(columns, r)) for r in means[2:4]})
         for label, runs in group.groupby("label"):
             assert int(counts[label][1]) == len(runs)
-            assert int(counts[label][2]) == int((runs.outcome != "ok").sum())
-            assert float(counts[label][4]) == pytest.approx(100 * runs.success.mean(), abs=0.05)
+            assert int(counts[label][2]) == int(runs.success.sum())
+            assert float(counts[label][-1]) == pytest.approx(100 * runs.success.mean(), abs=0.05)
             lengths = runs.loc[runs.outcome == "ok", "plan_length_m"].to_numpy()
-            table = [r for r in _markdown_table(section, "planner | metric")
-                     if r[0] == label and r[1] == "plan_length_m"][0]
-            assert int(table[2]) == lengths.size
-            assert float(table[3]) == pytest.approx(lengths.mean(), rel=1e-4)
-            assert float(table[5]) == pytest.approx(np.median(lengths), rel=1e-4)
-            assert float(table[6]) == pytest.approx(lengths.min(), rel=1e-4)
+            assert int(mean_rows[label]["n"]) == lengths.size
+            mean, _, std = mean_rows[label]["plan length (m)"].partition(" ± ")
+            assert float(mean) == pytest.approx(lengths.mean(), rel=1e-3)
+            if np.ptp(lengths) > 1e-9:
+                assert float(std) == pytest.approx(lengths.std(ddof=1), rel=1e-3)
+            assert float(median_rows[label]["plan length (m)"]) == pytest.approx(np.median(lengths), rel=1e-3)
             checked += 1
         ok = group[group.outcome == "ok"]
         tests = {r[1]: r for r in _markdown_table(section, "against | metric")}
-        for metric in ("plan_length_m", "plan_time_s", "path_length_m", "min_clearance_m"):
+        for metric, header in (("plan_length_m", "plan length (m)"), ("plan_time_s", "plan time (s)"),
+                               ("path_length_m", "driven length (m)"), ("min_clearance_m", "min clearance (m)")):
             p = stats.ranksums(ok[ok.label == "astar"][metric], ok[ok.label == "gwo"][metric]).pvalue
-            assert tests[metric][0] == "gwo" and float(tests[metric][4]) == pytest.approx(p, rel=1e-3), metric
+            assert tests[header][0] == "gwo" and float(tests[header][4]) == pytest.approx(p, rel=0.06), metric
         success = _markdown_table(section, "against | ref successes")[0]
         counts_of = [(int(g.success.sum()), len(g)) for g in (group[group.label == "astar"], group[group.label == "gwo"])]
         assert success[1:3] == [f"{s}/{n}" for s, n in counts_of]
         (a_s, a_n), (g_s, g_n) = counts_of
         assert float(success[3]) == pytest.approx(stats.fisher_exact([[a_s, a_n - a_s], [g_s, g_n - g_s]]).pvalue,
-                                                  rel=1e-3)
+                                                  rel=0.06)
         header = next(line for line in section.splitlines() if line.startswith("| planner | runs | successes"))
         columns = [c.strip() for c in header.strip("|").split(" | ")]
         paper = {r[0]: dict(zip(columns, r)) for r in _markdown_table(section, "planner | runs | successes")}
         for label, runs in group.groupby("label"):
             lengths = runs.loc[runs.outcome == "ok", "plan_length_m"].to_numpy()
-            assert float(paper[label]["optimal length"]) == pytest.approx(lengths.min(), rel=1e-4)
-            assert float(paper[label]["mean - optimal"]) == pytest.approx(lengths.mean() - lengths.min(), abs=1e-4)
-    assert checked == 4 and metric_table
+            assert float(paper[label]["best length (m)"]) == pytest.approx(lengths.min(), rel=1e-3)
+            assert float(paper[label]["mean - best (m)"]) == pytest.approx(lengths.mean() - lengths.min(), abs=1e-3)
+    assert checked == 4
 
 
 BAD_STUDIES = {
@@ -449,8 +455,8 @@ def test_a_planner_without_an_evaluation_history_gets_an_even_spread_marked_esti
 
 
 def test_the_convergence_curve_by_evaluations_is_the_recorded_step_function():
-    from swarmnav.sim.study.figures import _on_evaluation_grid
-    run = [(0, 9.0, 20, False), (1, 7.0, 61, False), (2, 7.0, 101, False), (3, 4.0, 150, False)]
-    costs = _on_evaluation_grid(run, np.array([0, 19, 20, 60, 61, 149, 150, 400]))
+    from swarmnav.sim.study.anytime import on_grid
+    costs = on_grid(np.array([20, 61, 101, 150]), np.array([9.0, 7.0, 7.0, 4.0]),
+                    np.array([0, 19, 20, 60, 61, 149, 150, 400]))
     assert np.isnan(costs[:2]).all()  # nothing was scored before the first population
     assert costs[2:].tolist() == [9.0, 9.0, 7.0, 7.0, 4.0, 4.0]

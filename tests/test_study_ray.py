@@ -15,7 +15,7 @@ import pytest
 
 from swarmnav.sim.study.ray_engine import RAY_AUTH_LOGGER, start_ray
 from swarmnav.sim.study.execute import run_study
-from swarmnav.sim.study.rows import TIMING_COLUMNS
+from swarmnav.sim.study.rows import PROGRESS_TIMING_COLUMNS, TIMING_COLUMNS
 from swarmnav.sim.study.spec import parse_study
 
 ray = pytest.importorskip("ray", reason="the ray extra is not installed (pip install 'swarmnav[ray]')")
@@ -79,8 +79,8 @@ def test_ray_rows_equal_local_rows(ray_start_log, tmp_path):
     frames = [pd.read_parquet(tmp_path / d / "runs.parquet").drop(columns=list(TIMING_COLUMNS))
               .sort_values("config_hash").reset_index(drop=True) for d in ("local", "ray")]
     pd.testing.assert_frame_equal(frames[0], frames[1])
-    progress = [pd.read_parquet(tmp_path / d / "progress.parquet").sort_values(["config_hash", "iteration"])
-                .reset_index(drop=True) for d in ("local", "ray")]
+    progress = [pd.read_parquet(tmp_path / d / "progress.parquet").drop(columns=list(PROGRESS_TIMING_COLUMNS))
+                .sort_values(["config_hash", "iteration"]).reset_index(drop=True) for d in ("local", "ray")]
     pd.testing.assert_frame_equal(progress[0], progress[1])
 
 

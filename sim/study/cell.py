@@ -198,7 +198,9 @@ def _add_metrics(row: dict[str, Any], episode) -> None:
 def _progress_rows(cell: Cell, episode) -> list[dict[str, Any]]:
     """Best cost per iteration with the evaluations spent by then, as the planner recorded them
     (``stats.evaluation_history``).  A planner that records a best-cost history but no evaluation
-    history gets its total spread evenly over its iterations, and ``evaluations_estimated`` says so."""
+    history gets its total spread evenly over its iterations, and ``evaluations_estimated`` says so.
+    ``wall_s`` is the planner's own ``stats.time_history`` (seconds since the plan started), null where it
+    records none."""
     stats = episode.path.stats
     history = stats.cost_history
     if not history:
@@ -209,9 +211,11 @@ def _progress_rows(cell: Cell, episode) -> list[dict[str, Any]]:
     else:
         steps = max(len(history) - 1, 1)
         evaluations = [int(round(stats.evaluations * i / steps)) for i in range(len(history))]
+    times = ([float(t) for t in stats.time_history] if len(stats.time_history) == len(history)
+             else [None] * len(history))
     return [{"config_hash": cell.config_hash, "iteration": i, "best_cost": float(cost),
-             "evaluations": spent, "evaluations_estimated": not recorded}
-            for i, (cost, spent) in enumerate(zip(history, evaluations))]
+             "evaluations": spent, "evaluations_estimated": not recorded, "wall_s": wall_s}
+            for i, (cost, spent, wall_s) in enumerate(zip(history, evaluations, times))]
 
 
 def _success(row: dict[str, Any]) -> bool:

@@ -123,7 +123,8 @@ def run_studies(args: argparse.Namespace) -> int:
         study = load_study(name)
         rows.append({"name": name, "mode": study.mode, "cells": count_cells(study),
                      "scenarios": [FilePath(s).stem for s in study.scenarios],
-                     "planners": [p.label for p in study.planners], "description": study.description})
+                     "planners": [p.label for p in study.planners], "claims": len(study.claims),
+                     "description": study.description})
     if args.json:
         print(json.dumps(rows))
     else:
@@ -133,23 +134,52 @@ def run_studies(args: argparse.Namespace) -> int:
 
 
 def add_report_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("dir", help="a study's output directory (holding runs.parquet)")
-    p.add_argument("--out", help="HTML report path (default: DIR/report.html); the Markdown twin goes beside it")
+    p.add_argument("dir", nargs="?", help="a study's output directory (holding runs.parquet)")
+    p.add_argument("--out", help="HTML report path (default: DIR/report.html); the Markdown twin and claims.json "
+                                 "go beside it")
+    p.add_argument("--json", action="store_true", help="print the claims' verdicts (claims.json) instead")
+    p.add_argument("--readme-table", nargs="+", metavar="PATH",
+                   help="print the README's table of claims from these claims.json files (or folders holding them, "
+                        "e.g. models/studies/results) instead of a report")
+    p.add_argument("--readme", help="with --readme-table: replace the table in this README file instead")
     p.add_argument("--ompl-log", metavar="OUT", help="also write the rows as OMPL benchmark logs, OUT/<scenario>.log "
                    "(one experiment each), for `ompl_benchmark_statistics OUT/*.log -d bench.db` and Planner Arena")
 
 
+def _readme_table(args: argparse.Namespace) -> int:
+    from swarmnav.sim.study.readme_table import block, read_documents, replace_block
+    text = block(read_documents(args.readme_table))
+    if args.readme:
+        path = FilePath(args.readme)
+        path.write_text(replace_block(path.read_text(encoding="utf-8"), text, str(path)), encoding="utf-8")
+        print(f"claims table: {path}")
+    else:
+        print(text)
+    return 0
+
+
 def run_report(args: argparse.Namespace) -> int:
     from swarmnav.models.errors import ConfigError
+    if args.readme_table:
+        return _readme_table(args)
+    if args.readme:
+        raise ConfigError("--readme", "needs --readme-table")
+    if args.dir is None:
+        raise ConfigError("dir", "is required (a study's output directory), unless --readme-table")
     from swarmnav.sim.study.report import write_report
     directory = FilePath(args.dir)
     if not (directory / "runs.parquet").is_dir():
         raise ConfigError("dir", "holds no runs.parquet (run `swarmnav study` first)", str(directory))
     html_path = FilePath(args.out) if args.out else directory / "report.html"
     markdown_path = write_report(directory, html_path)
-    print(f"report: {html_path}  markdown: {markdown_path}")
+    claims_path = html_path.parent / "claims.json"
+    if args.json:
+        print(claims_path.read_text(encoding="utf-8"), end="")
+    else:
+        print(f"report: {html_path}  markdown: {markdown_path}  claims: {claims_path}")
     if args.ompl_log:
         from swarmnav.sim.study.ompl_log import write_ompl_logs
         logs = write_ompl_logs(directory, args.ompl_log)
-        print(f"OMPL logs: {len(logs)} in {args.ompl_log}  (ompl_benchmark_statistics {args.ompl_log}/*.log -d bench.db)")
+        print(f"OMPL logs: {len(logs)} in {args.ompl_log}  (ompl_benchmark_statistics {args.ompl_log}/*.log -d bench.db)",
+              file=sys.stderr if args.json else sys.stdout)
     return 0

@@ -41,13 +41,22 @@ def scenario_geometry(ref: str, world_seed: int | None = None) -> dict[str, Any]
             "boxes": [[b.x_min_m, b.y_min_m, b.x_max_m, b.y_max_m] for b in scenario.boxes]}
 
 
+def _scenario_entry(ref: str, world_seed: int | None, study: Study) -> dict[str, Any]:
+    """The geometry of one scenario and what the report's anytime and path figures need of it."""
+    from swarmnav.sim.study.scenario_facts import scenario_facts
+    scenario = load_scenario(ref)
+    if world_seed is not None:
+        scenario = scenario.with_world_seed(world_seed)
+    return {**scenario_geometry(ref, world_seed), **scenario_facts(scenario, study.clearance_m, study.time_limit_s)}
+
+
 def study_metadata(study: Study) -> dict[str, Any]:
     world_seed = study.world_seeds[0]
-    return {"name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
+    return {"claims": [c.as_dict() for c in study.claims],"name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
             "reference": study.reference, "planners": [p.label for p in study.planners],
             "navigators": [n.label for n in study.navigators],
             "paper": [dataclasses.asdict(p) for p in study.paper],
-            "scenarios": {FilePath(s).stem: scenario_geometry(s, world_seed) for s in study.scenarios}}
+            "scenarios": {FilePath(s).stem: _scenario_entry(s, world_seed, study) for s in study.scenarios}}
 
 
 def _write_metadata(study: Study, out_dir: FilePath) -> None:

@@ -1,10 +1,12 @@
-"""``swarmnav report DIR``: a self-contained HTML report of a study's rows, and its Markdown twin.
+"""``swarmnav report DIR``: a self-contained HTML report of a study's rows, its Markdown twin, and the verdicts
+on the study's claims as ``claims.json``.
 
-It reads only ``DIR/runs.parquet``, ``DIR/progress.parquet`` and ``DIR/study.json``
-(the reference planner, the paper's values, and each scenario's arena and obstacles
-at t = 0 as recorded when the study ran), so a copied results folder reports alike.  The HTML embeds its
-images (base64 PNG); the Markdown links the same PNGs, written to
-``<report>_files/`` beside it.
+It reads only ``DIR/runs.parquet``, ``DIR/progress.parquet`` and ``DIR/study.json`` (the reference planner,
+the paper's values and claims, each scenario's arena and obstacles at t = 0, its moving obstacles' tracks and
+exact optimum, as recorded when the study ran), and the MCAP logs of physics runs kept with ``--logs`` (the
+driven trajectories), so a copied results folder reports alike.  The HTML embeds its figures as SVG (scaled
+to the page's width); ``<report>_files/`` beside it holds each figure as SVG and PNG, and each table as CSV
+and as a LaTeX ``booktabs`` table (``tables.tex`` inputs them all into one document).
 """
 
 from __future__ import annotations
@@ -12,43 +14,46 @@ from __future__ import annotations
 import base64
 import html
 import json
-import math
 import re
 from pathlib import Path as FilePath
 from typing import Any
 
-from swarmnav.sim.study import figures
-from swarmnav.sim.study.rows import load_progress, load_runs
-from swarmnav.sim.study.statistics import (arm_counts, by_scenario, compare, compare_success, friedman, impossible,
-                                           paper_table, summarise, values)
+from swarmnav.sim.study import anytime, figures
+from swarmnav.sim.study.claim_spec import Claim
+from swarmnav.sim.study.claims import claims_document
+from swarmnav.sim.study.report_tables import (claims_table, count_table, merge_identical, paper_values_table,
+                                              statistics_section, summary_tables)
+from swarmnav.sim.study.rows import load_progress_rows, load_runs
+from swarmnav.sim.study.statistics import by_scenario, paper_table
+from swarmnav.sim.study.tables import Table
 
-PLAN_METRICS = ["plan_length_m", "plan_time_s", "plan_iterations", "plan_convergence_iteration", "plan_bends",
-                "plan_evaluations", "plan_raw_length_m", "plan_gates_raised", "plan_tunnels_closed", "plan_arc_cost"]
-RUN_METRICS = ["path_length_m", "sim_time_s", "min_clearance_m", "collisions"]
-# The metrics tested between planners, each where the runs have it (seed 003 Table 4 tests path lengths).
-TEST_METRICS = ["plan_length_m", "plan_time_s", "path_length_m", "sim_time_s", "min_clearance_m"]
+CLAIMS_FILE = "claims.json"
+STYLE = ("body{font-family:sans-serif;max-width:1200px;margin:auto;padding:0 12px}"
+         "img{max-width:100%;height:auto;display:block}figure{margin:12px 0}"
+         ".table{overflow-x:auto;max-width:100%}table{border-collapse:collapse;margin:8px 0}"
+         "td,th{border:1px solid #bbb;padding:3px 5px;font-size:13px;text-align:right;white-space:nowrap}th{white-space:normal}"
+         "th{background:#eee}td:first-child,th:first-child{text-align:left}"
+         "td.t{text-align:left;white-space:normal;min-width:8em}")
 
 
-def _fmt(x: Any, digits: int = 4) -> str:
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "–"
-    if isinstance(x, float):
-        return f"{x:.{digits}g}" if abs(x) < 1e-3 and x != 0 else f"{x:.{digits}f}".rstrip("0").rstrip(".")
-    return str(x)
+def load_rows(directory: FilePath) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """The run rows (only the columns a report reads; each cell once) and the progress rows of a results folder,
+    as dicts."""
+    return load_runs(directory), load_progress_rows(directory)
 
 
 class _Document:
-    """Builds the HTML and the Markdown side by side."""
+    """Builds the HTML and the Markdown side by side; writes figures and tables into ``files_dir``."""
 
     def __init__(self, title: str, files_dir: FilePath):
-        self.html = [f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
-                     "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}"
-                     "table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 6px;"
-                     "font-size:13px;text-align:right}th{background:#eee}td:first-child{text-align:left}"
-                     ".flag{color:#b00}</style></head><body>", f"<h1>{html.escape(title)}</h1>"]
+        self.html = [f"<!doctype html><html><head><meta charset='utf-8'>"
+                     "<meta name='viewport' content='width=device-width, initial-scale=1'>"
+                     f"<title>{html.escape(title)}</title><style>{STYLE}</style></head><body>",
+                     f"<h1>{html.escape(title)}</h1>"]
         self.markdown = [f"# {title}", ""]
         self.files_dir = files_dir
         self.images = 0
+        self.tables: list[str] = []
 
     def heading(self, text: str, level: int = 2) -> None:
         self.html.append(f"<h{level}>{html.escape(text)}</h{level}>")
@@ -58,52 +63,44 @@ class _Document:
         self.html.append(f"<p>{html.escape(text)}</p>")
         self.markdown += [text, ""]
 
-    def table(self, header: list[str], rows: list[list[str]]) -> None:
-        self.html.append("<table><tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in header) + "</tr>"
-                         + "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in rows)
-                         + "</table>")
-        self.markdown += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-        self.markdown += ["| " + " | ".join(c.replace("|", "\\|") for c in r) + " |" for r in rows]
-        self.markdown.append("")
+    def table(self, table: Table) -> None:
+        self.html.append(table.html())
+        self.markdown += table.markdown()
+        folder = self.files_dir / "tables"
+        folder.mkdir(parents=True, exist_ok=True)
+        name = re.sub(r"[^A-Za-z0-9._-]+", "-", table.name)
+        while name in self.tables:
+            name += "-2"
+        self.tables.append(name)
+        (folder / f"{name}.csv").write_text(table.csv(), encoding="utf-8")
+        (folder / f"{name}.tex").write_text(table.latex(), encoding="utf-8")
 
-    def image(self, png: bytes | None, caption: str) -> None:
-        if png is None:
+    def figure(self, fig, caption: str) -> None:
+        if fig is None:
             return
         self.images += 1
-        name = f"figure-{self.images:03d}.png"
+        stem = f"figure-{self.images:03d}"
         self.files_dir.mkdir(parents=True, exist_ok=True)
-        (self.files_dir / name).write_bytes(png)
-        self.html.append(f"<figure><img src='data:image/png;base64,{base64.b64encode(png).decode()}'>"
-                         f"<figcaption>{html.escape(caption)}</figcaption></figure>")
-        self.markdown += [f"![{caption}]({self.files_dir.name}/{name})", ""]
+        svg, png = figures.encode(fig)
+        figures.close(fig)
+        (self.files_dir / f"{stem}.svg").write_bytes(svg)
+        (self.files_dir / f"{stem}.png").write_bytes(png)
+        self.html.append(f"<figure><img src='data:image/svg+xml;base64,{base64.b64encode(svg).decode()}' "
+                         f"alt='{html.escape(caption)}' style='max-width:100%;height:auto'>"
+                         f"<figcaption>{html.escape(caption)} (<a href='{self.files_dir.name}/{stem}.svg'>SVG</a>, "
+                         f"<a href='{self.files_dir.name}/{stem}.png'>PNG</a>)</figcaption></figure>")
+        self.markdown += [f"![{caption}]({self.files_dir.name}/{stem}.png)", ""]
 
-
-def count_rows(arms: dict[str, list[dict[str, Any]]]) -> tuple[list[str], list[list[str]]]:
-    """Runs, failures by outcome and success rate per arm."""
-    header = ["planner", "runs", "failed", "outcomes", "success %"]
-    rows = []
-    for name, arm_rows in arms.items():
-        c = arm_counts(arm_rows)
-        rows.append([name, str(c["runs"]), str(c["failed"]),
-                     ", ".join(f"{k} {v}" for k, v in sorted(c["outcomes"].items())),
-                     _fmt(100 * c["success_rate"], 1)])
-    return header, rows
-
-
-def metric_rows(arms: dict[str, list[dict[str, Any]]], metrics: list[str]) -> tuple[list[str], list[list[str]]]:
-    """Mean, sample std, median and best of each metric per arm, over the runs that produced it."""
-    header = ["planner", "metric", "n", "mean", "std", "median", "best"]
-    rows = []
-    for metric in metrics:
-        for name, arm_rows in arms.items():
-            s = summarise(arm_rows, metric)
-            if s is not None:
-                rows.append([name, metric, str(s.n), _fmt(s.mean), _fmt(s.std), _fmt(s.median), _fmt(s.best)])
-    return header, rows
-
-
-def _present(rows: list[dict[str, Any]], metrics: list[str]) -> list[str]:
-    return [m for m in metrics if any(r.get(m) is not None for r in rows)]
+    def finish(self, html_path: FilePath, markdown_path: FilePath) -> None:
+        self.html.append("</body></html>")
+        html_path.write_text("\n".join(self.html), encoding="utf-8")
+        markdown_path.write_text("\n".join(self.markdown) + "\n", encoding="utf-8")
+        if self.tables:
+            inputs = "\n".join(rf"\input{{tables/{name}.tex}}" for name in self.tables)
+            (self.files_dir / "tables.tex").write_text(
+                "\\documentclass{article}\n\\usepackage[utf8]{inputenc}\n\\usepackage{booktabs}\n"
+                "\\usepackage[landscape,margin=1.5cm]{geometry}\n\\begin{document}\n" + inputs
+                + "\n\\end{document}\n", encoding="utf-8")
 
 
 def _natural(text: str) -> tuple:
@@ -132,98 +129,103 @@ def ordered_runs(runs: list[dict[str, Any]], meta: dict[str, Any]) -> list[dict[
     return sorted(runs, key=key)
 
 
+def _driven(arms: dict[str, list[dict[str, Any]]]) -> tuple[dict[str, tuple], str]:
+    """The driven trajectory and collision points of each arm's path-figure run, read from its MCAP log
+    (kept by ``swarmnav study --logs``); and a sentence saying where there were none."""
+    from swarmnav.sim.log_reader import read_log
+    from swarmnav.sim.plot import collision_points_m
+    out, missing = {}, []
+    for name, rows in arms.items():
+        ok = sorted((r for r in rows if r.get("plan_waypoints")), key=lambda r: (r["seed"], str(r["world_seed"])))
+        if not ok or ok[0].get("mode") != "physics":
+            continue
+        log = ok[0].get("log")
+        if not log or not FilePath(log).is_file():
+            missing.append(name)
+            continue
+        run_log = read_log(log, allow_truncated=True)
+        out[name] = (run_log.position_m[:, :2], collision_points_m(run_log))
+    sentence = "" if not missing else (f"No driven trajectory for {', '.join(missing)}: the rows carry none and "
+                                       "no log was kept (run the study with --logs to draw them).")
+    return out, sentence
+
+
 def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePath:
-    """Write the HTML report and its Markdown twin (``.md`` beside it); return the Markdown path."""
+    """Write the HTML report, its Markdown twin (``.md`` beside it) and ``claims.json`` beside them; return
+    the Markdown path."""
     directory, html_path = FilePath(directory), FilePath(html_path)
-    runs = load_runs(directory)  # only the columns a report reads; each cell once
-    progress = load_progress(directory)
+    runs, progress = load_rows(directory)
+    history = anytime.histories(progress)
     meta_path = directory / "study.json"
     meta = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
     runs = ordered_runs(runs, meta)
     title = f"Study {meta.get('name', directory.name)}"
     markdown_path = html_path.with_suffix(".md")
+    html_path.parent.mkdir(parents=True, exist_ok=True)
     doc = _Document(title, html_path.parent / f"{html_path.stem}_files")
     if meta.get("description"):
         doc.paragraph(meta["description"])
     failed = sum(r["outcome"] != "ok" for r in runs)
     doc.paragraph(f"{len(runs)} runs, {failed} failed (no path, error or wall-limit timeout; counted, never "
                   f"dropped). Mode: {meta.get('mode', '?')}. Statistics compare each planner against the "
-                  f"reference planner {meta.get('reference', '?')!r}.")
+                  f"reference planner {meta.get('reference', '?')!r}. Numbers to 4 significant digits, "
+                  "p-values to 2.")
+    claims = [Claim.from_dict(c) for c in meta.get("claims", [])]
+    document = claims_document(meta.get("name", directory.name), claims, runs)
+    (html_path.parent / CLAIMS_FILE).write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
+    if claims:
+        doc.heading("Claims")
+        doc.paragraph("Each claim of the paper the study tests, with its verdict: reproduces (every pair "
+                      "significant in the claimed direction), contradicted (a pair significant in the opposite "
+                      "direction) or inconclusive; Holm-adjusted over all pairs of all claims, alpha 0.05. A12: "
+                      "Vargha-Delaney effect size, the probability that the claimed planner's run is better "
+                      "(0.5: no effect), of the weakest pair. n: runs tested / runs per side.")
+        doc.table(claims_table(document))
     for scenario, arms in by_scenario(runs).items():
         scenario_rows = [r for rows in arms.values() for r in rows]
+        arms, identical = merge_identical(arms)
         doc.heading(f"Scenario {scenario}")
-        metrics = _present(scenario_rows, PLAN_METRICS + RUN_METRICS)
-        doc.table(*count_rows(arms))
+        for sentence in identical:
+            doc.paragraph(sentence)
+        doc.table(count_table(scenario, arms))
         header, table = paper_table(arms)
         doc.paragraph("One row per planner in the shape of Gong et al. (2022) Table 3, over the completed runs "
-                      "(std: sample; their 'standard deviation' column equals mean - optimal in every row, "
-                      "so that is given too). Bends: heading changes between consecutive waypoints, as the paper "
-                      "counts them on grid paths; a continuous planner's path is its spline sampled densely, so "
-                      "there every sample counts and the figure says little.")
-        doc.table(header, [[_fmt(v) for v in line] for line in table])
-        doc.table(*metric_rows(arms, metrics))
+                      "(best length: each planner's shortest plan, the paper's 'optimal length'; std: sample; "
+                      "their 'standard deviation' column equals mean - best in every row, so that is given too). "
+                      "Bends: heading changes between consecutive waypoints, as the paper counts them on grid "
+                      "paths; a continuous planner's path is its spline sampled densely, so there every sample "
+                      "counts and the figure says little.")
+        doc.table(Table(f"{scenario}-paper-table", f"{scenario}: one row per planner (Gong et al. 2022 Table 3)",
+                        header, table))
+        for summary in summary_tables(scenario, arms):
+            doc.table(summary)
         errors = sorted({r["error"] for r in scenario_rows if r.get("error")})
         if errors:
             doc.paragraph("Failures: " + "; ".join(errors[:5]) + (" …" if len(errors) > 5 else ""))
-        _statistics(doc, arms, meta.get("reference"))
-        _paper_values(doc, scenario, arms, scenario_rows, meta.get("paper", []))
-        doc.image(figures.box_plots(arms, _present(scenario_rows, ["plan_length_m", "plan_time_s", "path_length_m",
-                                                                   "sim_time_s", "min_clearance_m"])),
-                  f"{scenario}: distributions over runs")
-        doc.image(figures.success_bars(arms), f"{scenario}: success rate")
-        doc.image(figures.convergence(arms, progress), f"{scenario}: median best cost with interquartile band")
-        doc.image(figures.paths(arms, meta.get("scenarios", {}).get(scenario)),
-                  f"{scenario}: the plan of one seed per planner")
-    doc.html.append("</body></html>")
-    html_path.parent.mkdir(parents=True, exist_ok=True)
-    html_path.write_text("\n".join(doc.html), encoding="utf-8")
-    markdown_path.write_text("\n".join(doc.markdown) + "\n", encoding="utf-8")
+        for item in statistics_section(scenario, arms, meta.get("reference")):
+            if isinstance(item, str):
+                doc.paragraph(item)
+            elif item.rows:
+                doc.table(item)
+            else:
+                doc.paragraph(f"({item.caption}: no completed runs to test.)")
+        paper = paper_values_table(scenario, arms, scenario_rows, meta.get("paper", []))
+        if paper is not None:
+            doc.paragraph("The paper's values beside ours (mean ± std over our completed runs).")
+            doc.table(paper)
+        geometry = meta.get("scenarios", {}).get(scenario)
+        present = [m for m in figures.METRIC_LABELS if any(r.get(m) is not None for r in scenario_rows)]
+        doc.figure(figures.box_plots(arms, present), f"{scenario}: distributions over the completed runs")
+        doc.figure(figures.outcome_bars(arms), f"{scenario}: outcomes (success: reached with no collision)")
+        fig, sentence = figures.anytime_figure(arms, history, (geometry or {}).get("optimum_m"))
+        if fig is None:
+            doc.paragraph(sentence)
+        doc.figure(fig, f"{scenario}: anytime performance. Top: fixed budget, median best cost over runs with the "
+                        "interquartile band (each planner's own objective: metres of path, plus any penalty). "
+                        f"Bottom: fixed target, the share of (run, target) pairs reached by each budget. {sentence}")
+        driven, missing = _driven(arms)
+        doc.figure(figures.paths(arms, geometry, driven),
+                   f"{scenario}: the plan of one seed per planner" + (", the trajectory it drove" if driven else "")
+                   + (f". {missing}" if missing else ""))
+    doc.finish(html_path, markdown_path)
     return markdown_path
-
-
-def _statistics(doc: _Document, arms: dict[str, list[dict[str, Any]]], reference: str | None) -> None:
-    if len(arms) < 2:
-        return
-    reference = reference if reference in arms else next((a for a in arms if a.split("(")[0] == reference),
-                                                        next(iter(arms)))
-    scenario_rows = [r for rows in arms.values() for r in rows]
-    doc.paragraph(f"{reference} against each planner, per metric. Wilcoxon rank-sum (scipy.stats.ranksums, as "
-                  "Gong et al. 2022 Table 4) with Cliff's delta (> 0: the reference's values are larger); Wilcoxon "
-                  "signed-rank on runs paired by seed and world seed, with the matched-pairs rank-biserial "
-                  "correlation; Holm-adjusted over the planners, per metric.")
-    rows = []
-    for metric in _present(scenario_rows, TEST_METRICS):
-        rows += [[c.other, metric, str(c.n_ref), str(c.n_other), _fmt(c.ranksum_p), _fmt(c.ranksum_p_holm),
-                  _fmt(c.cliffs_delta, 3), str(c.n_pairs), _fmt(c.signed_rank_p), _fmt(c.signed_rank_p_holm),
-                  _fmt(c.rank_biserial, 3)] for c in compare(arms, reference, metric)]
-    doc.table(["against", "metric", "n ref", "n other", "rank-sum p", "Holm p", "Cliff's delta", "pairs",
-               "signed-rank p", "Holm p", "rank-biserial"], rows)
-    success = compare_success(arms, reference)
-    doc.paragraph("Success rates: Fisher's exact test (two-sided, scipy.stats.fisher_exact) of successes and "
-                  f"failures, {reference} against each planner, Holm-adjusted.")
-    doc.table(["against", "ref successes", "other successes", "Fisher p", "Holm p"],
-              [[c.other, f"{c.ref_successes}/{c.ref_runs}", f"{c.other_successes}/{c.other_runs}",
-                _fmt(c.fisher_p), _fmt(c.fisher_p_holm)] for c in success])
-    for metric in _present(scenario_rows, TEST_METRICS[:1]):
-        result = friedman(arms, metric)
-        if result is not None:
-            doc.paragraph(f"Friedman test of {metric} across all {len(arms)} planners on {result['blocks']} seeds "
-                          f"every planner completed: chi² = {_fmt(result['statistic'])}, p = {_fmt(result['p'])}, "
-                          f"Kendall's W = {_fmt(result['kendall_w'], 3)}.")
-
-
-def _paper_values(doc: _Document, scenario: str, arms, scenario_rows, paper: list[dict[str, Any]]) -> None:
-    entries = [p for p in paper if p["scenario"] == scenario]
-    if not entries:
-        return
-    rows = []
-    for p in entries:
-        mine = [r for name, rs in arms.items() if name == p["planner"] or name.startswith(p["planner"] + "(")
-                for r in rs]
-        v = values(mine, p["metric"])
-        ours = f"{_fmt(float(v.mean()))} ± {_fmt(float(v.std(ddof=1)) if v.size > 1 else float('nan'))}" \
-            if v.size else "–"
-        flag = impossible(p["metric"], p["value"], scenario_rows) or ""
-        rows.append([p["planner"], p["metric"], _fmt(p["value"]), ours, str(v.size), p.get("note", ""), flag])
-    doc.paragraph("The paper's values beside ours (mean ± std over our completed runs).")
-    doc.table(["planner", "metric", "paper", "ours", "our runs", "source", "check"], rows)

@@ -1,5 +1,5 @@
 """A study's tables on disk: ``DIR/runs.parquet`` (one row per run) and ``DIR/progress.parquet``
-(best cost per iteration of each run).
+(best cost per iteration of each run, with the evaluations and wall seconds spent by then).
 
 Each is a *directory* of Parquet part files (a Parquet dataset), one part per
 flush (every ``flush_s`` seconds while cells finish), so a study stopped by
@@ -61,10 +61,11 @@ RUN_SCHEMA = pa.schema([
 ])
 PROGRESS_SCHEMA = pa.schema([
     ("config_hash", pa.string()), ("iteration", pa.int64()), ("best_cost", pa.float64()),
-    ("evaluations", pa.int64()), ("evaluations_estimated", pa.bool_()),
+    ("evaluations", pa.int64()), ("evaluations_estimated", pa.bool_()), ("wall_s", pa.float64()),
 ])
 # Columns that measure time on the wall clock: they differ between two runs of the same cell.
 TIMING_COLUMNS = ("cell_wall_s", "plan_time_s", "wall_time_s", "replan_wall_s", "navigator_wall_s")
+PROGRESS_TIMING_COLUMNS = ("wall_s",)  # the same, of progress.parquet
 
 
 DAMAGED = "damaged"

@@ -28,6 +28,17 @@ TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) o
     [[navigators]]                   # optional; default: one navigator, follow
     name = "follow"
 
+    [[claims]]                       # optional: a claim of the paper the rows test (see claim_spec.py)
+    id = "gwo-shorter-than-abc-sc1"
+    statement = "GWO's mean path is shorter than ABC's on scenario 1"
+    source = "Abdulla & Hadi (2025), Sect. 6.1"
+    scenario = "gwo-scenario-1"
+    metric = "plan_length_m"         # or "success"
+    better = "lower"
+    planner = "gwo"
+    than = ["abc"]
+    test = "rank_sum"                # or "signed_rank", "fisher" (success)
+
     [[paper]]                        # optional: a paper's value to print beside ours
     scenario = "gwo-scenario-1"
     planner = "GWO"                  # a planner label
@@ -58,6 +69,7 @@ from swarmnav.models.scenario import SCENARIO_DIR, list_scenarios, load_scenario
 from swarmnav.models.parameters import refuse_code
 from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.planners.swarm import Budget
+from swarmnav.sim.study.claim_spec import Claim, parse_claims
 
 MAX_SEEDS = 100_000  # seeds (or world seeds) of one study
 MAX_SEED = 2**63 - 1  # as --seed and a scenario's seed (a TOML integer; NumPy's seeds take it)
@@ -114,7 +126,7 @@ class Study:
     quick_seeds: int | None = None  # the first N seeds make the quick run (None: the quick run is the full one)
     clearance_m: float | None = None  # planning clearance override for every scenario (None: each scenario's)
     paired_seeds: bool = False  # the k-th seed runs with the k-th world seed only
-    claims: tuple[dict[str, Any], ...] = ()  # [[claims]] tables as written (their verdicts: swarmnav report)
+    claims: tuple[Claim, ...] = ()  # the paper's claims the rows test (the report's verdicts)
     trust_code: bool = False  # --trust-code: its files (study, scenarios) may name code to run
     budget: Budget | None = None  # every planner's budget, unless its entry names its own
 
@@ -409,10 +421,8 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
     cells = len(scenarios) * settings * (len(seeds) if paired else len(seeds) * len(world_seeds))
     if cells > MAX_CELLS:
         _fail(source, "seeds", f"the grid has {cells:,} runs (scenarios x settings x seeds), at most {MAX_CELLS:,}")
-    claims = data.get("claims", [])
-    if not isinstance(claims, list) or not all(isinstance(c, dict) for c in claims):
-        _fail(source, "claims", "expected an array of [[claims]] tables")
+    claims = parse_claims(source, data.get("claims", []), scenarios, planners, navigators)
     budget = _budget(source, data["budget"], "budget") if "budget" in data else None
     return Study(name, description, source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
                  reference, planners, navigators, paper, quick_seeds, _clearance(source, data, scenarios), paired,
-                 tuple(claims), bool(trust_code), budget)
+                 claims, bool(trust_code), budget)

@@ -12,8 +12,8 @@
   Friedman test across all arms on the seeds every arm completed, with Kendall's W;
 * success rates: Fisher's exact test (``scipy.stats.fisher_exact``) of the reference
   arm's successes and failures against each other arm's, Holm-corrected;
-* a one-row-per-arm table in the shape of Gong et al. (2022) Table 3: optimal (best)
-  and mean length, std, convergence iteration, bends and time, with the IMMAS
+* a one-row-per-arm table in the shape of Gong et al. (2022) Table 3: best (the paper's
+  "optimal") and mean length, std, convergence iteration, bends and time, with the IMMAS
   columns (Hasan et al. 2023: gates raised, tunnels closed, arc cost) where present.
 """
 
@@ -68,6 +68,25 @@ def summarise(rows: list[dict[str, Any]], metric: str) -> MetricSummary | None:
                          float(np.median(v)), best)
 
 
+OUTCOME_CLASSES = ("success", "collision", "timeout", "no path", "error")
+
+
+def outcome_class(row: dict[str, Any]) -> str:
+    """What became of a run, one of :data:`OUTCOME_CLASSES`: success is the goal reached with no collision
+    (plan-only: a collision-free plan); a collision is any contact on the way (plan-only: a plan that cuts an
+    obstacle); a timeout is the wall limit or, in physics, the simulated-time limit with no collision."""
+    outcome = row.get("outcome")
+    if outcome == "no_path":
+        return "no path"
+    if outcome in ("error", "timeout"):
+        return outcome
+    if row.get("success"):
+        return "success"
+    if row.get("mode") == "physics":
+        return "collision" if (row.get("collisions") or 0) > 0 else "timeout"
+    return "collision"
+
+
 def arm_counts(rows: list[dict[str, Any]]) -> dict[str, Any]:
     n = len(rows)
     outcomes: dict[str, int] = defaultdict(int)
@@ -75,7 +94,18 @@ def arm_counts(rows: list[dict[str, Any]]) -> dict[str, Any]:
         outcomes[r["outcome"]] += 1
     successes = sum(bool(r["success"]) for r in rows)
     return {"runs": n, "successes": successes, "success_rate": successes / n if n else float("nan"),
-            "failed": n - outcomes.get("ok", 0), "outcomes": dict(outcomes)}
+            "failed": n - outcomes.get("ok", 0), "outcomes": dict(outcomes),
+            "classes": {c: sum(outcome_class(r) == c for r in rows) for c in OUTCOME_CLASSES}}
+
+
+def ranksum_p(a: np.ndarray, b: np.ndarray) -> float:
+    """Two-sided p of the Wilcoxon rank-sum test (``scipy.stats.ranksums``); NaN without values on a side, and
+    1 when every value of both sides is the same (scipy's statistic is then 0 / 0: no difference at all)."""
+    if a.size == 0 or b.size == 0:
+        return float("nan")
+    if np.all(a == a[0]) and np.all(b == a[0]):
+        return 1.0
+    return float(stats.ranksums(a, b).pvalue)
 
 
 def cliffs_delta(a: np.ndarray, b: np.ndarray) -> float:
@@ -148,7 +178,7 @@ def compare(arms: dict[str, list[dict[str, Any]]], reference: str, metric: str) 
         if name == reference:
             continue
         other = values(rows, metric)
-        p = float(stats.ranksums(ref, other).pvalue) if ref.size and other.size else float("nan")
+        p = ranksum_p(ref, other)
         delta = cliffs_delta(ref, other) if ref.size and other.size else float("nan")
         a, b = paired(arms[reference], rows, metric)
         if a.size and np.any(a != b):
@@ -174,7 +204,8 @@ def friedman(arms: dict[str, list[dict[str, Any]]], metric: str) -> dict[str, An
         return {"blocks": len(blocks), "statistic": float("nan"), "p": float("nan"), "kendall_w": float("nan")}
     samples = [np.array([k[b] for b in blocks], dtype=float) for k in keyed]
     try:
-        result = stats.friedmanchisquare(*samples)
+        with np.errstate(invalid="ignore", divide="ignore"):  # every block tied: scipy's 0 / 0 is NaN
+            result = stats.friedmanchisquare(*samples)
         statistic, p = float(result.statistic), float(result.pvalue)
     except ValueError:
         statistic, p = float("nan"), float("nan")
@@ -231,18 +262,19 @@ def compare_success(arms: dict[str, list[dict[str, Any]]], reference: str) -> li
 
 
 # (header, metric, statistic) of the one-row-per-arm table; a column whose metric no run has is left out.
-PAPER_COLUMNS = (("optimal length", "plan_length_m", "best"), ("mean length", "plan_length_m", "mean"),
-                 ("std", "plan_length_m", "std"), ("mean - optimal", "plan_length_m", "spread"),
+PAPER_COLUMNS = (("best length (m)", "plan_length_m", "best"), ("mean length (m)", "plan_length_m", "mean"),
+                 ("std (m)", "plan_length_m", "std"), ("mean - best (m)", "plan_length_m", "spread"),
                  ("convergence iteration", "plan_convergence_iteration", "mean"),
-                 ("bends", "plan_bends", "mean"), ("time (s)", "plan_time_s", "mean"),
+                 ("bends", "plan_bends", "mean"), ("plan time (s)", "plan_time_s", "mean"),
                  ("gates", "plan_gates_raised", "mean"), ("tunnels", "plan_tunnels_closed", "mean"),
                  ("arc cost", "plan_arc_cost", "mean"), ("iterations", "plan_iterations", "mean"))
 
 
 def paper_table(arms: dict[str, list[dict[str, Any]]]) -> tuple[list[str], list[list[float | int | None]]]:
     """Per arm: runs, successes, then each :data:`PAPER_COLUMNS` entry over the completed runs.
-    ``mean - optimal`` is there because Gong et al. (2022) Table 3's "standard deviation" column equals
-    the mean minus the optimal length in every one of its rows."""
+    ``mean - best`` is there because Gong et al. (2022) Table 3's "standard deviation" column equals
+    the mean minus the optimal (our best) length in every one of its rows.  "Best length" is each planner's
+    shortest plan over its runs (the paper's "optimal length"), not the ``optimal`` planner's."""
     all_rows = [r for rows in arms.values() for r in rows]
     columns = [c for c in PAPER_COLUMNS if any(r.get(c[1]) is not None for r in all_rows)]
     header = ["planner", "runs", "successes"] + [c[0] for c in columns]
@@ -253,8 +285,9 @@ def paper_table(arms: dict[str, list[dict[str, Any]]]) -> tuple[list[str], list[
             summary = summarise(rows, metric)
             if summary is None:
                 line.append(None)
-            elif statistic == "spread":
-                line.append(summary.mean - summary.best)
+            elif statistic == "spread":  # rounding noise of identical runs (1e-15 m) is no spread
+                spread = summary.mean - summary.best
+                line.append(0.0 if abs(spread) <= 1e-12 * max(1.0, abs(summary.best)) else spread)
             else:
                 line.append(getattr(summary, statistic))
         table.append(line)
