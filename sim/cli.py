@@ -25,6 +25,7 @@ from typing import Any, Callable
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
 from swarmnav.sim import options
+from swarmnav.sim.options import parse_settings
 from swarmnav.sim.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
 
 # As sim.render does, before any subcommand imports mujoco (which reads it once, on import).
@@ -50,22 +51,6 @@ class OneLineParser(argparse.ArgumentParser):
 
     def error(self, message: str):
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
-
-
-def parse_settings(pairs: list[str] | None, option: str = "--set") -> dict[str, Any]:
-    """``KEY=VALUE`` pairs of an option; values are read as TOML (numbers, booleans, arrays) or else strings."""
-    params: dict[str, Any] = {}
-    for pair in pairs or []:
-        key, sep, text = pair.partition("=")
-        key = key.strip()
-        if not sep or not key:
-            raise ConfigError(option, f"expected key=value, got {pair!r}")
-        try:
-            value = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
-            value = text
-        params[key] = value
-    return params
 
 
 def _load(args: argparse.Namespace):

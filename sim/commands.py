@@ -4,7 +4,7 @@ Building the parser must stay light (``swarmnav scenarios`` is a whole process
 of well under a second), so this module imports only argparse and the option
 types: each ``run_*`` below imports its module (MuJoCo, SciPy, the planners,
 the log formats) inside the function, when that subcommand is the one chosen.
-The options' defaults that the modules also use live here, once.
+The defaults that the modules below the CLI also use live in :mod:`sim.defaults`, once.
 """
 
 from __future__ import annotations
@@ -13,37 +13,15 @@ import argparse
 from typing import Callable
 
 from swarmnav.sim import options
+from swarmnav.sim.defaults import (  # noqa: F401  (re-exported: the CLI's own defaults)
+    SINGLE_THREAD_ENVIRONMENT, DEFAULT_FPS, MIN_FPS, MAX_FPS, MIN_DPI, MAX_DPI, BENCH_SIM_QUICK,
+    BENCH_ENV_QUICK, BENCH_RENDER_QUICK_FRAMES, BENCH_PLANNERS_SCENARIOS, BENCH_PLANNERS_PLANNERS,
+    BENCH_PLANNERS_SAMPLING, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
+from swarmnav.sim.options import add_trust_code_argument  # noqa: F401
 from swarmnav.sim.study import cli as study_cli
 
 Adder = Callable[[argparse.ArgumentParser], None]
 Runner = Callable[[argparse.Namespace], int]
-
-# NumPy's BLAS and OpenMP on one thread, for the CLI and every study worker (set before NumPy loads).  The
-# planners' matrices are small: with another process busy on a 2-core machine, OpenBLAS's threads made a
-# robust GWO plan on a 40-disc field 0.03-0.37 s instead of 0.033 s.  A value already set in the environment wins.
-SINGLE_THREAD_ENVIRONMENT = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
-                             "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
-DEFAULT_FPS = 30.0  # frames per simulated second of a video (run --video, replay --video)
-MIN_FPS, MAX_FPS = 0.1, 240.0  # --fps bounds: each simulated second is MAX_FPS frames at most
-MIN_DPI, MAX_DPI = 10, 600  # plot: 600 dpi is 4800 x 6300 pixels (about 120 MB of RGBA)
-BENCH_SIM_QUICK = (5.0, 5)  # bench sim --quick: simulated seconds, repeats (under a minute)
-BENCH_ENV_QUICK = (4.0, 2)  # bench env --quick: a smoke run of the same measurement (noisier figures)
-BENCH_RENDER_QUICK_FRAMES = 40
-BENCH_PLANNERS_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3",
-                            "adl-abc-path-1", "adl-abc-path-2", "adl-abc-path-3",
-                            "dense-field-30", "restaurant-table-2", "restaurant-table-5")
-BENCH_PLANNERS_PLANNERS = ("abc", "adl_abc", "gwo", "pso")
-BENCH_PLANNERS_SAMPLING = ("rrt_star", "informed_rrt_star", "bit_star", "prm_star")  # OMPL's
-# bench navigation --quick: one world seed on one scenario of each generated kind.
-BENCH_NAVIGATION_QUICK_SCENARIOS = ("dyn-crossing-1", "dyn-head-on-1", "dyn-overtake-1", "dyn-crowd-1")
-BENCH_STUDY_QUICK = (10, 300)  # bench study --quick: seeds per scenario, GWO iterations; no Ray
-
-
-def add_trust_code_argument(parser: argparse.ArgumentParser) -> None:
-    """``--trust-code``: this invocation may run code that a file it reads names (a ``policy``)."""
-    parser.add_argument("--trust-code", action="store_true",
-                        help="let the files this command reads name code to run (the policy navigator's "
-                             "policy = 'module:function'); without it such a value is an error")
 
 
 def add_bench_sim_arguments(parser: argparse.ArgumentParser) -> None:

@@ -1,4 +1,5 @@
-"""Argument types for the command line: numbers checked where argparse reads them.
+"""Argument types for the command line: numbers checked where argparse reads them; ``KEY=VALUE`` settings;
+the shared ``--trust-code`` option.
 
 Each raises ``argparse.ArgumentTypeError``, which argparse reports against the
 option's name with exit code 2.
@@ -8,6 +9,10 @@ from __future__ import annotations
 
 import argparse
 import math
+import tomllib
+from typing import Any
+
+from swarmnav.models.errors import ConfigError
 
 MAX_SEED = 2**63 - 1  # the largest integer a TOML scenario can hold, so --seed and ``seed`` agree
 
@@ -67,3 +72,26 @@ def _number(text: str) -> float:
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"must be finite, got {text}")
     return value
+
+
+def add_trust_code_argument(parser: argparse.ArgumentParser) -> None:
+    """``--trust-code``: this invocation may run code that a file it reads names (a ``policy``)."""
+    parser.add_argument("--trust-code", action="store_true",
+                        help="let the files this command reads name code to run (the policy navigator's "
+                             "policy = 'module:function'); without it such a value is an error")
+
+
+def parse_settings(pairs: list[str] | None, option: str = "--set") -> dict[str, Any]:
+    """``KEY=VALUE`` pairs of an option; values are read as TOML (numbers, booleans, arrays) or else strings."""
+    params: dict[str, Any] = {}
+    for pair in pairs or []:
+        key, sep, text = pair.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ConfigError(option, f"expected key=value, got {pair!r}")
+        try:
+            value = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text
+        params[key] = value
+    return params

@@ -22,7 +22,7 @@ import numpy as np
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim import palette
-from swarmnav.sim.commands import MAX_DPI, MIN_DPI
+from swarmnav.sim.defaults import MAX_DPI, MIN_DPI
 from swarmnav.sim.log_reader import RunLog, outcome_text, read_log, truncation_advice
 
 MAX_SCANS = 400

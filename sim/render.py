@@ -51,7 +51,7 @@ from swarmnav.sim.render_look import (  # noqa: E402
     paint_obstacles,
     soften_lights,
 )
-from swarmnav.sim.commands import MAX_FPS, MIN_FPS  # noqa: E402
+from swarmnav.sim.defaults import MAX_FPS, MIN_FPS  # noqa: E402
 from swarmnav.sim.recording import RunContext, StepFrame  # noqa: E402
 from swarmnav.sim.video_file import VideoWriter  # noqa: E402
 

@@ -29,7 +29,7 @@ from typing import Iterator
 import numpy as np
 
 from swarmnav.models.errors import ConfigError
-from swarmnav.sim.commands import DEFAULT_FPS
+from swarmnav.sim.defaults import DEFAULT_FPS
 from swarmnav.sim.log_format import ranges_from_scan
 from swarmnav.sim.log_reader import RunLog, read_log, truncation_advice
 from swarmnav.sim.mcap_records import LogError
@@ -230,7 +230,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"video: {args.video}: {info['frames']} frames, {info['video_s']:.1f} s at {args.fps:g} fps "
                   f"({info['frames'] / max(info['render_s'], 1e-9):.0f} frames/s rendered)")
     if args.verify:
-        from swarmnav.sim.cli import parse_settings  # loaded already: the CLI is what calls this
+        from swarmnav.sim.options import parse_settings
         named = parse_settings(args.navigator_set, "--navigator-set")
         report = verify_log(log, named, args.trust_code)
         results["verify"] = {**report.as_dict(), "named_on_command_line": named}

@@ -84,3 +84,90 @@ def test_the_check_catches_an_import_inside_a_function():
 
 def test_no_grab_bag_utils_module():
     assert not list(ROOT.glob("*/utils.py"))
+
+
+def module_name(layer: str, path: Path) -> str:
+    """The installed name of a project file (``sim/api/`` is the top-level ``swarmnav`` package)."""
+    parts = list(path.relative_to(ROOT / layer).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    if layer == "sim" and parts[:1] == ["api"]:
+        return ".".join(["swarmnav", *parts[1:]])
+    return ".".join(["swarmnav", layer, *parts])
+
+
+def import_graph() -> dict[str, set[str]]:
+    """Project module -> the project modules it imports, at any depth (imports inside functions included)."""
+    files = {module_name(layer, path): (layer, path) for layer, path in project_modules()}
+    graph: dict[str, set[str]] = {name: set() for name in files}
+    for name, (layer, path) in files.items():
+        package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            targets: list[str] = []
+            if isinstance(node, ast.Import):
+                targets = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    base = ".".join(package.split(".")[:len(package.split(".")) - node.level + 1] + ([base] if base else []))
+                targets = [base] + [f"{base}.{alias.name}" for alias in node.names]
+            graph[name].update(t for t in targets if t in files and t != name)
+    return graph
+
+
+def import_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    cycles: list[list[str]] = []
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is not None:
+                if child not in index:
+                    index[child] = low[child] = len(index)
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(sorted(graph[child]))))
+                elif child in on_stack:
+                    low[node] = min(low[node], index[child])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                component = []
+                while True:
+                    member = stack.pop()
+                    on_stack.discard(member)
+                    component.append(member)
+                    if member == node:
+                        break
+                if len(component) > 1:
+                    cycles.append(sorted(component))
+    return cycles
+
+
+def test_no_import_cycle_among_the_project_modules():
+    assert import_cycles(import_graph()) == []
+
+
+def test_the_cycle_check_finds_a_cycle():
+    assert import_cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert import_cycles({"a": {"b"}, "b": set()}) == []
+
+
+def test_only_the_command_line_imports_the_command_line():
+    cli = {"swarmnav.sim.cli", "swarmnav.sim.commands"}
+    importers = {name for name, targets in import_graph().items() if targets & cli}
+    assert importers <= cli

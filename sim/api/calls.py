@@ -123,7 +123,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
     elif live:
         raise ConfigError("--live", "needs the log (drop --no-log)")
     if video:
-        from swarmnav.sim.commands import DEFAULT_FPS
+        from swarmnav.sim.defaults import DEFAULT_FPS
         from swarmnav.sim.render import VideoRecorder
         recorders.append(VideoRecorder(str(video), camera=camera, width=width, height=height,
                                        fps=DEFAULT_FPS if fps is None else fps))

@@ -27,7 +27,7 @@ import numpy as np
 
 from swarmnav.sim.benchmarks.figures import print_figures
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
-from swarmnav.sim.commands import BENCH_ENV_QUICK
+from swarmnav.sim.defaults import BENCH_ENV_QUICK
 from swarmnav.sim.runner import Simulation
 
 

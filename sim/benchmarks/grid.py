@@ -233,14 +233,3 @@ def run(args: argparse.Namespace) -> int:
     for key, value in result["targets"].items():
         print(f"target {key}: {value}")
     return 0
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="swarmnav bench grid", description=__doc__.splitlines()[0])
-    from swarmnav.sim.commands import add_bench_grid_arguments
-    add_bench_grid_arguments(parser)
-    return run(parser.parse_args(argv))
-
-
-if __name__ == "__main__":
-    sys.exit(main())

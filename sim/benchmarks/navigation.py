@@ -225,7 +225,7 @@ def run(args: argparse.Namespace) -> int:
         paper_rows = benchmark_paper_navigation(args.seeds, tuple(args.scenario or PAPER_SUITE), args.out)
         print(json.dumps(paper_rows)) if args.json else print_table(paper_rows)
         return 0
-    from swarmnav.sim.cli import parse_settings  # loaded already: the CLI is what calls this
+    from swarmnav.sim.options import parse_settings
     settings = navigator_settings(parse_settings(args.navigator_set, "--navigator-set"),
                                   args.navigator or list(NAVIGATORS))
     suite = None if args.suite == "dyn" else args.suite

@@ -49,7 +49,7 @@ from swarmnav.planners.path_cost import PathObjective
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.problem import scenario_problem
 from swarmnav.sim.benchmarks.planner_quality import SAMPLING_MODE, field_summary, scenario_rows, study_tables
-from swarmnav.sim.commands import BENCH_PLANNERS_SCENARIOS
+from swarmnav.sim.defaults import BENCH_PLANNERS_SCENARIOS
 
 SOURCE = "swarmnav bench planners"  # what an error in the options' study names
 PEERS = (("gwo", "mealpy.OriginalGWO"), ("abc", "mealpy.OriginalABC"))
@@ -354,10 +354,3 @@ def run(args: argparse.Namespace) -> int:
     else:
         print_table(result)
     return 0
-
-
-if __name__ == "__main__":
-    _parser = argparse.ArgumentParser(prog="python -m planners.bench_continuous", description=__doc__.splitlines()[0])
-    from swarmnav.sim.commands import add_bench_planners_arguments
-    add_bench_planners_arguments(_parser)
-    raise SystemExit(run(_parser.parse_args()))

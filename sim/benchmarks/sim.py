@@ -24,7 +24,7 @@ import mujoco
 from swarmnav.sim.benchmarks.figures import print_figures
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import MAX_CONTROL_STEPS, load_scenario
-from swarmnav.sim.commands import BENCH_SIM_QUICK
+from swarmnav.sim.defaults import BENCH_SIM_QUICK
 from swarmnav.sim.episode import Episode, EpisodeSpec, plan_episode, run_episode
 from swarmnav.sim.runner import Simulation
 

@@ -70,8 +70,7 @@ def numeric_columns() -> tuple[str, ...]:
 def arm_labels(components) -> list[str]:
     """Every label a row of these planner (or navigator) entries carries, as the grid writes them: the entry's
     label, or for a sweep each swept arm's label (``maco(p0=0.9, rho=0.9)``); a claim names one arm."""
-    from swarmnav.sim.study.grid import _sweep_label
-    return [_sweep_label(component, setting) if component.swept else component.label
+    return [component.arm_label(setting)
             for component in components for setting in (component.settings() if component.swept else [None])]
 
 

@@ -28,7 +28,7 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--retry-errors", action="store_true",
                    help="run again the cells whose row is an error (by default a resume runs only cells without a row)")
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
-    from swarmnav.sim.commands import add_trust_code_argument  # here: sim.commands imports this module
+    from swarmnav.sim.options import add_trust_code_argument
     add_trust_code_argument(p)
     p.add_argument("--junit", metavar="FILE", help="write the study's rows as JUnit XML (one test suite per scenario, "
                    "a failure per row that is not a success)")

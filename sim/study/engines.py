@@ -31,7 +31,7 @@ from collections import deque
 from multiprocessing.connection import wait as wait_any
 from typing import Any, Iterable, Iterator
 
-from swarmnav.sim.commands import SINGLE_THREAD_ENVIRONMENT
+from swarmnav.sim.defaults import SINGLE_THREAD_ENVIRONMENT
 from swarmnav.sim.study.cell import _versions_json, base_row, run_cell
 from swarmnav.sim.study.grid import Cell
 

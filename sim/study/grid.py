@@ -46,12 +46,6 @@ class Cell:
         return self.mode == "physics"
 
 
-def _sweep_label(component: Component, setting: dict[str, Any]) -> str:
-    if not component.swept:
-        return component.label
-    return component.label + "(" + ", ".join(f"{k}={setting[k]}" for k in component.swept) + ")"
-
-
 def config_hash(config: dict[str, Any]) -> str:
     """16 hex digits of SHA-256 over the canonical JSON of a cell's configuration."""
     text = json.dumps(config, sort_keys=True, separators=(",", ":"))
@@ -74,8 +68,8 @@ def iter_cells(study: Study) -> Iterator[Cell]:
     scenario_digest = {s: hashlib.sha256(resolve_scenario_path(s).read_bytes()).hexdigest() for s in study.scenarios}
     pairs = study.seed_pairs()
     for scenario, planner, planner_params, navigator, navigator_params in _settings(study):
-        label = _sweep_label(planner, planner_params)
-        navigator_label = _sweep_label(navigator, navigator_params)
+        label = planner.arm_label(planner_params)
+        navigator_label = navigator.arm_label(navigator_params)
         for world_seed, seed in pairs:
             config = {"scenario_sha256": scenario_digest[scenario], "planner": planner.name,
                       "label": planner.label, "navigator_label": navigator.label,

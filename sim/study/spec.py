@@ -92,6 +92,12 @@ class Component:
     swept: tuple[str, ...]  # the keys that sweep
     budget: Budget | None = None  # this entry's budget (None: the study's)
 
+    def arm_label(self, setting: dict[str, Any]) -> str:
+        """The label of one setting of the sweep: ``label(key=value, ...)`` over the swept keys, else the label."""
+        if not self.swept:
+            return self.label
+        return self.label + "(" + ", ".join(f"{k}={setting[k]}" for k in self.swept) + ")"
+
     def settings(self) -> list[dict[str, Any]]:
         """Every parameter table of the sweep (the Cartesian product of the lists), in file order."""
         fixed = {k: v for k, v in self.params.items() if k not in self.swept}
