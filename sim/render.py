@@ -1,8 +1,8 @@
 """Offscreen rendering of a run with EGL, and MP4 output (:mod:`sim.video_file`).
 
-The only module that knows about EGL: ``MUJOCO_GL`` is set to ``egl`` here (unless
-the user chose another backend) before ``mujoco`` is imported, so rendering works
-on headless, GPU-less servers through Mesa.
+The GL context is made when a :class:`SceneRenderer` is, by :func:`sim.gl_backend.new_renderer`
+(EGL unless the user chose another backend), so rendering works on headless,
+GPU-less servers through Mesa and importing this module loads no GL library.
 
 Speed: shadows, reflections and multisampling are switched off, which takes a
 640x480 frame from ~267 ms to ~20 ms on the reference machine, and the floor is
@@ -21,10 +21,6 @@ never steps physics.
 
 from __future__ import annotations
 
-import os
-
-os.environ.setdefault("MUJOCO_GL", "egl")
-
 import math  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -34,6 +30,7 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from swarmnav.models.errors import ConfigError  # noqa: E402
+from swarmnav.sim.gl_backend import new_renderer  # noqa: E402
 from swarmnav.sim.recording import RunContext, StepFrame  # noqa: E402
 from swarmnav.sim.video_file import VideoWriter  # noqa: E402
 
@@ -203,7 +200,7 @@ class SceneRenderer:
                 self._grid = floor_grid(*grid_m)
         self.camera = camera
         self.width, self.height = width, height
-        self._renderer = mujoco.Renderer(model, height, width)
+        self._renderer = new_renderer(model, height, width)  # the GL context is made here, not at import
         if fast:
             flags = self._renderer.scene.flags
             flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
