@@ -98,6 +98,37 @@ def action_command(action: np.ndarray, mode: str, geometry: DriveGeometry, max_s
     return ControlCommand(wheels, v, omega, waypoint_index)
 
 
+class ActionError(ValueError):
+    """A policy's action that is not 2 finite real numbers (the environment raises it; the navigator reports it
+    as a ConfigError of its ``policy`` parameter)."""
+
+
+def checked_action(action) -> np.ndarray:
+    """The action as a (2,) float64 array, or :class:`ActionError` saying what is wrong with it.
+
+    Accepted: any array-like of shape (2,) (or (1, 2), one environment's row) of real numbers, floating or
+    integer, all finite.  Rejected: other shapes, booleans, complex numbers, strings and objects, NaN and inf.
+    """
+    try:
+        array = np.asarray(action)
+    except Exception as exc:  # ragged lists and the like
+        raise ActionError(f"action {action!r} is not an array: {exc}") from None
+    if array.dtype == bool or not (np.issubdtype(array.dtype, np.floating) or np.issubdtype(array.dtype, np.integer)):
+        raise ActionError(f"action of dtype {array.dtype}; expected real numbers (float32 as the action space)")
+    if array.shape not in ((2,), (1, 2)):
+        raise ActionError(f"action of shape {array.shape}; expected (2,)")
+    array = array.reshape(2).astype(np.float64)
+    if not np.all(np.isfinite(array)):
+        raise ActionError(f"action {array.tolist()} is not finite")
+    return array
+
+
+def normalised_action(action: np.ndarray, mode: str, geometry: DriveGeometry) -> np.ndarray:
+    """The action as the reward's effort and smoothness terms see it: each component clipped and scaled to [-1, 1]."""
+    low, high = action_bounds(mode, geometry)
+    return np.clip(np.asarray(action, dtype=np.float64), low, high) / high
+
+
 def motion_speed_bound_m_s(motion) -> float:
     """The fastest a scripted obstacle motion moves (m/s): its speed, or a random walk's step per period."""
     if hasattr(motion, "speed_m_s"):

@@ -21,7 +21,8 @@ from typing import Any, Callable, ClassVar
 import numpy as np
 
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command, observation_layout
+from swarmnav.controllers.policy_interface import (ACTION_MODES, ActionError, PolicyObserver, action_command,
+                                                   checked_action, observation_layout)
 from swarmnav.models.errors import ConfigError
 
 FIELD = "navigator.params.policy"
@@ -92,9 +93,11 @@ class PolicyNavigator:
 
     def step(self, observation: Observation) -> NavigationStep:
         try:
-            action = np.asarray(self._policy(self._observer(observation)), dtype=float)
+            raw = self._policy(self._observer(observation))
         except Exception as exc:  # the user's code failed: their input, reported against the parameter
             raise ConfigError(FIELD, f"{self.policy!r} raised {type(exc).__name__}: {exc}") from None
-        if action.shape != (2,) or not np.all(np.isfinite(action)):
-            raise ConfigError(FIELD, f"{self.policy!r} returned {action!r}; expected 2 finite numbers")
+        try:
+            action = checked_action(raw)  # the environment's own check
+        except ActionError as exc:
+            raise ConfigError(FIELD, f"{self.policy!r} returned a bad action: {exc}") from None
         return NavigationStep(action_command(action, self.action, self._geometry, self._max_speed_m_s))

@@ -102,7 +102,7 @@ class NavigateEnv(gymnasium.Env):
         return timestep.observation, self.task.info()
 
     def step(self, action):
-        timestep = self.dm_env.step(np.asarray(action, dtype=np.float64))
+        timestep = self.dm_env.step(action)  # the task checks it (ActionError) and reads it in float64
         last = timestep.last()
         terminated = bool(last and timestep.discount == 0.0)
         truncated = bool(last and timestep.discount == 1.0)
