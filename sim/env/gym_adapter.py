@@ -9,7 +9,9 @@ entry points.)  ``reset(seed=..., options={"scenario": ..., "planner_seed": ...,
 ``seed`` seeds ``np_random`` and derives the episode's two seeds
 (:meth:`models.scenario.Seeds.derived`: ``SeedSequence(seed).spawn(2)``, the path
 planner's from the first child, the obstacles' random walks from the second), so
-another ``seed`` gives another world; ``planner_seed`` and ``world_seed`` in
+another ``seed`` gives another world; with ``scenarios=`` (:mod:`sim.env.worlds`) the
+seed (or, without one, a draw from ``np_random``) also draws the episode's scenario,
+so every reset is a new world; ``planner_seed`` and ``world_seed`` in
 ``options`` override the derived ones.  ``reset()`` with no seed after a seeded
 one derives the next episode's seeds from ``np_random`` (so an RL loop that seeds
 once meets a new world every episode, the same sequence for the same first seed);
@@ -31,7 +33,9 @@ import numpy as np
 from dm_env import specs
 from gymnasium import spaces
 
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.seeds import Seeds
+from swarmnav.sim.env.worlds import draw_rng, merged_layout, scenario_source
 from swarmnav.sim.env.task import EnvOptions, NavigationTask, make_environment
 
 ENV_ID = "swarmnav/Navigate-v0"
@@ -51,6 +55,8 @@ class NavigateEnv(gymnasium.Env):
 
     Args:
         scenario: a bundled scenario name, a path, or a Scenario.
+        scenarios: a new world per episode (:mod:`sim.env.worlds`): a list of scenarios or a generator
+            specification; ``scenario`` is then not used.
         render_mode: None or ``"rgb_array"``.
         width, height, camera: the rendered frames.
         **options: :class:`EnvOptions` fields (action, path_planner, reward, record_to, ...).
@@ -59,7 +65,7 @@ class NavigateEnv(gymnasium.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 50}
 
     def __init__(self, scenario: Any = "gwo-scenario-2", render_mode: str | None = None, width: int = 640,
-                 height: int = 480, camera: str = "top", **options: Any):
+                 height: int = 480, camera: str = "top", scenarios: Any = None, **options: Any):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode: expected None or 'rgb_array', got {render_mode!r}")
         self.render_mode = render_mode
@@ -67,11 +73,20 @@ class NavigateEnv(gymnasium.Env):
         self._options = EnvOptions(**options)
         self._renderer = None
         self._seeded = False  # whether a reset had a seed: then reset() derives new seeds from np_random
+        self._source, self._layout = None, None
+        if scenarios is not None:
+            self._source = scenario_source(scenarios)
+            envelope = [make_environment(s, self._options) for s in self._source.envelope()]
+            self._layout = self._source.widen(merged_layout([env.task.layout for env in envelope]))
+            actions = {(env.action_spec().minimum.tobytes(), env.action_spec().maximum.tobytes()) for env in envelope}
+            if len(actions) > 1:
+                raise ConfigError("env.scenarios", "the scenarios' robots differ: the action space must not change")
+            scenario = envelope[0].task.scenario
         self._build(scenario)
 
     def _build(self, scenario: Any) -> None:
         self.close()
-        self.dm_env = make_environment(scenario, self._options)
+        self.dm_env = make_environment(scenario, self._options, self._layout)
         self.observation_space = spaces.Dict({key: _box(spec) for key, spec in self.dm_env.observation_spec().items()})
         self.action_space = _box(self.dm_env.action_spec())
         self.metadata = {**self.metadata, "render_fps": 1.0 / self.dm_env.control_timestep()}
@@ -87,9 +102,15 @@ class NavigateEnv(gymnasium.Env):
         if unknown:
             raise ValueError(f"reset options: unknown {sorted(unknown)} (known: {', '.join(RESET_OPTIONS)})")
         if "scenario" in options:
+            if self._source is not None:
+                raise ConfigError("reset options.scenario", "the environment draws its scenarios (scenarios=)")
             self._build(options["scenario"])
         seeds = self.task.seeds
-        if seed is not None:
+        if self._source is not None:  # a new world every episode, from the seed or np_random
+            episode_seed = seed if seed is not None else int(self.np_random.integers(2**63))
+            self._build(self._source.draw(draw_rng(episode_seed)))
+            seeds = Seeds.derived(episode_seed)
+        elif seed is not None:
             seeds = Seeds.derived(seed)
             self._seeded = True
         elif self._seeded:

@@ -48,7 +48,7 @@ from dm_control.rl import control
 
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.policy_interface import (ACTION_MODES, PolicyObserver, action_command, checked_action,
-                                                   normalised_action, observation_layout)
+                                                   ObservationLayout, normalised_action, observation_layout)
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario, load_scenario
 from swarmnav.models.seeds import Seeds
@@ -162,16 +162,15 @@ class SwarmnavPhysics(dm_mujoco.Physics):
 class NavigationTask(control.Task):
     """Drive from the scenario's start to its goal; see the module docstring."""
 
-    def __init__(self, scenario: Scenario, physics: SwarmnavPhysics, xml: str, options: EnvOptions):
+    def __init__(self, scenario: Scenario, physics: SwarmnavPhysics, xml: str, options: EnvOptions,
+                 layout: ObservationLayout | None = None):
         self.options = options
         self.scene = index_scene(physics.model.ptr, xml)  # the indices, on the physics' own model
         self.simulation = Simulation(scenario, self.scene)
         fallback = scenario.seeds
         self.set_seeds(Seeds(fallback.planner if options.seed is None else int(options.seed),
                              fallback.world if options.world_seed is None else int(options.world_seed)))
-        self.layout = observation_layout(scenario, self.scene.drive,
-                                         options.path_waypoints if options.path_planner else 0,
-                                         options.obstacle_slots, options.tracked_obstacles)
+        self.layout = layout or task_layout(scenario, options, self.scene.drive)
         self.episode = -1
         self.stepper: EpisodeStepper | None = None
         self.over_at_start = False
@@ -303,11 +302,19 @@ class NavigationTask(control.Task):
         return McapRecorder(FilePath(self.options.record_to.replace("{episode}", str(self.episode))), overwrite=True)
 
 
-def make_environment(scenario: Scenario | str, options: EnvOptions | None = None, **kwargs: Any
-                     ) -> control.Environment:
+def task_layout(scenario: Scenario, options: EnvOptions, drive) -> ObservationLayout:
+    """The observation layout of ``scenario`` under ``options`` (the entries and bounds of the specs)."""
+    return observation_layout(scenario, drive, options.path_waypoints if options.path_planner else 0,
+                              options.obstacle_slots, options.tracked_obstacles)
+
+
+def make_environment(scenario: Scenario | str, options: EnvOptions | None = None,
+                     layout: ObservationLayout | None = None, **kwargs: Any) -> control.Environment:
     """The dm_env environment of a scenario (a name, a path or a :class:`Scenario`).
 
-    ``kwargs`` are :class:`EnvOptions` fields when ``options`` is not given.
+    ``kwargs`` are :class:`EnvOptions` fields when ``options`` is not given; ``layout`` fixes the
+    observation's entries and bounds (:mod:`sim.env.worlds`: the same spaces across scenarios), else the
+    scenario's own.
     """
     if isinstance(scenario, (str, FilePath)):
         scenario = load_scenario(str(scenario))
@@ -316,6 +323,6 @@ def make_environment(scenario: Scenario | str, options: EnvOptions | None = None
     physics = SwarmnavPhysics.from_xml_string(scene.xml)
     if not same_model(physics.model.ptr, scene.model):
         raise RuntimeError("dm_control compiled the scene's MJCF to a different model")
-    task = NavigationTask(scenario, physics, scene.xml, options)
+    task = NavigationTask(scenario, physics, scene.xml, options, layout)
     return control.Environment(physics, task, n_sub_steps=task.simulation.steps_per_control * options.action_repeat)
 
