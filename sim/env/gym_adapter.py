@@ -33,6 +33,7 @@ import numpy as np
 from dm_env import specs
 from gymnasium import spaces
 
+from swarmnav.controllers.policy_interface import FLAT_ORDER, flatten_observation
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.seeds import Seeds
 from swarmnav.sim.env.worlds import draw_rng, merged_layout, scenario_source
@@ -55,6 +56,8 @@ class NavigateEnv(gymnasium.Env):
 
     Args:
         scenario: a bundled scenario name, a path, or a Scenario.
+        flatten: observations as one float32 vector in the documented flat order
+            (:func:`controllers.policy_interface.flatten_observation`), the ``policy`` navigator's ``flatten``.
         scenarios: a new world per episode (:mod:`sim.env.worlds`): a list of scenarios or a generator
             specification; ``scenario`` is then not used.
         render_mode: None or ``"rgb_array"``.
@@ -65,13 +68,15 @@ class NavigateEnv(gymnasium.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 50}
 
     def __init__(self, scenario: Any = "gwo-scenario-2", render_mode: str | None = None, width: int = 640,
-                 height: int = 480, camera: str = "top", scenarios: Any = None, **options: Any):
+                 height: int = 480, camera: str = "top", scenarios: Any = None, flatten: bool = False,
+                 **options: Any):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode: expected None or 'rgb_array', got {render_mode!r}")
         self.render_mode = render_mode
         self._size = (width, height, camera)
         self._options = EnvOptions(**options)
         self._renderer = None
+        self._flatten = bool(flatten)
         self._seeded = False  # whether a reset had a seed: then reset() derives new seeds from np_random
         self._source, self._layout = None, None
         if scenarios is not None:
@@ -88,6 +93,12 @@ class NavigateEnv(gymnasium.Env):
         self.close()
         self.dm_env = make_environment(scenario, self._options, self._layout)
         self.observation_space = spaces.Dict({key: _box(spec) for key, spec in self.dm_env.observation_spec().items()})
+        layout = self.task.layout
+        if self._flatten:
+            low, high = layout.flat_bounds()
+            self.observation_space = spaces.Box(low=low, high=high, dtype=low.dtype)
+        self.metadata = {**self.metadata, "range_angles_rad": self.task.scene.range_angles_rad.tolist(),
+                         "flat_order": [key for key in FLAT_ORDER if key in layout.bounds()]}
         self.action_space = _box(self.dm_env.action_spec())
         self.metadata = {**self.metadata, "render_fps": 1.0 / self.dm_env.control_timestep()}
 
@@ -120,14 +131,17 @@ class NavigateEnv(gymnasium.Env):
         self.task.set_seeds(Seeds(seeds.planner if planner is None else int(planner),
                                   seeds.world if world is None else int(world)))
         timestep = self.dm_env.reset()
-        return timestep.observation, self.task.info()
+        return self._observation(timestep.observation), self.task.info()
+
+    def _observation(self, observation: dict[str, np.ndarray]):
+        return flatten_observation(observation) if self._flatten else observation
 
     def step(self, action):
         timestep = self.dm_env.step(action)  # the task checks it (ActionError) and reads it in float64
         last = timestep.last()
         terminated = bool(last and timestep.discount == 0.0)
         truncated = bool(last and timestep.discount == 1.0)
-        return timestep.observation, float(timestep.reward), terminated, truncated, self.task.info()
+        return self._observation(timestep.observation), float(timestep.reward), terminated, truncated, self.task.info()
 
     def render(self):
         if self.render_mode != "rgb_array":
