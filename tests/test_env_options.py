@@ -93,3 +93,11 @@ def test_bad_actions_are_a_clear_error_before_any_physics(action, problem):
     assert env.task.stepper.step_index == 1
     env.step(np.zeros(2, np.float32))  # the environment is still usable
     assert env.task.stepper.step_index == 2
+
+
+def test_a_time_limit_between_control_periods_is_refused_not_cut_short():
+    with pytest.raises(ConfigError, match=r"env.time_limit_s.*0.051 s.*after 0.04 s"):
+        make_environment("gwo-scenario-2", time_limit_s=0.051)
+    env = make_environment("gwo-scenario-2", time_limit_s=0.06)
+    steps = replay(env, [np.zeros(2, np.float32)] * 10)
+    assert len(steps) == 3 and steps[-1].last() and env.task.info()["time_s"] == pytest.approx(0.06)

@@ -37,6 +37,7 @@ end an episode either: ``reset`` returns ``info["outcome"]`` already set (and
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path as FilePath
 from typing import Any
@@ -121,6 +122,18 @@ class EnvOptions:
             object.__setattr__(self, "stop_on_collision", bool(self.terminate_on_collision))
 
 
+def check_time_limit(time_limit_s: float | None, control_dt_s: float) -> None:
+    """The episode runs whole control periods, the last one ending at or before the limit: a limit that is not
+    a whole number of periods would end the episode early (0.051 s at 50 Hz after 0.04 s), so it is refused."""
+    if time_limit_s is None:
+        return
+    periods = time_limit_s / control_dt_s
+    if abs(periods - round(periods)) > 1e-9 * max(1.0, periods):
+        raise ConfigError("env.time_limit_s", f"{time_limit_s:g} s is not a whole number of control periods "
+                                              f"({control_dt_s:g} s): the episode would end after "
+                                              f"{math.floor(periods + 1e-9) * control_dt_s:g} s")
+
+
 def model_bytes(model: mujoco.MjModel) -> bytes:
     """The model in MuJoCo's binary format (MJB)."""
     buffer = np.empty(mujoco.mj_sizeModel(model), dtype=np.uint8)
@@ -167,6 +180,7 @@ class NavigationTask(control.Task):
         self.options = options
         self.scene = index_scene(physics.model.ptr, xml)  # the indices, on the physics' own model
         self.simulation = Simulation(scenario, self.scene)
+        check_time_limit(options.time_limit_s, self.simulation.control_dt_s)
         fallback = scenario.seeds
         self.set_seeds(Seeds(fallback.planner if options.seed is None else int(options.seed),
                              fallback.world if options.world_seed is None else int(options.world_seed)))
