@@ -160,6 +160,23 @@ def segment_box_pair_distances(a: np.ndarray, b: np.ndarray, boxes: np.ndarray) 
     return np.where(enter <= leave, 0.0, best)
 
 
+def segment_disc_distance(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> float:
+    """Distance from the segment (ax, ay)-(bx, by) to the point (cx, cy), on plain floats.
+
+    The same construction as :func:`segment_disc_distances` (project the centre onto the
+    segment, clamp to its ends), for a caller that asks about one segment at a time (OMPL's
+    validity callbacks), where a NumPy call's fixed cost would dominate.  The tests check
+    that both agree.
+    """
+    dx = bx - ax
+    dy = by - ay
+    len2 = dx * dx + dy * dy
+    t = 0.0
+    if len2 > 0.0:
+        t = min(max(((cx - ax) * dx + (cy - ay) * dy) / len2, 0.0), 1.0)
+    return math.hypot(cx - (ax + t * dx), cy - (ay + t * dy))
+
+
 def segment_box_distance(ax: float, ay: float, bx: float, by: float,
                          x_min: float, y_min: float, x_max: float, y_max: float) -> float:
     """Distance from the segment (ax, ay)-(bx, by) to one axis-aligned box (0 where they touch or cross).

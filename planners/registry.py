@@ -19,6 +19,7 @@ from swarmnav.planners.waiter_ant_colony import WaiterAntColonyPlanner
 from swarmnav.planners.grey_wolf import GreyWolfPlanner
 from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.particle_swarm import ParticleSwarmPlanner
+from swarmnav.planners.sampling_ompl import OMPL_PLANNERS
 from swarmnav.planners.errors import BudgetExceeded, GoalBlocked, NoPathFound, PlanningError, StartBlocked
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import Box, Disc, Pose2D, Rect
@@ -41,7 +42,7 @@ def register(cls: type) -> type:
 for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,
              MaxMinAntSystemPlanner, ImprovedAntColonyPlanner, WaiterAntColonyPlanner, AntSystemPlanner,
              OptimalPlanner, BeeColonyPlanner, AdaptiveLimitBeeColonyPlanner, GreyWolfPlanner,
-             ParticleSwarmPlanner, MaxMinColonyPlanner):
+             ParticleSwarmPlanner, MaxMinColonyPlanner, *OMPL_PLANNERS):
     register(_cls)
 
 

@@ -32,6 +32,7 @@ BENCH_PLANNERS_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3"
                             "adl-abc-path-1", "adl-abc-path-2", "adl-abc-path-3",
                             "dense-field-30", "restaurant-table-2", "restaurant-table-5")
 BENCH_PLANNERS_PLANNERS = ("abc", "adl_abc", "gwo", "pso")
+BENCH_PLANNERS_SAMPLING = ("rrt_star", "informed_rrt_star", "bit_star", "prm_star")  # OMPL's
 # bench navigation --quick: one world seed on one scenario of each generated kind.
 BENCH_NAVIGATION_QUICK_SCENARIOS = ("dyn-crossing-1", "dyn-head-on-1", "dyn-overtake-1", "dyn-crowd-1")
 BENCH_STUDY_QUICK = (10, 300)  # bench study --quick: seeds per scenario, GWO iterations; no Ray
@@ -55,6 +56,9 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenarios", nargs="+", default=list(BENCH_PLANNERS_SCENARIOS), metavar="NAME")
     parser.add_argument("--planners", nargs="+", default=list(BENCH_PLANNERS_PLANNERS), choices=BENCH_PLANNERS_PLANNERS,
                         metavar="NAME", help=f"continuous planners among {', '.join(BENCH_PLANNERS_PLANNERS)}")
+    parser.add_argument("--sampling", nargs="*", default=list(BENCH_PLANNERS_SAMPLING), choices=BENCH_PLANNERS_SAMPLING,
+                        metavar="NAME", help=f"OMPL planners among {', '.join(BENCH_PLANNERS_SAMPLING)}, given "
+                        "population x iterations collision checks (default all; none: --sampling alone)")
     parser.add_argument("--seeds", type=options.positive_int, default=10, help="runs per planner and scenario (default 10)")
     parser.add_argument("--population", type=options.positive_int, default=50)
     parser.add_argument("--iterations", type=options.positive_int, default=100)

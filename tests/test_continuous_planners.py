@@ -210,17 +210,19 @@ def test_bench_planners_rows_agree_with_their_runs(tmp_path):
     add_bench_planners_arguments(parser)
     args = parser.parse_args(["--scenarios", "gwo-scenario-1", "adl-abc-path-1", "--planners", "gwo", "pso",
                               "--seeds", "2", "--population", "10", "--iterations", "5", "--peer-runs", "0",
-                              "--modes", "paper", "--fields", "0", "--out", str(tmp_path)])
+                              "--modes", "paper", "--fields", "0", "--sampling", "rrt_star", "--out", str(tmp_path)])
     result = bench_continuous.benchmark(args)
     assert result["peers"] == []
     rows = {(r["scenario"], r["planner"]): r for r in result["rows"]}
-    assert set(rows) == {(s, p) for s in ("gwo-scenario-1", "adl-abc-path-1") for p in ("gwo", "pso")}
+    assert set(rows) == {(s, p) for s in ("gwo-scenario-1", "adl-abc-path-1") for p in ("gwo", "pso", "rrt_star")}
     problem = scenario_problem(load_scenario("gwo-scenario-1"), clearance_m=0.0)
     optimum = OptimalPlanner().plan(problem, np.random.default_rng(0)).stats.extra["optimum_length_m"]
     runs = pd.read_parquet(tmp_path / "scenarios" / "runs.parquet")
-    assert len(runs) == 2 * 3 * 2 and (runs.clearance_m == 0.0).all()  # 2 scenarios x (2 planners + optimal)
+    # 2 scenarios x (2 planners + OMPL's rrt_star + optimal) x 2 seeds
+    assert len(runs) == 2 * 4 * 2 and (runs.clearance_m == 0.0).all()
     for (scenario, planner), row in rows.items():
-        arm = runs[(runs.scenario == scenario) & (runs.label == f"{planner}-paper")]
+        label = planner if row["mode"] == "ompl" else f"{planner}-paper"
+        arm = runs[(runs.scenario == scenario) & (runs.label == label)]
         assert row["runs"] == len(arm) == 2 and row["feasible_runs"] == int(arm.success.sum())
         if scenario == "adl-abc-path-1":         # no path exists there: every run fails, the note says why
             assert row["optimum_length_m"] is None and row["feasible_runs"] == 0
@@ -253,7 +255,7 @@ def test_bench_planners_random_fields_are_a_study_of_scenario_files(tmp_path):
     add_bench_planners_arguments(parser)
     args = parser.parse_args(["--scenarios", "gwo-scenario-1", "--planners", "gwo", "--modes", "robust",
                               "--seeds", "2", "--population", "10", "--iterations", "5", "--peer-runs", "0",
-                              "--fields", "2", "--out", str(tmp_path)])
+                              "--fields", "2", "--sampling", "--out", str(tmp_path)])
     (summary,) = bench_continuous.benchmark(args)["fields"]
     runs = pd.read_parquet(tmp_path / "fields" / "runs.parquet")
     assert summary["runs"] == 4 and summary["fields"] + summary["fields_without_path"] == 2

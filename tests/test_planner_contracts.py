@@ -32,6 +32,8 @@ def small_budget(name: str) -> dict:
         params.update(population=20, iterations=20)
     if "ants" in fields:
         params.update(ants=10, iterations=10)
+    if "round_evaluations" in fields:  # the OMPL planners: a budget of collision checks
+        params.update(max_evaluations=1000)
     return params
 
 

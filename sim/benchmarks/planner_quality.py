@@ -4,7 +4,9 @@ Two studies, built in code and run by the study machinery (:mod:`swarmnav.sim.st
 the same cells, the one episode function, the same Parquet rows as ``swarmnav study``):
 
 * ``bench-planners`` on the bundled scenarios: every planner in every mode (labels
-  ``gwo-paper``, ``gwo-robust``, ...) and ``optimal`` (the exact shortest path, the
+  ``gwo-paper``, ``gwo-robust``, ...), OMPL's sampling planners (labels ``rrt_star``, ...,
+  mode ``ompl``: :mod:`planners.sampling_ompl`, given as many collision checks as a swarm's
+  population x iterations evaluations) and ``optimal`` (the exact shortest path, the
   yardstick), plan only, with the papers' clearance (``--clearance-m``, default 0: the
   robot radius only) and the moving obstacles frozen at t = 0 (as every plan is);
 * ``bench-planners-fields`` on random disc fields of 10-40 discs written as scenario
@@ -26,6 +28,7 @@ from pathlib import Path as FilePath
 from typing import Any
 
 OPTIMUM_LABEL = "optimal"
+SAMPLING_MODE = "ompl"  # the mode column of OMPL's planners (they have no paper/robust modes)
 WITHIN_RATIO = 1.03  # issue 14: robust median length <= 1.03 x the exact optimum
 
 
@@ -35,11 +38,14 @@ def mode_label(planner: str, mode: str) -> str:
 
 def study_tables(name: str, scenarios: list[str], planners: list[str], modes: list[str], seeds: int,
                  population: int, iterations: int, clearance_m: float | None = None,
-                 paper_lengths_m: dict[tuple[str, str], float] | None = None) -> dict[str, Any]:
-    """The tables of a plan-only study of ``planners`` x ``modes`` and the exact optimum."""
+                 paper_lengths_m: dict[tuple[str, str], float] | None = None,
+                 sampling: list[str] = ()) -> dict[str, Any]:
+    """The tables of a plan-only study of ``planners`` x ``modes``, the ``sampling`` (OMPL) planners with a
+    budget of ``population * iterations`` collision checks, and the exact optimum."""
     entries = [{"name": p, "label": mode_label(p, m),
                 "params": {"population": population, "iterations": iterations, "mode": m}}
                for p in planners for m in modes]
+    entries += [{"name": p, "label": p, "params": {"max_evaluations": population * iterations}} for p in sampling]
     entries.append({"name": "optimal", "label": OPTIMUM_LABEL})
     tables: dict[str, Any] = {"name": name, "scenarios": scenarios, "mode": "plan", "seeds": seeds,
                               "planners": entries, "reference": entries[0]["label"]}
@@ -96,46 +102,51 @@ def arm_figures(arm: list[dict[str, Any]]) -> dict[str, Any]:
             "evaluations": round(statistics.fmean(evaluations)) if evaluations else None}
 
 
-def scenario_rows(rows: list[dict[str, Any]], planners: list[str], modes: list[str]) -> list[dict[str, Any]]:
+def _arm_keys(planners: list[str], modes: list[str], sampling: list[str]) -> list[tuple[str, str, str]]:
+    """(planner, mode, label) of each arm, in the order asked: the swarms in their modes, then OMPL's."""
+    return [(p, m, mode_label(p, m)) for p in planners for m in modes] + [(p, SAMPLING_MODE, p) for p in sampling]
+
+
+def scenario_rows(rows: list[dict[str, Any]], planners: list[str], modes: list[str],
+                  sampling: list[str] = ()) -> list[dict[str, Any]]:
     """One table row per scenario, planner and mode, in the order asked."""
     by_arm, optimum = arms(rows), optimum_by_scenario(rows)
     out = []
     for scenario in dict.fromkeys(r["scenario"] for r in rows):
-        for planner in planners:
-            for mode in modes:
-                arm = by_arm.get((scenario, mode_label(planner, mode)), [])
-                figures = arm_figures(arm)
-                best = optimum.get(scenario)
-                median = figures["median_length_m"]
-                out.append({"scenario": scenario, "planner": planner, "mode": mode, **figures,
-                            "optimum_length_m": best,
-                            "ratio_to_optimum": median / best if (median is not None and best) else None,
-                            "straight_line_m": arm[0]["straight_line_m"] if arm else None})
+        for planner, mode, label in _arm_keys(planners, modes, sampling):
+            arm = by_arm.get((scenario, label), [])
+            figures = arm_figures(arm)
+            best = optimum.get(scenario)
+            median = figures["median_length_m"]
+            out.append({"scenario": scenario, "planner": planner, "mode": mode, **figures,
+                        "optimum_length_m": best,
+                        "ratio_to_optimum": median / best if (median is not None and best) else None,
+                        "straight_line_m": arm[0]["straight_line_m"] if arm else None})
     return out
 
 
-def field_summary(rows: list[dict[str, Any]], planners: list[str], modes: list[str]) -> list[dict[str, Any]]:
+def field_summary(rows: list[dict[str, Any]], planners: list[str], modes: list[str],
+                  sampling: list[str] = ()) -> list[dict[str, Any]]:
     """Per planner and mode over the random fields: feasible runs, the median and worst of the per-field
     median length over the exact optimum, fields within :data:`WITHIN_RATIO`, the median plan time.  A field
     without any path (the exact planner proves it) is counted in ``fields_without_path`` and has no ratio."""
     by_arm, optimum = arms(rows), optimum_by_scenario(rows)
     with_path = [s for s, best in optimum.items() if best is not None]
     out = []
-    for planner in planners:
-        for mode in modes:
-            ratios, times, feasible, runs = [], [], 0, 0
-            for scenario in with_path:
-                figures = arm_figures(by_arm.get((scenario, mode_label(planner, mode)), []))
-                runs += figures["runs"]
-                feasible += figures["feasible_runs"]
-                times += [run_time_s(r) for r in by_arm.get((scenario, mode_label(planner, mode)), [])]
-                median = figures["median_length_m"]
-                ratios.append(median / optimum[scenario] if median is not None else math.inf)
-            out.append({"planner": planner, "mode": mode, "fields": len(with_path),
-                        "fields_without_path": len(optimum) - len(with_path), "runs": runs,
-                        "feasible_runs": feasible,
-                        "median_ratio": statistics.median(ratios) if ratios else None,
-                        "worst_median_ratio": max(ratios) if ratios else None,
-                        "fields_within_1_03": sum(r <= WITHIN_RATIO for r in ratios),
-                        "median_plan_time_s": statistics.median(times) if times else None})
+    for planner, mode, label in _arm_keys(planners, modes, sampling):
+        ratios, times, feasible, runs = [], [], 0, 0
+        for scenario in with_path:
+            figures = arm_figures(by_arm.get((scenario, label), []))
+            runs += figures["runs"]
+            feasible += figures["feasible_runs"]
+            times += [run_time_s(r) for r in by_arm.get((scenario, label), [])]
+            median = figures["median_length_m"]
+            ratios.append(median / optimum[scenario] if median is not None else math.inf)
+        out.append({"planner": planner, "mode": mode, "fields": len(with_path),
+                    "fields_without_path": len(optimum) - len(with_path), "runs": runs,
+                    "feasible_runs": feasible,
+                    "median_ratio": statistics.median(ratios) if ratios else None,
+                    "worst_median_ratio": max(ratios) if ratios else None,
+                    "fields_within_1_03": sum(r <= WITHIN_RATIO for r in ratios),
+                    "median_plan_time_s": statistics.median(times) if times else None})
     return out

@@ -123,6 +123,8 @@ def run_studies(args: argparse.Namespace) -> int:
 def add_report_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("dir", help="a study's output directory (holding runs.parquet)")
     p.add_argument("--out", help="HTML report path (default: DIR/report.html); the Markdown twin goes beside it")
+    p.add_argument("--ompl-log", metavar="OUT", help="also write the rows as OMPL benchmark logs, OUT/<scenario>.log "
+                   "(one experiment each), for `ompl_benchmark_statistics OUT/*.log -d bench.db` and Planner Arena")
 
 
 def run_report(args: argparse.Namespace) -> int:
@@ -134,4 +136,8 @@ def run_report(args: argparse.Namespace) -> int:
     html_path = FilePath(args.out) if args.out else directory / "report.html"
     markdown_path = write_report(directory, html_path)
     print(f"report: {html_path}  markdown: {markdown_path}")
+    if args.ompl_log:
+        from swarmnav.sim.study.ompl_log import write_ompl_logs
+        logs = write_ompl_logs(directory, args.ompl_log)
+        print(f"OMPL logs: {len(logs)} in {args.ompl_log}  (ompl_benchmark_statistics {args.ompl_log}/*.log -d bench.db)")
     return 0

@@ -1,0 +1,422 @@
+"""OMPL's asymptotically optimal sampling planners behind swarmnav's seam: ``rrt_star``,
+``informed_rrt_star``, ``bit_star`` and ``prm_star``.
+
+The Open Motion Planning Library (Sucan, Moll and Kavraki 2012, "The Open Motion Planning
+Library", IEEE Robotics & Automation Magazine 19(4)), through its Python bindings (PyPI
+``ompl``, 2.x), plans; swarmnav decides what is free:
+
+* **State space.** The robot is a disc, so its configuration space is the plane: a
+  ``RealVectorStateSpace(2)`` bounded by ``Problem.bounds`` (already shrunk by the inflation).
+  An SE(2) space would add the heading to OMPL's distance, and the path-length objective
+  would no longer be metres.
+* **Validity.** A state is valid when the point clears every inflated disc and box, a
+  motion when the straight segment does: both by ``Problem.segment_clearances_m`` (the exact
+  segment-disc and segment-box distances of :mod:`models.geometry`, at the problem's
+  inflation, robot radius plus the scenario's clearance), never by OMPL's discretised
+  motion checking.  So every returned path passes ``Problem.is_collision_free``.
+* **Objective.** ``PathLengthOptimizationObjective``: the cost is the path's length in metres,
+  the ``cost_history`` every swarm planner records.
+* **Budget.** ``max_evaluations`` counts collision checks (state and motion validity
+  calls, what these planners spend as the swarms spend objective evaluations); once it is
+  spent, further checks answer "invalid" without being made (``extra["refused_checks"]``)
+  and the planner stops, so ``stats.evaluations`` never exceeds it.  ``time_s`` (0: none) is
+  a wall-clock limit on top.
+* **Progress.** An *iteration* here is a round of ``round_evaluations`` collision checks;
+  ``cost_history`` is the best length after the set-up and after each round (``inf`` until
+  the first solution), ``evaluation_history`` the checks spent by then.  OMPL's own
+  iteration count (one sample each) is ``extra["ompl_iterations"]``.
+* **Seeding.** Each plan draws a seed from ``rng`` and gives it to ``ompl.util.RNG.setSeed``
+  before any OMPL object is built, so every sampler of the run is seeded from it.  OMPL
+  (``RandomNumbers.cpp``) seeds each sampler's generator from one global seed generator, and
+  ``setSeed`` reseeds that generator even after seeds were handed out (it logs an error,
+  silenced here), so a plan is reproducible in any process, after any earlier plan.  Plans
+  are serialised by a lock, since that generator is process-wide.  Guaranteed: with no
+  ``time_s`` the same seed gives the same path, bit for bit, on one thread (``rrt_star``,
+  ``informed_rrt_star`` and ``bit_star`` run their solve on the calling thread; ``prm_star``
+  is driven as below).  With ``time_s`` set, where the run stops depends on the machine.
+* **PRM\\*.** OMPL's ``PRM::solve`` alternates growing and expanding the roadmap on 2:1 *time*
+  slices and checks for a solution on a second thread, so it is not reproducible, and that
+  thread cannot call back into Python.  ``prm_star`` therefore drives OMPL's ``PRMstar``
+  roadmap directly: start and goal are added as milestones, then ``growRoadmap`` (sample a
+  valid state, connect it to its k-nearest, k = k_PRM log n: Karaman and Frazzoli 2011,
+  "Sampling-based algorithms for optimal motion planning", IJRR 30(7), Algorithm 4 with
+  Eq. (4)'s connection rule) runs round by round, and after each round the shortest
+  start-goal route on the roadmap (Dijkstra on its ``PlannerData``, edge cost the segment
+  length) is the best cost.  That is the algorithm of the paper; OMPL's extra expansion
+  step (random bounces from weakly connected milestones) is not run.
+* **Console.** OMPL's log level is set to ``LOG_NONE`` once, at the first import (which
+  happens on the first plan, so the CLI does not pay for it elsewhere).
+
+A goal OMPL cannot reach within the budget is :class:`planners.errors.NoPathFound`.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from swarmnav.models.geometry import segment_disc_distance
+from swarmnav.planners.errors import NoPathFound, check_parameters
+from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
+
+#: A state or segment counts as free when its gap to the inflated obstacles is at least this
+#: (the same touching tolerance as ``check_endpoints``; ``is_collision_free`` allows 1e-6).
+_TOUCH_M = 1e-9
+_OMPL_LOCK = threading.Lock()
+
+
+@functools.cache
+def _ompl() -> tuple[Any, Any, Any]:
+    """Import OMPL's ``base``, ``geometric`` and ``util`` on first use and silence its console, once."""
+    import ompl.base as ob
+    import ompl.geometric as og
+    import ompl.util as ou
+    ou.setLogLevel(ou.LOG_NONE)
+    return ob, og, ou
+
+
+class _CollisionChecks:
+    """The exact checks OMPL calls, counted and held to the budget.
+
+    Discs are measured one by one on plain floats (:func:`models.geometry.segment_disc_distance`,
+    a NumPy call per segment would cost tens of microseconds), boxes (grid maps) by
+    :meth:`Problem.segment_clearances_m`, culled to the boxes near the segment.
+    """
+
+    def __init__(self, problem: Problem, max_checks: float, deadline_s: float):
+        self.problem = problem
+        self.discs = [(float(c[0]), float(c[1]), float(r))
+                      for c, r in zip(problem.disc_centres_m, problem.inflated_radii_m)]
+        self.max_checks = max_checks
+        self.deadline_s = deadline_s
+        self.made = 0
+        self.refused = 0
+
+    @property
+    def spent(self) -> bool:
+        return self.made >= self.max_checks or time.perf_counter() >= self.deadline_s
+
+    def free(self, ax: float, ay: float, bx: float, by: float) -> bool:
+        """Whether the segment keeps at least the inflation from every obstacle (counted; refused, so
+        reported blocked, once the budget is spent)."""
+        if self.made >= self.max_checks:
+            self.refused += 1
+            return False
+        self.made += 1
+        for cx, cy, radius_m in self.discs:
+            if segment_disc_distance(ax, ay, bx, by, cx, cy) - radius_m < -_TOUCH_M:
+                return False
+        if self.problem.boxes:
+            gap = self.problem.segment_clearances_m(np.array((ax, ay)), np.array((bx, by)), cull_beyond_m=0.0)
+            return bool(gap[0] >= -_TOUCH_M)
+        return True
+
+    def state_valid(self, state) -> bool:
+        x, y = state[0], state[1]
+        return self.free(x, y, x, y)
+
+    def motion_valid(self, s1, s2) -> bool:
+        return self.free(s1[0], s1[1], s2[0], s2[1])
+
+
+@functools.cache
+def _motion_validator_type() -> type:
+    """OMPL's ``MotionValidator`` answered by :class:`_CollisionChecks` (built after the lazy import)."""
+    ob, _, _ = _ompl()
+
+    class ExactMotionValidator(ob.MotionValidator):
+        def __init__(self, si, checks: _CollisionChecks):
+            super().__init__(si)
+            self.checks = checks
+
+        def checkMotion(self, s1, s2) -> bool:  # noqa: N802 - OMPL's name
+            return self.checks.motion_valid(s1, s2)
+
+    return ExactMotionValidator
+
+
+@dataclass
+class _Progress:
+    """Best cost after the set-up and after each round, with the checks spent by then."""
+
+    costs: list[float] = field(default_factory=list)
+    checks: list[int] = field(default_factory=list)
+
+    def record(self, cost: float, checks: int) -> None:
+        self.costs.append(float(cost))
+        self.checks.append(int(checks))
+
+
+@dataclass
+class OmplPlanner:
+    """Shared set-up of the OMPL planners (see the module docstring).
+
+    Attributes:
+        max_evaluations: the budget in collision checks (0 or None: none, then ``time_s`` is needed).
+        time_s: wall-clock limit in seconds (0 or None: none).
+        round_evaluations: collision checks per recorded round of the best-cost history.
+    """
+
+    name: ClassVar[str]
+    supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
+    #: The OMPL class (in ``ompl.geometric``) this planner runs.
+    ompl_class: ClassVar[str]
+
+    max_evaluations: int | None = 5000
+    time_s: float | None = None
+    round_evaluations: int = 100
+
+    def __post_init__(self) -> None:
+        check_parameters(self, (
+            ("max_evaluations", self.max_evaluations is None or self.max_evaluations >= 0, "must be at least 0"),
+            ("time_s", self.time_s is None or (math.isfinite(self.time_s) and self.time_s >= 0),
+             "must be a finite number of seconds, at least 0"),
+            ("max_evaluations", bool(self.max_evaluations) or bool(self.time_s),
+             "must be positive unless time_s is (a sampling planner needs a budget)"),
+            ("round_evaluations", self.round_evaluations >= 1, "must be at least 1"),
+        ))
+        self.check_own_parameters()
+
+    def check_own_parameters(self) -> None:
+        """Checks of a subclass's own parameters."""
+
+    def configure(self, planner) -> None:
+        """Set a subclass's own parameters on the OMPL planner."""
+
+    def plan(self, problem: Problem, rng: np.random.Generator) -> Path:
+        """Plan with OMPL seeded from ``rng``.
+
+        Raises:
+            StartBlocked, GoalBlocked: an endpoint is outside the bounds or in an obstacle.
+            NoPathFound: no start-goal path within the budget.
+        """
+        t0 = time.perf_counter()
+        check_supported(self, problem)
+        check_endpoints(problem)
+        seed = int(rng.integers(1, 2**31 - 1))
+        with _OMPL_LOCK:
+            return self._run(problem, seed, t0)
+
+    def _run(self, problem: Problem, seed: int, t0: float) -> Path:
+        ob, og, ou = _ompl()
+        ou.RNG.setSeed(seed)
+        space = ob.RealVectorStateSpace(2)
+        bounds = ob.RealVectorBounds(2)
+        b = problem.bounds
+        bounds.low = [b.x_min_m, b.y_min_m]
+        bounds.high = [b.x_max_m, b.y_max_m]
+        space.setBounds(bounds)
+        si = ob.SpaceInformation(space)
+        checks = _CollisionChecks(problem, self.max_evaluations or math.inf,
+                                  t0 + self.time_s if self.time_s else math.inf)
+        si.setStateValidityChecker(checks.state_valid)
+        validator = _motion_validator_type()(si, checks)
+        si.setMotionValidator(validator)
+        si.setup()
+        start, goal = si.allocState(), si.allocState()
+        start[0], start[1] = problem.start.x_m, problem.start.y_m
+        goal[0], goal[1] = problem.goal.x_m, problem.goal.y_m
+        pdef = ob.ProblemDefinition(si)
+        pdef.setStartAndGoalStates(start, goal)
+        pdef.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+        planner = getattr(og, self.ompl_class)(si)
+        self.configure(planner)
+        planner.setProblemDefinition(pdef)
+        planner.setup()
+        progress = _Progress()
+        try:
+            waypoints, iterations = self.search(ob, planner, pdef, checks, progress)
+        finally:
+            validator.checks = None  # no cycle left between the validator and the run
+            del planner, pdef, validator, si
+        if waypoints is None:
+            raise NoPathFound(f"{self.name}: no path within the budget of "
+                              f"{self._budget_text()} ({checks.made} collision checks made)")
+        waypoints[0], waypoints[-1] = problem.start.xy, problem.goal.xy
+        if not problem.is_collision_free(waypoints):  # the validity checks make this unreachable
+            raise NoPathFound(f"{self.name}: OMPL returned a path the exact check refuses")
+        improved = [i for i in range(1, len(progress.costs)) if progress.costs[i] < progress.costs[i - 1]]
+        return Path.from_waypoints(
+            waypoints, time.perf_counter() - t0, iterations=len(progress.costs) - 1, evaluations=checks.made,
+            cost_history=tuple(progress.costs), evaluation_history=tuple(progress.checks),
+            extra={"ompl_planner": self.ompl_class, "ompl_seed": seed, "ompl_iterations": iterations,
+                   "refused_checks": checks.refused,
+                   "convergence_iteration": improved[-1] if improved else 0})
+
+    def _budget_text(self) -> str:
+        parts = ([f"{self.max_evaluations} collision checks"] if self.max_evaluations else []) + (
+            [f"{self.time_s:g} s"] if self.time_s else [])
+        return " and ".join(parts)
+
+    def search(self, ob, planner, pdef, checks: _CollisionChecks,
+               progress: _Progress) -> tuple[np.ndarray | None, int]:
+        """Run the OMPL planner to the budget, recording the best cost after each round; return
+        the waypoints of the best exact solution (None: none) and OMPL's iteration count."""
+        raise NotImplementedError
+
+
+def _path_waypoints(path) -> np.ndarray:
+    return np.array([(s[0], s[1]) for s in path.getStates()], dtype=float).reshape(-1, 2)
+
+
+@dataclass
+class _TreePlanner(OmplPlanner):
+    """A planner whose ``solve`` runs on the calling thread and keeps a best cost (RRT*, BIT*):
+    one ``solve`` under a termination condition that also closes each round."""
+
+    def search(self, ob, planner, pdef, checks, progress):
+        best = lambda: planner.bestCost().value()  # noqa: E731
+        progress.record(math.inf, checks.made)
+        next_round = [checks.made + self.round_evaluations]
+
+        def stop() -> bool:
+            if checks.made >= next_round[0]:
+                progress.record(best(), checks.made)
+                next_round[0] = checks.made + self.round_evaluations
+            return checks.spent
+
+        planner.solve(ob.PlannerTerminationCondition(stop))
+        if checks.made > progress.checks[-1]:
+            progress.record(best(), checks.made)
+        if not pdef.hasExactSolution():
+            return None, planner.numIterations()
+        return _path_waypoints(pdef.getSolutionPath()), planner.numIterations()
+
+
+@dataclass
+class RRTStarPlanner(_TreePlanner):
+    """``rrt_star``: OMPL's RRT* (Karaman and Frazzoli 2011, Algorithm 6), k-nearest rewiring off,
+    the r-disc radius of its Eq. (5) scaled by ``rewire_factor``.
+
+    Attributes:
+        range_m: longest motion added at once (0: OMPL's default, a fifth of the space's extent).
+        goal_bias: probability of sampling the goal (OMPL's default 0.05).
+        rewire_factor: OMPL's rewiring-radius factor (> 1 keeps the asymptotic optimality; default 1.1).
+    """
+
+    name: ClassVar[str] = "rrt_star"
+    ompl_class: ClassVar[str] = "RRTstar"
+
+    range_m: float = 0.0
+    goal_bias: float = 0.05
+    rewire_factor: float = 1.1
+
+    def check_own_parameters(self) -> None:
+        check_parameters(self, (
+            ("range_m", math.isfinite(self.range_m) and self.range_m >= 0, "must be a finite length >= 0"),
+            ("goal_bias", 0.0 <= self.goal_bias <= 1.0, "must lie in [0, 1]"),
+            ("rewire_factor", math.isfinite(self.rewire_factor) and self.rewire_factor >= 1.0,
+             "must be a finite number >= 1"),
+        ))
+
+    def configure(self, planner) -> None:
+        if self.range_m:
+            planner.setRange(self.range_m)
+        planner.setGoalBias(self.goal_bias)
+        planner.setRewireFactor(self.rewire_factor)
+
+
+@dataclass
+class InformedRRTStarPlanner(RRTStarPlanner):
+    """``informed_rrt_star``: OMPL's Informed RRT* (Gammell, Srinivasa and Barfoot 2014, "Informed
+    RRT*: optimal sampling-based path planning focused via direct sampling of an admissible
+    ellipsoidal heuristic", IROS; Algorithm 1): RRT* that, once it has a solution of length c,
+    samples only the prolate hyperspheroid of states that could improve it (Eq. (10))."""
+
+    name: ClassVar[str] = "informed_rrt_star"
+    ompl_class: ClassVar[str] = "InformedRRTstar"
+
+
+@dataclass
+class BITStarPlanner(_TreePlanner):
+    """``bit_star``: OMPL's BIT* (Gammell, Barfoot and Srinivasa 2020, "Batch Informed Trees (BIT*):
+    informed asymptotically optimal anytime search", IJRR 39(5); Algorithms 1-3), k-nearest
+    variant (OMPL's default).
+
+    Attributes:
+        samples_per_batch: samples added per batch (OMPL's default 100).
+        rewire_factor: the connection-radius factor (default 1.1).
+    """
+
+    name: ClassVar[str] = "bit_star"
+    ompl_class: ClassVar[str] = "BITstar"
+
+    samples_per_batch: int = 100
+    rewire_factor: float = 1.1
+
+    def check_own_parameters(self) -> None:
+        check_parameters(self, (
+            ("samples_per_batch", self.samples_per_batch >= 1, "must be at least 1"),
+            ("rewire_factor", math.isfinite(self.rewire_factor) and self.rewire_factor >= 1.0,
+             "must be a finite number >= 1"),
+        ))
+
+    def configure(self, planner) -> None:
+        planner.setSamplesPerBatch(self.samples_per_batch)
+        planner.setRewireFactor(self.rewire_factor)
+
+
+@dataclass
+class PRMStarPlanner(OmplPlanner):
+    """``prm_star``: OMPL's PRM* roadmap (Karaman and Frazzoli 2011, Algorithm 4, k-nearest
+    connections), grown round by round and queried by Dijkstra (see the module docstring for why
+    OMPL's ``solve`` is not used)."""
+
+    name: ClassVar[str] = "prm_star"
+    ompl_class: ClassVar[str] = "PRMstar"
+
+    def search(self, ob, planner, pdef, checks, progress):
+        # Start and goal become milestones (the solve ends at once: its termination condition holds).
+        planner.solve(ob.plannerAlwaysTerminatingCondition())
+        pdef.clearSolutionPaths()
+        waypoints, cost = _roadmap_route(ob, planner)
+        progress.record(cost, checks.made)
+        while not checks.spent:
+            limit = checks.made + self.round_evaluations
+            before = checks.made
+            planner.growRoadmapPtc(ob.PlannerTerminationCondition(lambda: checks.made >= limit or checks.spent))
+            if checks.made == before:  # nothing left to sample within the budget
+                break
+            route, cost = _roadmap_route(ob, planner)
+            if route is not None and cost < progress.costs[-1]:
+                waypoints = route
+            progress.record(min(cost, progress.costs[-1]), checks.made)
+        return waypoints, planner.milestoneCount()
+
+
+def _roadmap_route(ob, planner) -> tuple[np.ndarray | None, float]:
+    """Shortest start-goal route on a PRM roadmap (edges weighted by length) and its length."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    data = ob.PlannerData(planner.getSpaceInformation())
+    planner.getPlannerData(data)
+    n = data.numVertices()
+    if data.numStartVertices() == 0 or data.numGoalVertices() == 0:
+        return None, math.inf
+    points = np.array([(s[0], s[1]) for s in (data.getVertex(i).getState() for i in range(n))], dtype=float)
+    pairs = [(i, j) for i in range(n) for j in data.getEdges(i)]
+    if not pairs:
+        return None, math.inf
+    rows, cols = np.array(pairs, dtype=np.int64).T
+    lengths = np.hypot(*(points[rows] - points[cols]).T)
+    # A zero-length edge would vanish from the sparse matrix: keep it as the smallest positive weight.
+    graph = coo_matrix((np.maximum(lengths, np.finfo(float).tiny), (rows, cols)), shape=(n, n)).tocsr()
+    source, target = data.getStartIndex(0), data.getGoalIndex(0)
+    distances, predecessors = dijkstra(graph, directed=False, indices=source, return_predecessors=True)
+    if not math.isfinite(distances[target]):
+        return None, math.inf
+    route = [target]
+    while route[-1] != source:
+        route.append(int(predecessors[route[-1]]))
+    waypoints = points[route[::-1]]
+    return waypoints, float(np.sum(np.hypot(*np.diff(waypoints, axis=0).T)))
+
+
+OMPL_PLANNERS: tuple[type, ...] = (RRTStarPlanner, InformedRRTStarPlanner, BITStarPlanner, PRMStarPlanner)
