@@ -73,3 +73,12 @@ def test_gymnasiums_checker_passes_on_drawn_worlds():
 def test_bad_specifications_name_the_option(spec, field):
     with pytest.raises(ConfigError, match=field.replace(".", r"\.")):
         NavigateEnv(scenarios=spec)
+
+
+def test_recordings_of_drawn_worlds_are_numbered_on(tmp_path):
+    env = NavigateEnv(scenarios={"kinds": ["head_on"], "obstacles": [1, 2]}, record_to=str(tmp_path / "ep{episode}.mcap"))
+    for seed in range(3):
+        env.reset(seed=seed)
+        env.step(np.zeros(2, np.float32))
+    env.close()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ep0.mcap", "ep1.mcap", "ep2.mcap"]

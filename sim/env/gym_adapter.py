@@ -90,8 +90,10 @@ class NavigateEnv(gymnasium.Env):
         self._build(scenario)
 
     def _build(self, scenario: Any) -> None:
+        episode = self.task.episode if getattr(self, "dm_env", None) is not None else -1
         self.close()
         self.dm_env = make_environment(scenario, self._options, self._layout)
+        self.task.episode = episode  # record_to's {episode} keeps counting across drawn worlds
         self.observation_space = spaces.Dict({key: _box(spec) for key, spec in self.dm_env.observation_spec().items()})
         layout = self.task.layout
         if self._flatten:
