@@ -6,8 +6,8 @@ Mesa's ``libEGL``; ``import dm_control.mujoco`` does the same through
 ``dm_control._render``.  A process that loads PyTorch's triton after Mesa's EGL
 dies with a segfault (issue 25), and one that never renders has no use for a GL
 library.  So swarmnav imports both with ``MUJOCO_GL=disable`` in the environment
-(:func:`import_mujoco`, run by ``swarmnav.sim``'s ``__init__`` before any of its
-modules imports MuJoCo) and puts the user's value back right after; nothing
+(:func:`import_mujoco`, run by ``swarmnav.sim``'s ``__init__``, installs an import
+hook that does so when either is first imported, so starting the CLI still imports no MuJoCo) and puts the user's value back right after; nothing
 GL-related is loaded until :func:`new_renderer` makes the first renderer.
 
 :func:`new_renderer` picks the backend then: the user's ``MUJOCO_GL`` if it names
@@ -27,6 +27,8 @@ imported ``mujoco`` or ``dm_control`` before swarmnav keeps what they loaded.
 from __future__ import annotations
 
 import atexit
+import importlib.abc
+import importlib.util
 import os
 import sys
 import weakref
@@ -40,28 +42,55 @@ _renderers: weakref.WeakSet = weakref.WeakSet()
 _state = {"registered": False}
 
 
+GL_READERS = ("mujoco", "dm_control._render")  # the modules that read MUJOCO_GL when they are executed
+
+
+class _DisabledGLLoader(importlib.abc.Loader):
+    """Runs a module's own loader with ``MUJOCO_GL=disable``, then puts the user's value back."""
+
+    def __init__(self, loader: importlib.abc.Loader):
+        self.loader = loader
+
+    def create_module(self, spec):
+        return self.loader.create_module(spec)
+
+    def exec_module(self, module) -> None:
+        saved = os.environ.get("MUJOCO_GL")
+        os.environ["MUJOCO_GL"] = DISABLED
+        try:
+            self.loader.exec_module(module)
+        finally:
+            if saved is None:
+                os.environ.pop("MUJOCO_GL", None)
+            else:
+                os.environ["MUJOCO_GL"] = saved
+
+
+class _DisableGLOnImport(importlib.abc.MetaPathFinder):
+    """Finds ``mujoco`` and ``dm_control._render`` as the other finders do, with :class:`_DisabledGLLoader`."""
+
+    def __init__(self) -> None:
+        self._finding = False
+
+    def find_spec(self, name, path, target=None):
+        if name not in GL_READERS or self._finding:
+            return None
+        self._finding = True
+        try:
+            spec = importlib.util.find_spec(name)
+        finally:
+            self._finding = False
+        if spec is None or spec.loader is None:
+            return None
+        spec.loader = _DisabledGLLoader(spec.loader)
+        return spec
+
+
 def import_mujoco() -> None:
-    """Import ``mujoco`` (and ``dm_control._render`` when dm_control is installed) with the GL backend disabled."""
-    if "mujoco" in sys.modules and ("dm_control._render" in sys.modules or not _has_dm_control()):
-        return
-    saved = os.environ.get("MUJOCO_GL")
-    os.environ["MUJOCO_GL"] = DISABLED
-    try:
-        import mujoco  # noqa: F401
-        if _has_dm_control():
-            import dm_control._render  # noqa: F401
-    finally:
-        if saved is None:
-            del os.environ["MUJOCO_GL"]
-        else:
-            os.environ["MUJOCO_GL"] = saved
-
-
-def _has_dm_control() -> bool:
-    if "dm_control" in sys.modules:
-        return True
-    from importlib.util import find_spec
-    return find_spec("dm_control") is not None
+    """From now on, ``mujoco`` and ``dm_control._render`` import with the GL backend disabled (lazily: this imports
+    neither; the CLI starts without MuJoCo).  A module already imported keeps what it loaded."""
+    if not any(isinstance(finder, _DisableGLOnImport) for finder in sys.meta_path):
+        sys.meta_path.insert(0, _DisableGLOnImport())
 
 
 def backend() -> str:
