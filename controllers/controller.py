@@ -14,12 +14,16 @@ from swarmnav.models.world import Pose2D
 from swarmnav.planners.problem import Path
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Twist:
     """The base's measured velocity in its own frame: forward speed and turn rate."""
 
     linear_m_s: float = 0.0
     angular_rad_s: float = 0.0
+
+    def __init__(self, linear_m_s: float = 0.0, angular_rad_s: float = 0.0):
+        # Built every control step: set once, straight into the dict (see models.world.Pose2D).
+        self.__dict__.update(linear_m_s=linear_m_s, angular_rad_s=angular_rad_s)
 
 
 @dataclass(frozen=True)

@@ -134,7 +134,7 @@ class Belief:
     horizon_s: float = 0.0
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class NavigationStep:
     """A navigator's answer for one control step.
 
@@ -150,6 +150,11 @@ class NavigationStep:
     new_path: Path | None = None
     events: tuple[tuple[str, dict[str, Any]], ...] = ()
     belief: Belief | None = None
+
+    def __init__(self, command: ControlCommand, new_path: Path | None = None,
+                 events: tuple[tuple[str, dict[str, Any]], ...] = (), belief: Belief | None = None):
+        # One a control step: set once, straight into the dict (see Observation.__init__).
+        self.__dict__.update(command=command, new_path=new_path, events=events, belief=belief)
 
 
 class Navigator(Protocol):

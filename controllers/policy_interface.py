@@ -103,7 +103,7 @@ def action_bounds(mode: str, geometry: DriveGeometry) -> tuple[float, float]:
 def action_command(action: np.ndarray, mode: str, geometry: DriveGeometry, max_speed_m_s: float,
                    waypoint_index: int = 0) -> ControlCommand:
     """A (2,) action in ``mode`` -> the wheel command (out-of-range values are clipped; taken in float64)."""
-    a0, a1 = (float(a) for a in np.asarray(action, dtype=float).reshape(2))
+    a0, a1 = np.asarray(action, dtype=float).reshape(2).tolist()
     if mode == "twist":
         v = min(max(a0, -1.0), 1.0) * max_speed_m_s
         omega = min(max(a1, -1.0), 1.0) * max_turn_rate_rad_s(geometry, max_speed_m_s)

@@ -99,6 +99,8 @@ def analyse_environment(occupied: np.ndarray, start: Cell, goal: Cell, rho: floa
     Raises:
         NoPathFound: the start is unreachable from the goal even without closing.
     """
+    if propagation not in PROPAGATIONS:
+        raise ValueError(f"propagation must be one of {PROPAGATIONS}, got {propagation!r}")
     occ = np.asarray(occupied, dtype=bool)
     rows, cols = occ.shape
     blocked = occ.tolist()
@@ -192,11 +194,9 @@ def mmas_limits(occupied: np.ndarray, rho: float, diagonal_factor: float, p_best
     """The propagation's ``[tau_min, tau_max]`` (Stützle & Hoos 2000 Eqs. 7 and 11, :mod:`planners.max_min_trails`).
 
     ``tau_max = 1 / (1 - rho)``: Eq. (7) for the unit deposit of Eq. (2) (the fixed point of
-    ``tau <- rho tau + 1``); ``n`` of Eq. (11) is the number of free cells (each a decision
-    point of the tour) and ``avg`` half the eight moves, 4.  With the persistence at 1 or more
-    (no evaporation, or §3.2's doubling) the bound is ``diagonal_factor / (1 - 0.98)`` instead
-    (the default rho's limit), so that it stays finite.
+    ``tau <- rho tau + 1``; ``rho < 1``); ``n`` of Eq. (11) is the number of free cells (each a
+    decision point of the tour) and ``avg`` half the eight moves, 4.  ``diagonal_factor`` does not
+    enter: a diagonal step's ``c (rho tau + 1)`` above ``tau_max`` is clamped to it.
     """
     free = int(np.count_nonzero(~np.asarray(occupied, dtype=bool)))
-    persistence = rho if rho < 1.0 else 0.98
-    return unit_limits(persistence, 1.0 if rho < 1.0 else diagonal_factor, max(free, 1), 4.0, p_best)
+    return unit_limits(rho, 1.0, max(free, 1), 4.0, p_best)

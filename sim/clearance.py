@@ -27,6 +27,7 @@ from swarmnav.sim.scene import CompiledScene
 CLEARANCE_HORIZON_M = 2.0  # mj_geomDistance search radius: clearances are reported up to this value
 # lower_bound_m keeps this much to spare, far above mj_geomDistance's numerical error.
 BOUND_MARGIN_M = 1e-4
+PICK_SLACK_M = 1e-9  # taken off the nearest obstacle's lead over the next: far above the rounding of either
 
 
 def outer_robot_geoms(scene: CompiledScene) -> list[int]:
@@ -79,10 +80,24 @@ class ClearanceProbe:
         self._bound_valid = bool(self._robot_xy) and len(self.obstacle_ids) > 0 and \
             _upright_footprints(model, self.obstacle_ids, is_box)
         self._reference: tuple[float, float, float] | None = None  # (x, y, nearest footprint distance)
+        # The last pick over every obstacle, in a scene whose obstacles never move: (index, x, y, how much
+        # nearer the nearest footprint was than the next).  Footprint distances are 1-Lipschitz in the
+        # point, so within half that margin of (x, y) the same obstacle is the nearest and one
+        # footprint, computed with the same operations in the same order (the same bits), suffices.
+        self._pick: tuple[int, float, float, float] | None = None
+        self._shapes = [(float(cx), float(cy), float(hx), float(hy), float(r)) for (cx, cy), (hx, hy), r
+                        in zip(self._centres_m, self.half_m, self.radius_m)]
 
     def measure(self, data: mujoco.MjData, x_m: float, y_m: float) -> float:
         if not len(self.obstacle_ids):
             return math.inf
+        pick = self._pick
+        if pick is not None and 2.0 * math.hypot(x_m - pick[1], y_m - pick[2]) < pick[3]:
+            i = pick[0]
+            cx, cy, hx, hy, radius_m = self._shapes[i]
+            dx, dy = max(abs(cx - x_m) - hx, 0.0), max(abs(cy - y_m) - hy, 0.0)
+            self._reference = (x_m, y_m, math.sqrt(dx * dx + dy * dy) - radius_m)
+            return self._gap(data, int(self.obstacle_ids[i]))
         if self._moving.size:
             self._centres_m[self._moving] = data.geom_xpos[self.obstacle_ids[self._moving], :2]
         point = self._point_m
@@ -96,7 +111,14 @@ class ClearanceProbe:
         footprint_m = np.sqrt(d[:, 0] + d[:, 1]) - self.radius_m
         i = int(footprint_m.argmin())
         self._reference = (x_m, y_m, float(footprint_m[i]))
-        nearest = int(self.obstacle_ids[i])
+        if not self._moving.size:
+            margin_m = float(np.partition(footprint_m, 1)[1]) - float(footprint_m[i]) if len(footprint_m) > 1 \
+                else math.inf
+            self._pick = (i, x_m, y_m, margin_m - PICK_SLACK_M)
+        return self._gap(data, int(self.obstacle_ids[i]))
+
+    def _gap(self, data: mujoco.MjData, nearest: int) -> float:
+        """The least ``mj_geomDistance`` from the outer robot geoms to obstacle geom ``nearest``."""
         model, fromto = self.model, self._fromto
         gap = math.inf
         for g in self.robot_geom_ids:

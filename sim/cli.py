@@ -205,7 +205,9 @@ def cmd_run(args: argparse.Namespace) -> int:
               f"{out['world_seed']}) {status} in {result.sim_time_s:.2f} s sim "
               f"({result.wall_time_s:.2f} s wall); driven {result.path_length_m:.3f} m "
               f"(planned {path.stats.length_m:.3f} m); collisions {result.collisions}"
-              + (f", first at {result.first_collision_s:.2f} s" if result.first_collision_s is not None else "")
+              + (f", first at {result.first_collision_s:.2f} s with {result.first_contact['obstacle']} at "
+                 f"({result.first_contact['x_m']:.2f}, {result.first_contact['y_m']:.2f})"
+                 if result.first_contact is not None else "")
               + f"; min clearance {result.min_clearance_m:.3f} m"
               + (f"; SPL {out['spl']:.3f}" if out.get("spl") is not None else ""))
         if outcome.log:
@@ -227,7 +229,8 @@ def expectation_exit(expect: str | None, outcome) -> int:
     result = outcome.result
     print(f"swarmnav: expectation not met: --expect {expect}: {outcome.episode.spec.scenario.name}: "
           f"{result.outcome}, {result.collisions} collision(s), {result.sim_time_s:.2f} s sim"
-          + (f", first collision at {result.first_collision_s:.2f} s" if result.first_collision_s is not None else "")
+          + (f", first collision at {result.first_collision_s:.2f} s with {result.first_contact['obstacle']}"
+             if result.first_contact is not None else "")
           + f"; log: {outcome.log or 'none'}", file=sys.stderr)
     return EXIT_EXPECTATION
 

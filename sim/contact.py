@@ -33,6 +33,10 @@ class ContactMonitor:
         self.last_contact_s = -math.inf
         self.pair = ("", "")
         self.points: list[tuple[float, float]] = []
+        # Where the first collision began: time, base position, and which obstacle geom the robot touched
+        # (``obstacle_NN`` is the scenario's ``[[obstacles]]`` entry NN, ``wall_*`` an arena wall,
+        # ``map_box_NNN`` a box of the map).
+        self.first_contact: dict[str, object] | None = None
 
     def _hits(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
         """The contact geom pairs and which of them are robot-obstacle contacts."""
@@ -55,6 +59,10 @@ class ContactMonitor:
                 if self.first_collision_s is None:
                     self.first_collision_s = time_s
                 self.pair = (self.model.geom(int(g1)).name, self.model.geom(int(g2)).name)
+                if self.first_contact is None:
+                    robot, obstacle = self.pair if self.is_robot[int(g1)] else self.pair[::-1]
+                    self.first_contact = {"time_s": time_s, "x_m": x_m, "y_m": y_m, "obstacle": obstacle,
+                                          "robot_geom": robot}
                 if self.recorder is not None:
                     self.recorder.event(time_s, "collision_begin", {"geom_a": self.pair[0], "geom_b": self.pair[1]})
             self.last_contact_s = time_s

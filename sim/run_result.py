@@ -34,6 +34,8 @@ class RunResult:
     safety_triggers: int = 0
     reference_length_m: float | None = None  # L*: the shortest path among the static obstacles
     navigator_wall_s: float = 0.0  # wall time spent in navigator.step (not in summary(): benchmarks read it)
+    # Where the first collision began (time_s, x_m, y_m of the base, the obstacle geom's name, the robot geom's).
+    first_contact: dict[str, Any] | None = None
 
     @property
     def success(self) -> bool:
@@ -55,7 +57,8 @@ class RunResult:
 
     def summary(self) -> dict[str, Any]:
         return {"reached": self.reached, "outcome": self.outcome, "collisions": self.collisions,
-                "first_collision_s": self.first_collision_s, "sim_time_s": round(self.sim_time_s, 6),
+                "first_collision_s": self.first_collision_s, "first_contact": self.first_contact,
+                "sim_time_s": round(self.sim_time_s, 6),
                 "wall_time_s": round(self.wall_time_s, 4), "path_length_m": self.path_length_m,
                 # None when the scene has no obstacle (JSON has no infinity).
                 "min_clearance_m": self.min_clearance_m if math.isfinite(self.min_clearance_m) else None,

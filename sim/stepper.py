@@ -162,7 +162,12 @@ class EpisodeStepper:
 
     # --- the episode ------------------------------------------------------------------------------
     def reset(self) -> Observation:
-        """Start pose, obstacles at t = 0, recorder started, contacts at the start counted; the first observation."""
+        """Start pose, obstacles at t = 0, recorder started, contacts at the start counted; the first observation.
+
+        With a recorder, once per stepper (a recording is one episode); without, as often as wanted.
+        """
+        if self.recorder is not None and self.observation is not None:
+            raise RuntimeError("a recorded episode is reset once: make another stepper for the next episode")
         self._wall0 = time.perf_counter()
         self._start_state()
         if self.recorder is not None:
@@ -178,8 +183,9 @@ class EpisodeStepper:
              events: tuple[tuple[str, dict[str, Any]], ...] = ()) -> Observation:
         """One control period with ``command`` (and what the driver decided with it: a new path, events,
         its belief, all recorded); the next observation."""
-        if self.outcome:
-            raise RuntimeError(f"the episode is over ({self.outcome}): reset() starts another")
+        if self.outcome or self.observation is None:
+            raise RuntimeError(f"the episode is over ({self.outcome}): reset() starts another" if self.outcome
+                               else "reset() first")
         recorder = self.recorder
         time_s = self.observation.time_s
         if recorder is not None:
@@ -365,7 +371,8 @@ class EpisodeStepper:
         step, monitor = self.step_index, self.monitor
         self.result = RunResult(
             reached=outcome == "goal_reached", outcome=outcome, collisions=monitor.collisions,
-            first_collision_s=monitor.first_collision_s, sim_time_s=step * self.dt_s,
+            first_collision_s=monitor.first_collision_s, first_contact=monitor.first_contact,
+            sim_time_s=step * self.dt_s,
             wall_time_s=time.perf_counter() - self._wall0,
             path_length_m=self.length_m, min_clearance_m=float(self.min_clearance_m), steps=step,
             times_s=self.times_s[:step + 1].copy(), poses=self.poses[:step + 1].copy(),

@@ -83,9 +83,10 @@ class CheckedColony(MaxMinColonyPlanner):
             self.updates += 1
 
 
-def test_mmas_trails_stay_within_the_bounds_after_every_update():
+@pytest.mark.parametrize("deposit", ["iteration_best", "best_so_far"])
+def test_mmas_trails_stay_within_the_bounds_after_every_update(deposit):
     problem, *_ = endpoints(load_scenario("immas-env4-blocks"))
-    planner = CheckedColony(iterations=30)
+    planner = CheckedColony(iterations=30, deposit=deposit)
     path = planner.plan(problem, np.random.default_rng(3))
     assert planner.updates >= 25
     extra = path.stats.extra
@@ -99,6 +100,8 @@ def test_mmas_is_registered_and_refuses_a_persistence_of_one():
         make_planner("mmas", {"rho": 1.0})
     with pytest.raises(ConfigError, match="planner.params.deposit"):
         make_planner("mmas", {"deposit": "all"})
+    with pytest.raises(ConfigError, match="planner.params.evaporation_doubling"):
+        make_planner("immas", {"propagation": "route_cost", "evaporation_doubling": True})
 
 
 def test_immas_10x10_alpha_2_takes_the_papers_14_moves():
@@ -211,3 +214,22 @@ def test_new_scenarios_validate_and_sit_on_their_maps():
         scenario = load_scenario(str(path))
         assert scenario.name == path.stem and scenario.map_grid is not None
         assert not (SCENARIO_DIR / path.name).exists()  # not bundled twice
+
+
+def test_each_deviation_row_names_code_that_states_it():
+    """Every row of the README's "Deviations from the papers" names files that exist, and a planner file it
+    names cites the paper of the row in its docstring."""
+    root = Path(__file__).resolve().parent.parent
+    text = (root / "README.md").read_text(encoding="utf-8")
+    section = text.split("## Deviations from the papers", 1)[1].split("\n## ", 1)[0]
+    rows = [line for line in section.splitlines() if line.startswith("| ") and not line.startswith("| paper")
+            and not line.startswith("| ---")]
+    assert len(rows) >= 10
+    for row in rows:
+        author = row.split("|")[1].strip().split(" ")[0]
+        files = [f for f in row.split("`") if f.endswith((".py", ".md"))]
+        assert files, row
+        for name in files:
+            assert (root / name).is_file(), name
+            if name.startswith("planners/"):
+                assert author in (root / name).read_text(encoding="utf-8"), (author, name)

@@ -84,6 +84,9 @@ def test_a_path_through_an_obstacle_reports_the_collision_and_fails_expect(tmp_p
     assert code == EXIT_EXPECTATION
     assert out["plan"]["collision_free"] is False
     assert out["collisions"] >= 1 and out["first_collision_s"] is not None
+    contact = out["first_contact"]  # the disc at (1, 1), radius 0.2: obstacles[0] of gwo-scenario-1
+    assert contact["obstacle"] == "obstacle_00" and contact["time_s"] == out["first_collision_s"]
+    assert 0.5 < contact["x_m"] < 1.0 and abs(contact["x_m"] - contact["y_m"]) < 0.05
     assert captured.err.count("\n") == 1 and "--expect success" in captured.err
     # reached-with-contacts passes --expect reached but not --expect success
     assert main(["run", "gwo-scenario-2", "--planner", "astar", "--no-log", "--expect", "reached"]) == 0

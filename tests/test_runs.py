@@ -102,3 +102,33 @@ def test_stepping_k_physics_steps_at_once_away_from_obstacles_changes_nothing(mo
     assert fast.collisions == slow.collisions >= 1
     assert fast.first_collision_s == slow.first_collision_s
     assert np.array_equal(fast.poses, slow.poses)
+
+
+def test_the_episode_stepper_is_driven_by_anyone_and_refuses_steps_outside_its_episode():
+    """A hand-written driver (constant wheels) on the stepper: a reset repeats the episode; a step before
+    reset or after the end, and a second reset of a recorded episode, are errors."""
+    from swarmnav.controllers.controller import ControlCommand
+    from swarmnav.controllers.kinematics import WheelSpeeds
+    from swarmnav.sim.recording import RecorderGroup
+    from swarmnav.sim.runner import Simulation
+
+    simulation = Simulation(load_scenario("gwo-scenario-2"))
+    stepper = simulation.stepper(time_limit_s=1.0)
+    forward = ControlCommand(WheelSpeeds(4.0, 4.2), 0.2, 0.0, 0)
+    with pytest.raises(RuntimeError, match="reset"):
+        stepper.step(forward)
+    runs = []
+    for _ in range(2):
+        observation = stepper.reset()
+        while not stepper.outcome:
+            observation = stepper.step(forward)
+        runs.append(stepper.result)
+    assert runs[0].outcome == "timeout" and runs[0].steps == round(1.0 * simulation.scenario.sim.control_hz)
+    assert observation.time_s == runs[0].sim_time_s and np.array_equal(runs[0].poses, runs[1].poses)
+    assert runs[0].reference_length_m is not None and runs[0].path_length_m > 0.1
+    with pytest.raises(RuntimeError, match="over"):
+        stepper.step(forward)
+    recorded = simulation.stepper(time_limit_s=1.0, recorder=RecorderGroup([]))
+    recorded.reset()
+    with pytest.raises(RuntimeError, match="once"):
+        recorded.reset()

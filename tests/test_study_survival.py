@@ -195,3 +195,14 @@ def test_compaction_keeps_each_cell_once_the_last_written(tmp_path):
     assert [r["outcome"] for r in first] == ["ok"]
     progress = read_table(tmp_path, "progress.parquet").to_pylist()
     assert len(progress) == 12 and {p["best_cost"] for p in progress if p["config_hash"] == cells[0].config_hash} == {12.0}
+
+
+def test_cliffs_delta_counts_every_pair_with_ties():
+    import numpy as np
+
+    from swarmnav.sim.study.statistics import cliffs_delta
+    rng = np.random.default_rng(7)
+    for n, m in ((1, 1), (5, 9), (40, 33)):
+        a, b = rng.integers(0, 6, n).astype(float), rng.integers(0, 6, m).astype(float)  # many ties
+        pairs = [int(x > y) - int(x < y) for x in a for y in b]
+        assert cliffs_delta(a, b) == pytest.approx(sum(pairs) / len(pairs), abs=1e-15)

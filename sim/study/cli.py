@@ -8,8 +8,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path as FilePath
+
+WORKERS_PER_CORE = 8  # --workers at most this many per core of the machine
 
 
 def add_study_arguments(p: argparse.ArgumentParser) -> None:
@@ -46,6 +49,10 @@ def run_study(args: argparse.Namespace) -> int:
     from swarmnav.sim.study.spec import load_study
     if args.workers is not None and args.workers < 1:
         raise ConfigError("--workers", f"must be at least 1, got {args.workers}")
+    most = WORKERS_PER_CORE * (os.cpu_count() or 1)
+    if args.workers is not None and args.workers > most:
+        raise ConfigError("--workers", f"at most {most} ({WORKERS_PER_CORE} per core: each worker is a process of "
+                                       f"its own), got {args.workers}")
     if args.address and args.engine != "ray":
         raise ConfigError("--address", "needs --engine ray")
     if args.engine == "ray":
@@ -104,12 +111,12 @@ def add_studies_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run_studies(args: argparse.Namespace) -> int:
-    from swarmnav.sim.study.grid import expand
+    from swarmnav.sim.study.grid import count_cells
     from swarmnav.sim.study.spec import list_studies, load_study
     rows = []
     for name in list_studies():
         study = load_study(name)
-        rows.append({"name": name, "mode": study.mode, "cells": len(expand(study)),
+        rows.append({"name": name, "mode": study.mode, "cells": count_cells(study),
                      "scenarios": [FilePath(s).stem for s in study.scenarios],
                      "planners": [p.label for p in study.planners], "description": study.description})
     if args.json:

@@ -18,7 +18,7 @@ from pathlib import Path as FilePath
 from typing import Any
 
 from swarmnav.sim.study import figures
-from swarmnav.sim.study.rows import PROGRESS, RUNS, read_table
+from swarmnav.sim.study.rows import load_progress, load_runs
 from swarmnav.sim.study.statistics import (arm_counts, by_scenario, compare, compare_success, friedman, impossible,
                                            paper_table, summarise, values)
 
@@ -135,15 +135,8 @@ def ordered_runs(runs: list[dict[str, Any]], meta: dict[str, Any]) -> list[dict[
 def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePath:
     """Write the HTML report and its Markdown twin (``.md`` beside it); return the Markdown path."""
     directory, html_path = FilePath(directory), FilePath(html_path)
-    runs = read_table(directory, RUNS).to_pylist()
-    progress: dict[str, list[tuple[int, float, int, bool]]] = {}
-    seen = set()
-    for p in read_table(directory, PROGRESS).to_pylist():
-        key = (p["config_hash"], p["iteration"])
-        if key not in seen:  # a part may repeat after a resumed crash; the values are the same
-            seen.add(key)
-            progress.setdefault(p["config_hash"], []).append((p["iteration"], p["best_cost"], p["evaluations"],
-                                                              bool(p.get("evaluations_estimated"))))
+    runs = load_runs(directory)  # only the columns a report reads; each cell once
+    progress = load_progress(directory)
     meta_path = directory / "study.json"
     meta = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
     runs = ordered_runs(runs, meta)

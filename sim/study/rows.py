@@ -103,7 +103,7 @@ def _read_part(path: FilePath, schema: pa.Schema, columns: list[str] | None = No
         present = set(pq.read_schema(path).names)
         if "config_hash" not in present:
             raise DamagedPart("it holds no config_hash column (not a part of this table)")
-        table = pq.read_table(path, columns=[f.name for f in wanted if f.name in present])
+        table = pq.read_table(path, columns=[f.name for f in wanted if f.name in present], use_threads=False)
         arrays = [table.column(f.name).cast(f.type) if f.name in present else pa.nulls(len(table), f.type)
                   for f in wanted]
     except FileNotFoundError:
@@ -179,6 +179,39 @@ def done_hashes(out_dir: str | os.PathLike, except_outcomes: tuple[str, ...] = (
     if except_outcomes:
         table = table.filter(pc.invert(pc.is_in(table.column("outcome"), pa.array(except_outcomes, pa.string()))))
     return set(table.column("config_hash").to_pylist())
+
+
+# Columns a report never reads (provenance and raw details kept for the user): left on disk by load_runs.
+NOT_REPORTED = ("study", "scenario_ref", "planner_params", "navigator_params", "versions", "plan_extra",
+                "run_events")
+
+
+def load_runs(out_dir: str | os.PathLike, skip: tuple[str, ...] = NOT_REPORTED) -> list[dict[str, Any]]:
+    """The run rows as dicts (each cell once), without the ``skip`` columns: only the columns wanted are read
+    from the Parquet files, and the dicts are built column by column."""
+    return _as_dicts(read_table(out_dir, RUNS, [f.name for f in RUN_SCHEMA if f.name not in skip]))
+
+
+def _as_dicts(table: pa.Table) -> list[dict[str, Any]]:
+    """The rows as dicts, built column by column (faster and leaner than ``Table.to_pylist``)."""
+    names = table.column_names
+    columns = [table.column(n).to_pylist() for n in names]
+    return [dict(zip(names, values)) for values in zip(*columns)]
+
+
+def load_progress_rows(out_dir: str | os.PathLike) -> list[dict[str, Any]]:
+    """The progress rows as dicts (each cell and iteration once), in the order written."""
+    return _as_dicts(read_table(out_dir, PROGRESS))
+
+
+def load_progress(out_dir: str | os.PathLike) -> dict[str, list[tuple[int, float, int, bool]]]:
+    """Each cell's best-cost history, ``config_hash -> [(iteration, best_cost, evaluations, estimated)]`` (each
+    cell and iteration once), in the order written."""
+    progress: dict[str, list[tuple[int, float, int, bool]]] = {}
+    for p in load_progress_rows(out_dir):
+        progress.setdefault(p["config_hash"], []).append((p["iteration"], p["best_cost"], p["evaluations"],
+                                                          bool(p["evaluations_estimated"])))
+    return progress
 
 
 class RowWriter:

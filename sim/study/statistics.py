@@ -79,9 +79,15 @@ def arm_counts(rows: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def cliffs_delta(a: np.ndarray, b: np.ndarray) -> float:
-    """P(a > b) - P(a < b) over all pairs (Cliff 1993)."""
-    diff = a[:, None] - b[None, :]
-    return float((np.count_nonzero(diff > 0) - np.count_nonzero(diff < 0)) / diff.size)
+    """P(a > b) - P(a < b) over all pairs (Cliff 1993).
+
+    The pairs are counted exactly without forming them: with ``b`` sorted, the values of ``b`` below ``a[i]``
+    and above it are two binary searches, so two arms of 12,500 runs take milliseconds, not the 1.25 GB of
+    the full difference matrix."""
+    ordered = np.sort(b)
+    below = np.searchsorted(ordered, a, side="left").sum(dtype=np.int64)
+    above = (b.size - np.searchsorted(ordered, a, side="right")).sum(dtype=np.int64)
+    return float((below - above) / (a.size * b.size))
 
 
 def paired(ref_rows: list[dict[str, Any]], other_rows: list[dict[str, Any]], metric: str
