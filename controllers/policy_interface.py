@@ -11,7 +11,10 @@ environment's specs, :class:`ObservationLayout`).  Values that physics or an
 estimator can push past a bound are clipped to it; each entry says which.
 
 * ``ranges`` (K,): rangefinder distances divided by their reach, in [0, 1];
-  1 = nothing in range.  Present with both sensing models: the robot's rays are
+  1 = nothing in range.  Beam k points at 2 pi k / K rad from the heading,
+  counter-clockwise (k = 0 straight ahead, k = K/4 to the left), from the rim of
+  the robot (:meth:`ObservationLayout.range_angles_rad`; the environment's
+  ``metadata["range_angles_rad"]``).  Present with both sensing models: the robot's rays are
   in the scene either way and are how it sees the static map.
 * ``goal`` (2,): distance to the goal (m, in [0, D] with D the arena's diagonal;
   clipped there, which only matters off the arena of a scenario without walls)
@@ -39,6 +42,12 @@ estimator can push past a bound are clipped to it; each entry says which.
   in the robot frame (m), components within +-D (clipped).  "Next" counts
   from the waypoint after the nearest one, never going back along the path;
   when fewer than P are left the last (the goal) repeats.
+
+Flat order (:data:`FLAT_ORDER`, :func:`flatten_observation`): one vector, the
+entries present in this order, each flattened row by row: ``ranges``, ``goal``,
+``velocity``, ``path``, ``obstacles``, ``obstacle_mask``.  The environment's
+``flatten=True`` and the ``policy`` navigator's ``flatten`` give it (not
+Gymnasium's ``FlattenObservation``, which sorts the keys alphabetically).
 
 Float32 because that is what learning libraries expect and store; the physics,
 the poses, the wheel commands and the reward stay float64 (the reward's
@@ -70,6 +79,13 @@ from swarmnav.models.world import wrap_angle_rad
 ACTION_MODES = ("twist", "wheels")
 OBSERVATION_DTYPE = np.float32
 OBSTACLE_COLUMNS = ("x_m", "y_m", "vx_m_s", "vy_m_s", "radius_m")
+FLAT_ORDER = ("ranges", "goal", "velocity", "path", "obstacles", "obstacle_mask")
+
+
+def flatten_observation(observation: dict[str, np.ndarray]) -> np.ndarray:
+    """The observation dict as one float32 vector in :data:`FLAT_ORDER` (see the module docstring)."""
+    return np.concatenate([np.ravel(observation[key]) for key in FLAT_ORDER if key in observation]
+                          ).astype(OBSERVATION_DTYPE, copy=False)
 
 
 def max_turn_rate_rad_s(geometry: DriveGeometry, max_speed_m_s: float) -> float:
@@ -96,6 +112,37 @@ def action_command(action: np.ndarray, mode: str, geometry: DriveGeometry, max_s
     wheels = WheelSpeeds(min(max(a0, -limit), limit), min(max(a1, -limit), limit))
     v, omega = body_twist(wheels, geometry)
     return ControlCommand(wheels, v, omega, waypoint_index)
+
+
+class ActionError(ValueError):
+    """A policy's action that is not 2 finite real numbers (the environment raises it; the navigator reports it
+    as a ConfigError of its ``policy`` parameter)."""
+
+
+def checked_action(action) -> np.ndarray:
+    """The action as a (2,) float64 array, or :class:`ActionError` saying what is wrong with it.
+
+    Accepted: any array-like of shape (2,) (or (1, 2), one environment's row) of real numbers, floating or
+    integer, all finite.  Rejected: other shapes, booleans, complex numbers, strings and objects, NaN and inf.
+    """
+    try:
+        array = np.asarray(action)
+    except Exception as exc:  # ragged lists and the like
+        raise ActionError(f"action {action!r} is not an array: {exc}") from None
+    if array.dtype == bool or not (np.issubdtype(array.dtype, np.floating) or np.issubdtype(array.dtype, np.integer)):
+        raise ActionError(f"action of dtype {array.dtype}; expected real numbers (float32 as the action space)")
+    if array.shape not in ((2,), (1, 2)):
+        raise ActionError(f"action of shape {array.shape}; expected (2,)")
+    array = array.reshape(2).astype(np.float64)
+    if not np.all(np.isfinite(array)):
+        raise ActionError(f"action {array.tolist()} is not finite")
+    return array
+
+
+def normalised_action(action: np.ndarray, mode: str, geometry: DriveGeometry) -> np.ndarray:
+    """The action as the reward's effort and smoothness terms see it: each component clipped and scaled to [-1, 1]."""
+    low, high = action_bounds(mode, geometry)
+    return np.clip(np.asarray(action, dtype=np.float64), low, high) / high
 
 
 def motion_speed_bound_m_s(motion) -> float:
@@ -127,6 +174,18 @@ class ObservationLayout:
     obstacle_offset_max_m: float = 0.0
     obstacle_speed_max_m_s: float = 0.0
     obstacle_radius_max_m: float = 0.0
+
+    def range_angles_rad(self) -> np.ndarray:
+        """(K,) the direction of each ``ranges`` beam, rad CCW from the heading: 2 pi k / K."""
+        return 2.0 * math.pi * np.arange(self.range_count) / self.range_count
+
+    def flat_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lower, upper) of the flat observation, float32 (:func:`flatten_observation`'s order)."""
+        parts = [(np.broadcast_to(low, shape), np.broadcast_to(high, shape)) for shape, low, high in self.bounds().values()]
+        ordered = dict(zip(self.bounds(), parts))
+        low = flatten_observation({key: value[0] for key, value in ordered.items()})
+        high = flatten_observation({key: value[1] for key, value in ordered.items()})
+        return low, high
 
     def bounds(self) -> dict[str, tuple[tuple[int, ...], np.ndarray, np.ndarray]]:
         """Per entry: (shape, lower, upper), the bounds broadcastable to the shape (float64)."""

@@ -1,8 +1,8 @@
 """Offscreen rendering of a run with EGL, and MP4 output (:mod:`sim.video_file`).
 
-The only module that knows about EGL: ``MUJOCO_GL`` is set to ``egl`` here (unless
-the user chose another backend) before ``mujoco`` is imported, so rendering works
-on headless, GPU-less servers through Mesa.
+The GL context is made when a :class:`SceneRenderer` is, by :func:`sim.gl_backend.new_renderer`
+(EGL unless the user chose another backend), so rendering works on headless,
+GPU-less servers through Mesa and importing this module loads no GL library.
 
 What a frame shows: the scene from the ``top`` camera (the whole arena), the
 robot's ``chase`` camera, or ``follow`` (straight down on the robot, about
@@ -29,10 +29,6 @@ never steps physics.
 
 from __future__ import annotations
 
-import os
-
-os.environ.setdefault("MUJOCO_GL", "egl")
-
 import math  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -52,6 +48,7 @@ from swarmnav.sim.render_look import (  # noqa: E402
     soften_lights,
 )
 from swarmnav.sim.defaults import MAX_FPS, MIN_FPS  # noqa: E402
+from swarmnav.sim.gl_backend import new_renderer  # noqa: E402
 from swarmnav.sim.recording import RunContext, StepFrame  # noqa: E402
 from swarmnav.sim.video_file import VideoWriter  # noqa: E402
 
@@ -239,7 +236,7 @@ class SceneRenderer:
                 self._grid = floor_grid(*grid_m)
         self.camera = camera
         self.width, self.height = width, height
-        self._renderer = mujoco.Renderer(model, height, width)
+        self._renderer = new_renderer(model, height, width)  # the GL context is made here, not at import
         if fast:
             flags = self._renderer.scene.flags
             flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0

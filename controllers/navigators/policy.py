@@ -24,7 +24,9 @@ from typing import Any, Callable, ClassVar
 import numpy as np
 
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command, observation_layout
+from swarmnav.controllers.policy_interface import (ACTION_MODES, ActionError, PolicyObserver, action_command,
+                                                   checked_action, flatten_observation, observation_layout)
+from swarmnav.controllers.observation_normaliser import ObservationNormaliser
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import Range, above, code_parameter, within
 
@@ -56,6 +58,11 @@ class PolicyNavigator:
         obstacle_slots: N, the rows of ``obstacles`` (None: the scenario's moving obstacles, at least 1).
         tracked_obstacles: with the ``rangefinder`` sensing model, also give the tracker's estimates as
             ``obstacles`` (the ``detector`` model always does).
+        flatten: hand the policy one vector in the documented flat order
+            (:data:`controllers.policy_interface.FLAT_ORDER`), as the environment's ``flatten=True``.
+        normalise: an ``.npz`` of a saved observation normalisation
+            (:mod:`controllers.observation_normaliser`, e.g. a ``VecNormalize``'s statistics) applied to
+            the observation (after flattening) before the policy sees it.
 
     These three mean what the environment's options of the same names mean; a policy
     trained with some values must be run with the same ones.
@@ -72,6 +79,8 @@ class PolicyNavigator:
     path_waypoints: int = 0
     obstacle_slots: int | None = None
     tracked_obstacles: bool = False
+    flatten: bool = False
+    normalise: str = ""
 
     def __post_init__(self) -> None:
         if self.action not in ACTION_MODES:
@@ -80,6 +89,10 @@ class PolicyNavigator:
             raise ConfigError("navigator.params.path_waypoints", f"must be >= 0, got {self.path_waypoints}")
         if self.obstacle_slots is not None and self.obstacle_slots < 1:
             raise ConfigError("navigator.params.obstacle_slots", f"must be >= 1, got {self.obstacle_slots}")
+        if not isinstance(self.flatten, bool):
+            raise ConfigError("navigator.params.flatten", f"expected true or false, got {self.flatten!r}")
+        self._normaliser = (ObservationNormaliser.load(self.normalise, "navigator.params.normalise")
+                            if self.normalise else None)
         self._policy = load_policy(self.policy)
 
     def reset(self, setup: NavigationSetup) -> None:
@@ -96,11 +109,25 @@ class PolicyNavigator:
         self._observer = PolicyObserver(layout, (goal.x_m, goal.y_m), setup.path.waypoints)
         self.uses_detections = bool(layout.obstacle_slots)  # read by the runner after reset
 
+    def policy_observation(self, observation: Observation):
+        """What the policy is given: the observation dict, flattened and normalised as asked."""
+        obs = self._observer(observation)
+        if self.flatten:
+            obs = flatten_observation(obs)
+        if self._normaliser is not None:
+            try:
+                obs = self._normaliser(obs)
+            except ValueError as exc:
+                raise ConfigError("navigator.params.normalise", str(exc)) from None
+        return obs
+
     def step(self, observation: Observation) -> NavigationStep:
         try:
-            action = np.asarray(self._policy(self._observer(observation)), dtype=float)
+            raw = self._policy(self.policy_observation(observation))
         except Exception as exc:  # the user's code failed: their input, reported against the parameter
             raise ConfigError(FIELD, f"{self.policy!r} raised {type(exc).__name__}: {exc}") from None
-        if action.shape != (2,) or not np.all(np.isfinite(action)):
-            raise ConfigError(FIELD, f"{self.policy!r} returned {action!r}; expected 2 finite numbers")
+        try:
+            action = checked_action(raw)  # the environment's own check
+        except ActionError as exc:
+            raise ConfigError(FIELD, f"{self.policy!r} returned a bad action: {exc}") from None
         return NavigationStep(action_command(action, self.action, self._geometry, self._max_speed_m_s))

@@ -12,7 +12,13 @@ Random actions and the ``follow`` loop drive different trajectories, and the
 physics costs more near obstacles (the step-by-step contact check), so a
 fourth figure compares like with like: the environment in ``wheels`` mode
 replaying the runner's own wheel commands (the same trajectory, bit for bit),
-``env_replay_vs_runner``: the environment's overhead alone.  ``--quick`` runs
+``env_replay_vs_runner``: the environment's overhead alone.
+
+Vectorised throughput: ``gymnasium.vector.AsyncVectorEnv`` (one process per
+environment, the way SB3's ``SubprocVecEnv`` and Gymnasium users scale out) with 2
+workers against 1, the same random actions, environment steps per second summed
+over the workers (``vector_2_vs_1``, target >= 1.7 on 2 free cores; a machine
+shared with other work gives less).  ``--quick`` runs
 the same measurement over 4 simulated seconds twice (a smoke run; noisier).
 """
 
@@ -39,6 +45,26 @@ def _env_steps_per_s(env, steps: int, rng: np.random.Generator) -> float:
         if terminated or truncated:
             env.reset()
     return steps / (time.perf_counter() - t0)
+
+
+def _vector_steps_per_s(scenario_name: str, workers: int, steps: int) -> float:
+    """Environment steps per second of an AsyncVectorEnv of ``workers`` processes, ``steps`` batched steps."""
+    import functools
+
+    import gymnasium
+
+    from swarmnav.sim.env import NavigateEnv
+    vector = gymnasium.vector.AsyncVectorEnv([functools.partial(NavigateEnv, scenario_name)] * workers)
+    try:
+        vector.action_space.seed(0)
+        vector.reset(seed=0)
+        vector.step(vector.action_space.sample())  # the workers are up before the clock starts
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            vector.step(vector.action_space.sample())  # episodes reset on their own (next-step autoreset)
+        return workers * steps / (time.perf_counter() - t0)
+    finally:
+        vector.close()
 
 
 def _runner_steps_per_s(simulation: Simulation, planned, duration_s: float):
@@ -87,6 +113,8 @@ def benchmark_env(scenario_name: str = "dense-field-30", duration_s: float = 20.
         ratios.append(e / r)
     env.close()
     replay_env.close()
+    vector_1 = [_vector_steps_per_s(scenario_name, 1, control_steps) for _ in range(repeats)]
+    vector_2 = [_vector_steps_per_s(scenario_name, 2, control_steps) for _ in range(repeats)]
     return {
         "scenario": scenario_name,
         "control_hz": round(1.0 / simulation.control_dt_s, 6),
@@ -101,6 +129,10 @@ def benchmark_env(scenario_name: str = "dense-field-30", duration_s: float = 20.
         "env_replay_steps_per_s": statistics.median(replays),
         "env_replay_vs_runner": statistics.median(replay_ratios),
         "target_env_vs_runner": 0.7,
+        "vector_1_steps_per_s": statistics.median(vector_1),
+        "vector_2_steps_per_s": statistics.median(vector_2),
+        "vector_2_vs_1": statistics.median(vector_2) / statistics.median(vector_1),
+        "target_vector_2_vs_1": 1.7,
     }
 
 

@@ -37,6 +37,7 @@ end an episode either: ``reset`` returns ``info["outcome"]`` already set (and
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path as FilePath
 from typing import Any
@@ -47,7 +48,8 @@ from dm_control import mujoco as dm_mujoco
 from dm_control.rl import control
 
 from swarmnav.controllers.controller import ControlCommand
-from swarmnav.controllers.policy_interface import ACTION_MODES, PolicyObserver, action_command, observation_layout
+from swarmnav.controllers.policy_interface import (ACTION_MODES, PolicyObserver, action_command, checked_action,
+                                                   ObservationLayout, normalised_action, observation_layout)
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario, load_scenario
 from swarmnav.models.seeds import Seeds
@@ -75,6 +77,11 @@ class EnvOptions:
             as ``obstacles`` (the ``detector`` model always gives ``obstacles``).
         reward: the reward's weights.
         time_limit_s, stop_on_collision: override the scenario's.
+        terminate_on_collision: the name RL users look for: end the episode (termination, discount 0)
+            at the first collision; sets ``stop_on_collision`` (giving both, they must agree).
+        action_repeat: control periods per action (the action is held; the step's reward sums the
+            progress, time and effort of all of them and its cost their collisions; an episode that
+            ends within them ends there).  ``control_timestep()`` is the repeat's length.
         seed: the planner's seed (None: the scenario's, ``Scenario.seeds``).
         world_seed: the obstacles' random walks (None: the scenario's).
         record_to: an ``.mcap`` path to record each episode to with the recorder of
@@ -89,6 +96,8 @@ class EnvOptions:
     reward: RewardWeights = field(default_factory=RewardWeights)
     time_limit_s: float | None = None
     stop_on_collision: bool | None = None
+    terminate_on_collision: bool | None = None
+    action_repeat: int = 1
     seed: int | None = None
     world_seed: int | None = None
     record_to: str | None = None
@@ -102,6 +111,27 @@ class EnvOptions:
             raise ConfigError("env.obstacle_slots", f"must be >= 1, got {self.obstacle_slots}")
         if self.time_limit_s is not None and not self.time_limit_s > 0:
             raise ConfigError("env.time_limit_s", f"must be > 0, got {self.time_limit_s}")
+        if isinstance(self.action_repeat, bool) or not isinstance(self.action_repeat, int) or self.action_repeat < 1:
+            raise ConfigError("env.action_repeat", f"must be an integer >= 1, got {self.action_repeat!r}")
+        if not isinstance(self.reward, RewardWeights):
+            raise ConfigError("env.reward", f"expected a RewardWeights, got {type(self.reward).__name__}")
+        if self.terminate_on_collision is not None:
+            if self.stop_on_collision is not None and self.stop_on_collision != self.terminate_on_collision:
+                raise ConfigError("env.terminate_on_collision",
+                                  f"is {self.terminate_on_collision} but stop_on_collision is {self.stop_on_collision}")
+            object.__setattr__(self, "stop_on_collision", bool(self.terminate_on_collision))
+
+
+def check_time_limit(time_limit_s: float | None, control_dt_s: float) -> None:
+    """The episode runs whole control periods, the last one ending at or before the limit: a limit that is not
+    a whole number of periods would end the episode early (0.051 s at 50 Hz after 0.04 s), so it is refused."""
+    if time_limit_s is None:
+        return
+    periods = time_limit_s / control_dt_s
+    if abs(periods - round(periods)) > 1e-9 * max(1.0, periods):
+        raise ConfigError("env.time_limit_s", f"{time_limit_s:g} s is not a whole number of control periods "
+                                              f"({control_dt_s:g} s): the episode would end after "
+                                              f"{math.floor(periods + 1e-9) * control_dt_s:g} s")
 
 
 def model_bytes(model: mujoco.MjModel) -> bytes:
@@ -121,33 +151,40 @@ class SwarmnavPhysics(dm_mujoco.Physics):
     stepper: EpisodeStepper | None = None
     command: ControlCommand | None = None  # set by the task's before_step
     frozen: bool = False  # the episode ended at its start: its one step advances nothing
+    repeat: int = 1  # control periods per action
+    periods: int = 0  # control periods the last step ran (fewer than ``repeat`` when the episode ended)
 
     def step(self, nstep: int = 1) -> None:
-        if self.stepper is None or nstep != self.stepper.k:
+        if self.stepper is None or nstep != self.stepper.k * self.repeat:
             raise RuntimeError(f"step {nstep} physics steps: the environment steps "
-                               f"{getattr(self.stepper, 'k', '?')} at a time, through its task")
+                               f"{getattr(self.stepper, 'k', '?')} x {self.repeat} at a time, through its task")
+        self.periods = 0
         if self.frozen:
             return
         command, self.command = self.command, None
         if command is None:
             raise RuntimeError("no command for this step: the task's before_step sets it")
         with self.check_invalid_state():
-            self.stepper.step(command)
+            for _ in range(self.repeat):
+                self.stepper.step(command)
+                self.periods += 1
+                if self.stepper.outcome:
+                    break
 
 
 class NavigationTask(control.Task):
     """Drive from the scenario's start to its goal; see the module docstring."""
 
-    def __init__(self, scenario: Scenario, physics: SwarmnavPhysics, xml: str, options: EnvOptions):
+    def __init__(self, scenario: Scenario, physics: SwarmnavPhysics, xml: str, options: EnvOptions,
+                 layout: ObservationLayout | None = None):
         self.options = options
         self.scene = index_scene(physics.model.ptr, xml)  # the indices, on the physics' own model
         self.simulation = Simulation(scenario, self.scene)
+        check_time_limit(options.time_limit_s, self.simulation.control_dt_s)
         fallback = scenario.seeds
         self.set_seeds(Seeds(fallback.planner if options.seed is None else int(options.seed),
                              fallback.world if options.world_seed is None else int(options.world_seed)))
-        self.layout = observation_layout(scenario, self.scene.drive,
-                                         options.path_waypoints if options.path_planner else 0,
-                                         options.obstacle_slots, options.tracked_obstacles)
+        self.layout = layout or task_layout(scenario, options, self.scene.drive)
         self.episode = -1
         self.stepper: EpisodeStepper | None = None
         self.over_at_start = False
@@ -192,29 +229,35 @@ class NavigationTask(control.Task):
             context=context, path_m=waypoints, sense_obstacles=bool(self.layout.obstacle_slots),  # only when observed
             data=physics.data.ptr)
         physics.command = None
+        physics.repeat = options.action_repeat
+        self.action = self.previous_action = None  # normalised; None before the first step (zeros for smoothness)
         self.return_, self.cost, self.reward_value = 0.0, 0.0, 0.0
         self._collisions = 0  # collisions at the start go into the first step's cost
         self._observed(self.stepper.reset())
         physics.frozen = self.over_at_start = bool(self.outcome)
 
     def before_step(self, action: np.ndarray, physics: SwarmnavPhysics) -> None:
+        action = checked_action(action)  # ActionError: NaN, wrong shape or dtype, before any physics
+        self.previous_action, self.action = self.action, normalised_action(action, self.options.action,
+                                                                           self.scene.drive)
         if not self.over_at_start:
             physics.command = action_command(action, self.options.action, self.scene.drive,
                                              self.scenario.max_speed_m_s)
 
     def after_step(self, physics: SwarmnavPhysics) -> None:
         stepper = self.stepper
+        collisions = stepper.collisions
+        self.cost = float(collisions - self._collisions)
+        self._collisions = collisions
         if self.over_at_start:
             self.reward_value = 0.0
         else:
             distance_before_m = self.distance_m
             self._observed(stepper.observation)
-            self.reward_value = self.options.reward.reward(distance_before_m, self.distance_m,
-                                                           self.outcome == "goal_reached", stepper.dt_s)
+            self.reward_value = self.options.reward.reward(
+                distance_before_m, self.distance_m, self.outcome == "goal_reached", stepper.dt_s * physics.periods,
+                self.cost, self.action, self.previous_action)
         self.return_ += self.reward_value
-        collisions = stepper.collisions
-        self.cost = float(collisions - self._collisions)
-        self._collisions = collisions
 
     def get_observation(self, physics: SwarmnavPhysics) -> dict[str, np.ndarray]:
         return dict(self.obs)  # the observer builds fresh arrays at every observation: nothing to copy
@@ -273,11 +316,19 @@ class NavigationTask(control.Task):
         return McapRecorder(FilePath(self.options.record_to.replace("{episode}", str(self.episode))), overwrite=True)
 
 
-def make_environment(scenario: Scenario | str, options: EnvOptions | None = None, **kwargs: Any
-                     ) -> control.Environment:
+def task_layout(scenario: Scenario, options: EnvOptions, drive) -> ObservationLayout:
+    """The observation layout of ``scenario`` under ``options`` (the entries and bounds of the specs)."""
+    return observation_layout(scenario, drive, options.path_waypoints if options.path_planner else 0,
+                              options.obstacle_slots, options.tracked_obstacles)
+
+
+def make_environment(scenario: Scenario | str, options: EnvOptions | None = None,
+                     layout: ObservationLayout | None = None, **kwargs: Any) -> control.Environment:
     """The dm_env environment of a scenario (a name, a path or a :class:`Scenario`).
 
-    ``kwargs`` are :class:`EnvOptions` fields when ``options`` is not given.
+    ``kwargs`` are :class:`EnvOptions` fields when ``options`` is not given; ``layout`` fixes the
+    observation's entries and bounds (:mod:`sim.env.worlds`: the same spaces across scenarios), else the
+    scenario's own.
     """
     if isinstance(scenario, (str, FilePath)):
         scenario = load_scenario(str(scenario))
@@ -286,6 +337,6 @@ def make_environment(scenario: Scenario | str, options: EnvOptions | None = None
     physics = SwarmnavPhysics.from_xml_string(scene.xml)
     if not same_model(physics.model.ptr, scene.model):
         raise RuntimeError("dm_control compiled the scene's MJCF to a different model")
-    task = NavigationTask(scenario, physics, scene.xml, options)
-    return control.Environment(physics, task, n_sub_steps=task.simulation.steps_per_control)
+    task = NavigationTask(scenario, physics, scene.xml, options, layout)
+    return control.Environment(physics, task, n_sub_steps=task.simulation.steps_per_control * options.action_repeat)
 
