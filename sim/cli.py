@@ -24,7 +24,7 @@ from typing import Any, Callable
 # what it needs (MuJoCo, SciPy, the planners, the log formats) when it runs.
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
-from swarmnav.sim import options
+from swarmnav.sim import options, stop_signal
 from swarmnav.sim.options import parse_settings
 from swarmnav.sim.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
 
@@ -316,15 +316,10 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _exit_on_sigterm(signum: int, frame: Any) -> None:
-    # SystemExit unwinds through the runner, which closes the log it was writing.
-    raise SystemExit(128 + signum)
-
-
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``swarmnav`` console script."""
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _exit_on_sigterm)
+        signal.signal(signal.SIGTERM, stop_signal.exit_on_signal)
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command in PLUGIN_COMMANDS:

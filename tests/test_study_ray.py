@@ -120,15 +120,22 @@ def processes_with(text: str) -> list[int]:
     return pids
 
 
-def test_a_ray_worker_killed_from_outside_is_one_error_row(ray_start_log, tmp_path):
-    study = parse_study(STUDY.replace("time_limit_s = 3.0", "time_limit_s = 6.0"))
+def test_a_ray_worker_killed_from_outside_is_one_error_row(ray_start_log, tmp_path, monkeypatch):
+    # One cell per task, as for cells long enough to travel alone: a killed batch of several quick cells runs
+    # again one cell per task (the killed cell then succeeds), which the next test's self-killing cells cover.
+    from swarmnav.sim.study import engines
+    monkeypatch.setattr(engines.BatchSizer, "size", lambda self: 1)
+    # The straight line runs into gwo-scenario-1's first disc and stays there to the time limit: every cell
+    # takes the same, long enough (2,000 control steps) to be killed inside it on a quiet machine too.
+    study = parse_study('name = "killed"\nscenarios = ["gwo-scenario-1"]\nmode = "physics"\ntime_limit_s = 40.0\n'
+                        'seeds = 8\n[[planners]]\nname = "straight"\n')
     killed: list[int] = []
 
     def kill_one_task() -> None:
         deadline = time.monotonic() + 120
         while not killed and time.monotonic() < deadline:
             for pid in processes_with("ray::run_batch"):
-                time.sleep(0.5)  # inside its cell by now
+                time.sleep(0.1)  # inside its cell by now
                 os.kill(pid, signal.SIGKILL)
                 killed.append(pid)
                 return

@@ -46,6 +46,16 @@ def _rate(text: str) -> float:
     return value
 
 
+def _first_stop(exc: BaseException) -> BaseException:
+    """The Ctrl-C or SIGTERM that stopped the study: a native library may turn the CLI's ``SystemExit(143)``
+    into one of its own on the way out (Ray's ``wait`` raises ``SystemExit(1)`` when a signal interrupts it),
+    so the signal the CLI's handler recorded wins."""
+    from swarmnav.sim import stop_signal
+    if isinstance(exc, SystemExit) and stop_signal.received is not None:
+        return SystemExit(128 + stop_signal.received)
+    return exc
+
+
 def run_study(args: argparse.Namespace) -> int:
     from swarmnav.models.errors import ConfigError
     from swarmnav.sim.study.spec import load_study
@@ -74,12 +84,13 @@ def run_study(args: argparse.Namespace) -> int:
         summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,
                           show_progress=not args.json and sys.stderr.isatty(), retry_errors=args.retry_errors)
     except (KeyboardInterrupt, SystemExit) as exc:  # Ctrl-C, or SIGTERM (the CLI's handler raises SystemExit)
+        exc = _first_stop(exc)
         how = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else "SIGTERM" if exc.code == 143 else f"exit {exc.code}"
         print(f"swarmnav: study stopped ({how}); the rows of the finished cells are kept in {out}: run the same "
               "command to resume", file=sys.stderr)
         if isinstance(exc, KeyboardInterrupt):
             return 130
-        raise
+        raise exc from None
     if args.json:
         print(json.dumps(summary))
     else:
