@@ -229,5 +229,5 @@ def test_the_abc_study_expands_to_the_cells_its_file_implies_and_its_claims_name
     assert {c.label: c.budget for c in expand(study)}["abc-equal-budget"] == {"evaluations": 200000}
     assert len(study.claims) >= 8
     for claim in study.claims:
-        assert claim["scenario"] in names and claim["planner"] in labels
-        assert set(claim["than"]) <= set(labels) and claim["metric"] in ("plan_length_m", "plan_time_s", "success")
+        assert claim.scenario in names and claim.planner in labels
+        assert set(claim.than) <= set(labels) and claim.metric in ("plan_length_m", "plan_time_s", "success")
