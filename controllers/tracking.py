@@ -38,7 +38,7 @@ Radii: a circle fit must lie within ``max_radius_m``; the track's radius is the
 median of its fits (one stray fit no longer fixes it for good).
 
 This is a choice of ours (the papers only say the sensors detect obstacles,
-seed 004 §5.2); the tolerances the tests hold it to are stated there.
+Abdulla & Hadi (2025) §5.2); the tolerances the tests hold it to are stated there.
 """
 
 from __future__ import annotations

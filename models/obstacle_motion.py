@@ -22,7 +22,7 @@ Three kinds, each a frozen dataclass with ``positions_at(times_s) -> (T, 2)``:
 * :class:`WaypointMotion`: patrol through points at constant speed, closing the loop.
 
 Every kind takes ``start_s``: the obstacle holds its start position until then and
-moves as described from that time on (seed 003 §2.1 assumption 2: obstacles
+moves as described from that time on (Gong et al. (2022) §2.1 assumption 2: obstacles
 switch between constant straight-line motion and the stopped state).
 """
 
@@ -90,7 +90,7 @@ class LinearMotion:
     speed_m_s: float
     heading_rad: float
     at_edge: str  # "reflect" | "stop"
-    # Where the obstacle's centre may go (the arena; seed 004 starts obstacles on its edge).
+    # Where the obstacle's centre may go (the arena; Abdulla & Hadi (2025) starts obstacles on its edge).
     lower_m: tuple[float, float]
     upper_m: tuple[float, float]
     start_s: float = 0.0  # held at the start until then

@@ -386,7 +386,7 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
         if motion_raw is not None:
             m = _Table(motion_raw, f"obstacles[{i}].motion", source)
             kind = m.string("kind", choices=MOTION_KINDS)
-            # Centres stay inside the arena: seed 004 places obstacles on its edge.
+            # Centres stay inside the arena: Abdulla & Hadi (2025) places obstacles on its edge.
             lower = (0.0, 0.0)
             upper = (width_m, height_m)
             start_s = m.number("start_s", 0.0, non_negative=True)  # held at its start until then
@@ -396,7 +396,7 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
                                       m.string("at_edge", choices=("reflect", "stop")), lower, upper, start_s)
             elif kind == "random_walk":
                 # A walker's disc stays inside the walls and off the map's boxes; on a map it walks the
-                # paper's grid (seed 000) by default, elsewhere compass steps (obstacle_motion's docstring).
+                # paper's grid (Hasan et al. (2023)) by default, elsewhere compass steps (obstacle_motion's docstring).
                 if walls:
                     lower, upper = (radius, radius), (width_m - radius, height_m - radius)
                 motion = RandomWalkMotion(

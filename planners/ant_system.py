@@ -2,7 +2,7 @@
 
 The plain ant colony, on the shared colony core (:mod:`planners.ant_colony`) and the
 one optimisation loop (:class:`planners.swarm.SwarmPlanner`).  It stands in for the
-unnamed "traditional ACO" baselines of Gong et al. (2022) (IACO, seed 003: its refs.
+unnamed "traditional ACO" baselines of Gong et al. (2022) (IACO: its refs.
 [19] and [24] are not given), so that IACO can be compared with a plain ant system
 on the same maps.
 

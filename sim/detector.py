@@ -8,7 +8,7 @@ Chosen per scenario by ``sensors.model``:
   the rest are points of unknown obstacles, which a
   :class:`~controllers.tracking.HitTracker` turns into discs with velocities.
   Only what the rays saw.
-* ``detector``: an idealised obstacle detector (the sensor seed 003 assumes:
+* ``detector``: an idealised obstacle detector (the sensor Gong et al. (2022) assumes:
   "direction, step length, size and shape").  Computed here from the true state:
   each moving obstacle's centre, radius and velocity (finite difference over
   one control step of its scripted motion), reported once its surface is within

@@ -1,4 +1,4 @@
-"""The papers' own dynamic strategies: IACO's collision types (seed 003 §4) and IMMAS's stepwise walk (seed 000)."""
+"""The papers' own dynamic strategies: IACO's collision types (Gong et al. (2022) §4) and IMMAS's stepwise walk (Hasan et al. (2023))."""
 
 from __future__ import annotations
 
@@ -41,7 +41,7 @@ def _encounter(gap_cells: float, radius_m: float, speed_m_s: float, heading_x: f
 
 
 def test_obs1_head_on_odd_size_acts_now_with_two_escape_cells():
-    enc = _encounter(5, 0.6, 3 * V_ROB, -1)                # seed 003 §5.4 Obs1
+    enc = _encounter(5, 0.6, 3 * V_ROB, -1)                # Gong et al. (2022) §5.4 Obs1
     assert (enc.kind, enc.ng, enc.grid_scale) == (HEAD_ON, 5, 3)
     assert enc.step_scale == pytest.approx(3.0)
     diagonal = escape_offsets((-1, 1), enc.grid_scale)     # the figures' heading, rows downwards
@@ -61,7 +61,7 @@ def test_an_escape_along_an_axis_costs_the_robot_its_moves():
 
 
 def test_obs2_head_on_even_size_has_six_escape_cells():
-    enc = _encounter(3, 0.4, 2 * V_ROB, -1)                # seed 003 §5.4 Obs2
+    enc = _encounter(3, 0.4, 2 * V_ROB, -1)                # Gong et al. (2022) §5.4 Obs2
     assert (enc.kind, enc.ng, enc.grid_scale) == (HEAD_ON, 3, 2)
     cells = escape_offsets((-1, 1), enc.grid_scale)        # Eq. (13), as (y, x) of the figures
     assert sorted(cells) == sorted([(-1, -2), (-2, -2), (-2, -1), (1, 2), (2, 2), (2, 1)])
@@ -72,7 +72,7 @@ def test_obs2_head_on_even_size_has_six_escape_cells():
 
 
 def test_obs3_overtaking_from_behind_goes_on_one_cell_first():
-    enc = _encounter(5, 0.4, 3 * V_ROB, +1, behind=True)  # seed 003 §5.4 Obs3
+    enc = _encounter(5, 0.4, 3 * V_ROB, +1, behind=True)  # Gong et al. (2022) §5.4 Obs3
     assert (enc.kind, enc.ng) == (FROM_BEHIND, 5)
     x = min(precondition_x(math.hypot(*o), enc.step_scale, enc.grid_scale)
             for o in escape_offsets(EAST, enc.grid_scale))

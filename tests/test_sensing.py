@@ -23,7 +23,7 @@ def ray_disc_ranges(origin_m, directions, centre_m, radius_m, range_m):
 
 @pytest.mark.parametrize("rays, radius_m, start_m, velocity_m_s", [
     (36, 0.3, (-0.1, 1.0), (0.12, -0.05)), (36, 0.2, (-0.1, 1.0), (-0.2, 0.0)), (36, 0.4, (-0.1, 1.0), (0.0, 0.15)),
-    # seed 004's 12 beams, 30 degrees apart: a disc coming down a beam (a sideways motion seen by one
+    # Abdulla & Hadi (2025)'s 12 beams, 30 degrees apart: a disc coming down a beam (a sideways motion seen by one
     # beam only is not observable: the hit stays on that beam)
     (12, 0.3, (0.0, 1.6), (0.0, -0.2)), (12, 0.2, (1.4, 0.0), (-0.15, 0.0))])
 def test_tracker_recovers_centre_and_velocity_of_a_disc_seen_by_a_ring_of_rays(rays, radius_m, start_m, velocity_m_s):

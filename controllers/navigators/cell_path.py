@@ -1,4 +1,4 @@
-"""Walking a grid map cell by cell, as the two papers' robots do (seed 000, seed 003 §2.1).
+"""Walking a grid map cell by cell, as the two papers' robots do (Hasan et al. 2023; Gong et al. 2022, §2.1).
 
 The papers' robot occupies one cell and moves one cell per step.  Here a
 :class:`CellWalker` hands the controller the centres of the cells still to

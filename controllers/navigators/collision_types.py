@@ -1,4 +1,4 @@
-"""The four collision types of Gong, Yang, Yuan & Wang (2022), seed 003 §4, and their equations.
+"""The four collision types of Gong, Yang, Yuan & Wang (2022) §4, and their equations.
 
 Units are the paper's: the robot occupies one cell and moves one cell per
 step; a moving obstacle, regularised to a ``Grid_scale`` x ``Grid_scale`` block

@@ -1,4 +1,4 @@
-"""``iaco_local``: global IACO path plus local avoidance by collision type, Gong, Yang, Yuan & Wang (2022), seed 003 §4.
+"""``iaco_local``: global IACO path plus local avoidance by collision type, Gong, Yang, Yuan & Wang (2022) §4.
 
 The method of §4.3: plan an IACO path on the static map (Steps 1-2), then walk
 it cell by cell; each time the robot reaches a cell it classifies every sensed
@@ -66,7 +66,7 @@ STRATEGIES = ("paper", "wait_only")
 
 @dataclass
 class IacoLocalNavigator:
-    """Seed 003's global IACO path with local avoidance by collision type.
+    """Gong et al. (2022)'s global IACO path with local avoidance by collision type.
 
     Args:
         strategy: "paper" (§4.2's four strategies) or "wait_only" (ref. [24]: type 1's action for every type).

@@ -1,4 +1,4 @@
-"""``immas_stepwise``: IMMAS's robot walking among random-walk obstacles, Hasan, Abdullah & Saleh (2023), seed 000.
+"""``immas_stepwise``: IMMAS's robot walking among random-walk obstacles, Hasan, Abdullah & Saleh (2023).
 
 Algorithm 1 (pheromone propagation from the goal, clean weights, gate raising,
 tight-tunnel closing; :func:`planners.max_min_ant_system.analyse_environment`)
@@ -203,7 +203,7 @@ def stepwise_walk(walk: StepwiseWalk, start: Cell, dynamic_at: Callable[[int], n
 
 @dataclass
 class ImmasStepwiseNavigator:
-    """Seed 000's robot: Algorithm 1 once, then Algorithm 3 cell by cell among moving obstacles.
+    """Hasan et al. (2023)'s robot: Algorithm 1 once, then Algorithm 3 cell by cell among moving obstacles.
 
     Args:
         alpha, beta: Eq. (3)'s weights; None takes the scenario's ``immas`` planner's, else 3 and 1 (line 4).

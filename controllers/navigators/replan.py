@@ -1,6 +1,6 @@
 """``replan``: follow the path, and plan again when a sensed obstacle's sweep blocks the way ahead.
 
-After Abdulla & Hadi (2025, seed 004, §5 and Figs. 9-10): the robot follows the
+After Abdulla & Hadi (2025, §5 and Figs. 9-10): the robot follows the
 path its planner found, its 12 sensors watch a range around it (§5.2), and when
 an obstacle is detected "the robot decided to deviate from its initial path and
 instead used the ABC and GWO algorithms to create new paths".  The paper gives

@@ -8,7 +8,7 @@ Three plan-only studies, built in code and run by the study machinery
   seeds each (a planner that is the scenario's own gets the scenario's parameters); with
   ``--all-pairs`` also on a copy of each map scenario per ``[map].pairs`` entry (written to
   ``OUT/pair-scenarios``: the scenario's text with its name, start and goal replaced);
-* ``bench-grid-restaurant``: M-ACO (Tsai et al.'s waiter robot, seed 002) on its home
+* ``bench-grid-restaurant``: M-ACO (Habib et al. (2021)'s waiter robot) on its home
   scenario beside A*, with how many runs' node baselines (the paper's Dijkstra links) collide;
 * ``bench-grid-movingai``: ``immas`` and ``iaco`` on a sample of Moving AI benchmark
   instances written as scenario files (``OUT/movingai-scenarios``: the map file, 1 m cells,

@@ -1,6 +1,6 @@
 """``swarmnav bench navigation --suite papers``: the papers' own dynamic strategies beside their baselines.
 
-Gong et al. (2022) (seed 003 §5.4) and Hasan et al. (2023) (seed 000) compare
+Gong et al. (2022) (§5.4) and Hasan et al. (2023) compare
 their strategies with others on their own scenarios.  Here every navigator of
 :data:`PAPER_SUITE` runs on the same scenarios with the IACO planner for
 ``replan`` (``--planner iaco --navigator replan``) and ``dstar_replan`` when it
@@ -37,9 +37,9 @@ PAPER_SUITE = ("iaco-dynamic", "immas-dynamic-10x10", "immas-env3-dynamic", "imm
 
 # What the papers print for these cases (none of them is like for like; see the report notes).
 PAPER_FIGURES = {
-    "iaco-dynamic": "seed 003 §5.4: no table; its strategy avoids Obs1 where ref. [24]'s cannot, "
+    "iaco-dynamic": "Gong et al. (2022) §5.4: no table; its strategy avoids Obs1 where ref. [24]'s cannot, "
                     "with a shorter path and fewer turns after Obs2 and Obs3",
-    "immas-dynamic-10x10": "seed 000 §4.1, 10 x 10: alpha = 2: 14 iterations, cost 106.2, 1.55 s; "
+    "immas-dynamic-10x10": "Hasan et al. (2023) §4.1, 10 x 10: alpha = 2: 14 iterations, cost 106.2, 1.55 s; "
                            "alpha = 3: cost 105.8 (its obstacles and map are in a missing figure)",
 }
 

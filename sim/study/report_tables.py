@@ -20,7 +20,7 @@ METRICS = (("plan_length_m", "plan length (m)"), ("plan_time_s", "plan time (s)"
            ("path_length_m", "driven length (m)"), ("sim_time_s", "simulated time (s)"),
            ("min_clearance_m", "min clearance (m)"), ("collisions", "collisions"))
 UNITS = dict(METRICS)
-# The metrics tested between planners, each where the runs have it (seed 003 Table 4 tests path lengths).
+# The metrics tested between planners, each where the runs have it (Gong et al. (2022) Table 4 tests path lengths).
 TEST_METRICS = ["plan_length_m", "plan_time_s", "path_length_m", "sim_time_s", "min_clearance_m"]
 # What must be equal, run by run, for two arms to be one configuration (timings excluded).
 SAME = ("outcome", "plan_waypoints", "plan_length_m", "plan_evaluations", "reached", "collisions", "sim_time_s",

@@ -4,7 +4,7 @@
   mean ± std (sample, ddof = 1), median and best of each metric over the runs
   that produced it;
 * between arms on one scenario, for each metric (length, time, clearance, ...): the
-  Wilcoxon rank-sum test (``scipy.stats.ranksums``, as Gong et al. 2022, seed 003,
+  Wilcoxon rank-sum test (``scipy.stats.ranksums``, as Gong et al. 2022,
   Table 4 use it on path lengths) with Cliff's delta;
   the Wilcoxon signed-rank test (``scipy.stats.wilcoxon``) on the runs that pair by
   (seed, world seed) with the matched-pairs rank-biserial correlation; Holm's
