@@ -188,6 +188,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from swarmnav.calls import run
+    options.check_output_file(args.json_out, "--json-out")
     if args.video:
         from swarmnav.sim.render import check_video_size
         check_video_size(args.width, args.height, args.fps)  # before the plan: bad options fail at once

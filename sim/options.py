@@ -95,3 +95,11 @@ def parse_settings(pairs: list[str] | None, option: str = "--set") -> dict[str, 
             value = text
         params[key] = value
     return params
+
+
+def check_output_file(path: str | None, option: str) -> None:
+    """An output file option that names a folder is refused before any work (the work's results would be lost
+    to a one-line error at the end)."""
+    import os
+    if path is not None and os.path.isdir(path):
+        raise ConfigError(option, "Is a directory (give a file path)", path)

@@ -179,3 +179,12 @@ def test_study_junit_and_min_success(tmp_path):
     # astar succeeds on scenario 1: the same study passes a lower bar
     again = _swarmnav("study", str(study), "--out", str(tmp_path / "rows"), "--min-success", "0")
     assert again.returncode == 0
+
+
+@pytest.mark.parametrize("argv", [["run", "gwo-scenario-1", "--planner", "straight", "--no-log", "--json-out", "{dir}"],
+                                  ["study", "gwo-vs-abc", "--out", "{dir}/rows", "--junit", "{dir}"]])
+def test_an_output_file_naming_a_folder_is_refused_before_any_work(tmp_path, capsys, argv):
+    assert main([a.format(dir=tmp_path) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Is a directory" in err
+    assert not (tmp_path / "rows").exists()  # the study did not start

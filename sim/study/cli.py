@@ -72,6 +72,8 @@ def run_study(args: argparse.Namespace) -> int:
             import ray  # noqa: F401
         except ImportError:
             raise ConfigError("--engine", "ray is not installed (pip install 'swarmnav[ray]')") from None
+    from swarmnav.sim.options import check_output_file
+    check_output_file(args.junit, "--junit")
     study = load_study(args.file, trust_code=args.trust_code)
     if args.quick:
         if study.quick_seeds is None:
