@@ -167,7 +167,7 @@ def test_sigterm_ends_a_ray_study_with_one_line_and_keeps_its_rows(tmp_path):
         time.sleep(0.05)
     process.send_signal(signal.SIGTERM)
     _, err = process.communicate(timeout=60)
-    assert process.returncode == 128 + signal.SIGTERM
+    assert process.returncode == 128 + signal.SIGTERM, err[-4000:]
     assert "SIGTERM received" not in err and "PC: @" not in err and "Traceback" not in err
     assert [line for line in err.splitlines() if line.startswith("swarmnav:")] == [
         f"swarmnav: study stopped (SIGTERM); the rows of the finished cells are kept in {out}: run the same command "

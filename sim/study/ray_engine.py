@@ -161,5 +161,8 @@ def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | No
                     sizer.observe(row)
                     yield row, progress
     finally:
-        for ref in inflight:
-            ray.cancel(ref, force=True)
+        # The tasks still in flight are not cancelled: in Ray 2.60 ``ray.cancel`` races with a task's reply
+        # and can abort the driver ("Tried to complete task that was not pending", exit 1) after its rows
+        # were kept.  A stopped driver exits, and Ray ends the tasks of a job whose driver is gone; in a
+        # Python session the in-flight batches (a few seconds each, ``BatchSizer``) finish and are dropped.
+        inflight.clear()
