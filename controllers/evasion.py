@@ -127,3 +127,17 @@ def evasion_for(setup, trigger_s: float) -> Evasion:
     known = setup.map_problem
     return Evasion(setup.controller.geometry, known.robot_radius_m, setup.max_speed_m_s,
                    LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m), trigger_s=trigger_s)
+
+
+def evaded(evasion: Evasion | None, observation, answer):
+    """A navigator's :class:`~controllers.navigator.NavigationStep` with the evasion applied to its command
+    (an ``evade`` event when it starts to override); the answer itself when ``evasion`` is None."""
+    if evasion is None:
+        return answer
+    from swarmnav.controllers.navigator import NavigationStep
+    command, started = evasion.apply(observation.pose, answer.command, observation.detections)
+    if command is answer.command:
+        return answer
+    events = answer.events + ((("evade", {"linear_m_s": round(command.linear_m_s, 6),
+                                          "angular_rad_s": round(command.angular_rad_s, 6)}),) if started else ())
+    return NavigationStep(command, answer.new_path, events, answer.belief)
