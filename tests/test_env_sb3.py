@@ -4,6 +4,7 @@ Needs the ``rl`` extra (Stable-Baselines3, PyTorch's CPU wheel), which ``make in
 skipped only where the extra is not installed.  Kept small: 2,048 steps of a network of one hidden layer of 16.
 """
 
+import importlib.util
 import json
 import os
 import re
@@ -15,7 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("stable_baselines3")
+if importlib.util.find_spec("stable_baselines3") is None:  # not imported here: PyTorch loads only if these run
+    pytest.skip("needs the rl extra (pip install -e '.[rl]')", allow_module_level=True)
 
 from swarmnav.controllers.observation_normaliser import ObservationNormaliser  # noqa: E402
 from swarmnav.sim.episode import EpisodeSpec, run_episode  # noqa: E402
@@ -56,19 +58,18 @@ def rollout_in_the_environment(env, model, normaliser, seed):
     return seen, actions
 
 
-def test_the_saved_policy_acts_in_swarmnav_run_as_in_the_environment(trained, monkeypatch):
+@pytest.fixture(scope="module")
+def episode(trained):
+    """One generated world driven by the saved policy in the environment and through the policy navigator."""
     import torch
     from stable_baselines3 import PPO
     out, _, train_sb3, sb3_policy = trained
     torch.set_num_threads(1)
     model = PPO.load(out / "model.zip", device="cpu")
-    normaliser = ObservationNormaliser.load(out / "normalise.npz")
     assert model.policy.mlp_extractor.policy_net[0].out_features == 16  # the script's --net-arch was applied
+    normaliser = ObservationNormaliser.load(out / "normalise.npz")
     env = train_sb3.make_env(KINDS, TIME_LIMIT_S)  # a generated world, drawn from the reset's seed
     env_obs, env_actions = rollout_in_the_environment(env, model, normaliser, seed=5)
-
-    monkeypatch.setenv("SWARMNAV_SB3_MODEL", str(out / "model.zip"))
-    monkeypatch.setattr(sb3_policy, "_model", None)
     run_obs, run_actions = [], []
 
     def recording(obs):
@@ -76,11 +77,19 @@ def test_the_saved_policy_acts_in_swarmnav_run_as_in_the_environment(trained, mo
         run_actions.append(sb3_policy.act(obs))
         return run_actions[-1]
 
-    monkeypatch.setattr(sb3_policy, "recording", recording, raising=False)
     scenario, seeds = env.task.scenario, env.task.seeds
     params = {"policy": "sb3_policy:recording", "flatten": True, "normalise": str(out / "normalise.npz")}
-    run = run_episode(EpisodeSpec(scenario, navigator="policy", navigator_params=params, seed=seeds.planner,
-                                  world_seed=seeds.world), time_limit_s=TIME_LIMIT_S).result
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("SWARMNAV_SB3_MODEL", str(out / "model.zip"))
+        patch.setattr(sb3_policy, "_model", None)
+        patch.setattr(sb3_policy, "recording", recording, raising=False)
+        run = run_episode(EpisodeSpec(scenario, navigator="policy", navigator_params=params, seed=seeds.planner,
+                                      world_seed=seeds.world), time_limit_s=TIME_LIMIT_S).result
+    return env, env_obs, env_actions, run, run_obs, run_actions
+
+
+def test_the_saved_policy_acts_in_swarmnav_run_as_in_the_environment(episode):
+    env, env_obs, env_actions, run, run_obs, run_actions = episode
     # The same observations, entry by entry, and the same actions for them.
     assert len(run_obs) == len(env_obs) == run.steps > 10
     assert all(a.dtype == b.dtype == np.float32 and np.array_equal(a, b) for a, b in zip(run_obs, env_obs))
@@ -91,19 +100,18 @@ def test_the_saved_policy_acts_in_swarmnav_run_as_in_the_environment(trained, mo
     assert np.array_equal(stepper.poses[:stepper.step_index + 1], run.poses)
 
 
-def test_the_command_the_script_prints_runs_the_policy_with_a_video(trained, monkeypatch):
+def test_the_command_the_script_prints_runs_the_policy_with_a_video(trained, episode):
     """In a fresh process, as a user would: PyTorch (and its triton, installed by the test extra) loads on the
     policy's first action, after ``--video`` made its GL context (issue 25's segfault, exit -11, when it did)."""
-    out, command, train_sb3, _ = trained
+    out, command, _, _ = trained
+    env, _, _, run, _, _ = episode
     words = shlex.split(command)
     variables = dict(word.split("=", 1) for word in words[:2])
     assert set(variables) == {"PYTHONPATH", "SWARMNAV_SB3_MODEL"} and words[2:4] == ["swarmnav", "run"]
-    env = train_sb3.make_env(KINDS, TIME_LIMIT_S)
-    env.reset(seed=5)
     scenario, seeds = env.task.scenario, env.task.seeds
-    world = out / "world.toml"
     text = re.sub(r"(?m)^time_limit_s = .*$", f"time_limit_s = {TIME_LIMIT_S:g}", scenario.source_text)
     assert f"time_limit_s = {TIME_LIMIT_S:g}" in text
+    world = out / "world.toml"
     world.write_text(text)
     args = [str(world), *words[5:], "--world-seed", str(seeds.world), "--seed", str(seeds.planner), "--no-log",
             "--json", "--video", str(out / "run.mp4"), "--width", "160", "--height", "120", "--fps", "10"]
@@ -112,10 +120,6 @@ def test_the_command_the_script_prints_runs_the_policy_with_a_video(trained, mon
     assert done.returncode == 0, (done.returncode, done.stderr)
     assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr, done.stderr
     summary = json.loads(done.stdout)
-    params = {"policy": "sb3_policy:act", "flatten": True, "normalise": str(out / "normalise.npz")}
-    monkeypatch.setenv("SWARMNAV_SB3_MODEL", variables["SWARMNAV_SB3_MODEL"])
-    run = run_episode(EpisodeSpec(scenario, navigator="policy", navigator_params=params, seed=seeds.planner,
-                                  world_seed=seeds.world), time_limit_s=TIME_LIMIT_S).result
     assert summary["navigator"] == "policy" and summary["outcome"] == run.outcome
     assert summary["sim_time_s"] == pytest.approx(run.sim_time_s)
     assert summary["path_length_m"] == pytest.approx(run.path_length_m, rel=1e-12)
