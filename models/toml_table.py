@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 import tomllib
+import types
+import typing
 from dataclasses import dataclass
 from pathlib import Path as FilePath
 from typing import Any, Iterable, NoReturn
@@ -230,6 +232,52 @@ class TomlTable:
         if unknown:
             self.fail(_shown(unknown[0]), f"unknown key{hint}")
 
+    def typed(self, key: str, annotation: Any, bounds: Range | None = None) -> Any:
+        """A present key's value checked against a Python annotation (:func:`check_typed`)."""
+        return check_typed(self.raw(key), annotation, self.path(key), self.source, bounds)
+
     def close(self) -> None:
         """Reject keys that were never read."""
         self.only(self.used)
+
+
+def check_typed(value: Any, annotation: Any, field: str, source: str | None = None,
+                bounds: Range | None = None) -> Any:
+    """A value checked against a Python annotation (``bool``, ``int``, ``float``, ``str``, a union of them with
+    ``None``; any other annotation takes the value as it is), then a number against ``bounds``.
+
+    An ``int`` also takes a float with no fraction (``50.0``).  For a union, the first member that takes the
+    value wins; if none does, the problem lists each member's.
+    """
+    value = _typed(value, annotation, field, source)
+    if bounds is not None and isinstance(value, (int, float)) and not isinstance(value, bool):
+        if isinstance(value, int):
+            check_integer(value, field, source, bounds)
+        else:
+            check_number(value, field, source, bounds)
+    return value
+
+
+def _typed(value: Any, annotation: Any, field: str, source: str | None) -> Any:
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        members = typing.get_args(annotation)
+        if value is None and type(None) in members:
+            return None
+        problems = []
+        for member in members:
+            if member is type(None):
+                continue
+            try:
+                return _typed(value, member, field, source)
+            except ConfigError as exc:
+                problems.append(exc.problem)
+        fail(field, "; ".join(problems), source)
+    if annotation is bool:
+        return check_boolean(value, field, source)
+    if annotation is int:
+        return check_integer(value, field, source, integral_float=True)
+    if annotation is float:
+        return check_number(value, field, source)
+    if annotation is str:
+        return check_string(value, field, source)
+    return value
