@@ -51,23 +51,28 @@ class Range:
             if self.low == 0.0:
                 return "must be positive" if self.low_open else "must not be negative"
             if not self.low_open:
-                return f"must be at least {self.low:g}"
+                return f"must be at least {_shown_number(self.low)}"
         if self.low == -math.inf and not self.low_open:
-            return f"must be at most {self.high:g}"
+            return f"must be at most {_shown_number(self.high)}"
         return f"must be in {self}"
 
     def __str__(self) -> str:
-        return f"{'(' if self.low_open else '['}{self.low:g}, {self.high:g}]"
+        return f"{'(' if self.low_open else '['}{_shown_number(self.low)}, {_shown_number(self.high)}]"
+
+
+def _shown_number(value: float) -> str:
+    """An integer in full (a seed's 2**63 - 1), a float short (``1e+06``)."""
+    return str(value) if isinstance(value, int) else f"{value:g}"
 
 
 def within(low: float, high: float = math.inf) -> Range:
-    """[low, high]."""
-    return Range(float(low), float(high))
+    """[low, high] (an integer bound is kept exact: it compares exactly with integers)."""
+    return Range(low, high)
 
 
 def above(low: float, high: float = math.inf) -> Range:
     """(low, high]: e.g. a positive length, ``above(0, 100)``."""
-    return Range(float(low), float(high), low_open=True)
+    return Range(low, high, low_open=True)
 
 
 POSITIVE = above(0)
@@ -124,6 +129,14 @@ def check_string(value: Any, field: str, source: str | None = None, choices: Ite
     return value
 
 
+def check_array(value: Any, field: str, source: str | None = None, what: str = "an array",
+                non_empty: bool = False) -> list:
+    """A list (``what`` names what it should hold, for the error); with ``non_empty``, not empty."""
+    if not isinstance(value, list) or (non_empty and not value):
+        fail(field, f"expected {what}, got {_brief(value)}", source)
+    return value
+
+
 def read_text(path: FilePath, field: str) -> str:
     """A file's UTF-8 text; unreadable is a ConfigError naming ``field`` (``scenario``, ``study``) and the file."""
     try:
@@ -139,6 +152,12 @@ def parse_toml(text: str, source: str) -> "TomlTable":
     except tomllib.TOMLDecodeError as exc:
         fail("toml", f"malformed TOML ({exc})", source)
     return TomlTable(data, "", source)
+
+
+def _brief(value: Any, limit: int = 60) -> str:
+    """A value as an error shows it: its repr, cut short (a wrong array may be long)."""
+    text = repr(value)
+    return text if len(text) <= limit else f"{text[:limit - 5]}...{text[-1]}"
 
 
 def _shown(key: str) -> str:
@@ -159,7 +178,7 @@ class TomlTable:
         self.where = where
         self.source = source
         if not isinstance(data, dict):
-            fail(where or "toml", f"expected a table, got {data!r}", source)
+            fail(where or "toml", f"expected a table, got {_brief(data)}", source)
         self.data: dict[str, Any] = data
         self.used: set[str] = set()
 
@@ -212,10 +231,7 @@ class TomlTable:
 
     def array(self, key: str, default: Any = REQUIRED, what: str = "an array", non_empty: bool = False) -> list:
         """A list (``what`` names what it should hold, for the error); with ``non_empty``, not empty."""
-        value = self.raw(key, default)
-        if not isinstance(value, list) or (non_empty and not value):
-            self.fail(key, f"expected {what}, got {value!r}")
-        return value
+        return check_array(self.raw(key, default), self.path(key), self.source, what, non_empty)
 
     def table(self, key: str, default: Any = REQUIRED) -> "TomlTable":
         return TomlTable(self.raw(key, default), self.path(key), self.source)
