@@ -64,7 +64,7 @@ from swarmnav.models.scenario import SCENARIO_DIR
 from swarmnav.models.toml_table import POSITIVE, TomlTable, above, parse_toml, read_text, within
 from swarmnav.planners.registry import make_planner
 from swarmnav.planners.swarm import Budget
-from swarmnav.sim.study.claim_spec import Claim, parse_claims
+from swarmnav.sim.study.claim_spec import Claim, read_claims
 from swarmnav.sim.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, PaperValue,  # noqa: F401
                                               read_budget, read_clearance, read_components, read_paper,
                                               read_scenarios, read_seeds, refuse_scenario_code)
@@ -191,7 +191,7 @@ def _read_study(top: TomlTable, default_name: str, trust_code: bool) -> Study:
     cells = len(scenarios) * settings * (len(seeds) if paired else len(seeds) * len(world_seeds))
     if cells > MAX_CELLS:
         top.fail("seeds", f"the grid has {cells:,} runs (scenarios x settings x seeds), at most {MAX_CELLS:,}")
-    claims = parse_claims(top.source, top.raw("claims", []), scenarios, planners, navigators)
+    claims = read_claims(top, scenarios, planners, navigators)
     budget = read_budget(top.table("budget")) if top.has("budget") else None
     return Study(name, description, top.source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
                  reference, planners, navigators, paper, quick_seeds, read_clearance(top, scenarios), paired,
