@@ -22,7 +22,7 @@ from swarmnav.models.scenario_limits import (MAX_CONTROL_STEPS, MAX_GRID_CELLS, 
 from swarmnav.models.scenario_map import check_grid_size, read_map_section
 from swarmnav.models.scenario_obstacles import MOTION_KINDS, Obstacle, ObstacleWorld, read_obstacles  # noqa: F401
 from swarmnav.models.seeds import Seeds
-from swarmnav.models.toml_table import NON_NEGATIVE, POSITIVE, TomlTable, fail, parse_toml, read_text, within
+from swarmnav.models.toml_table import NON_NEGATIVE, POSITIVE, TomlTable, parse_toml, read_text, within
 from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem
 
 SCENARIO_DIR = FilePath(__file__).resolve().parent / "scenarios"
@@ -202,8 +202,8 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
     if section is not None:
         cell_m = section.cell_m
         if all(ob.moving for ob in obstacles):
-            # Only moving obstacles (Hasan et al. (2023)'s maps): plan on the static map, as the papers do.
-            # Static discs beside a map are rasterised with it at the map's resolution instead (map_grid None).
+            # Only moving obstacles (Hasan et al. (2023); Gong et al. (2022)): plan on the static map, as the
+            # papers do.  Static discs beside a map are rasterised with it at the map's resolution (map_grid None).
             from swarmnav.models.grid_map import inflated_map_grid
             map_grid = inflated_map_grid(section.grid.occupied, section.cell_m, robot_radius_m + clearance_m, boxes)
 
