@@ -38,7 +38,7 @@ import numpy as np
 
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.kinematics import DriveGeometry, wheel_speeds
-from swarmnav.controllers.navigator import DetectedObstacle
+from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.prediction import LocalObstacles, time_to_collision_s
 from swarmnav.models.geometry import segment_box_distances
 from swarmnav.models.world import Pose2D
@@ -122,19 +122,18 @@ class Evasion:
         return ControlCommand(wheel_speeds(v, omega, self.geometry), v, omega, command.waypoint_index), rising
 
 
-def evasion_for(setup, trigger_s: float) -> Evasion:
+def evasion_for(setup: NavigationSetup, trigger_s: float) -> Evasion:
     """The evasion layer for a run, from its :class:`~controllers.navigator.NavigationSetup`."""
     known = setup.map_problem
     return Evasion(setup.controller.geometry, known.robot_radius_m, setup.max_speed_m_s,
                    LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m), trigger_s=trigger_s)
 
 
-def evaded(evasion: Evasion | None, observation, answer):
+def evaded(evasion: Evasion | None, observation: Observation, answer: NavigationStep) -> NavigationStep:
     """A navigator's :class:`~controllers.navigator.NavigationStep` with the evasion applied to its command
     (an ``evade`` event when it starts to override); the answer itself when ``evasion`` is None."""
     if evasion is None:
         return answer
-    from swarmnav.controllers.navigator import NavigationStep
     command, started = evasion.apply(observation.pose, answer.command, observation.detections)
     if command is answer.command:
         return answer
