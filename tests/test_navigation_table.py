@@ -43,3 +43,15 @@ def test_the_table_follows_the_rows_and_a_bad_file_is_named(tmp_path, capsys):
     assert str(bad) in err and len(err.strip().splitlines()) == 1
     with pytest.raises(Exception, match="navigation-table markers"):
         replace_block("no markers here", block(rows), "README.md")
+
+
+def test_per_group_writes_that_many_scenes_of_each_group_and_needs_a_generated_suite(tmp_path, capsys):
+    from swarmnav.sim.benchmarks.navigation import write_suite
+    from swarmnav.sim.cli import main
+    paths, suite = write_suite("dyn300", False, None, str(tmp_path), per_group=3)
+    groups = list(dict.fromkeys(s.group for s in suite.scenes))
+    names = [Path(p).stem for p in paths]
+    assert len(names) == 3 * len(groups) and len(set(names)) == len(names)
+    assert all(sum(name.startswith(f"d300-{g}-") for name in names) == 3 for g in groups)
+    assert main(["bench", "navigation", "--per-group", "3"]) == 2
+    assert "--per-group" in capsys.readouterr().err
