@@ -58,6 +58,11 @@ RUN_SCHEMA = pa.schema([
     ("driven_turns", pa.int64()), ("run_events", pa.string()),
     ("budget", pa.string()), ("budget_evaluations", pa.int64()), ("budget_time_s", pa.float64()),
     ("budgeted", pa.bool_()), ("plan_mode", pa.string()), ("planner_resolved", pa.string()),
+    # against the clairvoyant oracle, physics rows of dynamic scenarios (sim/study/yardstick.py)
+    ("oracle_verdict", pa.string()), ("oracle_reason", pa.string()), ("oracle_t_star_s", pa.float64()),
+    ("oracle_cell_m", pa.float64()), ("time_score", pa.float64()), ("static_density", pa.float64()),
+    ("dispersion", pa.float64()), ("survivability", pa.float64()), ("dynamic_traversability", pa.float64()),
+    ("t_star_ratio", pa.float64()), ("difficulty_error", pa.string()),
 ])
 PROGRESS_SCHEMA = pa.schema([
     ("config_hash", pa.string()), ("iteration", pa.int64()), ("best_cost", pa.float64()),
