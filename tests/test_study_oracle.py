@@ -15,6 +15,7 @@ import pytest
 from swarmnav.models.scenario_generator import GeneratorOptions, generate
 from swarmnav.sim import palette
 from swarmnav.sim.cli import main
+from swarmnav.sim.study.against_oracle import binned_success
 from swarmnav.sim.study.rows import RUN_SCHEMA, RUNS, load_runs, part_name
 from swarmnav.sim.study.yardstick import FILE, Yardstick
 
@@ -162,6 +163,14 @@ def test_the_report_draws_success_against_dynamic_traversability_in_the_palette(
     assert "dynamic traversability" in svg and "success (%)" in svg
     assert palette.planner_colour(0) in svg and palette.planner_colour(1) in svg
     assert "velocity_obstacle" in svg and "follow" in svg
+    # The figure's numbers come from the rows: one bin per solvable scene here, ordered by the metric.
+    rows = load_runs(out)
+    solvable = sorted({(r["dynamic_traversability"], r["scenario"]) for r in rows if r["oracle_verdict"] == "solvable"})
+    centres, counts, shares = binned_success(rows)
+    assert centres == [m for m, _ in solvable] and counts == [1, 1]
+    for navigator, share in shares.items():
+        assert share == [float(next(r["success"] for r in rows if r["scenario"] == scene
+                                    and (r["navigator_label"] or "follow") == navigator)) for _, scene in solvable]
     html = (out / "report.html").read_text(encoding="utf-8")
     assert html.index("Navigation against the oracle") < html.index("data:image/svg+xml")
 

@@ -4,8 +4,10 @@ Read from the rows alone (their ``oracle_verdict``, ``time_score`` and difficult
 ran: :mod:`sim.study.yardstick`).  Per navigator (per arm where a scenario has several planners): every run in
 ``success`` and ``SPL`` (failures count, as everywhere in the report); the oracle-solvable runs alone in the
 share solved and the mean time score (BARN's, Perille et al. 2020), so a scene the oracle calls unsolvable, or
-could not decide, never counts against a navigator.  The figure sets each oracle-solvable scene's success
-share against one difficulty metric (:data:`FIGURE_METRIC`).
+could not decide, never counts against a navigator.  The figure sets each navigator's success on the
+oracle-solvable scenes against one difficulty metric (:data:`FIGURE_METRIC`), the scenes in bins of equal
+counts; the oracle itself, the yardstick, is in the table (its success validates its verdicts) but not in the
+figure.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from swarmnav.sim.study.statistics import arm
 from swarmnav.sim.study.tables import Table
 
 FIGURE_METRIC = "dynamic_traversability"
+FIGURE_BINS = 5
 METRIC_TITLES = {"dynamic_traversability": "dynamic traversability (Shi et al. 2024; lower is harder)",
                  "survivability": "survivability (Shi et al. 2024; higher is harder)",
                  "t_star_ratio": "T* over the static arrival", "static_density": "static density (BARN)",
@@ -62,8 +65,9 @@ def navigator_table(runs: list[dict[str, Any]]) -> Table | None:
     body = []
     for navigator, group in groups.items():
         solvable = [r for r in group if r["oracle_verdict"] == "solvable"]
+        clairvoyant = is_clairvoyant(group[0].get("navigator"))
         body.append([
-            navigator, len(group), 100.0 * sum(bool(r["success"]) for r in group) / len(group),
+            f"{navigator} (clairvoyant yardstick)" if clairvoyant else navigator, len(group), 100.0 * sum(bool(r["success"]) for r in group) / len(group),
             _mean([r.get("spl") or 0.0 for r in group]), len(solvable),
             sum(r["oracle_verdict"] == "unsolvable" for r in group),
             sum(r["oracle_verdict"] == "undecided" for r in group),
@@ -75,40 +79,55 @@ def navigator_table(runs: list[dict[str, Any]]) -> Table | None:
                   "undecided runs", "solved of solvable (%)", "time score"], body)
 
 
-def scene_success(runs: list[dict[str, Any]], metric: str = FIGURE_METRIC) -> dict[str, list[tuple[float, float]]]:
-    """navigator -> [(the scene's ``metric``, the navigator's success share there)], one point per oracle-solvable
-    scene (scenario and world seed) that has the metric, ordered by the metric."""
-    rows = [r for r in dynamic_rows(runs) if r.get(metric) is not None and r["oracle_verdict"] == "solvable"]
+def is_clairvoyant(navigator: str | None) -> bool:
+    """The yardstick itself (the ``oracle``), never a contender."""
+    from swarmnav.controllers.navigators import NAVIGATORS
+    return bool(getattr(NAVIGATORS.get(navigator or "follow"), "clairvoyant", False))
+
+
+def binned_success(runs: list[dict[str, Any]], metric: str = FIGURE_METRIC, bins: int = FIGURE_BINS):
+    """The oracle-solvable scenes (scenario and world seed) that have ``metric``, ordered by it and split into up
+    to ``bins`` bins of equal counts: (each bin's mean ``metric``, its scene count, navigator -> the success share
+    of that navigator's runs in each bin's scenes); the clairvoyant oracle left out.  None without such scenes."""
+    rows = [r for r in dynamic_rows(runs) if r.get(metric) is not None and r["oracle_verdict"] == "solvable"
+            and not is_clairvoyant(r.get("navigator"))]
     if not rows:
-        return {}
+        return None
+    scenes = sorted({(r["scenario"], r["world_seed"]): float(r[metric]) for r in rows}.items(),
+                    key=lambda item: (item[1], str(item[0])))
+    groups = [g for g in np.array_split(np.arange(len(scenes)), min(bins, len(scenes))) if len(g)]
+    bin_of = {scenes[i][0]: k for k, g in enumerate(groups) for i in g}
+    centres = [float(np.mean([scenes[i][1] for i in g])) for g in groups]
     name = group_name(rows)
-    cells: dict[str, dict[tuple, list[dict[str, Any]]]] = {}
+    tally: dict[str, np.ndarray] = {}
     for r in rows:
-        cells.setdefault(name(r), {}).setdefault((r["scenario"], r["world_seed"]), []).append(r)
-    return {nav: sorted((float(g[0][metric]), sum(bool(r["success"]) for r in g) / len(g)) for g in scenes.values())
-            for nav, scenes in cells.items()}
+        counts = tally.setdefault(name(r), np.zeros((len(groups), 2)))
+        counts[bin_of[(r["scenario"], r["world_seed"])]] += (bool(r["success"]), 1)
+    shares = {nav: [None if n == 0 else float(s / n) for s, n in counts] for nav, counts in tally.items()}
+    return centres, [len(g) for g in groups], shares
 
 
 def success_figure(runs: list[dict[str, Any]], metric: str = FIGURE_METRIC):
-    """Each navigator's success share per oracle-solvable scene against ``metric`` (points), with the mean over up to five bins
-    of equal counts (line); None when no row has the metric."""
+    """Each navigator's success over the oracle-solvable scenes, in bins of ``metric`` (:func:`binned_success`);
+    None when no row has the metric."""
     import matplotlib.pyplot as plt
     from swarmnav.sim import palette
     from swarmnav.sim.study.figures import MAX_WIDTH_IN
-    points = scene_success(runs, metric)
-    if not points:
+    found = binned_success(runs, metric)
+    if found is None:
         return None
+    centres, counts, shares = found
     fig, ax = plt.subplots(figsize=(min(MAX_WIDTH_IN, 7.0), 4.0))
-    for k, (navigator, xy) in enumerate(points.items()):
-        colour = palette.planner_colour(k)
-        data = np.array(xy)
-        ax.plot(data[:, 0], 100.0 * data[:, 1], "o", color=colour, alpha=0.45, markersize=4)
-        bins = [b for b in np.array_split(data, min(5, len(data))) if len(b)]
-        ax.plot([b[:, 0].mean() for b in bins], [100.0 * b[:, 1].mean() for b in bins], color=colour,
-                linestyle=palette.navigator_style(navigator), marker="s", markersize=3, label=navigator)
-    ax.set_xlabel(METRIC_TITLES.get(metric, metric))
+    for k, (navigator, share) in enumerate(shares.items()):
+        xy = np.array([(x, 100.0 * s) for x, s in zip(centres, share) if s is not None])
+        ax.plot(xy[:, 0], xy[:, 1], color=palette.planner_colour(k), linestyle=palette.navigator_style(navigator),
+                marker="o", markersize=4, label=navigator)
+    for x, n in zip(centres, counts):
+        ax.text(x, 108, str(n), ha="center", va="center", fontsize=7, color=palette.OBSTACLE)
+    ax.set_xlabel(METRIC_TITLES.get(metric, metric) + ", mean of each bin (grey, above: its scenes)")
     ax.set_ylabel("success (%)")
-    ax.set_ylim(-4, 104)
+    ax.set_ylim(-4, 114)
+    ax.set_yticks(range(0, 101, 20))
     ax.grid(alpha=0.3)
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     fig.tight_layout()

@@ -160,9 +160,10 @@ def _against_oracle(doc: _Document, runs: list[dict[str, Any]]) -> None:
     doc.table(table)
     metric = against_oracle.FIGURE_METRIC
     doc.figure(against_oracle.success_figure(runs, metric),
-               f"Success per oracle-solvable scene against its {against_oracle.METRIC_TITLES[metric]}: one point per navigator "
-               "and scene (scenario and world seed), the line the mean over bins of equal counts")
-
+               f"Success on the oracle-solvable scenes against their {against_oracle.METRIC_TITLES[metric]}: "
+               f"the scenes ordered by it in up to {against_oracle.FIGURE_BINS} bins of equal counts, each "
+               "navigator's success over its runs in each bin (the clairvoyant oracle left out); the grey numbers: "
+               "the scenes in each bin")
 
 def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePath:
     """Write the HTML report, its Markdown twin (``.md`` beside it) and ``claims.json`` beside them; return
