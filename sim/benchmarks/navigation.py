@@ -162,7 +162,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     runs = {n: [r for r in rows if r["navigator"] == n] for n in contenders + [ORACLE]}
     table = [{"scenario": None, **_row(nav, arm, verdicts, shipped)} for nav, arm in runs.items()]
     if speed:
-        _add_speed(table, rows, contenders)
+        _add_speed(table, rows)
     if by_scenario:
         for name in dict.fromkeys(r["scenario"] for r in rows):
             extra = {"difficulty": {k: shipped[name][k] for k in DIFFICULTY_KEYS}} if name in shipped else {}
@@ -172,7 +172,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     return table
 
 
-def _add_speed(table: list[dict[str, Any]], rows: list[dict[str, Any]], contenders: list[str]) -> None:
+def _add_speed(table: list[dict[str, Any]], rows: list[dict[str, Any]]) -> None:
     """The oracle's search times on every scene run (its row's ``oracle_search``) and MPPI's cost per control
     step optimising every step (its row's ``mppi_every_step``): :mod:`sim.benchmarks.navigation_speed`."""
     from swarmnav.sim.benchmarks.navigation_speed import mppi_step_cost, oracle_search_times
@@ -180,7 +180,7 @@ def _add_speed(table: list[dict[str, Any]], rows: list[dict[str, Any]], contende
     for row in table:
         if row["navigator"] == ORACLE:
             row["oracle_search"] = oracle_search_times(scenes)
-        elif row["navigator"] == "mppi" and "mppi" in contenders:
+        elif row["navigator"] == "mppi":
             row["mppi_every_step"] = mppi_step_cost()
 
 
