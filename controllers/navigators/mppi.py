@@ -147,6 +147,13 @@ class MppiNavigator:
         self.path_points = _resample(pts, 0.1)
         self.path_cum = np.arange(len(self.path_points)) * 0.1
 
+    def _clip(self, controls: np.ndarray) -> np.ndarray:
+        """Clip (..., 2) controls to the limits in place, channel by channel: a scalar bound per channel is about
+        ten times faster than broadcasting the (2,) bound arrays over a (K, T, 2) array (same values)."""
+        for channel in (0, 1):
+            np.clip(controls[..., channel], self.lo[channel], self.hi[channel], out=controls[..., channel])
+        return controls
+
     def rollouts(self, x: float, y: float, heading: float, controls: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(K, T) x and y after each step of each (K, T, 2) control sequence (the unicycle, explicit Euler:
         each step moves along the heading it starts with, as Nav2's motion model)."""
@@ -224,7 +231,7 @@ class MppiNavigator:
             noise = self.rng.standard_normal((self.samples, self.horizon_steps, 2), dtype=np.float32)
             noise *= self.std
         controls = noise + self.nominal[None]
-        np.clip(controls, self.lo, self.hi, out=controls)                 # rolled out within the limits
+        self._clip(controls)                                               # rolled out within the limits
         px, py = self.rollouts(pose.x_m, pose.y_m, pose.heading_rad, controls)
         cost = self.costs(px, py, observation)
         # Control cost gamma u^T Sigma^-1 eps (Williams et al. 2017, Eq. 30), summed over the sequence.
@@ -234,7 +241,7 @@ class MppiNavigator:
         low = float(cost.min())
         weights = np.exp((cost - low) * np.float32(-1.0 / self.temperature))
         weights /= weights.sum()
-        self.nominal = np.clip(self.nominal + np.tensordot(weights, noise, axes=1), self.lo, self.hi)
+        self.nominal = self._clip(self.nominal + np.tensordot(weights, noise, axes=1))
         return self._answer(pose, float(self.nominal[0, 0]), float(self.nominal[0, 1]), observation)
 
     def _answer(self, pose, v: float, omega: float, observation: Observation) -> NavigationStep:
