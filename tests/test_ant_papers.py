@@ -74,8 +74,9 @@ class CheckedColony(MaxMinColonyPlanner):
 
     updates: int = 0
 
-    def update(self, data, iteration_best):
-        super().update(data, iteration_best)
+    def update(self, state, walk, arrived, lengths, iteration_best):
+        super().update(state, walk, arrived, lengths, iteration_best)
+        data = state.data
         limits = data["limits"]
         if limits is not None:
             assert check_limits(data["tau"], limits, data["free"])
