@@ -1,6 +1,6 @@
 """Algorithms 1-2 of Hasan, Abdullah & Saleh (2023): the goal-to-start pheromone propagation of IMMAS.
 
-The environment-analysis stage of :mod:`planners.max_min_ant_system` (whose docstring gives the
+The environment-analysis stage of :mod:`planners.improved_max_min_ant_system` (whose docstring gives the
 equations, the MAX-MIN layering and the choices made): the D*-style propagation from the goal
 with the clean weights, GateRaiseState and CheckTightTunnelState (Algorithm 2), and the trails'
 MAX-MIN bounds (:mod:`planners.max_min_trails`).  The ``immas_stepwise`` navigator runs it too.

@@ -13,7 +13,7 @@ from swarmnav.planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColon
 from swarmnav.planners.dstar_lite import DStarLitePlanner
 from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, ThetaStarPlanner
 from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
-from swarmnav.planners.max_min_ant_system import MaxMinAntSystemPlanner
+from swarmnav.planners.improved_max_min_ant_system import ImprovedMaxMinAntSystemPlanner
 from swarmnav.planners.max_min_colony import MaxMinColonyPlanner
 from swarmnav.planners.waiter_ant_colony import WaiterAntColonyPlanner
 from swarmnav.planners.grey_wolf import GreyWolfPlanner
@@ -40,7 +40,7 @@ def register(cls: type) -> type:
 
 
 for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,
-             MaxMinAntSystemPlanner, ImprovedAntColonyPlanner, WaiterAntColonyPlanner, AntSystemPlanner,
+             ImprovedMaxMinAntSystemPlanner, ImprovedAntColonyPlanner, WaiterAntColonyPlanner, AntSystemPlanner,
              OptimalPlanner, BeeColonyPlanner, AdaptiveLimitBeeColonyPlanner, GreyWolfPlanner,
              ParticleSwarmPlanner, MaxMinColonyPlanner, *OMPL_PLANNERS):
     register(_cls)

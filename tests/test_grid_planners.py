@@ -24,7 +24,7 @@ from swarmnav.planners.improved_ant_colony import (adaptive_parameters, feature_
                                           prune_length)
 from swarmnav.models.world import Box, OccupancyGrid, Pose2D, Rect
 from swarmnav.planners.problem import Problem
-from swarmnav.planners.max_min_ant_system import analyse_environment
+from swarmnav.planners.pheromone_propagation import analyse_environment
 from swarmnav.planners.problem import map_problem
 from swarmnav.models.grid_map import benchmark_sets, format_map, map_to_grid, merge_boxes, parse_map, read_map, read_scenarios
 from swarmnav.planners.problem import scenario_problem

@@ -29,7 +29,7 @@ under its own modifications:
      - every written trail is clamped to ``[tau_min, tau_max]`` at once (Sect. 2.1: "the limits
        ... will be checked after each iteration"), with ``tau_max = 1 / (1 - rho)`` (Stützle &
        Hoos Eq. 7 for the unit deposit) and ``tau_min`` from ``p_best = 0.05`` (their Eq. 11,
-       ``n`` = the free cells, ``avg`` = 4); see :func:`mmas_limits`.
+       ``n`` = the free cells, ``avg`` = 4); see :func:`planners.pheromone_propagation.mmas_limits`.
 
      ``propagation = "route_cost"`` keeps swarmnav's earlier reading, ``tau(Y) = rho tau(X) + c``
      without bounds (for comparison; it is not MMAS).
@@ -98,13 +98,11 @@ from swarmnav.planners.grid_graph import (DIRECTIONS, Cell, cell_clearance_m, ce
                                           grid_endpoints, grid_problem)
 from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.max_min_trails import P_BEST
-from swarmnav.planners.pheromone_propagation import (PROPAGATIONS, EnvironmentAnalysis, analyse_environment,
-                                                     is_gate, is_tight_tunnel, mmas_limits)
+from swarmnav.planners.pheromone_propagation import PROPAGATIONS, EnvironmentAnalysis, analyse_environment
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 
-__all__ = ["MaxMinAntSystemPlanner", "EnvironmentAnalysis", "analyse_environment", "is_gate", "is_tight_tunnel",
-           "mmas_limits", "tour_scores", "PROPAGATIONS"]
+__all__ = ["ImprovedMaxMinAntSystemPlanner", "tour_scores"]
 
 
 def tour_scores(tau: np.ndarray, clean: np.ndarray, eta: np.ndarray, alpha: float, beta: float) -> np.ndarray:
@@ -113,7 +111,7 @@ def tour_scores(tau: np.ndarray, clean: np.ndarray, eta: np.ndarray, alpha: floa
 
 
 @dataclass
-class MaxMinAntSystemPlanner(SwarmPlanner):
+class ImprovedMaxMinAntSystemPlanner(SwarmPlanner):
     """IMMAS (Hasan et al. 2023): wide free space by cleaning weights and closing gates and tight tunnels.
 
     Each iteration of the loop is one move of the robot (Algorithm 3), so the
