@@ -83,7 +83,7 @@ class AntColonyPlanner(SwarmPlanner):
         iterations: colony iterations (at least 1).
         alpha: weight of the pheromone in the transition rule.
         rho: the update's rate: the evaporation of ``tau <- (1 - rho) tau + delta`` (the MAX-MIN
-            Ant System's persistence, see :mod:`planners.improved_max_min_ant_system`); in [0, 1).
+            Ant System's persistence, see :mod:`planners.max_min_ant_system`); in [0, 1).
         shortcut: line-of-sight shortcut of the best tour (the raw tour stays in ``stats.extra``).
         max_evaluations: optional cap on tours walked (0 or None: none); one ant's tour is one
             evaluation, so a budgeted iteration sends out only the ants the budget has left.

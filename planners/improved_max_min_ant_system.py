@@ -79,7 +79,7 @@ Deviations that remain (each also a row of the README's "Deviations from the pap
   95.8, not 106.2; gates, tunnels and costs of Table 1 depend on the map and are not reproduced.
 * **Baseline** (Table 1): the paper compares with its own improved MMAS [9] and a D*/PSO hybrid
   [8], whose texts it does not give; swarmnav's baseline is the plain MMAS of Stützle & Hoos
-  (``mmas``, :mod:`planners.max_min_colony`) and A*.
+  (``mmas``, :mod:`planners.max_min_ant_system`) and A*.
 """
 
 from __future__ import annotations

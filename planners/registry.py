@@ -14,7 +14,7 @@ from swarmnav.planners.dstar_lite import DStarLitePlanner
 from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, ThetaStarPlanner
 from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
 from swarmnav.planners.improved_max_min_ant_system import ImprovedMaxMinAntSystemPlanner
-from swarmnav.planners.max_min_colony import MaxMinColonyPlanner
+from swarmnav.planners.max_min_ant_system import MaxMinColonyPlanner
 from swarmnav.planners.waiter_ant_colony import WaiterAntColonyPlanner
 from swarmnav.planners.grey_wolf import GreyWolfPlanner
 from swarmnav.planners.optimal import OptimalPlanner

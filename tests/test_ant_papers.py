@@ -13,7 +13,7 @@ import pytest
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR, load_scenario
 from swarmnav.planners.pheromone_propagation import analyse_environment, mmas_limits
-from swarmnav.planners.max_min_colony import MaxMinColonyPlanner
+from swarmnav.planners.max_min_ant_system import MaxMinColonyPlanner
 from swarmnav.planners.max_min_trails import check_limits, trail_limits
 from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.sim.cli import main
