@@ -6,6 +6,11 @@
   reached the goal or got stuck (no unvisited neighbour left); :func:`walk_colony`
   is the same walk compiled (``planners/_colony_walk.c``), which the planners use.
 
+Speed: the state of an ant is one integer ``key = p * N + i`` (previous direction and cell),
+so a step reads its weights and candidates with one gather each from per-iteration ``(9 N, 8)``
+tables; tabu lists are flat masks multiplied into the weights; tours are stored as keys (cells
+and directions are recovered after the walk).
+
 A planner folds its paper's transition rule (``tau^alpha * eta^beta``, Eq. (1) of the ACO
 papers) into a per-cell and a per-turn weight table; the walk only draws from them
 (:class:`planners.ant_colony.GridColonyPlanner` runs it once per iteration).
@@ -137,13 +142,7 @@ def walk_colony_reference(graph: GridGraph, start: int, goal: int, ants: int, ce
     over the neighbours it has not visited (its tabu list): Eq. (1) of the ACO
     papers once a planner has folded its ``tau^alpha * eta^beta`` into the two
     tables (they are fixed within one iteration).  All walking ants move in the
-    same NumPy step; finished, pruned and failed ants leave the walking set.
-
-    Speed: the state of an ant is one integer ``key = p * N + i`` (previous
-    direction and cell), so a step reads its weights and candidates with one
-    gather each from per-iteration ``(9 N, 8)`` tables; tabu lists are flat
-    float masks multiplied into the weights; tours are stored as keys (cells and
-    directions are recovered after the walk).
+    same NumPy step; finished, pruned and failed ants leave the walking set (speed: see the module docstring).
 
     Args:
         graph: the cell graph (N cells).

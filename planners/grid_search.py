@@ -219,6 +219,11 @@ def theta_star_cells(occupied: np.ndarray, start: Cell, goal: Cell,
                 heapq.heappush(heap, (cand + h(v), -cand, v))
     if not closed[t]:
         raise NoPathFound(f"goal cell {goal} is unreachable from start cell {start}")
+    return _corners(parent, s, t, cols), g[t], expansions
+
+
+def _corners(parent: list[int], s: int, t: int, cols: int) -> list[Cell]:
+    """Theta*'s cells from ``s`` to ``t`` along ``parent`` (the start is its own parent)."""
     cells = []
     cur = t
     while True:
@@ -227,7 +232,7 @@ def theta_star_cells(occupied: np.ndarray, start: Cell, goal: Cell,
             break
         cur = parent[cur]
     cells.reverse()
-    return cells, g[t], expansions
+    return cells
 
 
 
