@@ -6,7 +6,7 @@ Importing this module imports every planner (and SciPy with the ant colonies);
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TypeVar
 
 from swarmnav.planners.ant_system import AntSystemPlanner
 from swarmnav.planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
@@ -27,16 +27,21 @@ from swarmnav.planners.problem import Path, Planner, PlanStats, Problem
 from swarmnav.planners.straight import StraightPlanner
 from swarmnav.models.parameters import build_component, register_component
 
-PLANNERS: dict[str, type] = {}
+PLANNERS: dict[str, type[Planner]] = {}
+PlannerClass = TypeVar("PlannerClass", bound=type)
 
 
-def register(cls: type) -> type:
-    """Add a planner class to :data:`PLANNERS`: it needs a free name and the obstacles it supports."""
+def register(cls: PlannerClass) -> PlannerClass:
+    """Add a planner class to :data:`PLANNERS`: it needs a free name, a ``plan`` method and the obstacles it
+    supports (:class:`planners.problem.Planner`)."""
     supports = getattr(cls, "supports", None)
     if not isinstance(supports, frozenset) or not supports or not supports <= {"discs", "boxes"}:
         raise TypeError(f"{cls.__name__} must declare the obstacles it supports, a non-empty subset "
                         "of {'discs', 'boxes'}")
-    return register_component(PLANNERS, "planner", cls)
+    if not callable(getattr(cls, "plan", None)):
+        raise TypeError(f"{cls.__name__} has no plan(problem, rng) method (planners.problem.Planner)")
+    register_component(PLANNERS, "planner", cls)
+    return cls
 
 
 for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,
@@ -47,7 +52,7 @@ for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, D
 
 
 def make_planner(name: str, params: dict[str, Any] | None = None, source: str | None = None,
-                 trust_code: bool = True) -> Any:
+                 trust_code: bool = True) -> Planner:
     """Build a registered planner from its name and a parameter table (``trust_code``: see build_component).
 
     Raises:
