@@ -92,6 +92,7 @@ class AntColonyPlanner(SwarmPlanner):
     parameter_ranges: ClassVar[dict[str, Range]] = {
         "ants": within(1, MAX_ANTS), "iterations": within(1, 1_000_000), "alpha": within(0, 100),
         "rho": within(0, 1), "max_evaluations": within(0, 1e9)}  # models.parameters: checked on build
+    name: ClassVar[str]
     #: What ``rho`` must be, as the checks word it.
     rho_requirement: ClassVar[str] = "must lie in [0, 1)"
     ants: int = 50
@@ -249,7 +250,7 @@ class GridColonyPlanner(AntColonyPlanner):
         if state.best_solution is None:
             raise NoPathFound(f"{self.name}: no ant of {state.evaluations} reached the goal")
         grid = problem.grid
-        cells = [tuple(int(v) for v in rc) for rc in data["graph"].cells(state.best_solution)]
+        cells = [(int(r), int(c)) for r, c in data["graph"].cells(state.best_solution)]
         raw = cells_to_waypoints(problem, grid, cells)
         waypoints = exact_shortcut(problem, raw) if self.shortcut else raw
         lengths_m = data["last_lengths"] * grid.cell_m
