@@ -57,11 +57,9 @@ class AntSystemPlanner(GridColonyPlanner):
         q: deposit constant Q of Eq. (4) (100).
         initial_pheromone: ``tau_0`` on every free cell (1).
         heuristic: ``"goal"`` (``1 / (d_ij + d_jg)``) or ``"edge"`` (``1 / d_ij``).
-        max_steps: NumPy steps after which an ant fails (0: eight times rows + cols, at most
-            half the cells).
-        cell_m: grid resolution; ``None`` keeps the problem's (at most 500,000 cells).
-        shortcut: line-of-sight shortcut of the best tour.
-        max_evaluations: optional cap on tours walked (0 or None: none).
+
+    ``max_steps`` (0: eight times rows + cols, at most half the cells), ``cell_m``, ``shortcut`` and
+    ``max_evaluations`` are the grid colonies' (:class:`planners.ant_colony.GridColonyPlanner`).
     """
 
     name: ClassVar[str] = "aco"

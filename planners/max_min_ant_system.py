@@ -58,11 +58,9 @@ class MaxMinColonyPlanner(GridColonyPlanner):
         rho: trail persistence of Eq. (6) (0.98; the evaporation is ``1 - rho``).
         p_best: Eq. (11)'s probability of building the best tour once converged (0.05).
         deposit: which one ant deposits, ``"iteration_best"`` or ``"best_so_far"``.
-        max_steps: NumPy steps after which an ant fails (0: eight times rows + cols, at most
-            half the cells).
-        cell_m: grid resolution; ``None`` keeps the problem's (at most 500,000 cells).
-        shortcut: line-of-sight shortcut of the best tour.
-        max_evaluations: optional cap on tours walked (0 or None: none).
+
+    ``max_steps`` (0: eight times rows + cols, at most half the cells), ``cell_m``, ``shortcut`` and
+    ``max_evaluations`` are the grid colonies' (:class:`planners.ant_colony.GridColonyPlanner`).
     """
 
     name: ClassVar[str] = "mmas"
