@@ -16,6 +16,11 @@
 
 Each paper's planner keeps only what its paper defines (its transition weights, its update, its
 own parameters), and all run through :class:`planners.swarm.SwarmPlanner`, the one optimisation loop.
+``immas`` (Hasan et al. 2023, :mod:`planners.improved_max_min_ant_system`) is not on this base: its
+Algorithm 3 moves one robot once, cell by cell, over a pheromone field propagated from the goal (no
+colony, no ants, no per-iteration update), so it shares :func:`roulette` and the MAX-MIN limits
+(:mod:`planners.max_min_trails`) only.  Its ``iterations`` (moves; 0: the cells) and ``rho`` (in (0, 1])
+mean other things than here.
 """
 
 from __future__ import annotations

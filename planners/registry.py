@@ -11,7 +11,7 @@ from typing import Any, TypeVar
 from swarmnav.planners.ant_system import AntSystemPlanner
 from swarmnav.planners.bee_colony import AdaptiveLimitBeeColonyPlanner, BeeColonyPlanner
 from swarmnav.planners.dstar_lite import DStarLitePlanner
-from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner, ThetaStarPlanner
+from swarmnav.planners.grid_search import AStarPlanner, DijkstraPlanner
 from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
 from swarmnav.planners.improved_max_min_ant_system import ImprovedMaxMinAntSystemPlanner
 from swarmnav.planners.max_min_ant_system import MaxMinColonyPlanner
@@ -25,6 +25,7 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import Box, Disc, Pose2D, Rect
 from swarmnav.planners.problem import Path, Planner, PlanStats, Problem
 from swarmnav.planners.straight import StraightPlanner
+from swarmnav.planners.theta_star import ThetaStarPlanner
 from swarmnav.models.parameters import build_component, register_component
 
 PLANNERS: dict[str, type[Planner]] = {}

@@ -17,7 +17,8 @@ from swarmnav.planners.errors import NoPathFound
 from swarmnav.models.geometry import segment_box_distance, segment_box_distances
 from swarmnav.planners.dstar_lite import DStarLite
 from swarmnav.planners.grid_graph import grid_line_of_sight
-from swarmnav.planners.grid_search import astar_cells, dijkstra_cells, theta_star_cells
+from swarmnav.planners.grid_search import astar_cells, dijkstra_cells
+from swarmnav.planners.theta_star import theta_star_cells
 from swarmnav.planners.grid_shortcut import box_line_of_sight
 from swarmnav.planners.colony_walk import GridGraph, walk_colony
 from swarmnav.planners.improved_ant_colony import (adaptive_parameters, feature_cells, iaco_heuristic, pheromone_intensity,
