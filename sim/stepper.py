@@ -46,17 +46,13 @@ from swarmnav.models.world import Pose2D
 from swarmnav.planners.problem import Path
 from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
 from swarmnav.sim.contact import ContactMonitor
+from swarmnav.sim.control_period import control_periods, steps_per_control
 from swarmnav.sim.detector import ObstacleSensing
 from swarmnav.sim.recording import Recorder, RunContext, StepFrame
 from swarmnav.sim.reference import reference_length_m as shortest_static_length_m
 from swarmnav.sim.run_result import RunResult
 from swarmnav.sim.scene import CompiledScene
 from swarmnav.sim.sensing import base_twist, ranges_from_sensors, yaw_from_quaternion
-
-
-def steps_per_control(scenario: Scenario, model: mujoco.MjModel) -> int:
-    """Physics steps per control period."""
-    return int(round(1.0 / (scenario.sim.control_hz * model.opt.timestep)))
 
 
 def moving_obstacles(scene: CompiledScene) -> list:
@@ -101,7 +97,8 @@ class EpisodeStepper:
     """One episode on a compiled scene of ``scenario``; see the module docstring.
 
     Args:
-        time_limit_s, stop_on_collision: None = the scenario's.
+        time_limit_s, stop_on_collision: None = the scenario's.  The time limit must be a whole number
+            of control periods (:func:`sim.control_period.control_periods`: ``ConfigError`` otherwise).
         recorder: gets ``start(context)`` at :meth:`reset`, every step, and ``finish`` once
             (:meth:`close` finishes it early, e.g. after an exception).
         path_m: the path planned at t = 0, recorded at time 0 (None: no path).
@@ -132,8 +129,9 @@ class EpisodeStepper:
         self.k = steps_per_control(scenario, model)
         self.physics_dt_s = float(model.opt.timestep)
         self.dt_s = self.k * self.physics_dt_s
-        limit_s = scenario.time_limit_s if time_limit_s is None else time_limit_s
-        self.n_max = int(math.floor(limit_s / self.dt_s + 1e-9))
+        # Whole control periods only (sim.control_period): the file's limit, or the override's.
+        self.n_max = control_periods(scenario.time_limit_s, self.dt_s, "time_limit_s", scenario.source_path) \
+            if time_limit_s is None else control_periods(time_limit_s, self.dt_s, "time limit (override)")
         self.times_s = np.arange(self.n_max + 1) * self.dt_s
         self.goal = goal_checker(scenario)
         moving = moving_obstacles(scene)
