@@ -266,7 +266,7 @@ class EpisodeStepper:
         # Views into data, made once: the base's position and quaternion, its velocity, the rangefinders.
         self._base_qpos = data.qpos[qadr:qadr + 7]
         self._base_qvel = data.qvel[scene.free_qvel_adr:scene.free_qvel_adr + 6]
-        self._qpos, self._ctrl, self._mocap_pos = data.qpos, data.ctrl, data.mocap_pos
+        self._qpos, self._qvel, self._ctrl, self._mocap_pos = data.qpos, data.qvel, data.ctrl, data.mocap_pos
         adr = np.asarray(scene.range_sensor_adr)
         contiguous = len(adr) > 0 and np.array_equal(adr, np.arange(adr[0], adr[0] + len(adr)))
         self._range_raw = data.sensordata[adr[0]:adr[0] + len(adr)] if contiguous else None
@@ -396,11 +396,8 @@ class EpisodeStepper:
 
     def _frame(self, observation: Observation, command: ControlCommand, belief: Belief | None = None) -> StepFrame:
         base_qpos = self._base_qpos.copy()  # one fresh copy; position and quaternion are views of it
-        return StepFrame(
-            time_s=observation.time_s, position_m=base_qpos[:3], quaternion_wxyz=base_qpos[3:],
-            heading_rad=observation.pose.heading_rad, range_m=observation.ranges_m,
-            wheel_command_rad_s=np.array([command.wheels.left_rad_s, command.wheels.right_rad_s]),
-            wheel_measured_rad_s=self.data.qvel[self._wheel_qvel_adr],
-            linear_m_s=command.linear_m_s, angular_rad_s=command.angular_rad_s,
-            waypoint_index=command.waypoint_index, moving_obstacles_m=self.obstacle_track_m[self.step_index].copy(),
-            belief=belief)
+        wheels = command.wheels
+        return StepFrame(observation.time_s, base_qpos[:3], base_qpos[3:], observation.pose.heading_rad,
+                         observation.ranges_m, np.array((wheels.left_rad_s, wheels.right_rad_s)),
+                         self._qvel[self._wheel_qvel_adr], command.linear_m_s, command.angular_rad_s,
+                         command.waypoint_index, self.obstacle_track_m[self.step_index].copy(), belief)
