@@ -97,8 +97,8 @@ class EpisodeStepper:
     """One episode on a compiled scene of ``scenario``; see the module docstring.
 
     Args:
-        time_limit_s, stop_on_collision: None = the scenario's.  The time limit must be a whole number
-            of control periods (:func:`sim.control_period.control_periods`: ``ConfigError`` otherwise).
+        time_limit_s, stop_on_collision: None = the scenario's; a limit of whole control periods only
+            (:func:`sim.control_period.control_periods`: ``ConfigError`` otherwise).
         recorder: gets ``start(context)`` at :meth:`reset`, every step, and ``finish`` once
             (:meth:`close` finishes it early, e.g. after an exception).
         path_m: the path planned at t = 0, recorded at time 0 (None: no path).
@@ -153,8 +153,7 @@ class EpisodeStepper:
         self._unneeded_above_m = max(self.danger_m, self.contact_free_gap_m)  # see _observe
         self.qadr = scene.free_qpos_adr
         self._wheel_qvel_adr = np.array(scene.wheel_qvel_adr)
-        # The MjData to run in: the caller's, or one made here once and reset in place at every
-        # reset() (a new MjData costs more than a hundred control steps of bookkeeping).
+        # The caller's MjData, or one made once and reset in place (a new one costs ~100 steps' bookkeeping).
         self._data = data if data is not None else mujoco.MjData(model)
         self._unfinished = recorder is not None  # the recorder is owed its finish()
         self.outcome = ""
@@ -209,10 +208,8 @@ class EpisodeStepper:
         step = self.step_index
         self.wheel_cmd[step] = (left, right)
         self.waypoint_index = command.waypoint_index
-        if self.in_danger:
-            self.danger_steps += 1
-        if left == 0.0 and right == 0.0:
-            self.stopped_steps += 1
+        self.danger_steps += self.in_danger
+        self.stopped_steps += left == 0.0 and right == 0.0
         if recorder is not None:
             recorder.step(self._frame(self.observation, command, belief))
         if self._contact_free and not self.monitor.in_contact:
