@@ -74,6 +74,10 @@ class MppiNavigator:
             ones (circular) from a random start each step; 0: fresh draws every step, as the paper.  Drawing
             60,000 normals was most of a step's time (named option, ours).
         safety_filter, time_before_collision_s: the optional Nav2-style filter.
+        carrot_in_sight: the carrot is the farthest point of the lookahead the robot can reach straight past
+            the known map (:meth:`controllers.guidance.PathCarrot.keep_in_sight`; ours, on by default: on
+            dyn300's door scenes the carrot behind a wall held the robot still against it; false: the plain
+            lookahead point).  The bundled dyn-* scenes have no static obstacle: there it changes nothing.
     """
 
     name: ClassVar[str] = "mppi"
@@ -111,6 +115,7 @@ class MppiNavigator:
     optimise_period_s: float = 0.1
     safety_filter: bool = False
     time_before_collision_s: float = 1.0
+    carrot_in_sight: bool = True
 
     def __post_init__(self) -> None:
         check_positive(self, ("samples", "horizon_steps", "model_dt_s", "linear_std_m_s", "angular_std_rad_s",
@@ -126,7 +131,7 @@ class MppiNavigator:
     def reset(self, setup: NavigationSetup) -> None:
         (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal,
          self.filter) = local_setup(setup, self.margin_m, self.lookahead_m, self.safety_filter,
-                                    self.time_before_collision_s)
+                                    self.time_before_collision_s, self.carrot_in_sight)
         self.rng = setup.rng
         self.optimised_at_s = -1.0
         self.nominal = np.zeros((self.horizon_steps, 2), dtype=np.float32)

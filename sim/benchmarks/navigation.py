@@ -23,11 +23,17 @@ The ``oracle`` row itself is the yardstick's validation: ``success_on_solvable``
 the runs it called solvable (target: at least 0.95), ``solvable_share`` the share it called solvable.
 
 ``--suite dyn300``: the 300 generated scenes of ``models/suites/dyn300.toml`` (each with its own world
-seed, ``--seeds`` ignored), in order of difficulty; ``--quick`` a stratified sample (2 per group);
+seed, ``--seeds`` ignored), in order of difficulty; ``--quick`` a stratified sample (2 per group), ``--per-group
+N`` one of N per group;
 ``--sensor-model detector|rangefinder`` (12 rangefinders at 1 m) overrides their sensing; with
 ``--by-scenario`` each scenario's rows carry its shipped ``difficulty`` metrics (to set success against them).  Where the
 shipped verdicts (``dyn300-verdicts.json``) disagree with this run's oracle, ``verdict_mismatches`` says how
 often (the oracle row).
+
+**Speed** (:mod:`sim.benchmarks.navigation_speed`; figures printed after the table, never asserted):
+``realtime_factor_cpu`` (simulated time over the runs' own CPU time, ``run_cpu_s``); the oracle row's
+``oracle_search`` (its search timed on every scene run: median and max, wall and CPU); the ``mppi`` row's
+``mppi_every_step`` (its control step at 1,000 x 30 optimising every step); each with the load average.
 """
 
 from __future__ import annotations
@@ -111,12 +117,15 @@ def oracle_verdicts(rows: list[dict[str, Any]]) -> dict[tuple[str, int], dict[st
     return out
 
 
-def write_suite(suite_name: str, quick: bool, sensor_model: str | None, folder: str) -> tuple[list[str], Any]:
-    """The suite's scenes as TOML files under ``folder`` (paths, in order of difficulty) and the suite."""
+def write_suite(suite_name: str, quick: bool, sensor_model: str | None, folder: str,
+                per_group: int | None = None) -> tuple[list[str], Any]:
+    """The suite's scenes as TOML files under ``folder`` (paths, in order of difficulty) and the suite;
+    ``quick``: a stratified sample of 2 scenes per group, ``per_group``: of that many."""
     import os
     from swarmnav.models.suites import load_suite, stratified_sample
     suite = load_suite(suite_name, sensor_model)
-    scenes = stratified_sample(suite) if quick else suite.scenes
+    scenes = (stratified_sample(suite, per_group) if per_group is not None
+              else stratified_sample(suite) if quick else suite.scenes)
     os.makedirs(os.path.join(folder, "scenarios"), exist_ok=True)
     paths = []
     for scene in scenes:
@@ -131,7 +140,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                          progress: bool = False, navigator_params: dict[str, dict[str, Any]] | None = None,
                          by_scenario: bool = False, out_dir: str | None = None, suite: str | None = None,
                          quick: bool = False, sensor_model: str | None = None,
-                         workers: int = 1) -> list[dict[str, Any]]:
+                         workers: int = 1, speed: bool = True, per_group: int | None = None) -> list[dict[str, Any]]:
     """One row per navigator and the oracle's (see the module docstring); ``navigator_params``: per navigator
     name.  With ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key;
     the overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given;
@@ -139,14 +148,14 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
             return benchmark_navigation(seeds, navigators, scenarios, progress, navigator_params, by_scenario,
-                                        folder, suite, quick, sensor_model, workers)
+                                        folder, suite, quick, sensor_model, workers, speed, per_group)
     from swarmnav.sim.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
     contenders = [n for n in (navigators or default_navigators(navigator_params)) if not is_clairvoyant(n)]
     shipped: dict[str, dict[str, Any]] = {}
     if suite is not None:
-        names, loaded = write_suite(suite, quick, sensor_model, out_dir)
+        names, loaded = write_suite(suite, quick, sensor_model, out_dir, per_group)
         shipped = loaded.verdicts
         run_seeds = None
     else:
@@ -156,6 +165,8 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     verdicts = oracle_verdicts(rows)
     runs = {n: [r for r in rows if r["navigator"] == n] for n in contenders + [ORACLE]}
     table = [{"scenario": None, **_row(nav, arm, verdicts, shipped)} for nav, arm in runs.items()]
+    if speed:
+        _add_speed(table, rows)
     if by_scenario:
         for name in dict.fromkeys(r["scenario"] for r in rows):
             extra = {"difficulty": {k: shipped[name][k] for k in DIFFICULTY_KEYS}} if name in shipped else {}
@@ -163,6 +174,18 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                 table.append({"scenario": name, **_row(nav, [r for r in arm if r["scenario"] == name], verdicts,
                                                        shipped), **extra})
     return table
+
+
+def _add_speed(table: list[dict[str, Any]], rows: list[dict[str, Any]]) -> None:
+    """The oracle's search times on every scene run (its row's ``oracle_search``) and MPPI's cost per control
+    step optimising every step (its row's ``mppi_every_step``): :mod:`sim.benchmarks.navigation_speed`."""
+    from swarmnav.sim.benchmarks.navigation_speed import mppi_step_cost, oracle_search_times
+    scenes = list(dict.fromkeys((r["scenario_ref"], r["world_seed"]) for r in rows if r["navigator"] == ORACLE))
+    for row in table:
+        if row["navigator"] == ORACLE:
+            row["oracle_search"] = oracle_search_times(scenes)
+        elif row["navigator"] == "mppi":
+            row["mppi_every_step"] = mppi_step_cost()
 
 
 def _mean(values: list[float]) -> float | None:
@@ -209,6 +232,8 @@ def _plain_row(navigator: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
         "mean_replans": _mean([r["replans"] for r in drove]),
         "navigator_us_per_step": 1e6 * sum(r["navigator_wall_s"] for r in drove) / max(steps, 1),
         "realtime_factor": sum(r["sim_time_s"] for r in drove) / max(sum(r["wall_time_s"] for r in drove), 1e-9),
+        "realtime_factor_cpu": (sum(r["sim_time_s"] for r in drove) / max(sum(r["run_cpu_s"] for r in drove), 1e-9)
+                                if drove and all(r.get("run_cpu_s") is not None for r in drove) else None),
     }
 
 
@@ -231,12 +256,14 @@ def run(args: argparse.Namespace) -> int:
     suite = None if args.suite == "dyn" else args.suite
     if suite is None and getattr(args, "sensor_model", None):
         raise ConfigError("--sensor-model", "applies to a generated suite (--suite dyn300) only")
+    if suite is None and getattr(args, "per_group", None):
+        raise ConfigError("--per-group", "applies to a generated suite (--suite dyn300) only")
     rows = benchmark_navigation(args.seeds, args.navigator, args.scenario,
                                 progress=not args.json and sys.stderr.isatty(), navigator_params=settings,
                                 by_scenario=args.by_scenario, out_dir=args.out, suite=suite,
                                 quick=bool(getattr(args, "quick", False)) and suite is not None,
                                 sensor_model=getattr(args, "sensor_model", None),
-                                workers=getattr(args, "workers", 1) or 1)
+                                workers=getattr(args, "workers", 1) or 1, per_group=getattr(args, "per_group", None))
     if args.json:
         print(json.dumps(rows))
         return 0
@@ -246,6 +273,12 @@ def run(args: argparse.Namespace) -> int:
         for name in dict.fromkeys(r["scenario"] for r in rows if r["scenario"] is not None):
             print()
             _print_table([r for r in rows if r["scenario"] == name], name)
+    from swarmnav.sim.benchmarks.navigation_speed import speed_lines
+    print()
+    oracle = next((r.get("oracle_search") for r in overall if r["navigator"] == ORACLE), None)
+    mppi = next((r.get("mppi_every_step") for r in overall if r["navigator"] == "mppi"), None)
+    for line in speed_lines(overall, oracle or {}, mppi):
+        print(line)
     return 0
 
 
