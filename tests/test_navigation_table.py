@@ -1,4 +1,4 @@
-"""The README's navigation table is the one generated from the committed dyn300 result."""
+"""The README's navigation tables are the ones generated from the committed results (dyn300, the dyn-* scenes)."""
 
 import json
 from pathlib import Path
@@ -6,16 +6,26 @@ from pathlib import Path
 import pytest
 
 from swarmnav.sim.benchmarks import navigation_table
-from swarmnav.sim.benchmarks.navigation_table import RESULT, block, current_block, read_rows, replace_block
+from swarmnav.sim.benchmarks.navigation_table import RESULT, RESULTS, block, current_block, read_rows, replace_block
 
 REPO = Path(__file__).resolve().parents[1]
 
 
-def test_the_readme_navigation_table_is_the_one_generated_from_the_committed_result(capsys):
-    assert navigation_table.main([str(RESULT)]) == 0
+@pytest.mark.parametrize("result", RESULTS, ids=lambda p: p.name)
+def test_the_readme_navigation_table_is_the_one_generated_from_the_committed_result(result, capsys):
+    assert navigation_table.main([str(result)]) == 0
     generated = capsys.readouterr().out.strip()
     readme = (REPO / "README.md").read_text()
-    assert current_block(readme) == generated, "run `make readme-table` (README and models/suites/results differ)"
+    assert current_block(readme, result) == generated, \
+        "run `make readme-table` (README and models/suites/results differ)"
+
+
+def test_the_committed_dyn_result_runs_every_bundled_dyn_scene_for_every_default_navigator():
+    from swarmnav.sim.benchmarks.navigation import default_navigators
+    rows = read_rows(RESULTS[1])
+    assert [r["navigator"] for r in rows] == [n for n in default_navigators() if n != "oracle"] + ["oracle"]
+    bundled = len(list((REPO / "models" / "scenarios").glob("dyn-*.toml")))
+    assert {r["runs"] for r in rows} == {bundled * 5}
 
 
 def test_the_committed_result_is_a_dyn300_run_of_every_default_navigator_beside_the_oracle():
@@ -41,8 +51,12 @@ def test_the_table_follows_the_rows_and_a_bad_file_is_named(tmp_path, capsys):
     assert navigation_table.main([str(bad)]) == 2
     err = capsys.readouterr().err
     assert str(bad) in err and len(err.strip().splitlines()) == 1
-    with pytest.raises(Exception, match="navigation-table markers"):
+    with pytest.raises(Exception, match="navigation-table markers for dyn300.json"):
         replace_block("no markers here", block(rows), "README.md")
+    other = RESULTS[1]
+    both = "a\n" + block(rows) + "\nb\n" + block(rows, other) + "\nc\n"
+    assert current_block(replace_block(both, block(changed, other), "README.md", other), other) == block(changed, other)
+    assert current_block(replace_block(both, block(changed, other), "README.md", other)) == block(rows)
 
 
 def test_per_group_writes_that_many_scenes_of_each_group_and_needs_a_generated_suite(tmp_path, capsys):

@@ -1,10 +1,12 @@
-"""The README's navigation table, generated from a committed ``bench navigation --json`` result.
+"""The README's navigation tables, generated from committed ``bench navigation --json`` results.
 
 ``python -m swarmnav.sim.benchmarks.navigation_table [RESULT.json] [--readme FILE]`` prints the table (one row
-per navigator and the oracle's, from the overall rows of the JSON that ``swarmnav bench navigation --suite
-dyn300 --json`` printed); with ``--readme FILE`` it replaces the lines between :data:`BEGIN` and :data:`END`
-in FILE instead.  The committed result is :data:`RESULT` (``models/suites/results/dyn300.json``); ``make
-readme-table`` regenerates the README's table from it (the run itself is long and is not part of the target).
+per navigator and the oracle's, from the overall rows of the JSON that ``swarmnav bench navigation [--suite
+dyn300] --json`` printed); with ``--readme FILE`` it replaces the lines between the markers that name that
+result (:func:`begin_marker`, :data:`END`) in FILE instead.  The committed results are :data:`RESULTS`
+(``models/suites/results/dyn300.json``: the 300-scene suite; ``dyn.json``: the bundled ``dyn-*`` scenes); ``make
+readme-table`` regenerates the README's tables from them (the runs themselves are long and are not part of the
+target).
 """
 
 from __future__ import annotations
@@ -17,9 +19,16 @@ from typing import Any
 
 from swarmnav.models.errors import ConfigError
 
-BEGIN = "<!-- navigation-table: generated from models/suites/results/dyn300.json by `make readme-table`; do not edit by hand -->"
 END = "<!-- end of navigation-table -->"
-RESULT = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results" / "dyn300.json"
+RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results"
+RESULT = RESULTS_DIR / "dyn300.json"
+RESULTS = (RESULT, RESULTS_DIR / "dyn.json")
+
+
+def begin_marker(result: FilePath) -> str:
+    """The README marker opening the table generated from ``result`` (named by its file name)."""
+    return (f"<!-- navigation-table: generated from models/suites/results/{FilePath(result).name} by "
+            "`make readme-table`; do not edit by hand -->")
 ORACLE = "oracle"
 
 
@@ -53,19 +62,25 @@ def table_lines(rows: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
-def block(rows: list[dict[str, Any]]) -> str:
-    return "\n".join([BEGIN, ""] + table_lines(rows) + ["", END])
+def block(rows: list[dict[str, Any]], result: FilePath = RESULT) -> str:
+    return "\n".join([begin_marker(result), ""] + table_lines(rows) + ["", END])
 
 
-def current_block(text: str) -> str | None:
-    start, end = text.find(BEGIN), text.find(END)
+def _span(text: str, result: FilePath) -> tuple[int, int]:
+    start = text.find(begin_marker(result))
+    end = text.find(END, start) if start >= 0 else -1
+    return start, end
+
+
+def current_block(text: str, result: FilePath = RESULT) -> str | None:
+    start, end = _span(text, result)
     return None if start < 0 or end < start else text[start:end + len(END)]
 
 
-def replace_block(text: str, new_block: str, source: str) -> str:
-    start, end = text.find(BEGIN), text.find(END)
+def replace_block(text: str, new_block: str, source: str, result: FilePath = RESULT) -> str:
+    start, end = _span(text, result)
     if start < 0 or end < start:
-        raise ConfigError("--readme", "has no navigation-table markers", source)
+        raise ConfigError("--readme", f"has no navigation-table markers for {FilePath(result).name}", source)
     return text[:start] + new_block + text[end + len(END):]
 
 
@@ -76,10 +91,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--readme", help="replace the table between the markers in this file")
     args = parser.parse_args(argv)
     try:
-        generated = block(read_rows(FilePath(args.result)))
+        result = FilePath(args.result)
+        generated = block(read_rows(result), result)
         if args.readme:
             path = FilePath(args.readme)
-            path.write_text(replace_block(path.read_text(encoding="utf-8"), generated, args.readme), encoding="utf-8")
+            path.write_text(replace_block(path.read_text(encoding="utf-8"), generated, args.readme, result),
+                            encoding="utf-8")
         else:
             print(generated)
     except ConfigError as exc:
