@@ -242,7 +242,7 @@ def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_replay(args: argparse.Namespace) -> int:
-    from swarmnav.sim import replay
+    from swarmnav.sim.log import replay
     return replay.run(args)
 
 
@@ -262,7 +262,7 @@ def add_foxglove_layout_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_foxglove_layout(args: argparse.Namespace) -> int:
-    from swarmnav.sim import foxglove_layout
+    from swarmnav.sim.log import foxglove_layout
     return foxglove_layout.run(args)
 
 

@@ -24,8 +24,8 @@ from mcap.writer import Writer
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.cli import main
-from swarmnav.sim.mcap_log import McapRecorder
-from swarmnav.sim.mcap_records import LogError, read_records
+from swarmnav.sim.log.writer import McapRecorder
+from swarmnav.sim.log.records import LogError, read_records
 from swarmnav.sim.episode import EpisodeSpec, run_episode
 
 REPO = Path(__file__).resolve().parent.parent
@@ -382,7 +382,7 @@ def test_a_run_whose_encoder_dies_ends_with_one_line_and_a_finished_log(tmp_path
     """ffmpeg killed mid-run: the run stops at the next frame, exit 2, one line, the log closed."""
     import time
 
-    from swarmnav.sim.log_reader import read_log
+    from swarmnav.sim.log.reader import read_log
     log, video = tmp_path / "run.mcap", tmp_path / "run.mp4"
     process = subprocess.Popen([sys.executable, "-m", "swarmnav.sim.cli", "run", SCENARIO, "--out", str(log),
                                 "--video", str(video), "--width", "64", "--height", "48", "--fps", "30"],

@@ -8,13 +8,13 @@ by frame, and renders offscreen (see :mod:`sim.render`) through the same
 ``--verify`` re-simulates from what the log holds (scenario TOML, planner name and
 parameters, seed, and the attached MJCF, not today's model files) and compares
 every logged pose and range scan with the re-simulated one (the comparison and
-its verdict are :mod:`sim.verify_report`).  On the same machine and versions we
+its verdict are :mod:`sim.log.verify_report`).  On the same machine and versions we
 expect bitwise equality; otherwise the largest deviation is reported and where it
 first appeared.  A log that ends early (killed, interrupted, recovered, or a file
 without its footer, read as far as it goes with a warning line) passes when every
 step it holds is equal: "prefix bitwise equal, the log ends at t = ...".
 
-Both stream the log (:func:`sim.log_reader.read_log`): memory is the arrays of
+Both stream the log (:func:`sim.log.reader.read_log`): memory is the arrays of
 numbers the comparison or the frames need, not the log's messages.
 """
 
@@ -30,11 +30,11 @@ import numpy as np
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim.defaults import DEFAULT_FPS
-from swarmnav.sim.log_format import ranges_from_scan
-from swarmnav.sim.log_reader import RunLog, read_log, truncation_advice
-from swarmnav.sim.mcap_records import LogError
+from swarmnav.sim.log.format import ranges_from_scan
+from swarmnav.sim.log.reader import RunLog, read_log, truncation_advice
+from swarmnav.sim.log.records import LogError
 from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
-from swarmnav.sim.verify_report import TrajectoryCapture, VerifyReport, compare_with_log
+from swarmnav.sim.log.verify_report import TrajectoryCapture, VerifyReport, compare_with_log
 
 
 EXIT_DIFFERENT = 4  # replay --verify: the re-simulation differs from the log
