@@ -30,7 +30,7 @@ MAX_TRACK_POINTS = 4000  # a track is decimated to this many points, about the f
 MOVING_OUTLINES = 6      # footprints outlined along each moving obstacle's track
 TITLE_CHARS = 80         # a title line wraps at this width: at 11 pt it fits the 8-inch figure
 TIME_PROXY = "#21918c"   # the legend's stand-in for a time-coloured line (the colormap's middle)
-# The figure is 8 x 10.5 inches: MAX_DPI (sim.commands) is 4800 x 6300 pixels.
+# The figure is 8 x 10.5 inches: MAX_DPI (sim.cli.commands) is 4800 x 6300 pixels.
 # Formats Matplotlib writes on its own without a warning (pgf needs TeX; avif and webp depend on
 # Pillow's build; eps and ps warn that they drop transparency).
 SELF_CONTAINED_FORMATS = {"png", "jpg", "jpeg", "tif", "tiff", "svg", "svgz", "pdf"}

@@ -23,7 +23,7 @@ from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import Writer
 
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 from swarmnav.sim.log.writer import McapRecorder
 from swarmnav.sim.log.records import LogError, read_records
 from swarmnav.sim.episode import EpisodeSpec, run_episode
@@ -207,7 +207,7 @@ FILE_SIZE_LIMITED_RUN = """
 import resource, signal, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG instead
 resource.setrlimit(resource.RLIMIT_FSIZE, (int(sys.argv[2]), int(sys.argv[2])))
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 sys.exit(main(["run", "gwo-scenario-2", "--out", sys.argv[1], "--seed", "0"]))
 """
 

@@ -20,7 +20,7 @@ from mcap.reader import make_reader  # noqa: E402
 from mcap_protobuf.decoder import DecoderFactory  # noqa: E402
 
 from swarmnav.models.scenario import load_scenario  # noqa: E402
-from swarmnav.sim.cli import main  # noqa: E402
+from swarmnav.sim.cli.main import main  # noqa: E402
 from swarmnav.sim.episode import EpisodeSpec, run_episode  # noqa: E402
 from swarmnav.sim.log.format import TOPICS  # noqa: E402
 from swarmnav.sim.log.reader import read_log  # noqa: E402

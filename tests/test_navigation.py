@@ -16,7 +16,7 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.scenario_generator import GeneratorOptions, generate
 from swarmnav.models.world import Pose2D
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode, static_problem
 
 ONLINE = ("replan", "dstar_replan", "dwa", "velocity_obstacle")

@@ -31,7 +31,7 @@ from swarmnav.sim.log.records import LogError, RawLog, open_regular, read_record
 
 @dataclass
 class LogSummary:
-    """The facts ``log info`` prints (the attributes :func:`sim.log_commands.describe` reads)."""
+    """The facts ``log info`` prints (the attributes :func:`sim.cli.log.describe` reads)."""
 
     raw: RawLog  # schemas, channels, metadata, counts; no messages
     events: list[tuple[float, str, dict[str, Any]]]

@@ -18,7 +18,7 @@ from swarmnav.sim.defaults import (  # noqa: F401  (re-exported: the CLI's own d
     BENCH_ENV_QUICK, BENCH_RENDER_QUICK_FRAMES, BENCH_PLANNERS_SCENARIOS, BENCH_PLANNERS_PLANNERS,
     BENCH_PLANNERS_SAMPLING, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
 from swarmnav.sim.options import add_trust_code_argument  # noqa: F401
-from swarmnav.sim.study import cli as study_cli
+from swarmnav.sim.cli import study as study_cli
 
 Adder = Callable[[argparse.ArgumentParser], None]
 Runner = Callable[[argparse.Namespace], int]
@@ -208,7 +208,7 @@ def add_log_info_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_log_info(args: argparse.Namespace) -> int:
-    from swarmnav.sim import log_commands
+    from swarmnav.sim.cli import log as log_commands
     return log_commands.run_info(args)
 
 
@@ -218,7 +218,7 @@ def add_log_recover_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_log_recover(args: argparse.Namespace) -> int:
-    from swarmnav.sim import log_commands
+    from swarmnav.sim.cli import log as log_commands
     return log_commands.run_recover(args)
 
 
