@@ -20,7 +20,7 @@ runs before MuJoCo's own ``eglTerminate`` hook).
 
 ``dm_control``'s own renderer (``Physics.render``) stays disabled in a process
 that imported it through swarmnav: the environment renders with
-:class:`sim.render.SceneRenderer`, never with ``Physics.render``.  A user who
+:class:`sim.video.render.SceneRenderer`, never with ``Physics.render``.  A user who
 imported ``mujoco`` or ``dm_control`` before swarmnav keeps what they loaded.
 """
 

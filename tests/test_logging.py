@@ -190,7 +190,7 @@ def test_sigkill_leaves_a_file_that_log_recover_completes(tmp_path, full_run, ca
 
 
 def test_replay_video_has_expected_frames_and_is_not_blank(tmp_path, full_run):
-    from swarmnav.sim.render import expected_frames
+    from swarmnav.sim.video.render import expected_frames
     from video_files import read_video_frames, video_info
 
     path, _ = full_run

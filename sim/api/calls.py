@@ -124,7 +124,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
         raise ConfigError("--live", "needs the log (drop --no-log)")
     if video:
         from swarmnav.sim.defaults import DEFAULT_FPS
-        from swarmnav.sim.render import VideoRecorder
+        from swarmnav.sim.video.render import VideoRecorder
         recorders.append(VideoRecorder(str(video), camera=camera, width=width, height=height,
                                        fps=DEFAULT_FPS if fps is None else fps))
     episode = run_episode(planned, recorders, stop_on_collision=stop_on_collision)

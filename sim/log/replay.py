@@ -2,8 +2,8 @@
 
 ``--video out.mp4`` rebuilds the scene from the MJCF attached to the log, poses
 the robot (free joint) and the moving obstacles (mocap bodies) from the log frame
-by frame, and renders offscreen (see :mod:`sim.render`) through the same
-:class:`sim.render.VideoRecorder` that ``swarmnav run --video`` uses.
+by frame, and renders offscreen (see :mod:`sim.video.render`) through the same
+:class:`sim.video.render.VideoRecorder` that ``swarmnav run --video`` uses.
 
 ``--verify`` re-simulates from what the log holds (scenario TOML, planner name and
 parameters, seed, and the attached MJCF, not today's model files) and compares
@@ -118,7 +118,7 @@ def frames_from_log(log: RunLog) -> Iterator[StepFrame]:
 def render_log(log: RunLog, video_path: str | Path, *, camera: str = "top", width: int = 640,
                height: int = 480, fps: float = DEFAULT_FPS, trail: bool = True) -> dict[str, float]:
     """Render a log to MP4; returns frame count, video and render seconds."""
-    from swarmnav.sim.render import VideoRecorder  # EGL only when a video is asked for
+    from swarmnav.sim.video.render import VideoRecorder  # EGL only when a video is asked for
 
     recorder = VideoRecorder(video_path, camera=camera, width=width, height=height, fps=fps, trail=trail)
     recorder.start(context_from_log(log))
@@ -213,7 +213,7 @@ def run(args: argparse.Namespace) -> int:
     if (args.navigator_set or args.trust_code) and not args.verify:
         raise ConfigError("--navigator-set" if args.navigator_set else "--trust-code", "needs --verify")
     if args.video:
-        from swarmnav.sim.render import check_video_size
+        from swarmnav.sim.video.render import check_video_size
         check_video_size(args.width, args.height, args.fps)
     log = read_log(args.log, allow_truncated=True)  # as plot and log info: what was recovered, with a warning
     if len(log.time_s) == 0:  # nothing to render or compare: one error line, no warning before it
