@@ -60,6 +60,14 @@ def test_chase_view_has_no_black_background(xy_m, yaw_rad):
     assert black < 0.01, f"{black:.1%} of the frame is black"
 
 
+@pytest.mark.parametrize("scenario", ["gwo-scenario-2", "immas-env1-scattered"])
+def test_top_view_has_no_black_side_bands(scenario):
+    """The top camera's 4:3 frame is wider than a square arena: ground fills its sides, not black."""
+    image = _frame("top", scenario=scenario)
+    black = (image.max(axis=2) < 25).mean()
+    assert black < 0.01, f"{black:.1%} of the frame is black"
+
+
 def test_obstacles_take_the_shared_palette():
     import mujoco
 

@@ -223,8 +223,9 @@ class SceneRenderer:
             raise ConfigError("--camera", f"no camera {camera!r} in the scene (has {names})")
         paint_obstacles(model)
         soften_lights(model)
-        # The top camera frames the floor; the others can look past its edge.
-        self._ground = ground_boxes(model) if camera != "top" else np.zeros((0, 2, 3))
+        # Every camera can look past the floor's edge (the top camera's 4:3 frame is wider than a square
+        # arena): the ground strips around the floor fill what would be black bands.
+        self._ground = ground_boxes(model)
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
         self._grid = np.zeros((0, 2, 3))
