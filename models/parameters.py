@@ -22,46 +22,16 @@ study, a log) only when the user passes ``--trust-code`` for that invocation;
 from __future__ import annotations
 
 import dataclasses
-import math
 import types
 import typing
-from dataclasses import dataclass
 from typing import Any
 
 from swarmnav.models.errors import ConfigError
+# Components declare their parameters' ranges with the reader's (Range, above, within), imported from here.
+from swarmnav.models.toml_table import Range, TomlTable, above, within  # noqa: F401
 
 TRUST_OPTION = "--trust-code"  # the opt-in that lets a data file name code
 _NAMES_CODE = "names_code"
-
-
-@dataclass(frozen=True)
-class Range:
-    """The values a numeric parameter may take: ``low``..``high``, ``low`` itself excluded when ``low_open``."""
-
-    low: float
-    high: float
-    low_open: bool = False
-
-    def holds(self, value: float) -> bool:
-        try:
-            if not math.isfinite(value):
-                return False
-        except OverflowError:  # an integer beyond any float
-            return False
-        return (self.low < value if self.low_open else self.low <= value) and value <= self.high
-
-    def __str__(self) -> str:
-        return f"{'(' if self.low_open else '['}{self.low:g}, {self.high:g}]"
-
-
-def within(low: float, high: float) -> Range:
-    """[low, high]."""
-    return Range(float(low), float(high))
-
-
-def above(low: float, high: float) -> Range:
-    """(low, high]: e.g. a positive length, ``above(0, 100)``."""
-    return Range(float(low), float(high), low_open=True)
 
 
 def parameter_ranges(cls: type) -> dict[str, Range]:
@@ -129,45 +99,6 @@ def refuse_code(registry: dict[str, type], kind: str, name: str, params: dict[st
                               f"(or give it on the command line: {option} {key}=...)", source)
 
 
-def _coerce(value: Any, annotation: Any, field: str) -> Any:
-    """Check a user-given parameter against a dataclass field's annotation."""
-    origin = typing.get_origin(annotation)
-    if origin in (typing.Union, types.UnionType):
-        args = typing.get_args(annotation)
-        if value is None and type(None) in args:
-            return None
-        errors = []
-        for arg in args:
-            if arg is type(None):
-                continue
-            try:
-                return _coerce(value, arg, field)
-            except ConfigError as exc:
-                errors.append(exc.problem)
-        raise ConfigError(field, "; ".join(errors))
-    if annotation is bool:
-        if isinstance(value, bool):
-            return value
-        raise ConfigError(field, f"expected true or false, got {value!r}")
-    if annotation is int:
-        if isinstance(value, float) and not math.isfinite(value):
-            raise ConfigError(field, f"expected an integer, got {value!r}")
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or float(value) != int(value):
-            raise ConfigError(field, f"expected an integer, got {value!r}")
-        return int(value)
-    if annotation is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(field, f"expected a number, got {value!r}")
-        if not math.isfinite(float(value)):
-            raise ConfigError(field, f"must be finite, got {value!r}")
-        return float(value)
-    if annotation is str:
-        if not isinstance(value, str):
-            raise ConfigError(field, f"expected a string, got {value!r}")
-        return value
-    return value
-
-
 def register_component(registry: dict[str, type], kind: str, cls: type) -> type:
     """Add a component class to a registry under its ``name``; a missing or taken name is an error."""
     name = getattr(cls, "name", None)
@@ -200,20 +131,12 @@ def build_component(registry: dict[str, type], kind: str, name: str, params: dic
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
     hints = typing.get_type_hints(cls)
     ranges = parameter_ranges(cls)
+    table = TomlTable({} if params is None else params, f"{kind}.params", source)
     kwargs = {}
-    for key, value in (params or {}).items():
+    for key in table.keys():
         if key not in fields:
-            raise ConfigError(f"{kind}.params.{key}",
-                              f"unknown parameter for {name!r} (known: {', '.join(sorted(fields)) or 'none'})",
-                              source)
-        try:
-            kwargs[key] = _coerce(value, hints.get(key, typing.Any), f"{kind}.params.{key}")
-        except ConfigError as exc:
-            raise ConfigError(exc.field, exc.problem, source) from None
-        allowed = ranges.get(key)
-        if allowed is not None and isinstance(kwargs[key], (int, float)) and not isinstance(kwargs[key], bool) \
-                and not allowed.holds(kwargs[key]):
-            raise ConfigError(f"{kind}.params.{key}", f"must be in {allowed}, got {kwargs[key]!r}", source)
+            table.fail(key, f"unknown parameter for {name!r} (known: {', '.join(sorted(fields)) or 'none'})")
+        kwargs[key] = table.typed(key, hints.get(key, typing.Any), ranges.get(key))
     try:
         return cls(**kwargs)
     except ConfigError as exc:

@@ -8,55 +8,27 @@ wrong.  The schema is documented in the README; units are in the field names.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path as FilePath
 from typing import Any
 
 import numpy as np
 
-from swarmnav.models.obstacle_motion import WALK_STEPS, LinearMotion, RandomWalkMotion, Stationary, WaypointMotion
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.obstacle_motion import RandomWalkMotion
+from swarmnav.models.scenario_limits import (MAX_CONTROL_STEPS, MAX_GRID_CELLS, MAX_NAME_CHARS,  # noqa: F401
+                                             MAX_PHYSICS_STEPS, MAX_SENSORS, MAX_TRACK_SAMPLES, MAX_WALK_STEPS,
+                                             MIN_LENGTH_M, MIN_ROBOT_RADIUS_M, MIN_TIMESTEP_S)
+from swarmnav.models.scenario_map import check_grid_size, read_map_section
+from swarmnav.models.scenario_obstacles import MOTION_KINDS, Obstacle, ObstacleWorld, read_obstacles  # noqa: F401
 from swarmnav.models.seeds import Seeds
+from swarmnav.models.toml_table import NON_NEGATIVE, POSITIVE, TomlTable, parse_toml, read_text, within
 from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem
 
 SCENARIO_DIR = FilePath(__file__).resolve().parent / "scenarios"
 #: Folders of scenario files that installed packages declare (entry-point group ``swarmnav.scenarios``, added by
 #: ``swarmnav.sim.plugins``): their names resolve after the bundled ones.
 EXTRA_SCENARIO_DIRS: list[FilePath] = []
-MOTION_KINDS = ("linear", "random_walk", "waypoints")
-
-# Stated maxima (README "Limits"), each checked before anything of that size is
-# allocated, so an oversized request is a ConfigError naming the field, not an
-# exhausted memory.
-MAX_NAME_CHARS = 64            # ``name`` becomes part of the default log file name
-MAX_SENSORS = 360              # rangefinders, evenly spaced (1 degree apart at most)
-MIN_ROBOT_RADIUS_M = 0.05      # smaller robots than the base scaled to 1/3 of its size are not modelled
-MAX_GRID_CELLS = 16_000_000    # the planning grid: 200 x 200 m at 0.05 m per cell
-MAX_CONTROL_STEPS = 1_000_000  # time_limit_s x control_hz (the runner keeps every pose): 5.5 h at 50 Hz
-MAX_PHYSICS_STEPS = 200_000_000  # time_limit_s / timestep_s: 111 h at 500 Hz
-MAX_TRACK_SAMPLES = 20_000_000   # control steps x moving obstacles (positions computed up front)
-MIN_LENGTH_M = 0.001           # obstacle radii and heights, map cells, sensor range: MuJoCo's XML keeps ~6 digits
-MIN_TIMESTEP_S = 1e-6
-MAX_WALK_STEPS = 100_000       # random-walk periods over all walks, drawn up front (about 3 s of work)
-
-
-@dataclass(frozen=True)
-class Obstacle:
-    """A cylinder; ``motion`` is None for static obstacles."""
-
-    x_m: float
-    y_m: float
-    radius_m: float
-    height_m: float
-    motion: LinearMotion | RandomWalkMotion | WaypointMotion | None = None
-
-    @property
-    def moving(self) -> bool:
-        return self.motion is not None
-
-    def trajectory(self):
-        return self.motion if self.motion is not None else Stationary((self.x_m, self.y_m))
 
 
 @dataclass(frozen=True)
@@ -160,87 +132,6 @@ class Scenario:
 
 
 
-class _Table:
-    """Typed access to one TOML table that remembers where it is, for error messages."""
-
-    def __init__(self, data: Any, where: str, source: str):
-        self.where = where
-        self.source = source
-        if not isinstance(data, dict):
-            self.fail("", f"expected a table, got {type(data).__name__}")
-        self.data = data
-        self.used: set[str] = set()
-
-    def path(self, key: str) -> str:
-        return f"{self.where}.{key}" if self.where and key else (self.where or key)
-
-    def fail(self, key: str, problem: str):
-        raise ConfigError(self.path(key), problem, self.source)
-
-    def has(self, key: str) -> bool:
-        return key in self.data
-
-    def raw(self, key: str, default: Any = ..., ) -> Any:
-        self.used.add(key)
-        if key not in self.data:
-            if default is ...:
-                self.fail(key, "is required")
-            return default
-        return self.data[key]
-
-    def number(self, key: str, default: Any = ..., *, positive: bool = False,
-               non_negative: bool = False, minimum: float | None = None) -> float:
-        value = self.raw(key, default)
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.fail(key, f"expected a number, got {value!r}")
-        value = float(value)
-        if not math.isfinite(value):
-            self.fail(key, f"must be finite, got {value}")
-        if positive and value <= 0:
-            self.fail(key, f"must be positive, got {value:g}")
-        if non_negative and value < 0:
-            self.fail(key, f"must not be negative, got {value:g}")
-        if minimum is not None and value < minimum:
-            self.fail(key, f"must be at least {minimum:g}, got {value:g}")
-        return value
-
-    def integer(self, key: str, default: Any = ..., *, minimum: int | None = None,
-                maximum: int | None = None) -> int:
-        value = self.raw(key, default)
-        if isinstance(value, bool) or not isinstance(value, int):
-            self.fail(key, f"expected an integer, got {value!r}")
-        if minimum is not None and value < minimum:
-            self.fail(key, f"must be at least {minimum}, got {value}")
-        if maximum is not None and value > maximum:
-            self.fail(key, f"must be at most {maximum}, got {value}")
-        return int(value)
-
-    def boolean(self, key: str, default: Any = ...) -> bool:
-        value = self.raw(key, default)
-        if not isinstance(value, bool):
-            self.fail(key, f"expected true or false, got {value!r}")
-        return value
-
-    def string(self, key: str, default: Any = ..., choices: tuple[str, ...] | None = None) -> str:
-        value = self.raw(key, default)
-        if not isinstance(value, str):
-            self.fail(key, f"expected a string, got {value!r}")
-        if choices is not None and value not in choices:
-            self.fail(key, f"unknown value {value!r} (expected one of: {', '.join(choices)})")
-        return value
-
-    def table(self, key: str, default: Any = ...) -> "_Table":
-        return _Table(self.raw(key, default), self.path(key), self.source)
-
-    def close(self) -> None:
-        """Reject keys that were never read."""
-        unknown = sorted(set(self.data) - self.used)
-        if unknown:
-            key = unknown[0]
-            # A key that would not read as one (empty, control characters) is shown quoted.
-            self.fail(key if key.isprintable() and key.strip() else repr(key), "unknown key")
-
-
 def list_scenarios() -> list[str]:
     """Names of the bundled scenarios (file stems under models/scenarios/), then those of installed packages."""
     names = {p.stem for p in SCENARIO_DIR.glob("*.toml")}
@@ -271,168 +162,50 @@ def load_scenario(name_or_path: str, trust_code: bool = False) -> Scenario:
         ConfigError: the file is missing, is not valid TOML, or breaks the schema.
     """
     path = resolve_scenario_path(str(name_or_path))
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError("scenario", f"cannot be read ({exc})", str(path)) from None
-    return parse_scenario(text, str(path), trust_code)
+    return parse_scenario(read_text(path, "scenario"), str(path), trust_code)
 
 
 def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False) -> Scenario:
-    """Validate scenario TOML text (see :func:`load_scenario`)."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError("toml", f"malformed TOML ({exc})", source) from None
-    top = _Table(data, "", source)
-
+    """Validate scenario TOML text (see :func:`load_scenario`), one table at a time with the one reader."""
+    top = parse_toml(text, source)
     name = top.string("name")
     problem = name_problem(name)
     if problem:
         top.fail("name", problem)
     description = top.string("description", "")
-    seed = top.integer("seed", 0, minimum=0)
-    time_limit_s = top.number("time_limit_s", 150.0, positive=True)
-
+    seed = top.integer("seed", 0, bounds=NON_NEGATIVE)
+    time_limit_s = top.number("time_limit_s", 150.0, bounds=POSITIVE)
     arena = top.table("arena")
-    width_m = arena.number("width_m", positive=True)
-    height_m = arena.number("height_m", positive=True)
+    width_m, height_m = arena.number("width_m", bounds=POSITIVE), arena.number("height_m", bounds=POSITIVE)
     walls = arena.boolean("walls", False)
     arena.close()
-
-    robot = top.table("robot", {})
-    robot_radius_m = robot.number("radius_m", 0.15, positive=True)
-    if robot_radius_m < MIN_ROBOT_RADIUS_M:
-        robot.fail("radius_m", f"must be at least {MIN_ROBOT_RADIUS_M:g} m (the smallest base modelled), "
-                               f"got {robot_radius_m:g}")
-    max_speed_m_s = robot.number("max_speed_m_s", 0.2, positive=True)
-    clearance_m = robot.number("clearance_m", 0.05, non_negative=True)
-    robot.close()
-
-    def pose(key: str) -> tuple[Pose2D, _Table]:
-        t = top.table(key)
-        x, y = t.number("x"), t.number("y")
-        return Pose2D(x, y, math.radians(t.number("heading_deg", 0.0))), t
-
-    start, start_t = pose("start")
-    start_t.close()
-    goal, goal_t = pose("goal")
-    tolerance_m = goal_t.number("tolerance_m", 0.1, positive=True)
-    goal_t.close()
-
+    robot_radius_m, max_speed_m_s, clearance_m = _robot(top.table("robot", {}))
+    start, goal, tolerance_m = _endpoints(top)
     sensors = top.table("sensors", {})
-    sensor_count = sensors.integer("count", 12, minimum=1, maximum=MAX_SENSORS)
-    sensor_range_m = sensors.number("range_m", 0.4, positive=True, minimum=MIN_LENGTH_M)
+    sensor_count = sensors.integer("count", 12, bounds=within(1, MAX_SENSORS))
+    sensor_range_m = sensors.number("range_m", 0.4, bounds=within(MIN_LENGTH_M))
     sensor_model = sensors.string("model", "rangefinder", choices=SENSOR_MODELS)
     sensors.close()
-
-    planner = top.table("planner", {})
-    planner_name = planner.string("name", "astar")
-    params = planner.raw("params", {})
-    if not isinstance(params, dict):
-        planner.fail("params", "expected a table")
-    planner.close()
-
-    navigator = top.table("navigator", {})
-    navigator_name = navigator.string("name", "follow")
-    navigator_params = navigator.raw("params", {})
-    if not isinstance(navigator_params, dict):
-        navigator.fail("params", "expected a table")
-    navigator.close()
-
-    sim_t = top.table("sim", {})
-    sim = SimSettings(timestep_s=sim_t.number("timestep_s", 0.002, positive=True, minimum=MIN_TIMESTEP_S),
-                      control_hz=sim_t.number("control_hz", 50.0, positive=True),
-                      stop_on_collision=sim_t.boolean("stop_on_collision", False),
-                      danger_m=sim_t.number("danger_m", 0.1, non_negative=True))
-    cell_m = sim_t.number("cell_m", 0.05, positive=True)
-    sim_t.close()
+    planner_name, planner_params = _component(top.table("planner", {}), "astar")
+    navigator_name, navigator_params = _component(top.table("navigator", {}), "follow")
+    sim, cell_m, cell_given = _sim(top.table("sim", {}))
     _check_run_size(time_limit_s, sim, source)
 
-    boxes, map_grid, map_cell_m, map_pairs = _parse_map(top, source, width_m, height_m)
-    if map_cell_m is None:
-        _check_grid_size(width_m, height_m, cell_m, "sim.cell_m" if sim_t.has("cell_m") else "arena", source)
-
-    raw_obstacles = top.raw("obstacles", [])
-    if not isinstance(raw_obstacles, list):
-        top.fail("obstacles", "expected an array of tables ([[obstacles]])")
-    static_tables = []
-    for i, raw in enumerate(raw_obstacles):
-        t = _Table(raw, f"obstacles[{i}]", source)
-        static_tables.append(t)
-    static_centres = []
-    static_radii = []
-    parsed = []
-    for i, t in enumerate(static_tables):
-        x, y = t.number("x"), t.number("y")
-        if not (0.0 <= x <= width_m and 0.0 <= y <= height_m):
-            t.fail("x" if not 0.0 <= x <= width_m else "y",
-                   f"the centre ({x:g}, {y:g}) must lie in the arena [0, {width_m:g}] x [0, {height_m:g}]")
-        radius = t.number("radius_m", positive=True, minimum=MIN_LENGTH_M)
-        height = t.number("height_m", 0.5, positive=True, minimum=MIN_LENGTH_M)
-        motion_raw = t.raw("motion", None)
-        parsed.append((t, x, y, radius, height, motion_raw))
-        if motion_raw is None:
-            static_centres.append((x, y))
-            static_radii.append(radius)
-    static_centres_arr = np.array(static_centres, dtype=float).reshape(-1, 2)
-    static_radii_arr = np.array(static_radii, dtype=float)
-
-    _check_motion_size(parsed, time_limit_s, sim, source)
-    box_array_m = np.array([[b.x_min_m, b.y_min_m, b.x_max_m, b.y_max_m] for b in boxes], dtype=float).reshape(-1, 4)
-    obstacles = []
-    for i, (t, x, y, radius, height, motion_raw) in enumerate(parsed):
-        motion = None
-        if motion_raw is not None:
-            m = _Table(motion_raw, f"obstacles[{i}].motion", source)
-            kind = m.string("kind", choices=MOTION_KINDS)
-            # Centres stay inside the arena: Abdulla & Hadi (2025) places obstacles on its edge.
-            lower = (0.0, 0.0)
-            upper = (width_m, height_m)
-            start_s = m.number("start_s", 0.0, non_negative=True)  # held at its start until then
-            if kind == "linear":
-                motion = LinearMotion((x, y), m.number("speed_m_s", non_negative=True),
-                                      math.radians(m.number("heading_deg")),
-                                      m.string("at_edge", choices=("reflect", "stop")), lower, upper, start_s)
-            elif kind == "random_walk":
-                # A walker's disc stays inside the walls and off the map's boxes; on a map it walks the
-                # paper's grid (Hasan et al. (2023)) by default, elsewhere compass steps (obstacle_motion's docstring).
-                if walls:
-                    lower, upper = (radius, radius), (width_m - radius, height_m - radius)
-                motion = RandomWalkMotion(
-                    (x, y), radius, m.number("step_m", positive=True), m.number("period_s", positive=True),
-                    time_limit_s, lower, upper, static_centres_arr, static_radii_arr, stream=i, world_seed=seed,
-                    static_boxes_m=box_array_m,
-                    steps=m.string("steps", "grid" if map_cell_m is not None else "compass", choices=WALK_STEPS),
-                    start_s=start_s)
-            else:
-                points = m.raw("points")
-                if (not isinstance(points, list) or not points
-                        or not all(isinstance(p, list) and len(p) == 2 and all(
-                            isinstance(v, (int, float)) and not isinstance(v, bool) for v in p) for p in points)):
-                    m.fail("points", "expected a non-empty array of [x, y] number pairs")
-                arr = np.array(points, dtype=float)
-                if not np.all(np.isfinite(arr)):
-                    m.fail("points", "must be finite")
-                outside = np.flatnonzero((arr < 0.0).any(axis=1) | (arr[:, 0] > width_m) | (arr[:, 1] > height_m))
-                if len(outside):
-                    m.fail(f"points[{outside[0]}]", f"({arr[outside[0], 0]:g}, {arr[outside[0], 1]:g}) must lie "
-                                                    f"in the arena [0, {width_m:g}] x [0, {height_m:g}]")
-                motion = WaypointMotion(np.vstack([[x, y], arr]), m.number("speed_m_s", positive=True), start_s)
-            m.close()
-        t.close()
-        obstacles.append(Obstacle(x, y, radius, height, motion))
-
+    section = read_map_section(top, SCENARIO_DIR, width_m, height_m)
+    if section is None:
+        check_grid_size(width_m, height_m, cell_m, "sim.cell_m" if cell_given else "arena", source)
+    boxes = section.boxes if section is not None else ()
+    obstacles = read_obstacles(top, ObstacleWorld(width_m, height_m, walls, seed, time_limit_s, sim.control_hz,
+                                                  boxes, section is not None))
     top.close()
-    if map_cell_m is not None:
-        cell_m = map_cell_m
-        if any(not ob.moving for ob in obstacles):
-            # Static discs beside a map: rasterise both at the map's resolution (conservative margin).
-            map_grid = None
-        else:
-            # Only moving obstacles (seeds 000 and 003): plan on the static map, as the papers do.
+    map_grid = None
+    if section is not None:
+        cell_m = section.cell_m
+        if all(ob.moving for ob in obstacles):
+            # Only moving obstacles (Hasan et al. (2023); Gong et al. (2022)): plan on the static map, as the
+            # papers do.  Static discs beside a map are rasterised with it at the map's resolution (map_grid None).
             from swarmnav.models.grid_map import inflated_map_grid
-            map_grid = inflated_map_grid(map_grid.occupied, map_cell_m, robot_radius_m + clearance_m, boxes)
+            map_grid = inflated_map_grid(section.grid.occupied, section.cell_m, robot_radius_m + clearance_m, boxes)
 
     scenario = Scenario(
         name=name, description=description, seed=seed, time_limit_s=time_limit_s,
@@ -440,12 +213,58 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
         robot_radius_m=robot_radius_m, max_speed_m_s=max_speed_m_s, clearance_m=clearance_m,
         start=start, goal=goal, goal_tolerance_m=tolerance_m,
         sensor_count=sensor_count, sensor_range_m=sensor_range_m,
-        planner_name=planner_name, planner_params=dict(params),
-        navigator_name=navigator_name, navigator_params=dict(navigator_params), obstacles=tuple(obstacles),
+        planner_name=planner_name, planner_params=planner_params,
+        navigator_name=navigator_name, navigator_params=navigator_params, obstacles=obstacles,
         sim=sim, cell_m=cell_m, source_text=text, source_path=source, boxes=boxes, world_seed=seed,
-        map_grid=map_grid, map_pairs=map_pairs, sensor_model=sensor_model, trust_code=bool(trust_code))
+        map_grid=map_grid, map_pairs=section.pairs if section is not None else (), sensor_model=sensor_model,
+        trust_code=bool(trust_code))
     _check_endpoints(scenario, source)
     return scenario
+
+
+def _robot(robot: TomlTable) -> tuple[float, float, float]:
+    """``[robot]``: radius, top speed and planning clearance (metres, metres per second, metres)."""
+    radius_m = robot.number("radius_m", 0.15, bounds=POSITIVE)
+    if radius_m < MIN_ROBOT_RADIUS_M:
+        robot.fail("radius_m", f"must be at least {MIN_ROBOT_RADIUS_M:g} m (the smallest base modelled), "
+                               f"got {radius_m:g}")
+    max_speed_m_s = robot.number("max_speed_m_s", 0.2, bounds=POSITIVE)
+    clearance_m = robot.number("clearance_m", 0.05, bounds=NON_NEGATIVE)
+    robot.close()
+    return radius_m, max_speed_m_s, clearance_m
+
+
+def _endpoints(top: TomlTable) -> tuple[Pose2D, Pose2D, float]:
+    """``start`` and ``goal`` poses (``heading_deg`` read in degrees) and the goal's ``tolerance_m``."""
+    poses = []
+    for key in ("start", "goal"):
+        t = top.table(key)
+        x, y = t.number("x"), t.number("y")
+        poses.append((Pose2D(x, y, math.radians(t.number("heading_deg", 0.0))), t))
+    (start, start_t), (goal, goal_t) = poses
+    start_t.close()
+    tolerance_m = goal_t.number("tolerance_m", 0.1, bounds=POSITIVE)
+    goal_t.close()
+    return start, goal, tolerance_m
+
+
+def _component(t: TomlTable, default_name: str) -> tuple[str, dict[str, Any]]:
+    """``[planner]`` or ``[navigator]``: a registry name and its ``params`` table (checked when it is built)."""
+    name = t.string("name", default_name)
+    params = dict(t.table("params", {}).data)
+    t.close()
+    return name, params
+
+
+def _sim(t: TomlTable) -> tuple[SimSettings, float, bool]:
+    """``[sim]``: the physics and control settings, the planning cell size and whether the file gave it."""
+    sim = SimSettings(timestep_s=t.number("timestep_s", 0.002, bounds=within(MIN_TIMESTEP_S)),
+                      control_hz=t.number("control_hz", 50.0, bounds=POSITIVE),
+                      stop_on_collision=t.boolean("stop_on_collision", False),
+                      danger_m=t.number("danger_m", 0.1, bounds=NON_NEGATIVE))
+    cell_m = t.number("cell_m", 0.05, bounds=POSITIVE)
+    t.close()
+    return sim, cell_m, t.has("cell_m")
 
 
 def name_problem(name: str) -> str | None:
@@ -484,95 +303,6 @@ def _check_run_size(time_limit_s: float, sim: SimSettings, source: str) -> None:
     if not control_steps <= MAX_CONTROL_STEPS:
         raise ConfigError("time_limit_s", f"{time_limit_s:g} s at {sim.control_hz:g} Hz needs {control_steps:.4g} "
                           f"control steps (at most {MAX_CONTROL_STEPS:,})", source)
-
-
-def _check_grid_size(width_m: float, height_m: float, cell_m: float, field_name: str, source: str) -> None:
-    """The planning grid of the arena at ``cell_m``, against :data:`MAX_GRID_CELLS`."""
-    cells = math.ceil(min(width_m / cell_m, 1e300)) * math.ceil(min(height_m / cell_m, 1e300))
-    if cells > MAX_GRID_CELLS:
-        smallest = math.sqrt(width_m * height_m / MAX_GRID_CELLS)
-        raise ConfigError(field_name, f"a {width_m:g} x {height_m:g} m arena at {cell_m:g} m per cell needs "
-                          f"{min(cells, 1e300):.4g} grid cells (at most {MAX_GRID_CELLS:,}; a cell of about "
-                          f"{smallest:.3g} m or more fits)", source)
-
-
-def _check_motion_size(parsed: list, time_limit_s: float, sim: SimSettings, source: str) -> None:
-    """Precomputed obstacle motion against :data:`MAX_TRACK_SAMPLES` and :data:`MAX_WALK_STEPS`.
-
-    Only the raw ``kind`` and ``period_s`` are looked at here; their types are
-    checked (with the same field names) when the motion is parsed.
-    """
-    moving = [(i, raw) for i, (_t, _x, _y, _r, _h, raw) in enumerate(parsed) if raw is not None]
-    control_steps = math.floor(time_limit_s * sim.control_hz + 1e-9) + 1
-    if moving and control_steps * len(moving) > MAX_TRACK_SAMPLES:
-        raise ConfigError("time_limit_s", f"{len(moving)} moving obstacles over {control_steps:,} control steps "
-                          f"need {control_steps * len(moving):,} precomputed positions "
-                          f"(at most {MAX_TRACK_SAMPLES:,})", source)
-    walk_steps = 0
-    for i, raw in moving:
-        if not isinstance(raw, dict) or raw.get("kind") != "random_walk":
-            continue
-        period = raw.get("period_s")
-        if isinstance(period, bool) or not isinstance(period, (int, float)) or not period > 0 \
-                or not math.isfinite(period):
-            continue  # reported as a type or range error when the motion is parsed
-        walk_steps += math.ceil(min(time_limit_s / period, 1e300)) + 2
-        if walk_steps > MAX_WALK_STEPS:
-            raise ConfigError(f"obstacles[{i}].motion.period_s",
-                              f"random walks with periods down to {period:g} s over {time_limit_s:g} s need "
-                              f"{walk_steps:.4g} steps drawn up front (at most {MAX_WALK_STEPS:,} over all walks)",
-                              source)
-
-
-def _parse_map(top: _Table, source: str, width_m: float, height_m: float
-               ) -> tuple[tuple[Box, ...], OccupancyGrid | None, float | None, tuple[tuple[int, ...], ...]]:
-    """The optional ``[map]`` table: a Moving AI ``.map`` file and its cell size.
-
-    ``file`` is looked up beside the scenario, then under ``models/maps/``.  The
-    map must span the arena exactly (map cell (0, 0) of the file is the top-left
-    corner).  Occupied cells become merged box obstacles.  ``pairs`` optionally
-    lists [x0, y0, x1, y1] start/goal cells (column, row counted from the bottom)
-    for ``swarmnav bench grid``.
-
-    Returns:
-        (boxes, the map's world grid before inflation or None, cell_m or None, the start/goal pairs).
-    """
-    if not top.has("map"):
-        return (), None, None, ()
-    from swarmnav.models.grid_map import map_to_grid, merge_boxes, read_map
-
-    t = top.table("map")
-    name = t.string("file")
-    cell_m = t.number("cell_m", positive=True, minimum=MIN_LENGTH_M)
-    pairs = t.raw("pairs", [])
-    t.close()
-    if not isinstance(pairs, list) or not all(
-            isinstance(p, list) and len(p) == 4 and all(isinstance(v, int) and not isinstance(v, bool) for v in p)
-            for p in pairs):
-        raise ConfigError("map.pairs", "expected an array of [x0, y0, x1, y1] integer cells", source)
-    here = FilePath(source).resolve().parent if source and not source.startswith("<") else SCENARIO_DIR
-    candidates = [here / name, SCENARIO_DIR.parent / "maps" / name]
-    path = next((c for c in candidates if c.is_file()), None)
-    if path is None:
-        raise ConfigError("map.file", f"no map file {name!r} beside the scenario or under models/maps/", source)
-    try:
-        occupied = read_map(path, MAX_GRID_CELLS)
-    except ConfigError as exc:
-        raise ConfigError("map.file", f"{path.name}: {exc.field}: {exc.problem}", source) from None
-    rows, cols = occupied.shape
-    if rows * cols > MAX_GRID_CELLS:
-        raise ConfigError("map.file", f"a {cols} x {rows} map has {rows * cols:,} cells "
-                          f"(at most {MAX_GRID_CELLS:,})", source)
-    if abs(cols * cell_m - width_m) > 1e-6 or abs(rows * cell_m - height_m) > 1e-6:
-        raise ConfigError("map.cell_m", f"a {cols} x {rows} map at {cell_m:g} m per cell spans "
-                          f"{cols * cell_m:g} x {rows * cell_m:g} m, not the arena's {width_m:g} x {height_m:g} m",
-                          source)
-    for i, (x0, y0, x1, y1) in enumerate(pairs):
-        for x, y in ((x0, y0), (x1, y1)):
-            if not (0 <= x < cols and 0 <= y < rows):
-                raise ConfigError(f"map.pairs[{i}]", f"cell ({x}, {y}) is outside the {cols} x {rows} map", source)
-    grid = map_to_grid(occupied, cell_m)
-    return merge_boxes(grid.occupied, cell_m), grid, cell_m, tuple(tuple(p) for p in pairs)
 
 
 def _check_endpoints(scenario: Scenario, source: str) -> None:

@@ -7,7 +7,7 @@ is a :class:`ConfigError` instead and maps to exit code 2.
 
 from __future__ import annotations
 
-from swarmnav.models.errors import ConfigError
+from swarmnav.models.toml_table import fail
 
 
 class PlanningError(RuntimeError):
@@ -40,4 +40,4 @@ def check_parameters(planner: object, checks: tuple[tuple[str, bool, str], ...])
     """
     for name, ok, requirement in checks:
         if not ok:
-            raise ConfigError(f"planner.params.{name}", f"{requirement}, got {getattr(planner, name)!r}")
+            fail(f"planner.params.{name}", f"{requirement}, got {getattr(planner, name)!r}")

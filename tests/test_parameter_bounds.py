@@ -173,7 +173,7 @@ def test_every_numeric_parameter_declares_its_range(registry):
 
 
 def test_a_value_out_of_range_names_the_field_and_the_range():
-    with pytest.raises(ConfigError, match=r"navigator\.params\.horizon_s: must be in \(0, 10\], got 1000000000000\.0"):
+    with pytest.raises(ConfigError, match=r"navigator\.params\.horizon_s: must be in \(0, 10\], got 1e\+12"):
         make_navigator("dwa", {"horizon_s": 1e12})
     with pytest.raises(ConfigError, match=r"planner\.params\.iterations: must be in .*got 18446744073709551616"):
         make_planner("gwo", {"iterations": 2**64})

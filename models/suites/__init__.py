@@ -10,15 +10,17 @@ order of difficulty; :func:`load_suite` orders the scenes by it when it is there
 from __future__ import annotations
 
 import json
-import tomllib
+import typing
 from dataclasses import dataclass, fields
 from pathlib import Path as FilePath
 from typing import Any
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario_generator import KINDS, GeneratorOptions, generate
+from swarmnav.models.toml_table import TomlTable, parse_toml, read_text, within
 
 SUITE_DIR = FilePath(__file__).resolve().parent
+MAX_SCENES = 100_000  # scenes of one suite (over all groups), checked before any is listed
 SENSOR_OVERRIDES = {"detector": {"sensor_model": "detector"},
                     "rangefinder": {"sensor_model": "rangefinder", "sensor_count": 12, "range_m": 1.0}}
 
@@ -50,50 +52,47 @@ def list_suites() -> list[str]:
     return sorted(p.stem for p in SUITE_DIR.glob("*.toml"))
 
 
-def _options(source: str, where: str, table: Any) -> dict[str, Any]:
-    if not isinstance(table, dict):
-        raise ConfigError(where, "expected a table of generator options", source)
-    known = {f.name for f in fields(GeneratorOptions)}
-    for key in table:
-        if key not in known or key == "name":
-            known_list = ", ".join(sorted(known - {"name"}))
-            raise ConfigError(f"{where}.{key}", f"unknown generator option (known: {known_list})", source)
-    return dict(table)
-
-
 def load_suite(name: str, sensor_model: str | None = None) -> Suite:
     """A suite by name (``models/suites/NAME.toml``) or path; ``sensor_model`` (``detector`` or ``rangefinder``:
     12 rangefinders at 1 m) overrides every scene's sensing.
 
     Raises:
-        ConfigError: an unknown suite, kind, option or sensing model, or a bad seed range (naming the field).
+        ConfigError: an unknown suite, kind, option or sensing model, a bad option value or seed range
+            (naming the file and the field, ``groups[2].options.speed_ratio``).
     """
     path = FilePath(name) if name.endswith(".toml") else SUITE_DIR / f"{name}.toml"
     if not path.is_file():
         raise ConfigError("--suite", f"no suite {name!r} (bundled: {', '.join(list_suites())})")
-    source = str(path)
-    data = tomllib.loads(path.read_text(encoding="utf-8"))
     if sensor_model is not None and sensor_model not in SENSOR_OVERRIDES:
         raise ConfigError("--sensor-model", f"expected one of {', '.join(SENSOR_OVERRIDES)}, got {sensor_model!r}")
-    defaults = _options(source, "defaults", data.get("defaults", {}))
+    top = parse_toml(read_text(path, "suite"), str(path))
+    suite_name = top.string("name", path.stem, non_empty=True)
+    version = top.integer("version", 1, bounds=within(1))
+    description = top.string("description", "")
+    prefix = top.string("prefix", "d300", non_empty=True)
+    defaults = top.table("defaults", {})
+    default_options = _options(defaults)
     scenes = []
-    for i, group in enumerate(data.get("groups", [])):
-        where = f"groups[{i}]"
-        kind = group.get("kind")
-        if kind not in KINDS:
-            raise ConfigError(f"{where}.kind", f"unknown kind {kind!r} (expected one of: {', '.join(KINDS)})", source)
-        seeds = group.get("seeds")
-        if not (isinstance(seeds, list) and len(seeds) == 2 and all(isinstance(s, int) for s in seeds)
-                and 0 <= seeds[0] < seeds[1]):
-            raise ConfigError(f"{where}.seeds", f"expected [first, end) with 0 <= first < end, got {seeds!r}", source)
-        label = str(group.get("name", kind))
-        options = {**defaults, **_options(source, f"{where}.options", group.get("options", {})),
-                   **SENSOR_OVERRIDES.get(sensor_model or "", {})}
-        for seed in range(*seeds):
-            scene_name = f"{data.get('prefix', 'd300')}-{label}-{seed}"
+    for group in top.tables("groups", []):
+        kind = group.string("kind", choices=KINDS)
+        first, end = _seed_range(group)
+        label = group.string("name", kind, non_empty=True)
+        own = group.table("options", {})
+        options = {**default_options, **_options(own), **SENSOR_OVERRIDES.get(sensor_model or "", {})}
+        group.close()
+        if len(scenes) + end - first > MAX_SCENES:
+            group.fail("seeds", f"the suite would have {len(scenes) + end - first:,} scenes (at most {MAX_SCENES:,})")
+        try:
+            GeneratorOptions(**options).check(kind)
+        except ConfigError as exc:  # the generator names its command-line option: name the file's field
+            key = exc.field.removeprefix("--").replace("-", "_")
+            (own if own.has(key) else defaults).fail(key, exc.problem)
+        for seed in range(first, end):
+            scene_name = f"{prefix}-{label}-{seed}"
             scenes.append(SuiteScene(scene_name, label, kind, seed, GeneratorOptions(**options, name=scene_name)))
+    top.close()
     if not scenes:
-        raise ConfigError("groups", "a suite needs at least one group", source)
+        top.fail("groups", "a suite needs at least one group")
     verdict_path = path.with_name(f"{path.stem}-verdicts.json")
     verdicts: dict[str, dict[str, Any]] = {}
     if verdict_path.is_file():
@@ -101,8 +100,27 @@ def load_suite(name: str, sensor_model: str | None = None) -> Suite:
         verdicts = {e["scenario"]: e for e in entries}
         rank = {e["scenario"]: k for k, e in enumerate(entries)}
         scenes.sort(key=lambda s: rank.get(s.name, len(rank)))
-    return Suite(str(data.get("name", path.stem)), int(data.get("version", 1)), str(data.get("description", "")),
-                 tuple(scenes), verdicts)
+    return Suite(suite_name, version, description, tuple(scenes), verdicts)
+
+
+def _options(t: TomlTable) -> dict[str, Any]:
+    """A table of generator options, each of its :class:`GeneratorOptions` field's type (``name`` is the suite's)."""
+    hints = typing.get_type_hints(GeneratorOptions)
+    known = sorted(f.name for f in fields(GeneratorOptions) if f.name != "name")
+    for key in t.keys():
+        if key not in known:
+            t.fail(key, f"unknown generator option (known: {', '.join(known)})")
+        t.typed(key, hints[key])
+    return dict(t.data)
+
+
+def _seed_range(group: TomlTable) -> tuple[int, int]:
+    """``seeds = [first, end)``: scenes ``first`` .. ``end - 1``."""
+    seeds = group.raw("seeds")
+    if not (isinstance(seeds, list) and len(seeds) == 2
+            and all(isinstance(s, int) and not isinstance(s, bool) for s in seeds) and 0 <= seeds[0] < seeds[1]):
+        group.fail("seeds", f"expected [first, end) with 0 <= first < end, got {seeds!r}")
+    return seeds[0], seeds[1]
 
 
 def stratified_sample(suite: Suite, per_group: int = 2) -> tuple[SuiteScene, ...]:

@@ -14,7 +14,7 @@
     navigator = "follow"                   # optional: only rows of this navigator label
     test = "rank_sum"                      # "rank_sum" | "signed_rank" (paired by seeds) | "fisher" (success)
 
-:func:`parse_claims` validates them against the study (its scenarios, its planner and navigator labels, the
+:func:`read_claims` validates them against the study (its scenarios, its planner and navigator labels, the
 row columns); every problem is one :class:`ConfigError` naming the file and the field.  The verdicts are
 :mod:`swarmnav.sim.study.claims`'s.
 """
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path as FilePath
 from typing import Any
 
-from swarmnav.models.errors import ConfigError
+from swarmnav.models.toml_table import REQUIRED, TomlTable, check_array, check_string, fail
 
 TESTS = ("rank_sum", "signed_rank", "fisher")
 BETTER = ("lower", "higher")
@@ -74,75 +74,59 @@ def arm_labels(components) -> list[str]:
             for component in components for setting in (component.settings() if component.swept else [None])]
 
 
-def _text(source: str, entry: dict, key: str, where: str, required: bool = True) -> str | None:
-    if key not in entry:
-        if required:
-            raise ConfigError(f"{where}.{key}", "is required", source)
-        return None
-    value = entry[key]
-    if not isinstance(value, str) or not value.strip():
-        raise ConfigError(f"{where}.{key}", f"expected a non-empty string, got {value!r}", source)
-    return value
-
-
-def _one_of(source: str, value: str, allowed: list[str] | tuple[str, ...], field: str, what: str) -> str:
-    if value not in allowed:
-        raise ConfigError(field, f"{value!r} is not {what} ({', '.join(allowed)})", source)
-    return value
-
-
-def parse_claims(source: str, value: Any, scenarios: tuple[str, ...], planners, navigators) -> tuple[Claim, ...]:
-    """Validate a study's ``[[claims]]`` array (``planners`` and ``navigators``: the study's components)."""
-    if not isinstance(value, list):
-        raise ConfigError("claims", "expected an array of [[claims]] tables", source)
+def read_claims(top: TomlTable, scenarios: tuple[str, ...], planners, navigators) -> tuple[Claim, ...]:
+    """Validate a study's ``[[claims]]`` array (``top``: the study's top table; ``planners`` and
+    ``navigators``: its components)."""
+    entries = top.tables("claims", [])
     names = [FilePath(s).stem for s in scenarios]
     planner_labels = arm_labels(planners)
     navigator_labels = arm_labels(navigators)
-    columns = numeric_columns() if value else ()
+    columns = numeric_columns() if entries else ()
     out: list[Claim] = []
-    for i, entry in enumerate(value):
-        where = f"claims[{i}]"
-        if not isinstance(entry, dict):
-            raise ConfigError(where, "expected a table", source)
-        for key in sorted(set(entry) - KEYS):
-            raise ConfigError(f"{where}.{key}", "unknown key", source)
-        claim_id = _text(source, entry, "id", where)
+    for entry in entries:
+        entry.only(KEYS)
+        claim_id = entry.string("id", non_empty=True)
         if not _ID.fullmatch(claim_id):
-            raise ConfigError(f"{where}.id", f"{claim_id!r} must be lowercase letters, digits and single hyphens",
-                              source)
+            entry.fail("id", f"{claim_id!r} must be lowercase letters, digits and single hyphens")
         if claim_id in (c.id for c in out):
-            raise ConfigError(f"{where}.id", f"{claim_id!r} is used by an earlier claim", source)
-        statement = _text(source, entry, "statement", where)
-        origin = _text(source, entry, "source", where)
-        scenario = _one_of(source, _text(source, entry, "scenario", where), names, f"{where}.scenario",
-                           "a scenario of the study")
-        metric = _text(source, entry, "metric", where)
+            entry.fail("id", f"{claim_id!r} is used by an earlier claim")
+        statement = entry.string("statement", non_empty=True)
+        origin = entry.string("source", non_empty=True)
+        scenario = _one_of(entry, "scenario", names, "a scenario of the study")
+        metric = entry.string("metric", non_empty=True)
         if metric != SUCCESS and metric not in columns:
-            raise ConfigError(f"{where}.metric", f"{metric!r} is neither 'success' nor a numeric row column "
-                                                 f"(e.g. plan_length_m, plan_time_s, path_length_m)", source)
-        better = _one_of(source, _text(source, entry, "better", where), BETTER, f"{where}.better", "a direction")
-        planner = _one_of(source, _text(source, entry, "planner", where), planner_labels, f"{where}.planner",
-                          "a planner label of the study")
-        than_value = entry.get("than")
-        if isinstance(than_value, str):
-            than_value = [than_value]
-        if not isinstance(than_value, list) or not than_value:
-            raise ConfigError(f"{where}.than", "expected a planner label or a non-empty list of them", source)
-        than = []
-        for j, label in enumerate(than_value):
-            if not isinstance(label, str):
-                raise ConfigError(f"{where}.than[{j}]", f"expected a planner label, got {label!r}", source)
-            _one_of(source, label, planner_labels, f"{where}.than[{j}]", "a planner label of the study")
-            if label == planner or label in than:
-                raise ConfigError(f"{where}.than[{j}]", f"{label!r} is the claimed planner or listed twice", source)
-            than.append(label)
-        navigator = _text(source, entry, "navigator", where, required=False)
-        if navigator is not None:
-            _one_of(source, navigator, navigator_labels, f"{where}.navigator", "a navigator label of the study")
-        test = _one_of(source, _text(source, entry, "test", where), TESTS, f"{where}.test", "a test")
+            entry.fail("metric", f"{metric!r} is neither 'success' nor a numeric row column "
+                                 f"(e.g. plan_length_m, plan_time_s, path_length_m)")
+        better = _one_of(entry, "better", BETTER, "a direction")
+        planner = _one_of(entry, "planner", planner_labels, "a planner label of the study")
+        than = _than(entry, planner, planner_labels)
+        navigator = _one_of(entry, "navigator", navigator_labels, "a navigator label of the study", None)
+        test = _one_of(entry, "test", TESTS, "a test")
         if (test == "fisher") != (metric == SUCCESS):
-            raise ConfigError(f"{where}.test", f"{test!r} does not test {metric!r} (success rates take 'fisher'; "
-                                               "a numeric metric 'rank_sum' or 'signed_rank')", source)
-        out.append(Claim(claim_id, statement, origin, scenario, metric, better, planner, tuple(than), test,
-                         navigator))
+            entry.fail("test", f"{test!r} does not test {metric!r} (success rates take 'fisher'; "
+                               "a numeric metric 'rank_sum' or 'signed_rank')")
+        out.append(Claim(claim_id, statement, origin, scenario, metric, better, planner, than, test, navigator))
     return tuple(out)
+
+
+def _one_of(entry: TomlTable, key: str, allowed, what: str, default: Any = REQUIRED) -> str | None:
+    """A non-empty string among ``allowed`` (``default`` when absent)."""
+    value = entry.string(key, default, non_empty=True)
+    if value is not default and value not in allowed:
+        entry.fail(key, f"{value!r} is not {what} ({', '.join(allowed)})")
+    return value
+
+
+def _than(entry: TomlTable, planner: str, planner_labels: list[str]) -> tuple[str, ...]:
+    """``than``: one planner label or a non-empty list of them, none the claimed planner, none twice."""
+    value = entry.raw("than", None)
+    labels = check_array([value] if isinstance(value, str) else value, entry.path("than"), entry.source,
+                         "a planner label or a non-empty list of them", non_empty=True)
+    than: list[str] = []
+    for j, label in enumerate(labels):
+        field = entry.path(f"than[{j}]")
+        check_string(label, field, entry.source, planner_labels)
+        if label == planner or label in than:
+            fail(field, f"{label!r} is the claimed planner or listed twice", entry.source)
+        than.append(label)
+    return tuple(than)
