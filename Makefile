@@ -16,11 +16,11 @@ STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c
 
 .PHONY: demo test bench install clean studies readme-table
 
-$(STAMP): pyproject.toml planners/_colony_walk.c planners/_grid_search.c
+$(STAMP): pyproject.toml Makefile planners/_colony_walk.c planners/_grid_search.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	@echo "installing swarmnav into $(VENV) (pip's output: $(VENV)/install.log)"
 	@$(BIN)/python -m pip install --quiet --upgrade pip > $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
-	@$(BIN)/python -m pip install --quiet -e '.[test,bench]' >> $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
+	@$(BIN)/python -m pip install --quiet -e '.[test,bench,rl]' >> $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
 	@touch $(STAMP)
 
 install: $(STAMP)

@@ -11,7 +11,7 @@ the same transform runs in ``swarmnav run``:
   (keys without them pass through, as ``VecNormalize(norm_obs_keys=...)`` leaves them);
 * scalars ``clip`` (default 10.0, VecNormalize's ``clip_obs``) and ``epsilon`` (default 1e-8).
 
-``examples/train_sb3.py`` writes one from its ``VecNormalize``.
+``examples/rl/train_sb3.py`` writes one from its ``VecNormalize``.
 """
 
 from __future__ import annotations

@@ -18,6 +18,15 @@ modules are torn down), so a script that renders and exits without ``close()``
 prints no EGL traceback (the hook is registered after the first context is made, so it
 runs before MuJoCo's own ``eglTerminate`` hook).
 
+Loading no GL library at import is not enough: the first context loads Mesa's
+software driver (``swrast_dri.so``) and with it ``libLLVM-15``, and importing triton
+(PyTorch's compiler; its CUDA build installs it, and torch imports it when installed
+on ``PPO(...)`` or ``PPO.load``) after that dies with a segfault (exit 139, nothing
+on stderr; seen with triton 3.7.1, probably its bundled LLVM meeting Mesa's).  Triton
+imported first, both work.  So :func:`new_renderer` imports triton before the first
+context when it is installed and not yet imported (about 0.1 s of CPU), and a policy
+that loads PyTorch lazily, on its first action after ``--video`` made its context, runs.
+
 ``dm_control``'s own renderer (``Physics.render``) stays disabled in a process
 that imported it through swarmnav: the environment renders with
 :class:`sim.video.render.SceneRenderer`, never with ``Physics.render``.  A user who
@@ -99,11 +108,22 @@ def backend() -> str:
     return chosen if chosen in BACKENDS else DEFAULT_BACKEND
 
 
+def _import_triton_first() -> None:
+    """Import triton, if it is installed and not imported yet, before Mesa's LLVM is loaded (see above)."""
+    if "triton" in sys.modules or importlib.util.find_spec("triton") is None:
+        return
+    try:
+        import triton  # noqa: F401
+    except Exception:  # a triton that cannot be imported cannot crash a later import of it either
+        pass
+
+
 def _context_class() -> Any:
     """MuJoCo's GL context class for :func:`backend`, installed where ``mujoco.Renderer`` looks for it."""
     from mujoco.rendering.classic import gl_context
     if getattr(gl_context, "GLContext", None) is not None:
         return gl_context.GLContext
+    _import_triton_first()
     name = backend()
     os.environ["MUJOCO_GL"] = name
     if name == "egl":

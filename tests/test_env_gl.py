@@ -58,3 +58,24 @@ print(frame.shape, frame.std() > 0, any("libEGL" in lib for lib in mapped()), os
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["(48,", "64,", "3)", "True", "True", "egl"], done.stdout
     assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr, done.stderr
+
+
+def test_triton_imports_beside_the_environment_and_after_a_render():
+    """Issue 25's 'done when': ``MUJOCO_GL=egl python -c "import swarmnav.sim.env, triton"`` exits 0; and triton
+    (which PyTorch imports when it is installed, e.g. on ``PPO.load``) imported after a render, as a policy loaded
+    lazily under ``--video`` does, no longer dies with a segfault (exit -11 before the first context imported it)."""
+    pytest.importorskip("triton")  # the test extra installs it on Linux
+    done = run_python("import swarmnav.sim.env, triton")
+    assert done.returncode == 0, (done.returncode, done.stderr)
+    done = run_python("""
+import swarmnav.sim.env
+env = swarmnav.sim.env.NavigateEnv("gwo-scenario-2", render_mode="rgb_array", width=64, height=48)
+env.reset(seed=1)
+first = env.render()
+import triton
+env.step(env.action_space.sample())
+second = env.render()
+print(first.std() > 0, second.std() > 0, any("libEGL" in lib for lib in mapped()))
+""")
+    assert done.returncode == 0, (done.returncode, done.stderr)
+    assert done.stdout.split() == ["True", "True", "True"], done.stdout

@@ -81,11 +81,26 @@ def test_a_bad_module_function_is_one_line_and_exit_2(policy_module, value):
     assert len(lines) == 1 and "navigator.params.policy" in lines[0] and "Traceback" not in out.stderr
 
 
-def test_a_policy_returning_a_wrong_shape_names_the_field(policy_module, tmp_path):
-    (tmp_path / "bad_policy.py").write_text("def act(obs):\n    return [1.0, 0.0, 0.0]\n")
-    with pytest.raises(ConfigError, match="navigator.params.policy"):
+BAD_ACTIONS = [("[1.0, 0.0, 0.0]", "shape"), ("[float('nan'), 0.0]", "not finite"), ("[True, False]", "dtype"),
+               ("['a', 'b']", "dtype")]
+
+
+@pytest.mark.parametrize("action, problem", BAD_ACTIONS)  # as the environment's ActionError (test_env_options)
+def test_a_policy_returning_a_bad_action_names_the_field(policy_module, tmp_path, action, problem):
+    module = f"bad_policy_{BAD_ACTIONS.index((action, problem))}"  # one module per case: imports are cached
+    (tmp_path / f"{module}.py").write_text(f"def act(obs):\n    return {action}\n")
+    with pytest.raises(ConfigError, match=f"navigator.params.policy.*bad action.*{problem}"):
         run_episode(EpisodeSpec(load_scenario("restaurant-table-5"), navigator="policy",
-                                navigator_params={"policy": "bad_policy:act"}), time_limit_s=1.0)
+                                navigator_params={"policy": f"{module}:act"}), time_limit_s=1.0)
+
+
+def test_a_nan_action_through_swarmnav_run_is_one_line_and_exit_2(policy_module, tmp_path):
+    (tmp_path / "nan_policy.py").write_text("def act(obs):\n    return [float('nan'), 0.0]\n")
+    out = swarmnav("run", "restaurant-table-5", "--navigator", "policy", "--navigator-set", "policy=nan_policy:act",
+                   "--no-log")
+    assert out.returncode == 2, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "navigator.params.policy" in lines[0] and "not finite" in lines[0], out.stderr
 
 
 def test_a_policy_that_raises_is_reported_against_the_parameter(tmp_path, monkeypatch):
