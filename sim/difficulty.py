@@ -143,20 +143,34 @@ def dynamic_metrics(scenario: Scenario) -> dict[str, float | None]:
             "dynamic_traversability": round(float(np.mean(free_shares)), 4)}
 
 
-def difficulty(scenario: Scenario, settings: OracleSettings | None = None) -> dict[str, Any]:
-    """Every metric of the module docstring for one scenario (its world seed), with the oracle's verdict."""
+def scene_metrics(scenario: Scenario) -> dict[str, Any]:
+    """The static and dynamic metrics of the module docstring (no oracle), with ``static_path_m``."""
     path_points, length = _reference_path(scenario)
-    out: dict[str, Any] = {"scenario": scenario.name, "world_seed": scenario.world_seed,
-                           "static_path_m": None if length is None else round(length, 4)}
+    out: dict[str, Any] = {"static_path_m": None if length is None else round(length, 4)}
     out.update({k: round(v, 4) for k, v in static_metrics(scenario, path_points).items()})
     out.update(dynamic_metrics(scenario))
-    plan = search(scenario, settings)
-    out["oracle"] = plan.verdict()
+    return out
+
+
+def oracle_metrics(scenario: Scenario, settings: OracleSettings | None = None,
+                   time_limit_s: float | None = None) -> dict[str, Any]:
+    """The oracle's verdict (``oracle``), ``oracle_t_star_s`` and ``t_star_ratio`` (module docstring), searched
+    up to ``time_limit_s`` (None: the scenario's)."""
+    plan = search(scenario, settings, time_limit_s)
+    out: dict[str, Any] = {"oracle": plan.verdict()}
     out["oracle_t_star_s"] = out["oracle"]["arrival_s"]
     ratio = None
     if plan.solvable:
         static = search(replace(scenario, obstacles=tuple(ob for ob in scenario.obstacles if not ob.moving)),
-                        settings)
+                        settings, time_limit_s)
         ratio = round(plan.arrival_s / static.arrival_s, 4) if static.solvable and static.arrival_s else None
     out["t_star_ratio"] = ratio
+    return out
+
+
+def difficulty(scenario: Scenario, settings: OracleSettings | None = None) -> dict[str, Any]:
+    """Every metric of the module docstring for one scenario (its world seed), with the oracle's verdict."""
+    out: dict[str, Any] = {"scenario": scenario.name, "world_seed": scenario.world_seed}
+    out.update(scene_metrics(scenario))
+    out.update(oracle_metrics(scenario, settings))
     return out

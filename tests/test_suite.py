@@ -66,3 +66,19 @@ def test_bench_rows_read_each_run_against_the_oracle_verdict(tmp_path):
         row = by_name[name]
         assert row["solved_share"] == row["success_rate"]      # the one run is oracle-solvable
         assert (row["time_score"] > 0) == (row["success_rate"] > 0) and row["time_score"] <= 1.0
+        assert row["realtime_factor_cpu"] > 0                   # simulated over the runs' own CPU time
+    search = oracle["oracle_search"]                            # the speed lines' figures: timed, not asserted
+    assert search["scenes"] == 1 and search["max_s"] == search["median_s"] > 0 and search["max_cpu_s"] > 0
+    from swarmnav.sim.benchmarks.navigation_speed import speed_lines
+    lines = speed_lines(rows, search, None)
+    assert lines[0].startswith("oracle search: median") and "1 scenes" in lines[0]
+    assert any(line.startswith("real-time factor: follow") for line in lines)
+    assert lines[-1].startswith("oracle physics success on its solvable scenes: 1.000 of 1")
+
+
+def test_the_mppi_speed_line_times_an_optimisation_at_every_control_step():
+    from swarmnav.sim.benchmarks.navigation_speed import mppi_step_cost
+    cost = mppi_step_cost(("dyn-crossing-3",), sim_s=1.0)
+    assert (cost["samples"], cost["horizon_steps"]) == (1000, 30)
+    assert cost["steps"] == 50 or cost["steps"] == 51            # 1 s at 50 Hz, every step timed
+    assert cost["cpu_us_per_step"] > 0 and set(cost["cpu_us_per_step_by_scene"]) == {"dyn-crossing-3"}

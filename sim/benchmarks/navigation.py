@@ -28,6 +28,11 @@ seed, ``--seeds`` ignored), in order of difficulty; ``--quick`` a stratified sam
 ``--by-scenario`` each scenario's rows carry its shipped ``difficulty`` metrics (to set success against them).  Where the
 shipped verdicts (``dyn300-verdicts.json``) disagree with this run's oracle, ``verdict_mismatches`` says how
 often (the oracle row).
+
+**Speed** (:mod:`sim.benchmarks.navigation_speed`; figures printed after the table, never asserted):
+``realtime_factor_cpu`` (simulated time over the runs' own CPU time, ``run_cpu_s``); the oracle row's
+``oracle_search`` (its search timed on every scene run: median and max, wall and CPU); the ``mppi`` row's
+``mppi_every_step`` (its control step at 1,000 x 30 optimising every step); each with the load average.
 """
 
 from __future__ import annotations
@@ -131,7 +136,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                          progress: bool = False, navigator_params: dict[str, dict[str, Any]] | None = None,
                          by_scenario: bool = False, out_dir: str | None = None, suite: str | None = None,
                          quick: bool = False, sensor_model: str | None = None,
-                         workers: int = 1) -> list[dict[str, Any]]:
+                         workers: int = 1, speed: bool = True) -> list[dict[str, Any]]:
     """One row per navigator and the oracle's (see the module docstring); ``navigator_params``: per navigator
     name.  With ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key;
     the overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given;
@@ -139,7 +144,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
             return benchmark_navigation(seeds, navigators, scenarios, progress, navigator_params, by_scenario,
-                                        folder, suite, quick, sensor_model, workers)
+                                        folder, suite, quick, sensor_model, workers, speed)
     from swarmnav.sim.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
@@ -156,6 +161,8 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     verdicts = oracle_verdicts(rows)
     runs = {n: [r for r in rows if r["navigator"] == n] for n in contenders + [ORACLE]}
     table = [{"scenario": None, **_row(nav, arm, verdicts, shipped)} for nav, arm in runs.items()]
+    if speed:
+        _add_speed(table, rows)
     if by_scenario:
         for name in dict.fromkeys(r["scenario"] for r in rows):
             extra = {"difficulty": {k: shipped[name][k] for k in DIFFICULTY_KEYS}} if name in shipped else {}
@@ -163,6 +170,18 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                 table.append({"scenario": name, **_row(nav, [r for r in arm if r["scenario"] == name], verdicts,
                                                        shipped), **extra})
     return table
+
+
+def _add_speed(table: list[dict[str, Any]], rows: list[dict[str, Any]]) -> None:
+    """The oracle's search times on every scene run (its row's ``oracle_search``) and MPPI's cost per control
+    step optimising every step (its row's ``mppi_every_step``): :mod:`sim.benchmarks.navigation_speed`."""
+    from swarmnav.sim.benchmarks.navigation_speed import mppi_step_cost, oracle_search_times
+    scenes = list(dict.fromkeys((r["scenario_ref"], r["world_seed"]) for r in rows if r["navigator"] == ORACLE))
+    for row in table:
+        if row["navigator"] == ORACLE:
+            row["oracle_search"] = oracle_search_times(scenes)
+        elif row["navigator"] == "mppi":
+            row["mppi_every_step"] = mppi_step_cost()
 
 
 def _mean(values: list[float]) -> float | None:
@@ -209,6 +228,8 @@ def _plain_row(navigator: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
         "mean_replans": _mean([r["replans"] for r in drove]),
         "navigator_us_per_step": 1e6 * sum(r["navigator_wall_s"] for r in drove) / max(steps, 1),
         "realtime_factor": sum(r["sim_time_s"] for r in drove) / max(sum(r["wall_time_s"] for r in drove), 1e-9),
+        "realtime_factor_cpu": (sum(r["sim_time_s"] for r in drove) / max(sum(r["run_cpu_s"] for r in drove), 1e-9)
+                                if drove and all(r.get("run_cpu_s") is not None for r in drove) else None),
     }
 
 
@@ -246,6 +267,12 @@ def run(args: argparse.Namespace) -> int:
         for name in dict.fromkeys(r["scenario"] for r in rows if r["scenario"] is not None):
             print()
             _print_table([r for r in rows if r["scenario"] == name], name)
+    from swarmnav.sim.benchmarks.navigation_speed import speed_lines
+    print()
+    oracle = next((r.get("oracle_search") for r in overall if r["navigator"] == ORACLE), None)
+    mppi = next((r.get("mppi_every_step") for r in overall if r["navigator"] == "mppi"), None)
+    for line in speed_lines(overall, oracle or {}, mppi):
+        print(line)
     return 0
 
 

@@ -147,7 +147,9 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
                     log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
                     recorders.append(McapRecorder(log_path, overwrite=True))
                     row["log"] = str(log_path)
+                cpu0 = time.thread_time()
                 episode = run_episode(episode, recorders, time_limit_s=cell.time_limit_s)
+                row["run_cpu_s"] = time.thread_time() - cpu0  # this thread's CPU: the load of others left out
                 row["run_events"] = tally.as_json()
         row["outcome"] = "ok"
     except WallLimitExceeded:

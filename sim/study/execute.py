@@ -4,7 +4,9 @@
 planner, the paper's values and, per scenario, what the report draws under the
 paths (arena, start, goal, the obstacle footprints at t = 0): a report needs only
 the rows and this file, so it works on a copied results folder;
-``DIR/runs.parquet`` and ``DIR/progress.parquet`` hold the rows (see ``rows``).
+``DIR/runs.parquet`` and ``DIR/progress.parquet`` hold the rows (see ``rows``); physics rows of dynamic
+scenarios carry the clairvoyant oracle's verdict, a time score and the scene's difficulty metrics, each scene
+measured once by the driver and kept in ``DIR/difficulty.json`` (see ``yardstick``).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from swarmnav.sim.study.grid import Cell, count_cells, iter_cells
 from swarmnav.sim.study.lock import FolderLock
 from swarmnav.sim.study.rows import RowWriter, compact, done_hashes, read_table
 from swarmnav.sim.study.spec import Study, study_from_tables
+from swarmnav.sim.study.yardstick import Yardstick
 
 METADATA = "study.json"
 
@@ -139,12 +142,13 @@ def _run_locked(study: Study, out_dir: FilePath, engine: str, workers: int | Non
     else:
         results = run_local(todo, workers, logs_dir)
     writer = RowWriter(out_dir)
+    yardstick = Yardstick(out_dir, study.time_limit_s, study.trust_code)
     bar = ProgressBar(pending, sys.stderr) if show_progress and pending else None
     counts: dict[str, int] = {}
     started = time.perf_counter()
     try:
         for row, progress in results:
-            writer.add(row, progress)
+            writer.add(yardstick.annotate(row), progress)
             counts[row["outcome"]] = counts.get(row["outcome"], 0) + 1
             if bar:
                 bar.update(sum(counts.values()), sum(v for k, v in counts.items() if k != "ok"))

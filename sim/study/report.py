@@ -18,7 +18,7 @@ import re
 from pathlib import Path as FilePath
 from typing import Any
 
-from swarmnav.sim.study import anytime, figures
+from swarmnav.sim.study import against_oracle, anytime, figures
 from swarmnav.sim.study.claim_spec import Claim
 from swarmnav.sim.study.claims import claims_document
 from swarmnav.sim.study.report_tables import (claims_table, count_table, merge_identical, paper_values_table,
@@ -150,6 +150,21 @@ def _driven(arms: dict[str, list[dict[str, Any]]]) -> tuple[dict[str, tuple], st
     return out, sentence
 
 
+def _against_oracle(doc: _Document, runs: list[dict[str, Any]]) -> None:
+    """Each navigator against the clairvoyant oracle, over the dynamic scenes (nothing without them)."""
+    table = against_oracle.navigator_table(runs)
+    if table is None:
+        return
+    doc.heading("Navigation against the oracle")
+    doc.paragraph(against_oracle.STATEMENT)
+    doc.table(table)
+    metric = against_oracle.FIGURE_METRIC
+    doc.figure(against_oracle.success_figure(runs, metric),
+               f"Success on the oracle-solvable scenes against their {against_oracle.METRIC_TITLES[metric]}: "
+               f"the scenes ordered by it in up to {against_oracle.FIGURE_BINS} bins of equal counts, each "
+               "navigator's success over its runs in each bin (the clairvoyant oracle left out); the grey numbers: "
+               "the scenes in each bin")
+
 def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePath:
     """Write the HTML report, its Markdown twin (``.md`` beside it) and ``claims.json`` beside them; return
     the Markdown path."""
@@ -181,6 +196,7 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
                       "Vargha-Delaney effect size, the probability that the claimed planner's run is better "
                       "(0.5: no effect), of the weakest pair. n: runs tested / runs per side.")
         doc.table(claims_table(document))
+    _against_oracle(doc, runs)
     for scenario, arms in by_scenario(runs).items():
         scenario_rows = [r for rows in arms.values() for r in rows]
         arms, identical = merge_identical(arms)

@@ -58,13 +58,18 @@ RUN_SCHEMA = pa.schema([
     ("driven_turns", pa.int64()), ("run_events", pa.string()),
     ("budget", pa.string()), ("budget_evaluations", pa.int64()), ("budget_time_s", pa.float64()),
     ("budgeted", pa.bool_()), ("plan_mode", pa.string()), ("planner_resolved", pa.string()),
+    # against the clairvoyant oracle, physics rows of dynamic scenarios (sim/study/yardstick.py)
+    ("oracle_verdict", pa.string()), ("oracle_reason", pa.string()), ("oracle_t_star_s", pa.float64()),
+    ("oracle_cell_m", pa.float64()), ("time_score", pa.float64()), ("static_density", pa.float64()),
+    ("dispersion", pa.float64()), ("survivability", pa.float64()), ("dynamic_traversability", pa.float64()),
+    ("t_star_ratio", pa.float64()), ("difficulty_error", pa.string()), ("run_cpu_s", pa.float64()),
 ])
 PROGRESS_SCHEMA = pa.schema([
     ("config_hash", pa.string()), ("iteration", pa.int64()), ("best_cost", pa.float64()),
     ("evaluations", pa.int64()), ("evaluations_estimated", pa.bool_()), ("wall_s", pa.float64()),
 ])
 # Columns that measure time on the wall clock: they differ between two runs of the same cell.
-TIMING_COLUMNS = ("cell_wall_s", "plan_time_s", "wall_time_s", "replan_wall_s", "navigator_wall_s")
+TIMING_COLUMNS = ("cell_wall_s", "plan_time_s", "wall_time_s", "replan_wall_s", "navigator_wall_s", "run_cpu_s")
 PROGRESS_TIMING_COLUMNS = ("wall_s",)  # the same, of progress.parquet
 
 
