@@ -59,7 +59,8 @@ studies: $(STAMP)
 # The README's claims table: each bundled study with [[claims]] run on its quick seeds (`make readme-table
 # CLAIMS_RUN=` in full) into a fresh
 # studies/readme-table/<name>/, its verdicts copied to models/studies/results/<name>/claims.json (committed),
-# and the table between the README's claims-table markers regenerated from them.
+# and the table between the README's claims-table markers regenerated from them; then the README's navigation
+# table from the committed `bench navigation --suite dyn300 --json` result (models/suites/results/dyn300.json).
 CLAIM_STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin) if s['claims']))")
 CLAIMS_RUN ?= --quick
 readme-table: $(STAMP)
@@ -70,6 +71,7 @@ readme-table: $(STAMP)
 		cp studies/readme-table/$$s/claims.json models/studies/results/$$s/claims.json || exit 1; \
 	done
 	$(BIN)/swarmnav report --readme-table models/studies/results --readme README.md
+	$(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/dyn300.json --readme README.md
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -102,8 +102,8 @@ def test_safety_filter_slows_for_a_far_obstacle_and_stops_for_a_near_one():
 def test_safety_filter_stops_the_robot_before_an_obstacle_that_drives_straight_at_it():
     text = short_case("head_on", "detector", speed_ratio=0.8, range_m=1.5, navigator="replan")
     scenario = parse_scenario(text)
-    # No replanning within reach (lookahead shorter than anything): the filter alone acts.
-    params = {"lookahead_m": 1e-3, "safety_filter": True, "time_before_collision_s": 3.0}
+    # No replanning within reach (lookahead shorter than anything), no evasion: the filter alone acts.
+    params = {"lookahead_m": 1e-3, "safety_filter": True, "time_before_collision_s": 3.0, "evade": False}
     result = run_episode(EpisodeSpec(scenario, navigator_params=params), time_limit_s=20.0).result
     assert result.safety_triggers >= 1 and result.collisions >= 1  # obstacles do not yield
     step = int(round(result.first_collision_s / (result.times_s[1] - result.times_s[0])))

@@ -53,6 +53,7 @@ from typing import Any, Callable, ClassVar, Iterable
 import numpy as np
 
 from swarmnav.models.parameters import Range, above, within
+from swarmnav.controllers.evasion import evaded, evasion_for
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, static_grid
 from swarmnav.models.errors import ConfigError
@@ -208,17 +209,22 @@ class ImmasStepwiseNavigator:
     Args:
         alpha, beta: Eq. (3)'s weights; None takes the scenario's ``immas`` planner's, else 3 and 1 (line 4).
         reach_m: distance to a cell's centre at which the robot has reached it.
+        evade, evade_trigger_s: the evasion layer of :mod:`controllers.evasion` (off by default: not the
+            paper's; a named option beyond it) and its trigger.
     """
 
     name: ClassVar[str] = "immas_stepwise"
     parameter_ranges: ClassVar[dict[str, Range]] = {
-        "alpha": within(0, 100), "beta": within(0, 100), "reach_m": above(0, 100)}  # models.parameters: checked on build
+        "alpha": within(0, 100), "beta": within(0, 100), "reach_m": above(0, 100),
+        "evade_trigger_s": within(0, 600)}  # models.parameters: checked on build
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured
     alpha: float | None = None
     beta: float | None = None
     reach_m: float = 0.1
+    evade: bool = False
+    evade_trigger_s: float = 2.0
 
     def __post_init__(self) -> None:
         for key, ok, problem in (("alpha", self.alpha is None or self.alpha >= 0, "must not be negative"),
@@ -228,6 +234,7 @@ class ImmasStepwiseNavigator:
                 raise ConfigError(f"navigator.params.{key}", f"{problem}, got {getattr(self, key)!r}")
 
     def reset(self, setup: NavigationSetup) -> None:
+        self.evasion = evasion_for(setup, self.evade_trigger_s) if self.evade else None
         problem = setup.map_problem  # static obstacles only: the moving ones are sensed
         self.grid = grid = static_grid(problem)
         planner = setup.planner if isinstance(setup.planner, MaxMinAntSystemPlanner) else MaxMinAntSystemPlanner()
@@ -280,6 +287,11 @@ class ImmasStepwiseNavigator:
         return self.walker.start([here, target])
 
     def step(self, observation: Observation) -> NavigationStep:
+        """The paper's step; with ``evade`` (off by default: not the paper's) the evasion layer of
+        :mod:`controllers.evasion` on its command."""
+        return evaded(self.evasion, observation, self._paper_step(observation))
+
+    def _paper_step(self, observation: Observation) -> NavigationStep:
         events: list[tuple[str, dict[str, Any]]] = []
         new_path = None
         command, reached = self.walker.command(observation.pose, observation.twist)

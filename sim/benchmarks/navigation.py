@@ -23,7 +23,8 @@ The ``oracle`` row itself is the yardstick's validation: ``success_on_solvable``
 the runs it called solvable (target: at least 0.95), ``solvable_share`` the share it called solvable.
 
 ``--suite dyn300``: the 300 generated scenes of ``models/suites/dyn300.toml`` (each with its own world
-seed, ``--seeds`` ignored), in order of difficulty; ``--quick`` a stratified sample (2 per group);
+seed, ``--seeds`` ignored), in order of difficulty; ``--quick`` a stratified sample (2 per group), ``--per-group
+N`` one of N per group;
 ``--sensor-model detector|rangefinder`` (12 rangefinders at 1 m) overrides their sensing; with
 ``--by-scenario`` each scenario's rows carry its shipped ``difficulty`` metrics (to set success against them).  Where the
 shipped verdicts (``dyn300-verdicts.json``) disagree with this run's oracle, ``verdict_mismatches`` says how
@@ -116,12 +117,15 @@ def oracle_verdicts(rows: list[dict[str, Any]]) -> dict[tuple[str, int], dict[st
     return out
 
 
-def write_suite(suite_name: str, quick: bool, sensor_model: str | None, folder: str) -> tuple[list[str], Any]:
-    """The suite's scenes as TOML files under ``folder`` (paths, in order of difficulty) and the suite."""
+def write_suite(suite_name: str, quick: bool, sensor_model: str | None, folder: str,
+                per_group: int | None = None) -> tuple[list[str], Any]:
+    """The suite's scenes as TOML files under ``folder`` (paths, in order of difficulty) and the suite;
+    ``quick``: a stratified sample of 2 scenes per group, ``per_group``: of that many."""
     import os
     from swarmnav.models.suites import load_suite, stratified_sample
     suite = load_suite(suite_name, sensor_model)
-    scenes = stratified_sample(suite) if quick else suite.scenes
+    scenes = (stratified_sample(suite, per_group) if per_group is not None
+              else stratified_sample(suite) if quick else suite.scenes)
     os.makedirs(os.path.join(folder, "scenarios"), exist_ok=True)
     paths = []
     for scene in scenes:
@@ -136,7 +140,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                          progress: bool = False, navigator_params: dict[str, dict[str, Any]] | None = None,
                          by_scenario: bool = False, out_dir: str | None = None, suite: str | None = None,
                          quick: bool = False, sensor_model: str | None = None,
-                         workers: int = 1, speed: bool = True) -> list[dict[str, Any]]:
+                         workers: int = 1, speed: bool = True, per_group: int | None = None) -> list[dict[str, Any]]:
     """One row per navigator and the oracle's (see the module docstring); ``navigator_params``: per navigator
     name.  With ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key;
     the overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given;
@@ -144,14 +148,14 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
             return benchmark_navigation(seeds, navigators, scenarios, progress, navigator_params, by_scenario,
-                                        folder, suite, quick, sensor_model, workers, speed)
+                                        folder, suite, quick, sensor_model, workers, speed, per_group)
     from swarmnav.sim.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
     contenders = [n for n in (navigators or default_navigators(navigator_params)) if not is_clairvoyant(n)]
     shipped: dict[str, dict[str, Any]] = {}
     if suite is not None:
-        names, loaded = write_suite(suite, quick, sensor_model, out_dir)
+        names, loaded = write_suite(suite, quick, sensor_model, out_dir, per_group)
         shipped = loaded.verdicts
         run_seeds = None
     else:
@@ -252,12 +256,14 @@ def run(args: argparse.Namespace) -> int:
     suite = None if args.suite == "dyn" else args.suite
     if suite is None and getattr(args, "sensor_model", None):
         raise ConfigError("--sensor-model", "applies to a generated suite (--suite dyn300) only")
+    if suite is None and getattr(args, "per_group", None):
+        raise ConfigError("--per-group", "applies to a generated suite (--suite dyn300) only")
     rows = benchmark_navigation(args.seeds, args.navigator, args.scenario,
                                 progress=not args.json and sys.stderr.isatty(), navigator_params=settings,
                                 by_scenario=args.by_scenario, out_dir=args.out, suite=suite,
                                 quick=bool(getattr(args, "quick", False)) and suite is not None,
                                 sensor_model=getattr(args, "sensor_model", None),
-                                workers=getattr(args, "workers", 1) or 1)
+                                workers=getattr(args, "workers", 1) or 1, per_group=getattr(args, "per_group", None))
     if args.json:
         print(json.dumps(rows))
         return 0

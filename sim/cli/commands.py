@@ -140,6 +140,8 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quick", action="store_true",
                         help=f"1 world seed on {', '.join(BENCH_NAVIGATION_QUICK_SCENARIOS)} (under a minute); "
                              "with --suite dyn300: a stratified sample, 2 scenes per group")
+    parser.add_argument("--per-group", type=options.positive_int, metavar="N",
+                        help="--suite dyn300 only: a stratified sample of N scenes per group (--quick: 2)")
     parser.add_argument("--sensor-model", choices=("detector", "rangefinder"),
                         help="--suite dyn300 only: every scene with this sensing (rangefinder: 12 at 1 m)")
     parser.add_argument("--workers", type=options.positive_int, default=1,

@@ -1,0 +1,57 @@
+"""The README's navigation table is the one generated from the committed dyn300 result."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from swarmnav.sim.benchmarks import navigation_table
+from swarmnav.sim.benchmarks.navigation_table import RESULT, block, current_block, read_rows, replace_block
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def test_the_readme_navigation_table_is_the_one_generated_from_the_committed_result(capsys):
+    assert navigation_table.main([str(RESULT)]) == 0
+    generated = capsys.readouterr().out.strip()
+    readme = (REPO / "README.md").read_text()
+    assert current_block(readme) == generated, "run `make readme-table` (README and models/suites/results differ)"
+
+
+def test_the_committed_result_is_a_dyn300_run_of_every_default_navigator_beside_the_oracle():
+    from swarmnav.sim.benchmarks.navigation import default_navigators
+    rows = read_rows(RESULT)
+    names = [r["navigator"] for r in rows]
+    assert names == [n for n in default_navigators() if n != "oracle"] + ["oracle"]
+    assert len({r["runs"] for r in rows}) == 1 and rows[0]["runs"] >= 22
+    oracle = rows[-1]
+    assert oracle["oracle_solvable_runs"] <= oracle["runs"] and oracle["verdict_mismatches"] is not None
+
+
+def test_the_table_follows_the_rows_and_a_bad_file_is_named(tmp_path, capsys):
+    rows = read_rows(RESULT)
+    changed = [dict(r) for r in rows]
+    changed[0]["solved_share"] = 0.123456
+    assert "**0.123**" in block(changed) and block(changed) != block(rows)
+    readme = tmp_path / "README.md"
+    readme.write_text("before\n" + block(rows) + "\nafter\n")
+    assert replace_block(readme.read_text(), block(changed), "README.md").startswith("before\n")
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"not": "rows"}))
+    assert navigation_table.main([str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert str(bad) in err and len(err.strip().splitlines()) == 1
+    with pytest.raises(Exception, match="navigation-table markers"):
+        replace_block("no markers here", block(rows), "README.md")
+
+
+def test_per_group_writes_that_many_scenes_of_each_group_and_needs_a_generated_suite(tmp_path, capsys):
+    from swarmnav.sim.benchmarks.navigation import write_suite
+    from swarmnav.sim.cli import main
+    paths, suite = write_suite("dyn300", False, None, str(tmp_path), per_group=3)
+    groups = list(dict.fromkeys(s.group for s in suite.scenes))
+    names = [Path(p).stem for p in paths]
+    assert len(names) == 3 * len(groups) and len(set(names)) == len(names)
+    assert all(sum(name.startswith(f"d300-{g}-") for name in names) == 3 for g in groups)
+    assert main(["bench", "navigation", "--per-group", "3"]) == 2
+    assert "--per-group" in capsys.readouterr().err
