@@ -191,11 +191,7 @@ def search(scenario: Scenario, settings: OracleSettings | None = None,
     turn_ticks = max(1, int(math.ceil((math.pi / 4.0) / (settings.turn_rate_rad_s * tick))))
     start_rc = (int(round((sy - y0) / cell)), int(round((sx - x0) / cell)))
     start_h = int(round(scenario.start.heading_rad / (math.pi / 4.0))) % HEADINGS
-    gx, gy = scenario.goal.x_m, scenario.goal.y_m
-    goal_d = np.hypot(xs[None, :] - gx, ys[:, None] - gy)
-    goal_mask = goal_d <= 0.5 * scenario.goal_tolerance_m
-    if not goal_mask.any():
-        goal_mask = goal_d <= goal_d.min() + 1e-12
+    goal_mask = _goal_cells(scenario, xs, ys)
 
     def finish(solvable: bool, reason: str, arrival_tick: int | None = None, poses=None) -> OraclePlan:
         return OraclePlan(solvable, None if arrival_tick is None else arrival_tick * tick, reason, tick, settings,
@@ -224,39 +220,11 @@ def search(scenario: Scenario, settings: OracleSettings | None = None,
     reached_at.append(reach.copy())
     for t in range(1, ticks):
         advance_fields(t)
-        new = np.zeros_like(reach)
         # Wait: free at t-1 and t.
         waited = reach & (runs[t] >= 2)[None]
-        # Move: departed at t - n from the neighbour behind, each tick's interpolated point clear.
-        moved = np.zeros_like(reach)
-        for h in range(HEADINGS):
-            dx, dy = STEPS[h]
-            n = 2 if (dx == 0 or dy == 0) else 3
-            if t < n:
-                continue
-            length = cell * math.hypot(dx, dy)
-            ok = _shift(reached_at[t - n][h], dy, dx)
-            for j in range(n + 1):
-                frac = j / n
-                f = fields[t - n + j]
-                src_ok = _shift(f, dy, dx) >= need + frac * length      # checked at the departure cell
-                dst_ok = f >= need + (1.0 - frac) * length              # or at the arrival cell
-                ok &= src_ok | dst_ok
-            moved[h] = ok
-        # Turn on the spot: the neighbouring heading, the cell free for the whole turn.
-        turned_l = np.zeros_like(reach)
-        turned_r = np.zeros_like(reach)
-        if t >= turn_ticks:
-            still = runs[t] >= turn_ticks + 1
-            before = reached_at[t - turn_ticks]
-            turned_l = np.roll(before, 1, axis=0) & still[None]         # heading h from h - 1 (counter-clockwise)
-            turned_r = np.roll(before, -1, axis=0) & still[None]
-        code = actions[t]
-        for mask, value in ((moved, MOVE), (turned_l, LEFT), (turned_r, RIGHT), (waited, WAIT)):
-            fresh = mask & ~new
-            code[fresh] = value
-            new |= mask
-        reach = new
+        turned_l, turned_r = _turned(reached_at, runs, t, turn_ticks, reach)
+        reach = _record(actions[t], ((_moved(reached_at, fields, t, cell, need, reach), MOVE), (turned_l, LEFT),
+                                     (turned_r, RIGHT), (waited, WAIT)))
         reached_at.append(reach)
         keep = max(3, turn_ticks)  # what the next ticks look back on; older layers are dropped
         if t > keep:
@@ -267,6 +235,63 @@ def search(scenario: Scenario, settings: OracleSettings | None = None,
         if not reach.any():
             return finish(False, "trapped")
     return finish(False, "time_limit")
+
+
+def _goal_cells(scenario: Scenario, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """(rows, cols) the lattice cells within half the goal tolerance of the goal (the nearest, if none is)."""
+    gx, gy = scenario.goal.x_m, scenario.goal.y_m
+    goal_d = np.hypot(xs[None, :] - gx, ys[:, None] - gy)
+    goal_mask = goal_d <= 0.5 * scenario.goal_tolerance_m
+    if not goal_mask.any():
+        goal_mask = goal_d <= goal_d.min() + 1e-12
+    return goal_mask
+
+
+def _moved(reached_at: list[np.ndarray], fields: list[np.ndarray], t: int, cell: float, need: np.ndarray | float,
+           reach: np.ndarray) -> np.ndarray:
+    """(HEADINGS, rows, cols) the states reached at tick ``t`` by a move: departed at ``t - n`` from the
+    neighbour behind, each tick's interpolated point clear."""
+    moved = np.zeros_like(reach)
+    for h in range(HEADINGS):
+        dx, dy = STEPS[h]
+        n = 2 if (dx == 0 or dy == 0) else 3
+        if t < n:
+            continue
+        length = cell * math.hypot(dx, dy)
+        ok = _shift(reached_at[t - n][h], dy, dx)
+        for j in range(n + 1):
+            frac = j / n
+            f = fields[t - n + j]
+            src_ok = _shift(f, dy, dx) >= need + frac * length      # checked at the departure cell
+            dst_ok = f >= need + (1.0 - frac) * length              # or at the arrival cell
+            ok &= src_ok | dst_ok
+        moved[h] = ok
+    return moved
+
+
+def _turned(reached_at: list[np.ndarray], runs: list[np.ndarray], t: int, turn_ticks: int,
+            reach: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The states reached at tick ``t`` by turning on the spot, (left, right): the neighbouring heading,
+    the cell free for the whole turn."""
+    turned_l = np.zeros_like(reach)
+    turned_r = np.zeros_like(reach)
+    if t >= turn_ticks:
+        still = runs[t] >= turn_ticks + 1
+        before = reached_at[t - turn_ticks]
+        turned_l = np.roll(before, 1, axis=0) & still[None]         # heading h from h - 1 (counter-clockwise)
+        turned_r = np.roll(before, -1, axis=0) & still[None]
+    return turned_l, turned_r
+
+
+def _record(code: np.ndarray, ways: tuple[tuple[np.ndarray, int], ...]) -> np.ndarray:
+    """The states reached at one tick, the union of ``ways`` (each a mask and its action); ``code`` (the
+    tick's actions) gets, for each state, the first way that reaches it."""
+    new = np.zeros_like(ways[0][0])
+    for mask, value in ways:
+        fresh = mask & ~new
+        code[fresh] = value
+        new |= mask
+    return new
 
 
 def _read_back(actions: np.ndarray, t: int, h: int, r: int, c: int, xs: np.ndarray, ys: np.ndarray,

@@ -125,6 +125,12 @@ def checked_action(action) -> np.ndarray:
     Accepted: any array-like of shape (2,) (or (1, 2), one environment's row) of real numbers, floating or
     integer, all finite.  Rejected: other shapes, booleans, complex numbers, strings and objects, NaN and inf.
     """
+    if type(action) is np.ndarray and action.shape == (2,) and action.dtype.kind == "f":  # the usual action, fast
+        array = action.astype(np.float64)
+        a0, a1 = array.tolist()
+        if math.isfinite(a0) and math.isfinite(a1):
+            return array
+        raise ActionError(f"action {array.tolist()} is not finite")
     try:
         array = np.asarray(action)
     except Exception as exc:  # ragged lists and the like

@@ -299,6 +299,10 @@ def _check_run_size(time_limit_s: float, sim: SimSettings, source: str) -> None:
             or round(steps_per_control) < 1:
         raise ConfigError("sim.control_hz", "the control period must be a whole number of physics "
                           f"timesteps (got {steps_per_control:g} steps)", source)
+    periods = time_limit_s / (round(steps_per_control) * sim.timestep_s)  # the runner's whole control periods
+    if round(periods) < 1 or abs(periods - round(periods)) > 1e-9 * max(1.0, periods):
+        raise ConfigError("time_limit_s", f"{time_limit_s:g} s is not a whole number of control periods "
+                          f"({round(steps_per_control) * sim.timestep_s:g} s)", source)
     control_steps = time_limit_s * sim.control_hz
     if not control_steps <= MAX_CONTROL_STEPS:
         raise ConfigError("time_limit_s", f"{time_limit_s:g} s at {sim.control_hz:g} Hz needs {control_steps:.4g} "

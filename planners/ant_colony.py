@@ -1,45 +1,51 @@
-"""The ant-colony core shared by ``immas``, ``iaco`` and ``maco``.
+"""The ant-colony base shared by the colony planners, as :mod:`planners.continuous` is for the continuous ones.
 
-What the three papers have in common lives here, once:
+* :class:`AntColonyPlanner`: what every colony has, its parameters and their checks: ``ants`` ants
+  walk in each of ``iterations`` iterations, the transition rule weighs pheromone by ``alpha``
+  (Eq. (1) of Dorigo, Maniezzo & Colorni 1996 and of Stützle & Hoos 2000; Eq. (1) of Gong et al.
+  2022; Eq. (3) of Habib et al. 2021), the update by ``rho``, the best tour is shortcut by line of
+  sight (``shortcut``), and a tour walked is one evaluation of the budget (``max_evaluations``).
+  ``maco`` (:mod:`planners.waiter_ant_colony`) builds on it over random nodes.
+* :class:`GridColonyPlanner`: a colony on the inflated occupancy grid (``aco``, ``mmas``, ``iaco``):
+  the heuristic weight ``beta``, the ants' ``max_steps``, the grid's ``cell_m``, and the iteration
+  itself: fold the paper's transition rule into weight tables, walk the colony
+  (:func:`planners.colony_walk.walk_colony`), keep the best tour, apply the paper's update; the
+  best tour's waypoints and the statistics every colony reports at the end.
+* :func:`roulette`, :func:`evaporate` and :func:`deposit`: the roulette-wheel choice and the
+  pheromone update ``tau <- (1 - rho) tau + sum(delta)``, shared by every colony and by ``immas``.
 
-* :func:`roulette`: roulette-wheel choice of one option per ant, for all ants in one call;
-* :func:`evaporate` and :func:`deposit`: the pheromone update ``tau <- (1 - rho) tau + sum(delta)``;
-* :class:`GridGraph`: the 8-connected, no-corner-cutting cell graph of an occupancy grid;
-* :func:`walk_colony_reference`: tour construction on a :class:`GridGraph`, vectorised over ants:
-  every walking ant advances one cell per NumPy step, with masks for the ants that
-  reached the goal or got stuck (no unvisited neighbour left); :func:`walk_colony`
-  is the same walk compiled (``planners/_colony_walk.c``), which the planners use.
-
-Each planner supplies only its desirability (how Eq. (1)/(3)/(6) of its paper
-weighs the neighbours, as a per-cell and a per-turn table) and its update rule, and runs through
-:class:`planners.swarm.SwarmPlanner`, the one optimisation loop.
+Each paper's planner keeps only what its paper defines (its transition weights, its update, its
+own parameters), and all run through :class:`planners.swarm.SwarmPlanner`, the one optimisation loop.
+``immas`` (Hasan et al. 2023, :mod:`planners.improved_max_min_ant_system`) is not on this base: its
+Algorithm 3 moves one robot once, cell by cell, over a pheromone field propagated from the goal (no
+colony, no ants, no per-iteration update), so it shares :func:`roulette` and the MAX-MIN limits
+(:mod:`planners.max_min_trails`) only.  Its ``iterations`` (moves; 0: the cells) and ``rho`` (in (0, 1])
+mean other things than here.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.planners._colony_walk import walk_block
-from swarmnav.planners.errors import NoPathFound
-from swarmnav.planners.grid_graph import (DIRECTIONS, STEP_COSTS, cell_clearance_m, cells_to_waypoints, count_bends,
-                                          neighbour_table)
+from swarmnav.models.parameters import Range, within
+from swarmnav.planners.colony_walk import STEP_LENGTHS, ColonyWalk, GridGraph, walk_colony
+from swarmnav.planners.errors import NoPathFound, check_parameters
+from swarmnav.planners.grid_graph import cell_clearance_m, cells_to_waypoints, count_bends, grid_endpoints, grid_problem
 from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Problem
-from swarmnav.planners.swarm import SwarmState
-from swarmnav.models.world import OccupancyGrid
+from swarmnav.planners.swarm import SwarmPlanner, SwarmState
 
-#: Index used for "no previous move" (an ant on its first step).
-NO_DIRECTION = 8
-STEP_LENGTHS = np.array(STEP_COSTS)
-#: Steps of a colony walk whose roulette uniforms are drawn in one call.
-UNIFORM_BLOCK = 32
-#: :data:`STEP_LENGTHS` with a 0 for :data:`NO_DIRECTION`.
-STEP_LENGTHS_9 = np.append(STEP_LENGTHS, 0.0)
-DIRECTION_VECTORS = np.array(DIRECTIONS, dtype=float)  # (d_row, d_col)
+#: Most ants: on the grid each keeps a visited mask of the whole grid.
+MAX_ANTS = 10_000
+#: Most cells a grid colony's grid may have: the colony's tables take about 600 bytes a cell.
+MAX_COLONY_CELLS = 500_000
+
+#: A parameter check: (parameter name, passes, what it must be), as :func:`planners.errors.check_parameters` takes.
+Check = tuple[str, bool, str]
 
 
 def roulette(weights: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -73,282 +79,197 @@ def deposit(tau: np.ndarray, indices: np.ndarray, amounts: np.ndarray | float) -
     np.add.at(tau, np.asarray(indices, dtype=np.int64), amounts)
 
 
-@dataclass(frozen=True, eq=False)
-class GridGraph:
-    """The cell graph ants walk on.
+@dataclass
+class AntColonyPlanner(SwarmPlanner):
+    """The parameters every ant colony shares, and their checks (subclasses add their paper's).
 
     Attributes:
-        grid: the occupancy grid (cells are flat indices ``row * cols + col``).
-        table: (N, 8) neighbour indices in :data:`planners.grid_graph.DIRECTIONS` order, -1 where illegal.
-        key_table: (9 N, 8) the same table repeated once per previous direction
-            (:data:`NO_DIRECTION` last), indexed by an ant's key ``direction * N + cell``.
+        ants: colony size m (at most :data:`MAX_ANTS`, 10,000).
+        iterations: colony iterations (at least 1).
+        alpha: weight of the pheromone in the transition rule.
+        rho: the update's rate: the evaporation of ``tau <- (1 - rho) tau + delta`` (the MAX-MIN
+            Ant System's persistence, see :mod:`planners.max_min_ant_system`); in [0, 1).
+        shortcut: line-of-sight shortcut of the best tour (the raw tour stays in ``stats.extra``).
+        max_evaluations: optional cap on tours walked (0 or None: none); one ant's tour is one
+            evaluation, so a budgeted iteration sends out only the ants the budget has left.
     """
 
-    grid: OccupancyGrid
-    table: np.ndarray
-    key_table: np.ndarray
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "ants": within(1, MAX_ANTS), "iterations": within(1, 1_000_000), "alpha": within(0, 100),
+        "rho": within(0, 1), "max_evaluations": within(0, 1e9)}  # models.parameters: checked on build
+    name: ClassVar[str]
+    #: What ``rho`` must be, as the checks word it.
+    rho_requirement: ClassVar[str] = "must lie in [0, 1)"
+    ants: int = 50
+    iterations: int = 100
+    alpha: float = 1.0
+    rho: float = 0.5
+    shortcut: bool = True
+    max_evaluations: int | None = None
 
-    @classmethod
-    def of(cls, grid: OccupancyGrid) -> "GridGraph":
-        table = neighbour_table(grid.occupied)
-        return cls(grid=grid, table=table, key_table=np.tile(table, (NO_DIRECTION + 1, 1)))
+    def __post_init__(self) -> None:
+        check_parameters(self, self.parameter_checks())
 
-    @property
-    def cols(self) -> int:
-        return self.grid.occupied.shape[1]
+    def parameter_checks(self) -> tuple[Check, ...]:
+        """The checks of this planner's parameters, the shared ones first (a subclass adds its own)."""
+        return (
+            ("ants", 1 <= self.ants <= MAX_ANTS, f"must lie in [1, {MAX_ANTS:,}]"),
+            ("iterations", self.iterations >= 1, "must be at least 1"),
+            ("alpha", self.alpha >= 0, "must not be negative"),
+            ("rho", 0.0 <= self.rho < 1.0, self.rho_requirement),
+            ("max_evaluations", self.max_evaluations is None or self.max_evaluations >= 0, "must not be negative"),
+        )
 
-    @property
-    def size(self) -> int:
-        return self.table.shape[0]
-
-    def index(self, cell: tuple[int, int]) -> int:
-        return int(cell[0]) * self.cols + int(cell[1])
-
-    def cells(self, indices: np.ndarray) -> np.ndarray:
-        """(K, 2) (row, col) of flat indices."""
-        idx = np.asarray(indices, dtype=np.int64)
-        return np.column_stack(np.divmod(idx, self.cols))
+    def colony_size(self, state: SwarmState) -> int:
+        """The ants of this iteration: ``ants``, or fewer when the budget has less left (a tour is
+        one evaluation)."""
+        return int(min(self.ants, state.evaluations_left))
 
 
 @dataclass
-class ColonyWalk:
-    """Tours of one colony iteration.
+class GridColonyPlanner(AntColonyPlanner):
+    """An ant colony on the inflated occupancy grid: the loop of one iteration and the run's end.
+
+    A subclass supplies its paper's pheromone and heuristic (:meth:`init_trails`), the weights
+    its ants walk on (:meth:`move_weights`; by default the classic transition rule
+    ``tau_j^alpha eta_ij^beta`` with a fixed ``eta^beta`` table) and its update (:meth:`update`).
+
+    Readings shared by the grid colonies (the papers' are about graphs, or give no grid details):
+    pheromone sits on cells (the move into cell j reads ``tau_j``); an ant never re-enters a cell
+    (its tabu list), in a dead end it steps back one cell (the dead end stays tabu), and it fails
+    after ``max_steps`` NumPy steps; only ants that reach the goal count.
 
     Attributes:
-        paths: (A, S + 1) flat cell indices, -1 after an ant's last cell.
-        steps: (A,) moves made by each ant.
-        length_cells: (A,) tour length in cells (1 per orthogonal move, sqrt 2 per diagonal).
-        turns: (A,) direction changes along each tour.
-        reached: (A,) the ant reached the goal.
+        beta: weight of the heuristic in the transition rule.
+        max_steps: NumPy steps after which an ant fails (0: the planner's default).
+        cell_m: grid resolution; ``None`` keeps the problem's.  The grid may have at most
+            :data:`MAX_COLONY_CELLS` (500,000) cells.
     """
 
-    paths: np.ndarray
-    steps: np.ndarray
-    length_cells: np.ndarray
-    turns: np.ndarray
-    reached: np.ndarray
+    parameter_ranges: ClassVar[dict[str, Range]] = {
+        "beta": within(0, 100), "max_steps": within(0, 100_000_000),
+        "cell_m": within(1e-6, 100)}  # models.parameters: checked on build
+    beta: float = 5.0
+    max_steps: int = 0
+    cell_m: float | None = None
 
-    def tour(self, ant: int) -> np.ndarray:
-        """Flat cell indices of one ant's tour."""
-        return self.paths[ant, : self.steps[ant] + 1]
+    def parameter_checks(self) -> tuple[Check, ...]:
+        return super().parameter_checks() + (
+            ("beta", self.beta >= 0, "must not be negative"),
+            ("max_steps", self.max_steps >= 0, "must not be negative"),
+            ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
+        )
 
+    # ------------------------------------------------------------ the paper's parts
+    def init_trails(self, state: SwarmState, problem: Problem, start: tuple[int, int], goal: tuple[int, int]) -> None:
+        """Add the paper's initial pheromone ``state.data["tau"]`` (0 on occupied cells) and its
+        heuristic tables to ``state.data``."""
+        raise NotImplementedError
 
-def walk_colony(graph: GridGraph, start: int, goal: int, ants: int, cell_weights: np.ndarray,
-                turn_weights: np.ndarray | None, rng: np.random.Generator, max_steps: int,
-                backtrack: bool = True, max_length: float = np.inf) -> ColonyWalk:
-    """:func:`walk_colony_reference`, compiled (``planners/_colony_walk.c``): the same tours and draws.
+    def move_weights(self, state: SwarmState, problem: Problem,
+                     iteration: int) -> tuple[np.ndarray, np.ndarray | None, int, float]:
+        """What the ants of this iteration walk on: (cell weights (N, 8), turn weights (9, 8) or None,
+        their ``max_steps``, the tour length in cells beyond which an ant stops).
 
-    The NumPy walk costs about 25 NumPy calls per step whatever the number of
-    ants, and an IACO ant walks ~180 steps on a 50 x 50 map (it backs out of dead
-    ends): ~0.6-0.8 s of call overhead per 50 x 100 plan (profiled, issue 14).
-    The C kernel does the same arithmetic per ant, in the same order, a block of
-    :data:`UNIFORM_BLOCK` steps per call; the block's uniforms are drawn here as
-    the reference draws them (one ``rng.random((UNIFORM_BLOCK, ants))`` per block
-    begun with an ant still walking), and the j-th ant still walking at a step,
-    in ant order, uses column j, as in the reference's compacted arrays.
-    """
-    n = graph.size
-    cw = np.ascontiguousarray(cell_weights, dtype=float)
-    turns = np.ones((1, 8)) if turn_weights is None else np.ascontiguousarray(turn_weights, dtype=float)
-    table = np.ascontiguousarray(graph.table, dtype=np.int64)
-    width = max_steps + 1
-    keys = np.empty(ants * width, dtype=np.int64)
-    keys[::width] = NO_DIRECTION * n + start
-    steps = np.zeros(ants, dtype=np.int64)
-    length = np.zeros(ants)
-    reached = np.full(ants, start == goal)
-    unvisited = np.ones(ants * (n + 1), dtype=bool)
-    unvisited[np.arange(ants) * (n + 1) + start] = False
-    walking = np.full(ants, start != goal)
-    key = np.full(ants, NO_DIRECTION * n + start, dtype=np.int64)
-    run = np.zeros(ants, dtype=np.int64)
-    walked = np.zeros(ants)
-    still = int(walking.sum())
-    for first in range(0, max_steps, UNIFORM_BLOCK):
-        if still == 0:
-            break
-        uniforms = rng.random((UNIFORM_BLOCK, ants))
-        still = walk_block(cw, turns, table, STEP_LENGTHS_9, uniforms, UNIFORM_BLOCK, first,
-                           min(first + UNIFORM_BLOCK, max_steps), n, goal, width, bool(backtrack),
-                           float(max_length), keys, unvisited, walking, key, run, walked, steps, length, reached)
-    steps[walking] = run[walking]
-    length[walking] = walked[walking]
-    return _colony_walk(keys, steps, length, reached, n, start)
+        By default Dorigo et al. (1996) Eq. (1)'s numerator ``tau_j^alpha eta_ij^beta``, with the
+        fixed ``data["eta_beta"]`` and ``data["max_steps"]``, and no length limit.
+        """
+        data = state.data
+        cell_weights = np.power(data["tau"], self.alpha)[data["safe_table"]]          # Eq. (1)'s numerator
+        cell_weights *= data["eta_beta"]
+        return cell_weights, None, data["max_steps"], np.inf
 
+    def update(self, state: SwarmState, walk: ColonyWalk, arrived: np.ndarray, lengths: np.ndarray,
+               iteration_best: tuple[np.ndarray, float] | None) -> None:
+        """The paper's pheromone update after the walk (``arrived``: the ants that reached the goal,
+        ``lengths`` their tours' in cells, ``iteration_best`` the best of them (tour, length) or None)."""
+        raise NotImplementedError
 
-def walk_colony_reference(graph: GridGraph, start: int, goal: int, ants: int, cell_weights: np.ndarray,
-                          turn_weights: np.ndarray | None, rng: np.random.Generator, max_steps: int,
-                          backtrack: bool = True, max_length: float = np.inf) -> ColonyWalk:
-    """Let ``ants`` ants walk from ``start`` until each reaches ``goal``, gets stuck, or runs out of steps.
+    def extra_stats(self, state: SwarmState, problem: Problem) -> dict[str, Any]:
+        """The paper's own statistics, added to the shared ones of :meth:`finish`."""
+        return {}
 
-    An ant at cell i that last moved in direction p picks direction d with
-    probability proportional to ``turn_weights[p, d] * cell_weights[i, d]``
-    over the neighbours it has not visited (its tabu list): Eq. (1) of the ACO
-    papers once a planner has folded its ``tau^alpha * eta^beta`` into the two
-    tables (they are fixed within one iteration).  All walking ants move in the
-    same NumPy step; finished, pruned and failed ants leave the walking set.
+    # -------------------------------------------------------------- shared parts
+    def prepare(self, problem: Problem) -> Problem:
+        return grid_problem(problem, self.cell_m, MAX_COLONY_CELLS)
 
-    Speed: the state of an ant is one integer ``key = p * N + i`` (previous
-    direction and cell), so a step reads its weights and candidates with one
-    gather each from per-iteration ``(9 N, 8)`` tables; tabu lists are flat
-    float masks multiplied into the weights; tours are stored as keys (cells and
-    directions are recovered after the walk).
+    def default_max_steps(self, problem: Problem) -> int:
+        """``max_steps``, or when 0 eight times rows + cols, at most half the cells."""
+        rows, cols = problem.grid.shape
+        return self.max_steps or min(rows * cols // 2, 8 * (rows + cols))
 
-    Args:
-        graph: the cell graph (N cells).
-        start, goal: flat cell indices.
-        ants: colony size.
-        cell_weights: (N, 8) non-negative weight of each move of :data:`planners.grid_graph.DIRECTIONS`
-            out of each cell; it must be 0 where ``graph.table`` is -1.
-        turn_weights: (9, 8) factor from the previous direction (row; :data:`NO_DIRECTION`
-            on the first move) to the next, or ``None`` for none.
-        rng: the run's generator (uniforms drawn in blocks of :data:`UNIFORM_BLOCK` steps x ``ants``).
-        max_steps: NumPy steps after which an ant that has not arrived counts as failed.
-        backtrack: an ant with no unvisited neighbour steps back one cell (the dead
-            end stays on its tabu list) instead of failing; it fails only when
-            back at the start with nowhere to go.
-        max_length: an ant whose tour grows longer than this (in cells) stops and fails.
-    """
-    n = graph.size
-    add_reduce, min_reduce, max_reduce = np.add.reduce, np.minimum.reduce, np.maximum.reduce
-    or_reduce, and_reduce = np.logical_or.reduce, np.logical_and.reduce
-    less_equal = np.less_equal
-    weights = _key_weights(cell_weights, turn_weights)
-    candidates = graph.key_table                              # (9 N, 8) cells, -1 where illegal
-    key_back_lengths = -np.repeat(STEP_LENGTHS_9, n)           # (9 N,) length undone by stepping back
-    width = max_steps + 1
-    keys = np.empty(ants * width, dtype=np.int64)              # tours as keys, ant-major (valid up to steps)
-    keys[::width] = NO_DIRECTION * n + start
-    steps = np.zeros(ants, dtype=np.int64)
-    length = np.zeros(ants)
-    reached = np.zeros(ants, dtype=bool)
-    reached[:] = start == goal
-    unvisited = np.ones(ants * (n + 1), dtype=bool)            # per ant: N cells and a dummy slot
-    unvisited[np.arange(ants) * (n + 1) + start] = False
-    # The walking set, in ant order, and its gathered per-ant state.
-    ids = np.arange(ants) if start != goal else np.arange(0)
-    key = np.full(ids.size, NO_DIRECTION * n + start, dtype=np.int64)
-    run = np.zeros(ids.size, dtype=np.int64)                   # steps of the walking ants
-    walked = np.zeros(ids.size)                                # their lengths
-    rows = np.arange(ids.size)
-    tabu_base = (ids * (n + 1))[:, None]
-    key_base = ids * width
-    uniforms = np.empty((0, ants))
-    for step in range(max_steps):
-        if ids.size == 0:
-            break
-        if step % UNIFORM_BLOCK == 0:
-            uniforms = rng.random((UNIFORM_BLOCK, ants))       # one draw per ant and step, fetched in blocks
-        cand = candidates[key]                                 # (A, 8)
-        w = weights[key]
-        w *= unvisited[tabu_base + cand]                       # -1 reads the previous dummy slot: weight 0
-        cumulative = w.cumsum(axis=1)
-        total = cumulative[:, -1]
-        draw = uniforms[step % UNIFORM_BLOCK, :ids.size] * total
-        # Roulette (as :func:`roulette`): the first column whose running sum exceeds the draw.
-        choice = add_reduce(less_equal(cumulative, draw[:, None]), axis=1)
-        np.minimum(choice, 7, out=choice)                      # draw == total by rounding
-        if min_reduce(total) > 0.0:
-            # Every walking ant moves (the common case): no masks needed.
-            nxt = cand[rows, choice]
-            key = choice * n + nxt
-            unvisited[tabu_base[:, 0] + nxt] = False
-            run += 1
-            keys[key_base + run] = key
-            walked += STEP_LENGTHS[choice]
-            arrived = nxt == goal
-            if not or_reduce(arrived) and max_reduce(walked) <= max_length:
-                continue
-            steps[ids] = run
-            length[ids] = walked
-            reached[ids[arrived]] = True
-            keep = ~arrived & (walked <= max_length)
-        else:
-            # Some ants are stuck: they step back one cell (masks, no index lists).
-            ok = total > 0.0
-            nxt = cand[rows, choice]
-            new_key = choice * n + nxt
-            walked += np.where(ok, STEP_LENGTHS_9[choice], key_back_lengths[key])
-            keys[key_base + run + ok] = new_key                 # a stuck ant overwrites the top it leaves
-            run += np.where(ok, 1, -1 if backtrack else 0)
-            unvisited[tabu_base[:, 0] + np.where(ok, nxt, n)] = False  # slot n: a per-ant dummy
-            key = np.where(ok, new_key, keys[key_base + run])
-            arrived = ok & (nxt == goal)
-            keep = ~arrived & (walked <= max_length) & (run >= 0 if backtrack else ok)
-            if and_reduce(keep):
-                continue
-            steps[ids] = np.maximum(run, 0)
-            length[ids] = walked
-            reached[ids[arrived]] = True
-        ids, key, run, walked = ids[keep], key[keep], run[keep], walked[keep]
-        rows = np.arange(ids.size)
-        tabu_base = (ids * (n + 1))[:, None]
-        key_base = ids * width
-    if ids.size:
-        steps[ids] = run
-        length[ids] = walked
-    return _colony_walk(keys, steps, length, reached, n, start)
+    def goal_visibility(self, state: SwarmState) -> np.ndarray:
+        """(N, 8) ``1 / (d_ij + d_jg)`` of every move (``d_jg`` the straight distance from ``j`` to the
+        goal, in cells): the inverse of the estimated length of the rest of the tour through ``j``."""
+        data = state.data
+        return 1.0 / (STEP_LENGTHS[None, :] + data["d_goal"][data["safe_table"]])
 
+    def init_state(self, state: SwarmState, problem: Problem, rng: np.random.Generator) -> None:
+        grid = problem.grid
+        start, goal = grid_endpoints(problem, grid)
+        graph = GridGraph.of(grid)
+        rows, cols = grid.shape
+        legal = graph.table >= 0
+        rr, cc = np.divmod(np.arange(rows * cols), cols)
+        state.data = {"graph": graph, "start": graph.index(start), "goal": graph.index(goal), "legal": legal,
+                      "safe_table": np.where(legal, graph.table, 0), "d_goal": np.hypot(rr - goal[0], cc - goal[1]),
+                      "last_lengths": np.zeros(0), "successes": 0, "best_length_cells": math.inf}
+        self.init_trails(state, problem, start, goal)
 
-def _key_weights(cell_weights: np.ndarray, turn_weights: np.ndarray | None) -> np.ndarray:
-    """(9 N, 8) weight of each move by key ``direction * N + cell``: the turn factor times the cell's."""
-    cw = np.asarray(cell_weights, dtype=float)
-    if turn_weights is None:
-        return np.tile(cw, (NO_DIRECTION + 1, 1))
-    return (np.asarray(turn_weights, dtype=float)[:, None, :] * cw[None, :, :]).reshape(-1, 8)
+    def step(self, state: SwarmState, problem: Problem, rng: np.random.Generator, iteration: int) -> None:
+        """One iteration: the colony walks on :meth:`move_weights`, the best tour is kept
+        (:meth:`keep_best`), then the paper's :meth:`update`."""
+        data = state.data
+        cell_weights, turn_weights, max_steps, max_length = self.move_weights(state, problem, iteration)
+        ants = self.colony_size(state)
+        walk = walk_colony(data["graph"], data["start"], data["goal"], ants, cell_weights, turn_weights, rng,
+                           max_steps, max_length=max_length)
+        state.evaluations += ants
+        arrived = np.flatnonzero(walk.reached)
+        lengths = walk.length_cells[arrived]
+        data["last_lengths"] = lengths
+        data["successes"] += arrived.size
+        iteration_best = None
+        if arrived.size:
+            best = int(np.argmin(lengths))
+            iteration_best = (walk.tour(arrived[best]).copy(), float(lengths[best]))
+            self.keep_best(state, problem, *iteration_best)
+        self.update(state, walk, arrived, lengths, iteration_best)
 
+    def keep_best(self, state: SwarmState, problem: Problem, tour: np.ndarray, length_cells: float) -> None:
+        """Keep the iteration's best tour if it is shorter, in metres, than the best so far."""
+        cost_m = length_cells * problem.grid.cell_m
+        if cost_m < state.best_cost:
+            state.best_cost, state.best_solution = cost_m, tour
+            state.data["best_length_cells"] = length_cells
 
-def _colony_walk(keys: np.ndarray, steps: np.ndarray, length: np.ndarray, reached: np.ndarray, n: int,
-                 start: int) -> ColonyWalk:
-    """The tours (cells, turns) from the walk's key stacks (ant-major, ``steps + 1`` valid keys each)."""
-    ants = steps.size
-    used = int(steps.max()) + 1 if ants else 1
-    keys = keys.reshape(ants, -1)[:, :used]
-    keys[:, 0] = NO_DIRECTION * n + start                      # an ant stuck at the start overwrote it
-    moved = np.arange(used)[None, :] <= steps[:, None]
-    paths = np.where(moved, keys % n, -1)
-    dirs = np.where(moved, keys // n, NO_DIRECTION)
-    change = moved[:, 2:] & (dirs[:, 2:] != dirs[:, 1:-1])
-    turns = change.sum(axis=1)
-    return ColonyWalk(paths=paths, steps=steps, length_cells=length, turns=turns, reached=reached)
+    def finish(self, state: SwarmState, problem: Problem,
+               rng: np.random.Generator) -> tuple[np.ndarray, dict[str, Any]]:
+        """The best tour as waypoints (shortcut or not) and the statistics every colony reports (raw
+        cells and length, the last iteration's tour lengths, bends), then the paper's own.
 
-
-def cosine_table() -> np.ndarray:
-    """(9, 8) cosine of the turn from a previous move direction (row; 8 = none) to a next one.
-
-    The row for "no previous move" is 1 (treated as straight on).
-    """
-    unit = DIRECTION_VECTORS / np.linalg.norm(DIRECTION_VECTORS, axis=1, keepdims=True)
-    table = np.ones((9, 8))
-    table[:8] = unit @ unit.T
-    return table
-
-
-def best_tour_result(state: SwarmState, problem: Problem, shortcut: bool,
-                     name: str) -> tuple[np.ndarray, dict[str, Any]]:
-    """The shared end of a grid colony's run: the best tour as waypoints (shortcut or not) and the
-    statistics every colony reports (raw cells and length, the last iteration's tour lengths, bends).
-
-    Raises:
-        NoPathFound: no ant reached the goal.
-    """
-    data = state.data
-    if state.best_solution is None:
-        raise NoPathFound(f"{name}: no ant of {state.evaluations} reached the goal")
-    grid = problem.grid
-    cells = [tuple(int(v) for v in rc) for rc in data["graph"].cells(state.best_solution)]
-    raw = cells_to_waypoints(problem, grid, cells)
-    waypoints = exact_shortcut(problem, raw) if shortcut else raw
-    lengths_m = data["last_lengths"] * grid.cell_m
-    clearance = cell_clearance_m(grid)
-    idx = np.array(cells)
-    return waypoints, {
-        "moves": len(cells) - 1,
-        "mean_cell_clearance_m": float(np.mean(clearance[idx[:, 0], idx[:, 1]])),
-        "raw_cells": [list(c) for c in cells],
-        "raw_length_m": state.best_cost,
-        "mean_length_m": float(np.mean(lengths_m)) if lengths_m.size else math.nan,
-        "std_length_m": float(np.std(lengths_m)) if lengths_m.size else math.nan,
-        "bends": count_bends(cells),
-        "successful_tours": int(data["successes"]),
-    }
+        Raises:
+            NoPathFound: no ant reached the goal.
+        """
+        data = state.data
+        if state.best_solution is None:
+            raise NoPathFound(f"{self.name}: no ant of {state.evaluations} reached the goal")
+        grid = problem.grid
+        cells = [(int(r), int(c)) for r, c in data["graph"].cells(state.best_solution)]
+        raw = cells_to_waypoints(problem, grid, cells)
+        waypoints = exact_shortcut(problem, raw) if self.shortcut else raw
+        lengths_m = data["last_lengths"] * grid.cell_m
+        clearance = cell_clearance_m(grid)
+        idx = np.array(cells)
+        extra = {
+            "moves": len(cells) - 1,
+            "mean_cell_clearance_m": float(np.mean(clearance[idx[:, 0], idx[:, 1]])),
+            "raw_cells": [list(c) for c in cells],
+            "raw_length_m": state.best_cost,
+            "mean_length_m": float(np.mean(lengths_m)) if lengths_m.size else math.nan,
+            "std_length_m": float(np.std(lengths_m)) if lengths_m.size else math.nan,
+            "bends": count_bends(cells),
+            "successful_tours": int(data["successes"]),
+        }
+        extra.update(self.extra_stats(state, problem))
+        return waypoints, extra

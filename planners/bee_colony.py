@@ -56,7 +56,8 @@ from typing import ClassVar
 import numpy as np
 
 from swarmnav.models.parameters import Range, above, within
-from swarmnav.planners.continuous import ContinuousPlanner, ContinuousState
+from swarmnav.planners.continuous import ContinuousPlanner
+from swarmnav.planners.exact_check import ContinuousState
 from swarmnav.planners.path_cost import inverse_fitness
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.problem import Problem

@@ -41,7 +41,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.planners.continuous import ContinuousPlanner, ContinuousState
+from swarmnav.planners.continuous import ContinuousPlanner
+from swarmnav.planners.exact_check import ContinuousState
 from swarmnav.planners.problem import Problem
 
 

@@ -1,4 +1,4 @@
-"""Grid searches A*, Dijkstra and Theta*, and the planners ``astar``, ``dijkstra``, ``theta_star``.
+"""Grid searches A* and Dijkstra, the planners ``astar`` and ``dijkstra``, and the grid planners' plumbing.
 
 They search the shared grid graph (:mod:`planners.grid_graph`: 8-connected, no
 corner cutting) with ``heapq`` over plain Python lists, reading each cell's moves
@@ -6,17 +6,16 @@ from the table of the 256 move masks.  :class:`GridPlanner` is the plumbing
 every grid planner shares: it turns the cell path into waypoints in metres (the
 exact start and goal replace the centres of their cells), keeps the raw cell
 path in ``stats.extra["raw_cells"]``, and by default shortcuts it by exact line
-of sight (:func:`planners.grid_shortcut.exact_shortcut`).  D* Lite lives in
-:mod:`planners.dstar_lite`.
+of sight (:func:`planners.grid_shortcut.exact_shortcut`).  Theta* lives in
+:mod:`planners.theta_star`, D* Lite in :mod:`planners.dstar_lite`.
 """
 
 from __future__ import annotations
 
 import heapq
-import math
 import time
 from dataclasses import dataclass
-from typing import Any, Callable, ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -25,9 +24,8 @@ from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners._grid_search import astar
 from swarmnav.planners.grid_graph import (ADJACENCY, DIRECTIONS, INF, SQRT2, STEP_COSTS, Cell, cells_to_waypoints,
-                                          check_cells, count_bends, grid_endpoints, grid_line_of_sight,
-                                          grid_problem, moves_by_mask)
-from swarmnav.planners.grid_shortcut import box_line_of_sight, exact_shortcut
+                                          check_cells, count_bends, grid_endpoints, grid_problem, moves_by_mask)
+from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Path, Problem, check_endpoints
 
 
@@ -147,90 +145,6 @@ def _walk_back(parent: list[int], t: int, cols: int) -> list[Cell]:
     return cells
 
 
-def theta_star_cells(occupied: np.ndarray, start: Cell, goal: Cell,
-                     line_of_sight: Callable[[Cell, Cell], bool] | None = None
-                     ) -> tuple[list[Cell], float, int]:
-    """Theta* (Nash, Daniel, Koenig & Felner 2007): A* whose parent may be any visible ancestor.
-
-    Args:
-        occupied: (rows, cols) bool.
-        start, goal: (row, col) free cells.
-        line_of_sight: visibility test between two cells; by default
-            :func:`grid_line_of_sight` on ``occupied``.  Each pair is asked
-            at most once (answers are kept for the search).
-
-    Returns:
-        (corner cells from start to goal, Euclidean length in cells, expansions).
-    """
-    occupied = np.asarray(occupied, dtype=bool)
-    check_cells(occupied, start, goal)
-    rows, cols = occupied.shape
-    masks = ADJACENCY.get(occupied)
-    moves = moves_by_mask(cols)
-    free = (~occupied).tolist()
-    los = line_of_sight or (lambda p, q: grid_line_of_sight(free, p, q))
-    s = start[0] * cols + start[1]
-    t = goal[0] * cols + goal[1]
-    n = rows * cols
-    g = [INF] * n
-    parent = [-1] * n
-    closed = bytearray(n)
-    seen: dict[int, bool] = {}      # line of sight by (parent, cell): Theta* asks most pairs several times
-    g[s] = 0.0
-    parent[s] = s
-    gr, gc = goal
-
-    def h(v: int) -> float:
-        vr, vc = divmod(v, cols)
-        return math.hypot(vr - gr, vc - gc)
-
-    heap = [(h(s), 0.0, s)]
-    expansions = 0
-    while heap:
-        _, _, u = heapq.heappop(heap)
-        if closed[u]:
-            continue
-        closed[u] = 1
-        expansions += 1
-        if u == t:
-            break
-        pu = parent[u]
-        pr, pc = divmod(pu, cols)
-        ur, uc = divmod(u, cols)
-        for off, w in moves[masks[u]]:
-            v = u + off
-            if closed[v]:
-                continue
-            vr, vc = divmod(v, cols)
-            if pu != u:
-                key = pu * n + v
-                visible = seen.get(key)
-                if visible is None:
-                    visible = seen[key] = los((pr, pc), (vr, vc))
-            else:
-                visible = False
-            if visible:
-                cand, par = g[pu] + math.hypot(vr - pr, vc - pc), pu
-            else:
-                cand, par = g[u] + w, u
-            if cand < g[v] - 1e-12:
-                g[v] = cand
-                parent[v] = par
-                heapq.heappush(heap, (cand + h(v), -cand, v))
-    if not closed[t]:
-        raise NoPathFound(f"goal cell {goal} is unreachable from start cell {start}")
-    cells = []
-    cur = t
-    while True:
-        cells.append(divmod(cur, cols))
-        if cur == s:
-            break
-        cur = parent[cur]
-    cells.reverse()
-    return cells, g[t], expansions
-
-
-
 @dataclass
 class GridPlanner:
     """Shared plumbing of the grid planners: endpoints, waypoints, shortcut and stats.
@@ -294,21 +208,3 @@ class DijkstraPlanner(GridPlanner):
     def search(self, problem, grid, start, goal):
         cells, cost, expansions = dijkstra_cells(grid.occupied, start, goal)
         return cells, cost, expansions, {}
-
-
-@dataclass
-class ThetaStarPlanner(GridPlanner):
-    """Theta*, any-angle: the grid yardstick for the length of a path that need not follow moves.
-
-    Line of sight is checked cell by cell on the inflated grid and, where the
-    problem has box obstacles (maps), also exactly against the inflated boxes
-    (:func:`box_line_of_sight`).
-    """
-
-    name: ClassVar[str] = "theta_star"
-
-    def search(self, problem, grid, start, goal):
-        los = box_line_of_sight(problem, grid) if problem.boxes else None
-        cells, cost, expansions = theta_star_cells(grid.occupied, start, goal, los)
-        return cells, cost, expansions, {}
-

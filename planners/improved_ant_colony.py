@@ -1,7 +1,7 @@
 """IACO: the improved ant colony of Gong, Yang, Yuan & Wang (2022).
 
-On the inflated occupancy grid, with the shared colony core
-(:mod:`planners.ant_colony`) and the one optimisation loop:
+On the inflated occupancy grid, on the grid colony base
+(:class:`planners.ant_colony.GridColonyPlanner`) and the one optimisation loop:
 
 * **Collar line** (§3.1): a guide polyline from start to goal through feature
   points of the obstacles it meets; the cells it crosses start with extra pheromone.
@@ -69,17 +69,11 @@ import numpy as np
 from scipy import ndimage
 
 from swarmnav.models.parameters import Range, above, within
-from swarmnav.planners.ant_colony import (STEP_LENGTHS, GridGraph, best_tour_result, cosine_table, deposit, evaporate,
-                                          walk_colony)
-from swarmnav.planners.errors import check_parameters
-from swarmnav.planners.grid_graph import Cell, grid_endpoints, grid_line_of_sight, grid_problem, line_cells
+from swarmnav.planners.ant_colony import Check, GridColonyPlanner, deposit, evaporate
+from swarmnav.planners.colony_walk import STEP_LENGTHS, ColonyWalk, cosine_table
+from swarmnav.planners.grid_graph import Cell, grid_line_of_sight, line_cells
 from swarmnav.planners.problem import Problem
-from swarmnav.planners.swarm import SwarmPlanner, SwarmState
-
-#: Most cells IACO's grid may have: the colony's tables take about 600 bytes a cell.
-MAX_COLONY_CELLS = 500_000
-#: Most ants: each keeps a visited mask of the whole grid.
-MAX_ANTS = 10_000
+from swarmnav.planners.swarm import SwarmState
 
 
 def feature_cells(occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -197,7 +191,7 @@ def prune_length(q: float, t_c: float, collar_length: float, negligible: float) 
 
 
 @dataclass
-class ImprovedAntColonyPlanner(SwarmPlanner):
+class ImprovedAntColonyPlanner(GridColonyPlanner):
     """IACO (Gong et al. 2022).  Defaults are the paper's Table 2.
 
     The quantities of the paper's Table 3 are in ``stats.extra``: its "optimal
@@ -206,7 +200,7 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
     iteration's arrived tours, ``convergence_iteration`` and ``bends``.
 
     Args:
-        ants: colony size m (50; at most :data:`MAX_ANTS`, 10,000).
+        ants: colony size m (50; at most :data:`planners.ant_colony.MAX_ANTS`, 10,000).
         iterations: N (100).
         alpha, beta: initial alpha and beta of Eqs. (9)-(10) (1 and 5).
         rho: initial evaporation, until Eq. (11) has a best length (0.3).
@@ -243,24 +237,19 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
             and its Eq. (7) deposit would lie below ``tau_floor``); before any best, the
             limit is 4 x the collar length (at least rows + cols).
         cell_m: grid resolution; ``None`` keeps the problem's.  The grid may have at most
-            :data:`MAX_COLONY_CELLS` (500,000) cells.
+            :data:`planners.ant_colony.MAX_COLONY_CELLS` (500,000) cells.
         shortcut: line-of-sight shortcut of the best tour (the raw cells stay in stats).
     """
 
     name: ClassVar[str] = "iaco"
     parameter_ranges: ClassVar[dict[str, Range]] = {
-        "ants": within(1, MAX_ANTS), "iterations": within(1, 1_000_000), "alpha": within(0, 100),
-        "beta": within(0, 100), "rho": within(0, 1), "q": above(0, 1e12), "t_c": above(0, 1e6),
-        "delta": within(0, 100), "kappa": above(0, 1), "initial_pheromone": above(0, 1e12),
-        "collar_pheromone": within(0, 1e12), "tau_floor": above(0, 1e6), "exponent_limit": within(0, 700),
-        "max_steps": within(0, 100_000_000), "step_ratio": above(0, 1000), "prune_ratio": above(0, 1000),
-        "cell_m": within(1e-6, 100), "max_evaluations": within(0, 1e9)}  # models.parameters: checked on build
+        "q": above(0, 1e12), "t_c": above(0, 1e6), "delta": within(0, 100), "kappa": above(0, 1),
+        "initial_pheromone": above(0, 1e12), "collar_pheromone": within(0, 1e12), "tau_floor": above(0, 1e6),
+        "exponent_limit": within(0, 700), "step_ratio": above(0, 1000),
+        "prune_ratio": above(0, 1000)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
-    ants: int = 50
-    iterations: int = 100
-    alpha: float = 1.0
-    beta: float = 5.0
     rho: float = 0.3
+    beta: float = 5.0
     q: float = 100.0
     t_c: float = 1.5
     delta: float = 2.0
@@ -269,51 +258,38 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
     collar_pheromone: float = 4.0
     tau_floor: float = 1e-12
     exponent_limit: float = 3.0
-    max_steps: int = 0
     step_ratio: float = 1.25
     prune_ratio: float = 1.0
-    cell_m: float | None = None
-    shortcut: bool = True
-    max_evaluations: int | None = None
 
-    def __post_init__(self) -> None:
-        check_parameters(self, (
-            ("ants", 1 <= self.ants <= MAX_ANTS, f"must lie in [1, {MAX_ANTS:,}]"),
-            ("iterations", self.iterations >= 1, "must be at least 1"),
+    def parameter_checks(self) -> tuple[Check, ...]:
+        return super().parameter_checks() + (
             ("kappa", 0.0 < self.kappa < 1.0, "must lie in (0, 1)"),
-            ("rho", 0.0 <= self.rho < 1.0, "must lie in [0, 1)"),
             ("t_c", self.t_c >= 1.0, "must be at least 1 (below 1, Eq. (7) would reward longer tours "
                                      "without bound; Table 1's values are 1 to 5)"),
             ("q", self.q > 0, "must be positive"),
-            ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
-        ))
+        )
 
-    def prepare(self, problem: Problem) -> Problem:
-        return grid_problem(problem, self.cell_m, MAX_COLONY_CELLS)
-
-    def init_state(self, state: SwarmState, problem: Problem, rng: np.random.Generator) -> None:
+    def init_trails(self, state: SwarmState, problem: Problem, start: tuple[int, int], goal: tuple[int, int]) -> None:
+        """tau_0 on every free cell, more on the cells the collar line crosses (§3.1), and Eq. (6)'s goal guidance."""
+        data = state.data
         grid = problem.grid
-        start, goal = grid_endpoints(problem, grid)
-        graph = GridGraph.of(grid)
         rows, cols = grid.shape
-        rr, cc = np.divmod(np.arange(rows * cols), cols)
-        d_goal = np.hypot(rr - goal[0], cc - goal[1])
         points, collar_cells = collar_line(grid.occupied, start, goal)
         tau = np.where(grid.occupied.ravel(), 0.0, self.initial_pheromone)
         crossed = {cell for a, b in zip(points[:-1], points[1:]) for cell in line_cells(a, b)}
         crossed_idx = np.array([r * cols + c for r, c in crossed
                                 if 0 <= r < rows and 0 <= c < cols and not grid.occupied[r, c]], dtype=np.int64)
         tau[crossed_idx] += self.collar_pheromone
-        legal = graph.table >= 0
-        safe_table = np.where(legal, graph.table, 0)
+        d_goal = data["d_goal"]
         # Eq. (6)'s goal guidance d_ig / (d_ij + d_jg) of every move, fixed for the run.
-        guidance = iaco_heuristic(d_goal[:, None], STEP_LENGTHS[None, :], d_goal[safe_table], 0.0)
-        state.data = {"graph": graph, "start": graph.index(start), "goal": graph.index(goal),
-                      "guidance": guidance, "legal": legal, "safe_table": safe_table, "cos": cosine_table(),
-                      "tau": tau, "collar_length": collar_cells, "collar_points": points,
-                      "last_lengths": np.zeros(0), "successes": 0, "params": (self.alpha, self.beta, self.rho)}
+        guidance = iaco_heuristic(d_goal[:, None], STEP_LENGTHS[None, :], d_goal[data["safe_table"]], 0.0)
+        data.update({"guidance": guidance, "cos": cosine_table(), "tau": tau, "collar_length": collar_cells,
+                     "collar_points": points, "params": (self.alpha, self.beta, self.rho)})
 
-    def step(self, state: SwarmState, problem: Problem, rng: np.random.Generator, iteration: int) -> None:
+    def move_weights(self, state: SwarmState, problem: Problem,
+                     iteration: int) -> tuple[np.ndarray, np.ndarray | None, int, float]:
+        """Eqs. (9)-(11)'s alpha, beta and rho of this iteration, then Eq. (1)'s numerator with Eq. (6),
+        and the length beyond which an ant stops (``prune_ratio``, :func:`prune_length`)."""
         data = state.data
         best_cells = None if state.best_solution is None else data["best_length_cells"]
         alpha, beta, rho = adaptive_parameters(self.alpha, self.beta, self.delta, self.kappa, iteration + 1,
@@ -334,38 +310,27 @@ class ImprovedAntColonyPlanner(SwarmPlanner):
         # An ant that backtracks keeps walking without growing its tour: cap its NumPy steps too.
         # (``limit`` is infinite when t_c = 1: Eq. (7) is then the constant Q and prunes nothing.)
         max_steps = self.max_steps or int(min(rows * cols // 2, max(rows + cols, self.step_ratio * limit)))
-        ants = int(min(self.ants, state.evaluations_left))       # a tour is one evaluation
-        walk = walk_colony(data["graph"], data["start"], data["goal"], ants, cell_weights, bend_beta, rng,
-                           max_steps, max_length=limit)
-        state.evaluations += ants
-        arrived = np.flatnonzero(walk.reached)
-        lengths = walk.length_cells[arrived]
-        data["last_lengths"] = lengths
-        data["successes"] += arrived.size
-        # Eq. (3): evaporate, then Eq. (8): each arrived ant deposits Q_m / (L_m + turn) on its cells.
-        evaporate(tau, rho)
+        return cell_weights, bend_beta, max_steps, limit
+
+    def update(self, state: SwarmState, walk: ColonyWalk, arrived: np.ndarray, lengths: np.ndarray,
+               iteration_best: tuple[np.ndarray, float] | None) -> None:
+        """Eq. (3): evaporate, then Eq. (8): each arrived ant deposits ``Q_m / (L_m + turn)`` on its cells."""
+        data = state.data
+        tau = data["tau"]
+        evaporate(tau, data["params"][2])
         if arrived.size:
             q_m = pheromone_intensity(self.q, self.t_c, data["collar_length"], lengths, self.exponent_limit)
             amounts = q_m / (lengths + walk.turns[arrived])
             tours = [walk.tour(a)[1:] for a in arrived]
             deposit(tau, np.concatenate(tours), np.repeat(amounts, [len(t) for t in tours]))
-            best = int(np.argmin(lengths))
-            cost_m = float(lengths[best]) * problem.grid.cell_m
-            if cost_m < state.best_cost:
-                state.best_cost = cost_m
-                state.best_solution = walk.tour(arrived[best]).copy()
-                data["best_length_cells"] = float(lengths[best])
         free = tau > 0.0
         np.maximum(tau, self.tau_floor, out=tau, where=free)
 
-    def finish(self, state: SwarmState, problem: Problem,
-               rng: np.random.Generator) -> tuple[np.ndarray, dict[str, Any]]:
-        waypoints, extra = best_tour_result(state, problem, self.shortcut, "iaco")
+    def extra_stats(self, state: SwarmState, problem: Problem) -> dict[str, Any]:
         data = state.data
         alpha, beta, rho = data["params"]
-        extra.update({
+        return {
             "collar_length_m": data["collar_length"] * problem.grid.cell_m,
             "collar_points": [list(p) for p in data["collar_points"]],
             "final_alpha": alpha, "final_beta": beta, "final_rho": rho,
-        })
-        return waypoints, extra
+        }

@@ -22,7 +22,8 @@ from typing import ClassVar
 import numpy as np
 
 from swarmnav.models.parameters import Range, above, within
-from swarmnav.planners.continuous import ContinuousPlanner, ContinuousState
+from swarmnav.planners.continuous import ContinuousPlanner
+from swarmnav.planners.exact_check import ContinuousState
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.problem import Problem
 

@@ -1,6 +1,6 @@
 """Algorithms 1-2 of Hasan, Abdullah & Saleh (2023): the goal-to-start pheromone propagation of IMMAS.
 
-The environment-analysis stage of :mod:`planners.max_min_ant_system` (whose docstring gives the
+The environment-analysis stage of :mod:`planners.improved_max_min_ant_system` (whose docstring gives the
 equations, the MAX-MIN layering and the choices made): the D*-style propagation from the goal
 with the clean weights, GateRaiseState and CheckTightTunnelState (Algorithm 2), and the trails'
 MAX-MIN bounds (:mod:`planners.max_min_trails`).  The ``immas_stepwise`` navigator runs it too.
@@ -11,6 +11,7 @@ from __future__ import annotations
 import heapq
 import math
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 from scipy import ndimage
@@ -138,32 +139,17 @@ def analyse_environment(occupied: np.ndarray, start: Cell, goal: Cell, rho: floa
             continue
         expansions += 1
         if close:
-            for dr, dc in ORTHOGONAL:
-                yr, yc = r + dr, c + dc
-                if (0 <= yr < rows and 0 <= yc < cols and not blocked[yr][yc] and (yr, yc) not in keep
-                        and not closed_set[yr][yc] and is_tight_tunnel(blocked, r, c, dr, dc)):
-                    blocked[yr][yc] = True
-                    tunnels.append((yr, yc))
+            _close_tight_tunnels(blocked, closed_set, keep, r, c, tunnels)
         tx = tau[r][c]
-        for dr, dc, cost in moves:
-            yr, yc = r + dr, c + dc
-            if not (0 <= yr < rows and 0 <= yc < cols) or blocked[yr][yc] or closed_set[yr][yc]:
-                continue
-            if dr and dc and (blocked[r][yc] or blocked[yr][c]):
-                continue
-            ky = kx + cost
-            if ky < k[yr][yc]:
-                k[yr][yc] = ky
-                if bounded:
-                    # Eq. (2) by the iteration-best ant X (unit deposit), then "multiply by 1.4 or 1"
-                    # (§3.2), then the MMAS bounds (§2.1).
-                    tau[yr][yc] = limits.clamp_value(cost * (persistence * tx + 1.0))
-                else:
-                    tau[yr][yc] = rho * tx + cost
-                if trace is not None:
-                    trace.append(((yr, yc), tau[yr][yc]))
-                parent[yr][yc] = (r, c)
-                heapq.heappush(heap, (ky, yr, yc))
+        if bounded:
+            # Eq. (2) by the iteration-best ant X (unit deposit), then "multiply by 1.4 or 1"
+            # (§3.2), then the MMAS bounds (§2.1).
+            def trail(cost: float, tx: float = tx, persistence: float = persistence) -> float:
+                return limits.clamp_value(cost * (persistence * tx + 1.0))
+        else:
+            def trail(cost: float, tx: float = tx) -> float:
+                return rho * tx + cost
+        _relax(r, c, kx, trail, moves, blocked, closed_set, k, tau, parent, heap, trace)
         if bounded and evaporation_doubling:
             persistence *= 2.0                                   # §3.2: "the evaporation rate doubles"
     if not reached:
@@ -174,7 +160,52 @@ def analyse_environment(occupied: np.ndarray, start: Cell, goal: Cell, rho: floa
             result.closing_reverted = True
             return result
         raise NoPathFound(f"goal cell {goal} is unreachable from start cell {start}")
+    return _analysis(blocked, k, tau, parent, clean_weight, bounded, gates, tunnels, expansions, limits)
+
+
+def _close_tight_tunnels(blocked: list[list[bool]], closed_set: list[list[bool]], keep: set[Cell], r: int, c: int,
+                         tunnels: list[Cell]) -> None:
+    """CheckTightTunnelState (Algorithm 2) around the expanded cell X = (r, c): close each free, unexpanded
+    horizontal or vertical neighbour that is a tight-tunnel entrance (never the start or the goal)."""
+    rows, cols = len(blocked), len(blocked[0])
+    for dr, dc in ORTHOGONAL:
+        yr, yc = r + dr, c + dc
+        if (0 <= yr < rows and 0 <= yc < cols and not blocked[yr][yc] and (yr, yc) not in keep
+                and not closed_set[yr][yc] and is_tight_tunnel(blocked, r, c, dr, dc)):
+            blocked[yr][yc] = True
+            tunnels.append((yr, yc))
+
+
+def _relax(r: int, c: int, kx: float, trail: Callable[[float], float], moves: list[tuple[int, int, float]],
+           blocked: list[list[bool]], closed_set: list[list[bool]], k: list[list[float]], tau: list[list[float]],
+           parent: list[list[Cell | None]], heap: list[tuple[float, int, int]],
+           trace: list[tuple[Cell, float]] | None) -> None:
+    """PheromoneTrails (Algorithm 1 line 17) from the expanded cell X = (r, c): each free neighbour Y that X
+    reaches more cheaply (no corner cutting) gets the route cost ``k(X) + c``, the trail ``trail(c)`` and X as
+    its parent, and joins the open list."""
+    rows, cols = len(blocked), len(blocked[0])
+    for dr, dc, cost in moves:
+        yr, yc = r + dr, c + dc
+        if not (0 <= yr < rows and 0 <= yc < cols) or blocked[yr][yc] or closed_set[yr][yc]:
+            continue
+        if dr and dc and (blocked[r][yc] or blocked[yr][c]):
+            continue
+        ky = kx + cost
+        if ky < k[yr][yc]:
+            k[yr][yc] = ky
+            tau[yr][yc] = trail(cost)
+            if trace is not None:
+                trace.append(((yr, yc), tau[yr][yc]))
+            parent[yr][yc] = (r, c)
+            heapq.heappush(heap, (ky, yr, yc))
+
+
+def _analysis(blocked: list[list[bool]], k: list[list[float]], tau: list[list[float]],
+              parent: list[list[Cell | None]], clean_weight: float, bounded: bool, gates: list[Cell],
+              tunnels: list[Cell], expansions: int, limits: TrailLimits | None) -> EnvironmentAnalysis:
+    """The propagation's lists as the arrays of :class:`EnvironmentAnalysis`, with the clean weights (line 16)."""
     blocked_arr = np.array(blocked, dtype=bool)
+    rows, cols = blocked_arr.shape
     neighbours = ndimage.convolve(blocked_arr.astype(np.int64), np.array([[1, 1, 1], [1, 0, 1], [1, 1, 1]]),
                                   mode="constant", cval=0)
     parent_arr = np.full((rows, cols, 2), -1, dtype=np.int64)

@@ -13,7 +13,7 @@ Library", IEEE Robotics & Automation Magazine 19(4)), through its Python binding
   motion when the straight segment does: both by ``Problem.segment_clearances_m`` (the exact
   segment-disc and segment-box distances of :mod:`models.geometry`, at the problem's
   inflation, robot radius plus the scenario's clearance), never by OMPL's discretised
-  motion checking.  So every returned path passes ``Problem.is_collision_free``.
+  motion checking.  So every returned path passes ``Problem.is_collision_free`` (:mod:`planners.ompl_checks`).
 * **Objective.** ``PathLengthOptimizationObjective``: the cost is the path's length in metres,
   the ``cost_history`` every swarm planner records.
 * **Budget.** ``max_evaluations`` counts collision checks (state and motion validity
@@ -52,95 +52,21 @@ A goal OMPL cannot reach within the budget is :class:`planners.errors.NoPathFoun
 
 from __future__ import annotations
 
-import functools
 import math
 import threading
 import time
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.models.geometry import segment_disc_distance
 from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.errors import NoPathFound, check_parameters
+from swarmnav.planners.ompl_checks import CollisionChecks, motion_validator_type, ompl_modules
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
 
-#: A state or segment counts as free when its gap to the inflated obstacles is at least this
-#: (the same touching tolerance as ``check_endpoints``; ``is_collision_free`` allows 1e-6).
-_TOUCH_M = 1e-9
 _OMPL_LOCK = threading.Lock()
-
-
-@functools.cache
-def _ompl() -> tuple[Any, Any, Any]:
-    """Import OMPL's ``base``, ``geometric`` and ``util`` on first use and silence its console, once."""
-    import ompl.base as ob
-    import ompl.geometric as og
-    import ompl.util as ou
-    ou.setLogLevel(ou.LOG_NONE)
-    return ob, og, ou
-
-
-class _CollisionChecks:
-    """The exact checks OMPL calls, counted and held to the budget.
-
-    Discs are measured one by one on plain floats (:func:`models.geometry.segment_disc_distance`,
-    a NumPy call per segment would cost tens of microseconds), boxes (grid maps) by
-    :meth:`Problem.segment_clearances_m`, culled to the boxes near the segment.
-    """
-
-    def __init__(self, problem: Problem, max_checks: float, deadline_s: float):
-        self.problem = problem
-        self.discs = [(float(c[0]), float(c[1]), float(r))
-                      for c, r in zip(problem.disc_centres_m, problem.inflated_radii_m)]
-        self.max_checks = max_checks
-        self.deadline_s = deadline_s
-        self.made = 0
-        self.refused = 0
-
-    @property
-    def spent(self) -> bool:
-        return self.made >= self.max_checks or time.perf_counter() >= self.deadline_s
-
-    def free(self, ax: float, ay: float, bx: float, by: float) -> bool:
-        """Whether the segment keeps at least the inflation from every obstacle (counted; refused, so
-        reported blocked, once the budget is spent)."""
-        if self.made >= self.max_checks:
-            self.refused += 1
-            return False
-        self.made += 1
-        for cx, cy, radius_m in self.discs:
-            if segment_disc_distance(ax, ay, bx, by, cx, cy) - radius_m < -_TOUCH_M:
-                return False
-        if self.problem.boxes:
-            gap = self.problem.segment_clearances_m(np.array((ax, ay)), np.array((bx, by)), cull_beyond_m=0.0)
-            return bool(gap[0] >= -_TOUCH_M)
-        return True
-
-    def state_valid(self, state) -> bool:
-        x, y = state[0], state[1]
-        return self.free(x, y, x, y)
-
-    def motion_valid(self, s1, s2) -> bool:
-        return self.free(s1[0], s1[1], s2[0], s2[1])
-
-
-@functools.cache
-def _motion_validator_type() -> type:
-    """OMPL's ``MotionValidator`` answered by :class:`_CollisionChecks` (built after the lazy import)."""
-    ob, _, _ = _ompl()
-
-    class ExactMotionValidator(ob.MotionValidator):
-        def __init__(self, si, checks: _CollisionChecks):
-            super().__init__(si)
-            self.checks = checks
-
-        def checkMotion(self, s1, s2) -> bool:  # noqa: N802 - OMPL's name
-            return self.checks.motion_valid(s1, s2)
-
-    return ExactMotionValidator
 
 
 @dataclass
@@ -217,7 +143,7 @@ class OmplPlanner:
             return self._run(problem, seed, t0)
 
     def _run(self, problem: Problem, seed: int, t0: float) -> Path:
-        ob, og, ou = _ompl()
+        ob, og, ou = ompl_modules()
         ou.RNG.setSeed(seed)
         space = ob.RealVectorStateSpace(2)
         bounds = ob.RealVectorBounds(2)
@@ -226,10 +152,10 @@ class OmplPlanner:
         bounds.high = [b.x_max_m, b.y_max_m]
         space.setBounds(bounds)
         si = ob.SpaceInformation(space)
-        checks = _CollisionChecks(problem, self.max_evaluations or math.inf,
+        checks = CollisionChecks(problem, self.max_evaluations or math.inf,
                                   t0 + self.time_s if self.time_s else math.inf)
         si.setStateValidityChecker(checks.state_valid)
-        validator = _motion_validator_type()(si, checks)
+        validator = motion_validator_type()(si, checks)
         si.setMotionValidator(validator)
         si.setup()
         start, goal = si.allocState(), si.allocState()
@@ -267,7 +193,7 @@ class OmplPlanner:
             [f"{self.time_s:g} s"] if self.time_s else [])
         return " and ".join(parts)
 
-    def search(self, ob, planner, pdef, checks: _CollisionChecks,
+    def search(self, ob, planner, pdef, checks: CollisionChecks,
                progress: _Progress) -> tuple[np.ndarray | None, int]:
         """Run the OMPL planner to the budget, recording the best cost after each round; return
         the waypoints of the best exact solution (None: none) and OMPL's iteration count."""

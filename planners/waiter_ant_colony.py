@@ -55,16 +55,14 @@ from typing import Any, ClassVar
 import numpy as np
 
 from swarmnav.models.parameters import Range, above, within
-from swarmnav.planners.ant_colony import deposit, evaporate, roulette
-from swarmnav.planners.errors import NoPathFound, check_parameters
+from swarmnav.planners.ant_colony import AntColonyPlanner, Check, deposit, evaporate, roulette
+from swarmnav.planners.errors import NoPathFound
 from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Problem
-from swarmnav.planners.swarm import SwarmPlanner, SwarmState
+from swarmnav.planners.swarm import SwarmState
 
 #: Most random nodes: the links are nodes^2 / 2 segments, each measured against every obstacle.
 MAX_NODES = 1_000
-#: Most ants per iteration.
-MAX_ANTS = 10_000
 #: The routes the planner can return: the colony's, or a baseline of the paper over the same nodes.
 ROUTES = ("maco", "dijkstra", "astar")
 
@@ -151,13 +149,13 @@ def dense_graph_route(distance: np.ndarray, allowed: np.ndarray, source: int, ta
 
 
 @dataclass
-class WaiterAntColonyPlanner(SwarmPlanner):
+class WaiterAntColonyPlanner(AntColonyPlanner):
     """M-ACO (Habib et al. 2021) over random nodes, with PTP linking.
 
     Args:
         nodes: random nodes R (the paper uses 10 and 15; at most :data:`MAX_NODES`, 1,000).
         corridor_m: half-width of the corridor around the start-goal line.
-        ants: colony size (at most :data:`MAX_ANTS`, 10,000).
+        ants: colony size (at most :data:`planners.ant_colony.MAX_ANTS`, 10,000).
         iterations: colony iterations.
         alpha: pheromone gain of Eq. (3) (1).
         rho: evaporation rate of Eq. (4) (0.9, the paper's best).
@@ -172,32 +170,26 @@ class WaiterAntColonyPlanner(SwarmPlanner):
 
     name: ClassVar[str] = "maco"
     parameter_ranges: ClassVar[dict[str, Range]] = {
-        "nodes": within(1, MAX_NODES), "corridor_m": above(0, 1000), "ants": within(1, MAX_ANTS),
-        "iterations": within(0, 1_000_000), "alpha": within(0, 100), "rho": within(0, 1), "p0": within(0, 1),
-        "q": above(0, 1e12), "max_evaluations": within(0, 1e9)}  # models.parameters: checked on build
+        "nodes": within(1, MAX_NODES), "corridor_m": above(0, 1000), "p0": within(0, 1),
+        "q": above(0, 1e12)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
-    nodes: int = 15
-    corridor_m: float = 1.5
     ants: int = 20
     iterations: int = 50
-    alpha: float = 1.0
     rho: float = 0.9
+    nodes: int = 15
+    corridor_m: float = 1.5
     p0: float = 0.9
     q: float = 1.0
-    shortcut: bool = True
     route: str = "maco"
-    max_evaluations: int | None = None
 
-    def __post_init__(self) -> None:
-        check_parameters(self, (
+    def parameter_checks(self) -> tuple[Check, ...]:
+        return super().parameter_checks() + (
             ("route", self.route in ROUTES, f"must be one of {', '.join(ROUTES)}"),
             ("nodes", 1 <= self.nodes <= MAX_NODES, f"must lie in [1, {MAX_NODES:,}]"),
-            ("ants", 1 <= self.ants <= MAX_ANTS, f"must lie in [1, {MAX_ANTS:,}]"),
-            ("iterations", self.iterations >= 1, "must be at least 1"),
             ("p0", 0.0 <= self.p0 <= 1.0, "must lie in [0, 1]"),
-            ("rho", 0.0 <= self.rho < 1.0, "must lie in [0, 1)"),
             ("corridor_m", self.corridor_m > 0, "must be positive"),
-        ))
+            ("q", self.q > 0, "must be positive"),
+        )
 
     def init_state(self, state: SwarmState, problem: Problem, rng: np.random.Generator) -> None:
         pts = random_nodes(problem, self.nodes, self.corridor_m, rng)
@@ -218,7 +210,7 @@ class WaiterAntColonyPlanner(SwarmPlanner):
         data = state.data
         tau, safe, distance, goal = data["tau"], data["safe"], data["distance"], data["goal"]
         m = len(tau)
-        ants = int(min(self.ants, state.evaluations_left))      # a tour is one evaluation
+        ants = self.colony_size(state)
         cur = np.zeros(ants, dtype=np.int64)
         visited = np.zeros((ants, m), dtype=bool)
         visited[:, 0] = True

@@ -18,6 +18,8 @@ runner asks it first and measures only when the answer could matter.
 from __future__ import annotations
 
 import math
+import weakref
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -30,11 +32,15 @@ BOUND_MARGIN_M = 1e-4
 PICK_SLACK_M = 1e-9  # taken off the nearest obstacle's lead over the next: far above the rounding of either
 
 
-def outer_robot_geoms(scene: CompiledScene) -> list[int]:
-    """The chassis and the robot collision geoms whose bounding sphere reaches beyond its radius."""
+def outer_robot_geoms(scene: CompiledScene, data: mujoco.MjData | None = None) -> list[int]:
+    """The chassis and the robot collision geoms whose bounding sphere reaches beyond its radius.
+
+    ``data``: the scene's model after ``mj_forward`` at its default state (None: made here).
+    """
     model = scene.model
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
+    if data is None:
+        data = mujoco.MjData(model)
+        mujoco.mj_forward(model, data)
     chassis = scene.chassis_geom_id
     base_xy = data.geom_xpos[chassis, :2]
     chassis_radius = float(model.geom_size[chassis, 0])
@@ -47,6 +53,34 @@ def outer_robot_geoms(scene: CompiledScene) -> list[int]:
     return out
 
 
+@dataclass(frozen=True, eq=False)
+class _SceneGeometry:
+    """What a probe needs of a scene that no run changes: worked out once per scene, from one ``MjData``."""
+
+    robot_geom_ids: list[int]
+    obstacle_ids: np.ndarray
+    is_box: np.ndarray
+    centres_m: np.ndarray  # at the default state (the mocap obstacles' are replaced at every measure)
+    upright: bool
+
+
+_GEOMETRY: "weakref.WeakKeyDictionary[CompiledScene, _SceneGeometry]" = weakref.WeakKeyDictionary()
+
+
+def _scene_geometry(scene: CompiledScene) -> _SceneGeometry:
+    geometry = _GEOMETRY.get(scene)
+    if geometry is None:
+        model = scene.model
+        data = mujoco.MjData(model)  # a few hundred microseconds each: one for all, once per scene
+        mujoco.mj_forward(model, data)
+        obstacle_ids = np.array([ob.geom_id for ob in scene.obstacles], dtype=np.int64)
+        is_box = model.geom_type[obstacle_ids] == mujoco.mjtGeom.mjGEOM_BOX
+        geometry = _GEOMETRY[scene] = _SceneGeometry(
+            outer_robot_geoms(scene, data), obstacle_ids, is_box, data.geom_xpos[obstacle_ids, :2].copy(),
+            _upright_footprints(model, obstacle_ids, is_box, data))
+    return geometry
+
+
 class ClearanceProbe:
     """Measures the gap between the robot and its nearest obstacle (``inf`` with no obstacle).
 
@@ -57,9 +91,10 @@ class ClearanceProbe:
     def __init__(self, scene: CompiledScene, data: mujoco.MjData | None = None):
         model = scene.model
         self.model = model
-        self.robot_geom_ids = outer_robot_geoms(scene)
-        self.obstacle_ids = np.array([ob.geom_id for ob in scene.obstacles], dtype=np.int64)
-        is_box = model.geom_type[self.obstacle_ids] == mujoco.mjtGeom.mjGEOM_BOX
+        geometry = _scene_geometry(scene)
+        self.robot_geom_ids = geometry.robot_geom_ids
+        self.obstacle_ids = geometry.obstacle_ids
+        is_box = geometry.is_box
         size = model.geom_size[self.obstacle_ids, :2]
         # One formula for both shapes: |max(|rel| - half, 0)| - radius, with half = 0 for
         # discs and radius = 0 for boxes.
@@ -69,16 +104,13 @@ class ClearanceProbe:
         # Obstacle centres: those fixed to the world read once (MuJoCo recomputes the same values every
         # step), the others (mocap) at every measure; work arrays for the footprint distances.
         self._moving = np.flatnonzero(model.geom_bodyid[self.obstacle_ids] != 0)
-        initial = mujoco.MjData(model)
-        mujoco.mj_kinematics(model, initial)
-        self._centres_m = initial.geom_xpos[self.obstacle_ids, :2].copy()
+        self._centres_m = geometry.centres_m.copy()
         self._point_m = np.zeros(2)
         self._work = np.zeros_like(self._centres_m)
         # For lower_bound_m: each outer robot geom's centre (a view of x, y into data) and bounding radius.
         self._robot_xy = [] if data is None else [(data.geom_xpos[g, :2], float(model.geom_rbound[g]))
                                                   for g in self.robot_geom_ids]
-        self._bound_valid = bool(self._robot_xy) and len(self.obstacle_ids) > 0 and \
-            _upright_footprints(model, self.obstacle_ids, is_box)
+        self._bound_valid = bool(self._robot_xy) and len(self.obstacle_ids) > 0 and geometry.upright
         self._reference: tuple[float, float, float] | None = None  # (x, y, nearest footprint distance)
         # The last pick over every obstacle, in a scene whose obstacles never move: (index, x, y, how much
         # nearer the nearest footprint was than the next).  Footprint distances are 1-Lipschitz in the
@@ -145,10 +177,10 @@ class ClearanceProbe:
         return footprint_m - obstacle_shift_m - reach_m - BOUND_MARGIN_M
 
 
-def _upright_footprints(model: mujoco.MjModel, geom_ids: np.ndarray, is_box: np.ndarray) -> bool:
-    """Whether every obstacle's plan view is its footprint: upright cylinders, axis-aligned boxes."""
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
+def _upright_footprints(model: mujoco.MjModel, geom_ids: np.ndarray, is_box: np.ndarray,
+                        data: mujoco.MjData) -> bool:
+    """Whether every obstacle's plan view is its footprint: upright cylinders, axis-aligned boxes
+    (``data``: after ``mj_forward`` at the default state)."""
     xmat = data.geom_xmat[geom_ids].reshape(-1, 3, 3)
     upright = np.all(np.abs(xmat[:, :, 2] - (0.0, 0.0, 1.0)) < 1e-12, axis=1)
     aligned = np.all(np.abs(xmat - np.eye(3)) < 1e-12, axis=(1, 2))

@@ -64,7 +64,7 @@ def _static_distance(scenario: Scenario, points: np.ndarray) -> np.ndarray:
 def _reference_path(scenario: Scenario) -> tuple[np.ndarray, float | None]:
     """The static shortest path's points every 0.1 m and its length (straight with no path found)."""
     from swarmnav.planners.errors import PlanningError
-    from swarmnav.planners.grid_search import ThetaStarPlanner
+    from swarmnav.planners.theta_star import ThetaStarPlanner
     from swarmnav.planners.optimal import OptimalPlanner
     from swarmnav.sim.episode import static_problem
     problem = static_problem(scenario)

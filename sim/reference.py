@@ -14,7 +14,7 @@ import numpy as np
 
 from swarmnav.models.scenario import Scenario
 from swarmnav.planners.errors import PlanningError
-from swarmnav.planners.grid_search import ThetaStarPlanner
+from swarmnav.planners.theta_star import ThetaStarPlanner
 from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.problem import Problem, scenario_problem
 

@@ -24,9 +24,11 @@ def ranges_from_sensors(raw: np.ndarray, cutoff_m: float) -> np.ndarray:
     NumPy's masks (the same values; a NaN stays NaN).
     """
     inf = math.inf
+    values = raw.tolist() if type(raw) is np.ndarray and raw.dtype == np.float64 else \
+        np.asarray(raw, dtype=float).tolist()
     if cutoff_m > 0:
-        return np.array([inf if r < 0.0 or r >= cutoff_m else r for r in np.asarray(raw, dtype=float).tolist()])
-    return np.array([inf if r < 0.0 else r for r in np.asarray(raw, dtype=float).tolist()])
+        return np.array([inf if r < 0.0 or r >= cutoff_m else r for r in values])
+    return np.array([inf if r < 0.0 else r for r in values])
 
 
 def yaw_from_quaternion(w: float, x: float, y: float, z: float) -> float:
@@ -34,7 +36,7 @@ def yaw_from_quaternion(w: float, x: float, y: float, z: float) -> float:
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
-def base_twist(qvel: np.ndarray, dof_adr: int, heading_rad: float) -> tuple[float, float]:
-    """(forward speed m/s, turn rate rad/s) of a free-joint base moving in the plane."""
-    vx, vy = float(qvel[dof_adr]), float(qvel[dof_adr + 1])
-    return vx * math.cos(heading_rad) + vy * math.sin(heading_rad), float(qvel[dof_adr + 5])
+def base_twist(vx_m_s: float, vy_m_s: float, wz_rad_s: float, heading_rad: float) -> tuple[float, float]:
+    """(forward speed m/s, turn rate rad/s) of a free-joint base moving in the plane, from its world-frame
+    linear velocity (``qvel[0:2]``), its body-frame angular velocity about z (``qvel[5]``) and its heading."""
+    return vx_m_s * math.cos(heading_rad) + vy_m_s * math.sin(heading_rad), wz_rad_s

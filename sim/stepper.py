@@ -46,17 +46,13 @@ from swarmnav.models.world import Pose2D
 from swarmnav.planners.problem import Path
 from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
 from swarmnav.sim.contact import ContactMonitor
+from swarmnav.sim.control_period import control_periods, steps_per_control
 from swarmnav.sim.detector import ObstacleSensing
 from swarmnav.sim.recording import Recorder, RunContext, StepFrame
 from swarmnav.sim.reference import reference_length_m as shortest_static_length_m
 from swarmnav.sim.run_result import RunResult
 from swarmnav.sim.scene import CompiledScene
 from swarmnav.sim.sensing import base_twist, ranges_from_sensors, yaw_from_quaternion
-
-
-def steps_per_control(scenario: Scenario, model: mujoco.MjModel) -> int:
-    """Physics steps per control period."""
-    return int(round(1.0 / (scenario.sim.control_hz * model.opt.timestep)))
 
 
 def moving_obstacles(scene: CompiledScene) -> list:
@@ -101,14 +97,15 @@ class EpisodeStepper:
     """One episode on a compiled scene of ``scenario``; see the module docstring.
 
     Args:
-        time_limit_s, stop_on_collision: None = the scenario's.
+        time_limit_s, stop_on_collision: None = the scenario's; a limit of whole control periods only
+            (:func:`sim.control_period.control_periods`: ``ConfigError`` otherwise).
         recorder: gets ``start(context)`` at :meth:`reset`, every step, and ``finish`` once
             (:meth:`close` finishes it early, e.g. after an exception).
         path_m: the path planned at t = 0, recorded at time 0 (None: no path).
         sense_obstacles: whether observations carry detections (the sensing model's work is
             spared for a driver that never reads them).
         data: an ``MjData`` of ``scene.model`` to run in (the environment's physics owns one);
-            by default a new one at every :meth:`reset`.
+            by default one made with the stepper (every :meth:`reset` resets it in place).
 
     After :meth:`reset`: ``observation`` (the last one), ``outcome`` ("" while running),
     ``result`` (once over), ``step_index``, ``poses``, ``wheel_cmd``, ``obstacle_track_m``
@@ -132,12 +129,14 @@ class EpisodeStepper:
         self.k = steps_per_control(scenario, model)
         self.physics_dt_s = float(model.opt.timestep)
         self.dt_s = self.k * self.physics_dt_s
-        limit_s = scenario.time_limit_s if time_limit_s is None else time_limit_s
-        self.n_max = int(math.floor(limit_s / self.dt_s + 1e-9))
+        # Whole control periods only (sim.control_period): the file's limit, or the override's.
+        self.n_max = control_periods(scenario.time_limit_s, self.dt_s, "time_limit_s", scenario.source_path) \
+            if time_limit_s is None else control_periods(time_limit_s, self.dt_s, "time limit (override)")
         self.times_s = np.arange(self.n_max + 1) * self.dt_s
         self.goal = goal_checker(scenario)
         moving = moving_obstacles(scene)
         self.mocap_index = np.array([ob.mocap_index for ob in moving], dtype=np.int64)
+        self._moves = bool(moving)
         self.obstacle_track_m = obstacle_positions(scenario, scene, self.times_s)  # (T, M, 2)
         self._radii_m = np.array([scenario.obstacles[ob.scenario_index].radius_m for ob in moving])
         # How far the moving obstacles can have moved: obstacle_shift_m[j] - obstacle_shift_m[i]
@@ -151,9 +150,11 @@ class EpisodeStepper:
         top_speed_m_s = scene.drive.max_wheel_speed_rad_s * scene.drive.wheel_radius_m
         self.contact_free_gap_m = 2.0 * top_speed_m_s * self.dt_s + 0.01
         self.danger_m = scenario.sim.danger_m
+        self._unneeded_above_m = max(self.danger_m, self.contact_free_gap_m)  # see _observe
         self.qadr = scene.free_qpos_adr
         self._wheel_qvel_adr = np.array(scene.wheel_qvel_adr)
-        self._data = data
+        # The caller's MjData, or one made once and reset in place (a new one costs ~100 steps' bookkeeping).
+        self._data = data if data is not None else mujoco.MjData(model)
         self._unfinished = recorder is not None  # the recorder is owed its finish()
         self.outcome = ""
         self.result: RunResult | None = None
@@ -201,16 +202,22 @@ class EpisodeStepper:
                     self.safety_triggers += 1
         wheels = command.wheels
         left, right = wheels.left_rad_s, wheels.right_rad_s
-        data = self.data
-        data.ctrl[0] = left
-        data.ctrl[1] = right
-        self.wheel_cmd[self.step_index] = (left, right)
+        ctrl = self._ctrl
+        ctrl[0] = left
+        ctrl[1] = right
+        step = self.step_index
+        self.wheel_cmd[step] = (left, right)
         self.waypoint_index = command.waypoint_index
         self.danger_steps += self.in_danger
         self.stopped_steps += left == 0.0 and right == 0.0
         if recorder is not None:
             recorder.step(self._frame(self.observation, command, belief))
-        self._advance()
+        if self._contact_free and not self.monitor.in_contact:
+            # No contact can begin within the period (see _advance): the k physics steps in one call.
+            mujoco.mj_step(self.model, self.data, self.k)
+            self.step_index = step + 1
+        else:
+            self._advance()
         return self._sense()
 
     def close(self, outcome: str) -> None:
@@ -256,6 +263,7 @@ class EpisodeStepper:
         # Views into data, made once: the base's position and quaternion, its velocity, the rangefinders.
         self._base_qpos = data.qpos[qadr:qadr + 7]
         self._base_qvel = data.qvel[scene.free_qvel_adr:scene.free_qvel_adr + 6]
+        self._qpos, self._qvel, self._ctrl, self._mocap_pos = data.qpos, data.qvel, data.ctrl, data.mocap_pos
         adr = np.asarray(scene.range_sensor_adr)
         contiguous = len(adr) > 0 and np.array_equal(adr, np.arange(adr[0], adr[0] + len(adr)))
         self._range_raw = data.sensordata[adr[0]:adr[0] + len(adr)] if contiguous else None
@@ -281,13 +289,9 @@ class EpisodeStepper:
 
         When the clearance measured at the start of the step exceeds what the
         robot can travel in one control period (obstacles move only between
-        control steps), no contact can begin, and the k steps run in one call.
+        control steps), no contact can begin, and :meth:`step` runs the k steps in one call.
         """
-        model, data, monitor, qpos, qadr = self.model, self.data, self.monitor, self.data.qpos, self.qadr
-        if self._contact_free and not monitor.in_contact:
-            mujoco.mj_step(model, data, self.k)
-            self.step_index += 1
-            return
+        model, data, monitor, qpos, qadr = self.model, self.data, self.monitor, self._qpos, self.qadr
         base = self.step_index * self.k
         for substep in range(self.k):
             mujoco.mj_step(model, data)
@@ -298,8 +302,8 @@ class EpisodeStepper:
     def _sense(self) -> Observation:
         """Obstacles to the new time, the observation, the outcome; the end of the episode when there is one."""
         step = self.step_index
-        if len(self.mocap_index):
-            self.data.mocap_pos[self.mocap_index, :2] = self.obstacle_track_m[step]
+        if self._moves:
+            self._mocap_pos[self.mocap_index, :2] = self.obstacle_track_m[step]
         self.observation = observation = self._observe()
         pose = observation.pose
         if self.goal.reached(pose):
@@ -322,23 +326,24 @@ class EpisodeStepper:
         danger or the batching of :meth:`_advance` depends on its value (and beyond
         the probe's horizon the value is the horizon).
         """
-        data, scene, step = self.data, self.scene, self.step_index
+        step = self.step_index
         x, y, _, w, qx, qy, qz = self._base_qpos.tolist()
         heading = yaw_from_quaternion(w, qx, qy, qz)
         if step:
-            last_x, last_y, _ = self.poses[step - 1].tolist()
+            last_x, last_y = self._last_xy
             self.length_m += math.hypot(x - last_x, y - last_y)
+        self._last_xy = (x, y)
         self.poses[step] = (x, y, heading)
         self._observed_step = step
-        bound_m = self.clearance_bound_m()
+        bound_m = self.clearance.lower_bound_m(self.obstacle_shift_m[step] - self._shift_at_measure_m)
         if bound_m > CLEARANCE_HORIZON_M:
             gap: float | None = CLEARANCE_HORIZON_M  # what measure() returns beyond its horizon
-        elif bound_m > max(self.min_clearance_m, self.danger_m, self.contact_free_gap_m):
+        elif bound_m > self.min_clearance_m and bound_m > self._unneeded_above_m:
             gap = None  # not a new minimum, not in danger, no contact possible: the value is not needed
         else:
-            gap = self.clearance.measure(data, x, y)
+            gap = self.clearance.measure(self.data, x, y)
             # The obstacles the probe saw are where the last mj_step put them (the previous step's).
-            self._shift_at_measure_m = self.obstacle_shift_m[max(step - 1, 0)]
+            self._shift_at_measure_m = self.obstacle_shift_m[step - 1 if step else 0]
         self._clearance_m = gap
         if gap is None:
             self.in_danger = False
@@ -348,15 +353,17 @@ class EpisodeStepper:
                 self.min_clearance_m = gap
             self.in_danger = gap < self.danger_m
             self._contact_free = gap > self.contact_free_gap_m
-        v, omega = base_twist(self._base_qvel.tolist(), 0, heading)
+        vx, vy, _, _, _, omega = self._base_qvel.tolist()
         pose = Pose2D(x, y, heading)
-        raw = self._range_raw if self._range_raw is not None else data.sensordata[scene.range_sensor_adr]
+        scene = self.scene
+        raw = self._range_raw if self._range_raw is not None else self.data.sensordata[scene.range_sensor_adr]
         ranges = ranges_from_sensors(raw, scene.range_cutoff_m)
         time_s = step * self.dt_s
-        return Observation(time_s=time_s, pose=pose, twist=Twist(v, omega), ranges_m=ranges,
-                           range_angles_rad=scene.range_angles_rad, range_offset_m=scene.range_offset_m,
-                           range_cutoff_m=scene.range_cutoff_m,
-                           detections=self.sensing.sense(step, time_s, pose, ranges) if self.sense_obstacles else ())
+        linear_m_s, angular_rad_s = base_twist(vx, vy, omega, heading)
+        return Observation(time_s, pose, Twist(linear_m_s, angular_rad_s), ranges, scene.range_angles_rad,
+                           scene.range_offset_m,
+                           self.sensing.sense(step, time_s, pose, ranges) if self.sense_obstacles else (),
+                           scene.range_cutoff_m)
 
     def _stop(self, observation: Observation, outcome: str) -> None:
         """End the episode: zero the wheels, record the last step and the outcome, build the result."""
@@ -386,11 +393,8 @@ class EpisodeStepper:
 
     def _frame(self, observation: Observation, command: ControlCommand, belief: Belief | None = None) -> StepFrame:
         base_qpos = self._base_qpos.copy()  # one fresh copy; position and quaternion are views of it
-        return StepFrame(
-            time_s=observation.time_s, position_m=base_qpos[:3], quaternion_wxyz=base_qpos[3:],
-            heading_rad=observation.pose.heading_rad, range_m=observation.ranges_m,
-            wheel_command_rad_s=np.array([command.wheels.left_rad_s, command.wheels.right_rad_s]),
-            wheel_measured_rad_s=self.data.qvel[self._wheel_qvel_adr],
-            linear_m_s=command.linear_m_s, angular_rad_s=command.angular_rad_s,
-            waypoint_index=command.waypoint_index, moving_obstacles_m=self.obstacle_track_m[self.step_index].copy(),
-            belief=belief)
+        wheels = command.wheels
+        return StepFrame(observation.time_s, base_qpos[:3], base_qpos[3:], observation.pose.heading_rad,
+                         observation.ranges_m, np.array((wheels.left_rad_s, wheels.right_rad_s)),
+                         self._qvel[self._wheel_qvel_adr], command.linear_m_s, command.angular_rad_s,
+                         command.waypoint_index, self.obstacle_track_m[self.step_index].copy(), belief)

@@ -12,8 +12,8 @@ import pytest
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR, load_scenario
-from swarmnav.planners.max_min_ant_system import analyse_environment, mmas_limits
-from swarmnav.planners.max_min_colony import MaxMinColonyPlanner
+from swarmnav.planners.pheromone_propagation import analyse_environment, mmas_limits
+from swarmnav.planners.max_min_ant_system import MaxMinColonyPlanner
 from swarmnav.planners.max_min_trails import check_limits, trail_limits
 from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.sim.cli.main import main
@@ -74,8 +74,9 @@ class CheckedColony(MaxMinColonyPlanner):
 
     updates: int = 0
 
-    def update(self, data, iteration_best):
-        super().update(data, iteration_best)
+    def update(self, state, walk, arrived, lengths, iteration_best):
+        super().update(state, walk, arrived, lengths, iteration_best)
+        data = state.data
         limits = data["limits"]
         if limits is not None:
             assert check_limits(data["tau"], limits, data["free"])

@@ -11,7 +11,7 @@ import pytest
 
 from swarmnav.models.grid_map import benchmark_sets, read_map, read_scenarios
 from swarmnav.models.scenario import load_scenario, parse_scenario
-from swarmnav.planners.max_min_ant_system import MaxMinAntSystemPlanner
+from swarmnav.planners.improved_max_min_ant_system import ImprovedMaxMinAntSystemPlanner
 from swarmnav.planners.problem import map_problem, scenario_problem
 from swarmnav.planners.registry import make_planner
 from swarmnav.sim.benchmarks import grid
@@ -44,8 +44,8 @@ def test_a_movingai_scenario_file_poses_the_published_instance(tmp_path):
         rows = occupied.shape[0]
         direct = map_problem(occupied[::-1], 1.0, (rows - 1 - instance.start_row, instance.start_col),
                              (rows - 1 - instance.goal_row, instance.goal_col))
-        ours = MaxMinAntSystemPlanner().plan(problem, np.random.default_rng(0)).stats.extra["raw_length_m"]
-        theirs = MaxMinAntSystemPlanner().plan(direct, np.random.default_rng(0)).stats.extra["raw_length_m"]
+        ours = ImprovedMaxMinAntSystemPlanner().plan(problem, np.random.default_rng(0)).stats.extra["raw_length_m"]
+        theirs = ImprovedMaxMinAntSystemPlanner().plan(direct, np.random.default_rng(0)).stats.extra["raw_length_m"]
         assert ours == pytest.approx(theirs)
 
 

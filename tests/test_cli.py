@@ -88,6 +88,7 @@ def test_unreachable_goal_exits_3(tmp_path, capsys):
      "obstacles[0].motion.at_edge"),
     (lambda t: t.replace("count = 12", "count = 0"), "sensors.count"),
     (lambda t: t.replace("seed = 0", "seed = 1.5"), "seed"),
+    (lambda t: t.replace("time_limit_s = 60.0", "time_limit_s = 0.051"), "time_limit_s"),
 ])
 def test_bad_input_gets_one_line_naming_the_field_and_exit_2(tmp_path, capsys, mutation, field):
     path = write(tmp_path, mutation(BASE))
@@ -178,3 +179,15 @@ def test_plan_json_says_which_mode_a_continuous_planner_used(capsys):
     details = json.loads(capsys.readouterr().out)["details"]
     assert details["mode"] == "robust"
     json.dumps(details, allow_nan=False)
+
+
+def test_run_refuses_a_time_limit_between_control_periods_before_running(tmp_path, capsys):
+    """0.051 s at 50 Hz used to end after 0.04 s: now one line naming the file and the field, exit 2, no log."""
+    path = write(tmp_path, BASE.replace("time_limit_s = 60.0", "time_limit_s = 0.051"))
+    code, out, err = run_cli(capsys, "run", path, "--out", str(tmp_path / "x.mcap"))
+    assert code == 2 and out == "" and not (tmp_path / "x.mcap").exists()
+    assert len(err.strip().splitlines()) == 1 and path in err and "time_limit_s" in err and "0.051 s" in err
+    code, out, err = run_cli(capsys, "run", write(tmp_path, BASE.replace("time_limit_s = 60.0", "time_limit_s = 0.06")),
+                             "--no-log", "--json")
+    assert code == 0, err
+    assert json.loads(out)["sim_time_s"] == pytest.approx(0.06)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from swarmnav.models.world import OccupancyGrid
-from swarmnav.planners.ant_colony import GridGraph, cosine_table, walk_colony, walk_colony_reference
+from swarmnav.planners.colony_walk import GridGraph, cosine_table, walk_colony, walk_colony_reference
 
 
 def _graph(rng: np.random.Generator, rows: int, cols: int, density: float) -> GridGraph:

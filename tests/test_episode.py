@@ -236,3 +236,16 @@ def test_a_navigator_that_does_not_declare_what_it_uses_is_refused_at_registrati
 
     with pytest.raises(TypeError, match="does not declare uses_planner"):
         register(HalfDeclared)
+
+    class Stepless:
+        name = "stepless"
+        uses_detections = False
+        uses_planner = False
+        replan_wall_s = 0.0
+
+        def reset(self, setup):
+            pass
+
+    with pytest.raises(TypeError, match="no step method"):
+        register(Stepless)
+    assert "stepless" not in NAVIGATORS

@@ -17,14 +17,15 @@ from swarmnav.planners.errors import NoPathFound
 from swarmnav.models.geometry import segment_box_distance, segment_box_distances
 from swarmnav.planners.dstar_lite import DStarLite
 from swarmnav.planners.grid_graph import grid_line_of_sight
-from swarmnav.planners.grid_search import astar_cells, dijkstra_cells, theta_star_cells
+from swarmnav.planners.grid_search import astar_cells, dijkstra_cells
+from swarmnav.planners.theta_star import theta_star_cells
 from swarmnav.planners.grid_shortcut import box_line_of_sight
-from swarmnav.planners.ant_colony import GridGraph, walk_colony
+from swarmnav.planners.colony_walk import GridGraph, walk_colony
 from swarmnav.planners.improved_ant_colony import (adaptive_parameters, feature_cells, iaco_heuristic, pheromone_intensity,
                                           prune_length)
 from swarmnav.models.world import Box, OccupancyGrid, Pose2D, Rect
 from swarmnav.planners.problem import Problem
-from swarmnav.planners.max_min_ant_system import analyse_environment
+from swarmnav.planners.pheromone_propagation import analyse_environment
 from swarmnav.planners.problem import map_problem
 from swarmnav.models.grid_map import benchmark_sets, format_map, map_to_grid, merge_boxes, parse_map, read_map, read_scenarios
 from swarmnav.planners.problem import scenario_problem

@@ -236,3 +236,12 @@ def test_skipping_the_sensing_model_for_a_navigator_that_never_reads_it_changes_
     assert np.array_equal(fast.poses, slow.poses)
     assert np.array_equal(fast.wheel_command_rad_s, slow.wheel_command_rad_s)
     assert fast.summary() | {"wall_time_s": 0} == slow.summary() | {"wall_time_s": 0}
+
+
+def test_bench_sim_figures_are_rates_of_the_same_run_and_name_their_targets():
+    from swarmnav.sim.benchmarks.sim import benchmark_sim
+
+    figures = benchmark_sim("dense-field-30", duration_s=1.0, repeats=1)
+    assert figures["ratio"] == pytest.approx(figures["closed_loop_steps_per_s"] / figures["bare_steps_per_s"])
+    assert figures["logging_ratio"] == pytest.approx(figures["logging_steps_per_s"] / figures["bare_steps_per_s"])
+    assert 0 < figures["target_logging_ratio"] < figures["target_ratio"] <= 1

@@ -23,7 +23,7 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
 from swarmnav.models.world import Pose2D
 from swarmnav.planners.registry import make_planner
-from swarmnav.planners.max_min_ant_system import analyse_environment
+from swarmnav.planners.pheromone_propagation import analyse_environment
 from swarmnav.planners.problem import map_problem, scenario_problem
 from swarmnav.sim.episode import EpisodeSpec, run_episode
 

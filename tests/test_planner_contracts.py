@@ -14,7 +14,7 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import list_scenarios, load_scenario
 from swarmnav.planners.registry import PLANNERS, make_planner, register
 from swarmnav.planners.errors import BudgetExceeded, NoPathFound, PlanningError
-from swarmnav.planners.problem import scenario_problem
+from swarmnav.planners.problem import Planner, scenario_problem
 from swarmnav.sim.cli import main as cli
 
 SCENARIOS = list_scenarios()
@@ -58,6 +58,20 @@ def test_every_planner_declares_its_name_and_the_obstacles_it_supports():
         register(Undeclared)
     with pytest.raises(ValueError):
         register(PLANNERS["astar"])
+
+
+def test_the_registry_holds_and_builds_planners_only():
+    """``make_planner`` returns a :class:`Planner` (its declared type): a class without ``plan`` is refused when it
+    registers, and every registered name builds an object the protocol recognises."""
+    class Planless:
+        name = "planless"
+        supports = frozenset({"discs"})
+
+    with pytest.raises(TypeError, match="no plan"):
+        register(Planless)
+    assert "planless" not in PLANNERS
+    for name in PLANNERS:
+        assert isinstance(make_planner(name), Planner), name
 
 
 @pytest.mark.parametrize("planner_name", sorted(PLANNERS))

@@ -135,3 +135,16 @@ def test_the_episode_stepper_is_driven_by_anyone_and_refuses_steps_outside_its_e
     recorded.reset()
     with pytest.raises(RuntimeError, match="once"):
         recorded.reset()
+
+
+def test_an_overridden_time_limit_between_control_periods_is_refused_by_the_stepper():
+    """The stepper runs whole control periods: a limit that is not one is a ConfigError, never cut short."""
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.sim.runner import Simulation
+
+    simulation = Simulation(load_scenario("gwo-scenario-2"))
+    with pytest.raises(ConfigError, match=r"0.051 s is not a whole number of control periods.*after 0.04 s"):
+        simulation.stepper(time_limit_s=0.051)
+    with pytest.raises(ConfigError, match="not a whole number"):
+        simulation.stepper(time_limit_s=0.01)  # shorter than one period
+    assert simulation.stepper(time_limit_s=0.06).n_max == 3

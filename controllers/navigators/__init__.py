@@ -5,9 +5,9 @@ No module in this package imports MuJoCo.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TypeVar
 
-from swarmnav.controllers.navigator import check_declarations
+from swarmnav.controllers.navigator import Navigator, check_declarations
 from swarmnav.controllers.navigators.follow import FollowNavigator
 from swarmnav.controllers.navigators.iaco_local import IacoLocalNavigator
 from swarmnav.controllers.navigators.immas_stepwise import ImmasStepwiseNavigator
@@ -20,13 +20,20 @@ from swarmnav.controllers.navigators.replan import ReplanNavigator
 from swarmnav.controllers.navigators.velocity_obstacle import VelocityObstacleNavigator
 from swarmnav.models.parameters import build_component, register_component
 
-NAVIGATORS: dict[str, type] = {}
+NAVIGATORS: dict[str, type[Navigator]] = {}
+NavigatorClass = TypeVar("NavigatorClass", bound=type)
 
 
-def register(cls: type) -> type:
-    """Add a navigator class to :data:`NAVIGATORS`; a missing or taken name, or a missing declaration of what
-    it uses (:func:`controllers.navigator.check_declarations`), is an error."""
-    return register_component(NAVIGATORS, "navigator", check_declarations(cls))
+def register(cls: NavigatorClass) -> NavigatorClass:
+    """Add a navigator class to :data:`NAVIGATORS`; a missing or taken name, a missing ``reset`` or ``step``, or a
+    missing declaration of what it uses (:func:`controllers.navigator.check_declarations`), is an error."""
+    check_declarations(cls)
+    missing = [method for method in ("reset", "step") if not callable(getattr(cls, method, None))]
+    if missing:
+        raise TypeError(f"navigator {cls.__name__} has no {' or '.join(missing)} method "
+                        "(controllers.navigator.Navigator)")
+    register_component(NAVIGATORS, "navigator", cls)
+    return cls
 
 
 for _cls in (FollowNavigator, ReplanNavigator, DStarReplanNavigator, DynamicWindowNavigator, VelocityObstacleNavigator,
@@ -37,7 +44,7 @@ register(ClairvoyantOracleNavigator)  # the clairvoyant yardstick (controllers/n
 
 
 def make_navigator(name: str, params: dict[str, Any] | None = None, source: str | None = None,
-                   trust_code: bool = True) -> Any:
+                   trust_code: bool = True) -> Navigator:
     """Build a registered navigator from its name and a parameter table (ConfigError naming the field;
     ``trust_code``: see :func:`models.parameters.build_component`)."""
     return build_component(NAVIGATORS, "navigator", name, params, source, trust_code)

@@ -1,7 +1,7 @@
 """``immas_stepwise``: IMMAS's robot walking among random-walk obstacles, Hasan, Abdullah & Saleh (2023).
 
 Algorithm 1 (pheromone propagation from the goal, clean weights, gate raising,
-tight-tunnel closing; :func:`planners.max_min_ant_system.analyse_environment`)
+tight-tunnel closing; :func:`planners.pheromone_propagation.analyse_environment`)
 runs once before the robot moves.  Then Algorithm 3 walks the robot cell by
 cell: at each step the dynamic obstacles move (UpdateDynObs, line 10; the
 scenario's ``random_walk`` motion), the neighbours an obstacle occupies
@@ -58,8 +58,8 @@ from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Obse
 from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, static_grid
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import OccupancyGrid
-from swarmnav.planners.max_min_ant_system import (EnvironmentAnalysis, MaxMinAntSystemPlanner, analyse_environment,
-                                                  tour_scores)
+from swarmnav.planners.improved_max_min_ant_system import ImprovedMaxMinAntSystemPlanner, tour_scores
+from swarmnav.planners.pheromone_propagation import EnvironmentAnalysis, analyse_environment
 
 
 def occupied_cells(grid: OccupancyGrid, centres_m: np.ndarray, reach_m: np.ndarray) -> np.ndarray:
@@ -237,11 +237,10 @@ class ImmasStepwiseNavigator:
         self.evasion = evasion_for(setup, self.evade_trigger_s) if self.evade else None
         problem = setup.map_problem  # static obstacles only: the moving ones are sensed
         self.grid = grid = static_grid(problem)
-        planner = setup.planner if isinstance(setup.planner, MaxMinAntSystemPlanner) else MaxMinAntSystemPlanner()
-        alpha = planner.alpha if self.alpha is None and isinstance(setup.planner, MaxMinAntSystemPlanner) \
-            else (3.0 if self.alpha is None else self.alpha)
-        beta = planner.beta if self.beta is None and isinstance(setup.planner, MaxMinAntSystemPlanner) \
-            else (1.0 if self.beta is None else self.beta)
+        given = isinstance(setup.planner, ImprovedMaxMinAntSystemPlanner)
+        planner = setup.planner if given else ImprovedMaxMinAntSystemPlanner()
+        alpha = planner.alpha if self.alpha is None and given else (3.0 if self.alpha is None else self.alpha)
+        beta = planner.beta if self.beta is None and given else (1.0 if self.beta is None else self.beta)
         start = grid.cell_of(problem.start.x_m, problem.start.y_m)
         goal = grid.cell_of(problem.goal.x_m, problem.goal.y_m)
         t0 = time.perf_counter()

@@ -22,8 +22,8 @@ for them.  Collisions present at the start (the robot placed in contact) are
 counted in the first step's cost, so the costs always sum to the run's collisions.
 
 An episode already over at its start (the start within the goal's tolerance;
-the robot in contact when the scenario stops on collision; a time limit below
-one control period) ends where ``swarmnav run`` ends it, with no physics step.
+the robot in contact when the scenario stops on collision) ends where ``swarmnav run``
+ends it, with no physics step.
 dm_env has no first time step that is also the last, so ``reset()`` returns the
 usual FIRST time step and the first ``step(action)`` returns the LAST one
 (discount 0 for the goal or a collision, 1 for the time limit) without applying
@@ -37,7 +37,6 @@ end an episode either: ``reset`` returns ``info["outcome"]`` already set (and
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path as FilePath
 from typing import Any
@@ -54,6 +53,7 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario, load_scenario
 from swarmnav.models.seeds import Seeds
 from swarmnav.sim.episode import EpisodeSpec, plan_episode
+from swarmnav.sim.control_period import control_periods
 from swarmnav.sim.env.observations import action_spec, observation_specs
 from swarmnav.sim.env.reward import RewardWeights
 from swarmnav.sim.runner import Simulation
@@ -123,15 +123,10 @@ class EnvOptions:
 
 
 def check_time_limit(time_limit_s: float | None, control_dt_s: float) -> None:
-    """The episode runs whole control periods, the last one ending at or before the limit: a limit that is not
-    a whole number of periods would end the episode early (0.051 s at 50 Hz after 0.04 s), so it is refused."""
-    if time_limit_s is None:
-        return
-    periods = time_limit_s / control_dt_s
-    if abs(periods - round(periods)) > 1e-9 * max(1.0, periods):
-        raise ConfigError("env.time_limit_s", f"{time_limit_s:g} s is not a whole number of control periods "
-                                              f"({control_dt_s:g} s): the episode would end after "
-                                              f"{math.floor(periods + 1e-9) * control_dt_s:g} s")
+    """The episode runs whole control periods: a limit that is not a whole number of them is refused
+    (:mod:`sim.control_period`; 0.051 s at 50 Hz would end after 0.04 s)."""
+    if time_limit_s is not None:
+        control_periods(time_limit_s, control_dt_s, "env.time_limit_s")
 
 
 def model_bytes(model: mujoco.MjModel) -> bytes:
@@ -231,6 +226,7 @@ class NavigationTask(control.Task):
         physics.command = None
         physics.repeat = options.action_repeat
         self.action = self.previous_action = None  # normalised; None before the first step (zeros for smoothness)
+        self._action_in_reward = bool(options.reward.effort_per_s or options.reward.smoothness)
         self.return_, self.cost, self.reward_value = 0.0, 0.0, 0.0
         self._collisions = 0  # collisions at the start go into the first step's cost
         self._observed(self.stepper.reset())
@@ -238,8 +234,9 @@ class NavigationTask(control.Task):
 
     def before_step(self, action: np.ndarray, physics: SwarmnavPhysics) -> None:
         action = checked_action(action)  # ActionError: NaN, wrong shape or dtype, before any physics
-        self.previous_action, self.action = self.action, normalised_action(action, self.options.action,
-                                                                           self.scene.drive)
+        if self._action_in_reward:  # only the effort and smoothness terms read the normalised action
+            self.previous_action, self.action = self.action, normalised_action(action, self.options.action,
+                                                                               self.scene.drive)
         if not self.over_at_start:
             physics.command = action_command(action, self.options.action, self.scene.drive,
                                              self.scenario.max_speed_m_s)
