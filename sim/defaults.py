@@ -1,8 +1,8 @@
 """Defaults and bounds that the command line and the modules below it share (the CLI's options, the plot,
 the video, the study workers, the benchmarks).
 
-They live here, below the CLI, so that nothing but the CLI imports the CLI (``sim/commands.py`` and
-``sim/cli.py`` import these names from here).  Plain constants: importing this module costs nothing.
+They live here, below the CLI, so that nothing but the CLI imports the CLI (``sim/cli/commands.py`` and
+``sim/cli/main.py`` import these names from here).  Plain constants: importing this module costs nothing.
 """
 
 from __future__ import annotations

@@ -23,14 +23,14 @@ import numpy as np
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim import palette
 from swarmnav.sim.defaults import MAX_DPI, MIN_DPI
-from swarmnav.sim.log_reader import RunLog, outcome_text, read_log, truncation_advice
+from swarmnav.sim.log.reader import RunLog, outcome_text, read_log, truncation_advice
 
 MAX_SCANS = 400
 MAX_TRACK_POINTS = 4000  # a track is decimated to this many points, about the figure's resolution
 MOVING_OUTLINES = 6      # footprints outlined along each moving obstacle's track
 TITLE_CHARS = 80         # a title line wraps at this width: at 11 pt it fits the 8-inch figure
 TIME_PROXY = "#21918c"   # the legend's stand-in for a time-coloured line (the colormap's middle)
-# The figure is 8 x 10.5 inches: MAX_DPI (sim.commands) is 4800 x 6300 pixels.
+# The figure is 8 x 10.5 inches: MAX_DPI (sim.defaults) is 4800 x 6300 pixels.
 # Formats Matplotlib writes on its own without a warning (pgf needs TeX; avif and webp depend on
 # Pillow's build; eps and ps warn that they drop transparency).
 SELF_CONTAINED_FORMATS = {"png", "jpg", "jpeg", "tif", "tiff", "svg", "svgz", "pdf"}
@@ -220,6 +220,43 @@ def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
     norm = Normalize(0.0, max(log.duration_s, 1e-9))
     _draw_obstacles(ax, log, norm, cmap)
 
+    driven = _draw_run(ax, log, norm, cmap)
+    collisions = collision_points_m(log)
+    if len(collisions):
+        ax.plot(collisions[:, 0], collisions[:, 1], "x", color=palette.COLLISION, ms=10, mew=2.5, zorder=7)
+    margin = 0.3
+    ax.set_xlim(-margin, width_m + margin)
+    ax.set_ylim(-margin, height_m + margin)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    fig.suptitle(figure_title(log), fontsize=11)
+    # Below the map, outside it: the legend never hides an obstacle or the trajectory.
+    ax.legend(handles=_legend_handles(log, len(collisions)), loc="upper center", bbox_to_anchor=(0.5, -0.07),
+              ncol=3, fontsize=7, frameon=False)
+    moving = any(ob["moving"] for ob in log.obstacles)
+    if driven is not None or moving:
+        colourbar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.8, pad=0.02)
+        what = ", ".join(w for w, shown in (("trajectory", driven is not None), ("moving obstacles", moving)) if shown)
+        colourbar.set_label(f"simulation time [s] ({what})")
+
+    _draw_wheels(ax_wheels, log)
+
+    out = Path(out)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with open(out, "wb") as stream:  # exactly this path: no extension added, no rename
+            fig.savefig(stream, format=image, dpi=dpi)
+    except OSError as error:
+        raise type(error)(error.errno, error.strerror, str(out)) from None
+    finally:
+        plt.close(fig)
+    return out
+
+
+def _draw_run(ax, log: RunLog, norm, cmap):
+    """The range hits, every planned path, the driven trajectory (coloured by time, with time marks), the
+    start and the goal; returns the trajectory's time-coloured line (None for a log without poses)."""
     hits = range_hits_m(log)
     if len(hits):
         ax.scatter(hits[:, 0], hits[:, 1], s=2, c=palette.COLLISION, alpha=0.35, zorder=3)
@@ -244,25 +281,11 @@ def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
     if log.paths:
         goal = log.paths[-1][1][-1]
         ax.plot(goal[0], goal[1], "*", color=palette.GOAL, ms=14, mec="black", zorder=6)
-    collisions = collision_points_m(log)
-    if len(collisions):
-        ax.plot(collisions[:, 0], collisions[:, 1], "x", color=palette.COLLISION, ms=10, mew=2.5, zorder=7)
-    margin = 0.3
-    ax.set_xlim(-margin, width_m + margin)
-    ax.set_ylim(-margin, height_m + margin)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    fig.suptitle(figure_title(log), fontsize=11)
-    # Below the map, outside it: the legend never hides an obstacle or the trajectory.
-    ax.legend(handles=_legend_handles(log, len(collisions)), loc="upper center", bbox_to_anchor=(0.5, -0.07),
-              ncol=3, fontsize=7, frameon=False)
-    moving = any(ob["moving"] for ob in log.obstacles)
-    if driven is not None or moving:
-        colourbar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.8, pad=0.02)
-        what = ", ".join(w for w, shown in (("trajectory", driven is not None), ("moving obstacles", moving)) if shown)
-        colourbar.set_label(f"simulation time [s] ({what})")
+    return driven
 
+
+def _draw_wheels(ax_wheels, log: RunLog) -> None:
+    """The bottom panel: commanded and measured wheel speeds over simulated time, collisions marked."""
     t = log.wheel_time_s
     for column, side, colour in ((0, "left", palette.PLANNERS[0]), (1, "right", palette.PLANNERS[1])):
         ax_wheels.plot(t, log.wheel_command_rad_s[:, column], color=colour, ls="--", lw=0.9,
@@ -277,17 +300,6 @@ def plot_run(log: RunLog, out: str | Path, dpi: int = 120) -> Path:
     ax_wheels.grid(alpha=0.3)
     if len(t):
         ax_wheels.legend(loc="upper right", fontsize=8, ncol=2)
-
-    out = Path(out)
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        with open(out, "wb") as stream:  # exactly this path: no extension added, no rename
-            fig.savefig(stream, format=image, dpi=dpi)
-    except OSError as error:
-        raise type(error)(error.errno, error.strerror, str(out)) from None
-    finally:
-        plt.close(fig)
-    return out
 
 
 def run(args: argparse.Namespace) -> int:

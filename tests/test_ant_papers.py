@@ -16,7 +16,7 @@ from swarmnav.planners.pheromone_propagation import analyse_environment, mmas_li
 from swarmnav.planners.max_min_ant_system import MaxMinColonyPlanner
 from swarmnav.planners.max_min_trails import check_limits, trail_limits
 from swarmnav.planners.registry import PLANNERS, make_planner
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 from swarmnav.sim.episode import scenario_problem
 from swarmnav.sim.study.grid import expand
 from swarmnav.sim.study.rows import RUN_SCHEMA

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 import swarmnav
-from swarmnav.sim.cli import EXIT_EXPECTATION, main
+from swarmnav.sim.cli.main import EXIT_EXPECTATION, main
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE = ROOT / "examples" / "swarmnav_plugin_example"

@@ -9,7 +9,7 @@ import pytest
 
 from probe_scenario import PROBE_SCENARIO
 
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 
 BASE = PROBE_SCENARIO.replace("time_limit_s = 30.0", "time_limit_s = 60.0")  # tests/probe_scenario.py
 

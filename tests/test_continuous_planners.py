@@ -211,7 +211,7 @@ def test_bench_planners_rows_agree_with_their_runs(tmp_path):
     import pandas as pd
 
     from swarmnav.sim.benchmarks import planners as bench_continuous
-    from swarmnav.sim.commands import add_bench_planners_arguments
+    from swarmnav.sim.cli.commands import add_bench_planners_arguments
 
     parser = argparse.ArgumentParser()
     add_bench_planners_arguments(parser)
@@ -256,7 +256,7 @@ def test_bench_planners_random_fields_are_a_study_of_scenario_files(tmp_path):
 
     from swarmnav.planners.random_fields import random_disc_field
     from swarmnav.sim.benchmarks import planners as bench_continuous
-    from swarmnav.sim.commands import add_bench_planners_arguments
+    from swarmnav.sim.cli.commands import add_bench_planners_arguments
 
     parser = argparse.ArgumentParser()
     add_bench_planners_arguments(parser)

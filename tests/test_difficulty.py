@@ -6,7 +6,7 @@ import pytest
 
 from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.scenario_generator import GeneratorOptions, generate
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 from swarmnav.sim.difficulty import difficulty
 
 

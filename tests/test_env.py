@@ -293,7 +293,7 @@ def test_the_environments_final_metrics_are_run_jsons_for_the_same_wheel_command
     runs: the environment has no navigator to replan or trigger a safety filter.)"""
     import json
 
-    from swarmnav.sim.cli import main
+    from swarmnav.sim.cli.main import main
     assert main(["run", name, "--navigator", "follow", "--json", "--no-log"]) == 0
     run = json.loads(capsys.readouterr().out)
     commands = run_episode(EpisodeSpec(load_scenario(name), navigator="follow")).result.wheel_command_rad_s

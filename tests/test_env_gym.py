@@ -12,7 +12,7 @@ from gymnasium.utils.env_checker import check_env
 
 from swarmnav.models.scenario import Seeds, load_scenario
 from swarmnav.sim.env import ENV_ID, NavigateEnv
-from swarmnav.sim.log_reader import read_log
+from swarmnav.sim.log.reader import read_log
 
 
 @pytest.mark.parametrize("scenario, options", [

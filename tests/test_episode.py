@@ -12,7 +12,7 @@ import pytest
 from swarmnav.controllers.navigators import NAVIGATORS
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Seeds, parse_scenario
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -193,7 +193,7 @@ def test_the_gwo_study_compares_at_the_papers_settings_and_at_equal_evaluations(
 def test_case_b_as_printed_has_no_path_and_names_the_chain(name, capsys):
     """Kamil et al. (2020) Table 3 as printed: the exact planner proves no path (exit 3); the description
     names the chain of discs that closes it, and the chain is there (each grown disc meets the next)."""
-    from swarmnav.sim.cli import main
+    from swarmnav.sim.cli.main import main
 
     scenario = load_scenario(name)
     assert len(scenario.obstacles) == 24 and scenario.robot_radius_m == 0.5

@@ -1,4 +1,5 @@
-"""Imports point one way: models <- planners <- controllers <- sim.
+"""Imports point one way: models <- planners <- controllers <- sim; no cycle; nothing below the CLI imports it
+and no runtime module imports a benchmark.
 
 Every import of every module is read with ``ast`` (imports inside functions
 included), so a lazy import that climbs a floor fails here too.
@@ -167,7 +168,40 @@ def test_the_cycle_check_finds_a_cycle():
     assert import_cycles({"a": {"b"}, "b": set()}) == []
 
 
+CLI = "swarmnav.sim.cli"  # sim/cli/: the parser and the commands
+BENCHMARKS = "swarmnav.sim.benchmarks"  # sim/benchmarks/: run by `swarmnav bench` only
+
+
+def in_package(module: str, package: str) -> bool:
+    return module == package or module.startswith(package + ".")
+
+
+def outside_importers(graph: dict[str, set[str]], package: str, allowed: tuple[str, ...] = ()) -> list[str]:
+    """The modules outside ``package`` (and outside the ``allowed`` packages) that import a module of it."""
+    return sorted(name for name, targets in graph.items()
+                  if not any(in_package(name, home) for home in (package, *allowed))
+                  and any(in_package(target, package) for target in targets))
+
+
 def test_only_the_command_line_imports_the_command_line():
-    cli = {"swarmnav.sim.cli", "swarmnav.sim.commands"}
-    importers = {name for name, targets in import_graph().items() if targets & cli}
-    assert importers <= cli
+    graph = import_graph()
+    assert any(in_package(name, CLI) for name in graph)  # the check sees the package
+    assert outside_importers(graph, CLI) == []
+
+
+def test_no_runtime_module_imports_a_benchmark():
+    """Benchmarks stay outside the runtime's import graph: only the command line (``bench``) imports them."""
+    graph = import_graph()
+    assert any(in_package(target, BENCHMARKS) for name, targets in graph.items() if in_package(name, CLI)
+               for target in targets)  # the check sees the bench command's (lazy) imports
+    assert outside_importers(graph, BENCHMARKS, allowed=(CLI,)) == []
+
+
+def test_the_package_checks_find_an_importer():
+    graph = {"swarmnav.sim.cli.main": {"swarmnav.sim.runner", "swarmnav.sim.benchmarks.sim"},
+             "swarmnav.sim.runner": {"swarmnav.sim.cli.commands"},
+             "swarmnav.sim.client": {"swarmnav.sim.benchmarks"},  # a name that merely starts like the package
+             "swarmnav.sim.benchmarks.sim": {"swarmnav.sim.runner"}}
+    assert outside_importers(graph, CLI) == ["swarmnav.sim.runner"]
+    assert outside_importers(graph, BENCHMARKS, allowed=(CLI,)) == ["swarmnav.sim.client"]
+    assert outside_importers(graph, BENCHMARKS) == ["swarmnav.sim.cli.main", "swarmnav.sim.client"]

@@ -15,10 +15,10 @@ from mcap.reader import make_reader
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.episode import EpisodeSpec, run_episode
-from swarmnav.sim.log_columns import Rows
-from swarmnav.sim.log_summary import from_records, read_summary
-from swarmnav.sim.mcap_log import McapRecorder
-from swarmnav.sim.mcap_records import read_records
+from swarmnav.sim.log.columns import Rows
+from swarmnav.sim.log.summary import from_records, read_summary
+from swarmnav.sim.log.writer import McapRecorder
+from swarmnav.sim.log.records import read_records
 
 
 @pytest.fixture(scope="module")

@@ -61,7 +61,7 @@ def test_the_table_follows_the_rows_and_a_bad_file_is_named(tmp_path, capsys):
 
 def test_per_group_writes_that_many_scenes_of_each_group_and_needs_a_generated_suite(tmp_path, capsys):
     from swarmnav.sim.benchmarks.navigation import write_suite
-    from swarmnav.sim.cli import main
+    from swarmnav.sim.cli.main import main
     paths, suite = write_suite("dyn300", False, None, str(tmp_path), per_group=3)
     groups = list(dict.fromkeys(s.group for s in suite.scenes))
     names = [Path(p).stem for p in paths]

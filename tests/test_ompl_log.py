@@ -15,7 +15,7 @@ import pytest
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.planners.problem import scenario_problem
-from swarmnav.sim import cli
+from swarmnav.sim.cli import main as cli
 from swarmnav.sim.study.rows import PROGRESS, RUNS, read_table
 
 STUDY = """

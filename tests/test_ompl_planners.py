@@ -17,7 +17,7 @@ from swarmnav.planners.errors import NoPathFound, PlanningError
 from swarmnav.planners.problem import scenario_problem
 from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.planners.sampling_ompl import OMPL_PLANNERS
-from swarmnav.sim import cli
+from swarmnav.sim.cli import main as cli
 
 NAMES = [cls.name for cls in OMPL_PLANNERS]
 BUDGET = {"max_evaluations": 2000, "round_evaluations": 100}
@@ -58,7 +58,7 @@ def test_the_four_planners_are_registered():
 
 
 def test_importing_the_registry_does_not_import_ompl():
-    code = "import sys, swarmnav.planners.registry, swarmnav.sim.cli; print('ompl' in sys.modules)"
+    code = "import sys, swarmnav.planners.registry, swarmnav.sim.cli.main; print('ompl' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"
 

@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 from swarmnav.sim.study.claim_spec import Claim
 from swarmnav.sim.study.claims import CONTRADICTED, INCONCLUSIVE, REPRODUCES, a12, verdicts
 from swarmnav.sim.study.spec import list_studies, load_study

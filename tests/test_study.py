@@ -16,7 +16,7 @@ from scipy import stats
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.planners.errors import PlanningError
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
 from swarmnav.sim.study.grid import expand
 from swarmnav.sim.study.spec import list_studies, load_study

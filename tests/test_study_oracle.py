@@ -14,7 +14,7 @@ import pytest
 
 from swarmnav.models.scenario_generator import GeneratorOptions, generate
 from swarmnav.sim import palette
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 from swarmnav.sim.study.against_oracle import binned_success
 from swarmnav.sim.study.rows import RUN_SCHEMA, RUNS, load_runs, part_name
 from swarmnav.sim.study.yardstick import FILE, Yardstick

@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 
 from swarmnav.models.errors import ConfigError
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 
 pytest.importorskip("ray", reason="the ray extra is not installed (pip install 'swarmnav[ray]')")
 

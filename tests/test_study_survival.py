@@ -14,7 +14,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 from swarmnav.sim.study.execute import run_study
 from swarmnav.sim.study.grid import expand
 from swarmnav.sim.study.rows import RUNS, RowWriter, compact, read_table

@@ -21,7 +21,7 @@ from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.suites import load_suite
 from swarmnav.models.toml_table import TomlTable, parse_toml, within
 from swarmnav.planners.registry import make_planner
-from swarmnav.sim.cli import main
+from swarmnav.sim.cli.main import main
 from swarmnav.sim.study.spec import parse_study
 
 SCENARIO = {

@@ -112,7 +112,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
     recorders: list[Any] = []
     log_path = None
     if log:
-        from swarmnav.sim.mcap_log import McapRecorder, default_log_path
+        from swarmnav.sim.log.writer import McapRecorder, default_log_path
         log_path = FilePath(log) if log is not True else default_log_path(
             planned.spec.scenario.name, planned.spec.planner, planned.spec.seed, time.strftime("%Y%m%d-%H%M%S"))
         if log_path.is_dir():
@@ -124,7 +124,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
         raise ConfigError("--live", "needs the log (drop --no-log)")
     if video:
         from swarmnav.sim.defaults import DEFAULT_FPS
-        from swarmnav.sim.render import VideoRecorder
+        from swarmnav.sim.video.render import VideoRecorder
         recorders.append(VideoRecorder(str(video), camera=camera, width=width, height=height,
                                        fps=DEFAULT_FPS if fps is None else fps))
     episode = run_episode(planned, recorders, stop_on_collision=stop_on_collision)

@@ -74,7 +74,7 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
     recorder_cls = None
     if with_logging:
         try:
-            from swarmnav.sim.mcap_log import McapRecorder
+            from swarmnav.sim.log.writer import McapRecorder
             recorder_cls = McapRecorder
         except ImportError:
             recorder_cls = None

@@ -148,7 +148,7 @@ class NavigateEnv(gymnasium.Env):
     def render(self):
         if self.render_mode != "rgb_array":
             return None
-        from swarmnav.sim.render import SceneRenderer
+        from swarmnav.sim.video.render import SceneRenderer
         stepper = self.task.stepper
         if self._renderer is None:
             width, height, camera = self._size

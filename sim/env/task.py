@@ -309,7 +309,7 @@ class NavigationTask(control.Task):
     def _open_recorder(self):
         if self.options.record_to is None:
             return None
-        from swarmnav.sim.mcap_log import McapRecorder
+        from swarmnav.sim.log.writer import McapRecorder
         return McapRecorder(FilePath(self.options.record_to.replace("{episode}", str(self.episode))), overwrite=True)
 
 

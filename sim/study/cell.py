@@ -143,7 +143,7 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
                 tally = EventTally()
                 recorders = [tally]
                 if logs_dir is not None:
-                    from swarmnav.sim.mcap_log import McapRecorder
+                    from swarmnav.sim.log.writer import McapRecorder
                     log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
                     recorders.append(McapRecorder(log_path, overwrite=True))
                     row["log"] = str(log_path)

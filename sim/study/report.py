@@ -132,7 +132,7 @@ def ordered_runs(runs: list[dict[str, Any]], meta: dict[str, Any]) -> list[dict[
 def _driven(arms: dict[str, list[dict[str, Any]]]) -> tuple[dict[str, tuple], str]:
     """The driven trajectory and collision points of each arm's path-figure run, read from its MCAP log
     (kept by ``swarmnav study --logs``); and a sentence saying where there were none."""
-    from swarmnav.sim.log_reader import read_log
+    from swarmnav.sim.log.reader import read_log
     from swarmnav.sim.plot import collision_points_m
     out, missing = {}, []
     for name, rows in arms.items():

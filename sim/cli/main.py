@@ -20,15 +20,16 @@ import tomllib
 from pathlib import Path as FilePath
 from typing import Any, Callable
 
-# Building the parser imports only light modules (sim.commands): each subcommand imports
+# Building the parser imports only light modules (sim.cli.commands): each subcommand imports
 # what it needs (MuJoCo, SciPy, the planners, the log formats) when it runs.
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
-from swarmnav.sim import options, stop_signal
+from swarmnav.sim import options
+from swarmnav.sim.cli import stop_signal
 from swarmnav.sim.options import parse_settings
-from swarmnav.sim.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
+from swarmnav.sim.cli.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
 
-# As sim.render does, before any subcommand imports mujoco (which reads it once, on import).
+# As sim.video.render does, before any subcommand imports mujoco (which reads it once, on import).
 os.environ.setdefault("MUJOCO_GL", "egl")
 for _name, _value in SINGLE_THREAD_ENVIRONMENT.items():  # before any subcommand imports NumPy
     os.environ.setdefault(_name, _value)
@@ -190,7 +191,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from swarmnav.calls import run
     options.check_output_file(args.json_out, "--json-out")
     if args.video:
-        from swarmnav.sim.render import check_video_size
+        from swarmnav.sim.video.render import check_video_size
         check_video_size(args.width, args.height, args.fps)  # before the plan: bad options fail at once
     try:
         outcome = run(_load(args), args.planner, parse_settings(args.set, "--set"), args.navigator,

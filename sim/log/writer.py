@@ -2,19 +2,19 @@
 
 One :class:`McapRecorder` per run.  It owns one ``foxglove.Context``; the MCAP
 file and, with ``live=True``, a loopback WebSocket server for Foxglove
-(:mod:`sim.live_view`) are both sinks of that context, so they see exactly the
-same messages.  The channels, time stamps and names are in :mod:`sim.log_format`.
+(:mod:`sim.log.live_view`) are both sinks of that context, so they see exactly the
+same messages.  The channels, time stamps and names are in :mod:`sim.log.format`.
 
 Metadata records: ``scenario`` (name, TOML text), ``planner`` and ``navigator`` (name, JSON params),
 ``run`` (seed, world seed, time steps, sensor layout, obstacles), ``versions`` and, from
 ``finish``, ``outcome`` (the runner's summary).  Values are plain text where they are
 strings (Foxglove shows ``goal_reached``, not ``"goal_reached"``) and JSON where they are
-numbers, booleans, lists or objects (:func:`sim.log_format.metadata_text`).  Attachment:
+numbers, booleans, lists or objects (:func:`sim.log.format.metadata_text`).  Attachment:
 ``scene.xml``, the compiled MJCF.  Everything needed to re-simulate is in the file.
 
 The writer is the foxglove SDK with ``disable_seeking=True``, so the file is
 written strictly front to back and a killed process never leaves a
-half-rewritten chunk header behind.  It writes into a :class:`sim.log_file.LogFile`,
+half-rewritten chunk header behind.  It writes into a :class:`sim.log.file.LogFile`,
 so a failure to open or to write (a full disk) is an ``OSError`` naming the file.
 ``flush`` closes the current chunk; we flush at least once per simulated second
 (``flush_interval_s``), so a SIGKILL loses at most that much and ``swarmnav log
@@ -41,10 +41,10 @@ from foxglove.messages import (
     Vector3,
 )
 
-from swarmnav.sim.live_view import DEFAULT_LIVE_HOST, DEFAULT_LIVE_PORT, LiveServer
-from swarmnav.sim.log_encoding import SceneEncoder, StepEncoder, timestamp_field
-from swarmnav.sim.log_file import LogFile
-from swarmnav.sim.log_format import (
+from swarmnav.sim.log.live_view import DEFAULT_LIVE_HOST, DEFAULT_LIVE_PORT, LiveServer
+from swarmnav.sim.log.encoding import SceneEncoder, StepEncoder, timestamp_field
+from swarmnav.sim.log.file import LogFile
+from swarmnav.sim.log.format import (
     BASE_FRAME,
     CONTROLLER_SCHEMA,
     EVENTS_TOPIC,
@@ -62,7 +62,7 @@ from swarmnav.sim.log_format import (
     time_ns,
     writer_versions,
 )
-from swarmnav.sim.log_messages import (
+from swarmnav.sim.log.messages import (
     belief_update,
     chassis_radius_m,
     controller_json,
@@ -76,10 +76,10 @@ from swarmnav.sim.log_messages import (
     wheels_json,
     yaw_quaternion,
 )
-from swarmnav.sim.pacing import RealTimePacer
+from swarmnav.sim.log.pacing import RealTimePacer
 from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
 
-# TOPICS and default_log_path live in sim.log_format; re-exported for existing callers.
+# TOPICS and default_log_path live in sim.log.format; re-exported for existing callers.
 __all__ = ["McapRecorder", "TOPICS", "default_log_path"]
 
 ZSTD_LEVEL = 1  # chunk compression level (see start)
@@ -114,7 +114,7 @@ class McapRecorder:
             port 0 picks a free one, see :attr:`live_port_bound`).
         live_speed: with ``live``, hold the run to this multiple of real time so a
             viewer can follow it (``None`` or 0: as fast as it goes), through a
-            :class:`sim.pacing.RealTimePacer`.
+            :class:`sim.log.pacing.RealTimePacer`.
         on_live: called with the server's URL once it listens (the caller prints it;
             the recorder never prints).
         overwrite: replace an existing file instead of refusing.
@@ -188,7 +188,7 @@ class McapRecorder:
             compression_threads=0,  # the 2 cores belong to the simulation
         )
         self._writer = foxglove.open_mcap(self._file, context=self._fox, writer_options=options)
-        # The per-step protobuf channels take bytes from a StepEncoder (sim.log_encoding): the SDK's
+        # The per-step protobuf channels take bytes from a StepEncoder (sim.log.encoding): the SDK's
         # schemas and encoding, without building its message objects every step.
         self._tf, self._pose = (
             foxglove.Channel(topic, schema=message.get_schema(), message_encoding="protobuf", context=self._fox)

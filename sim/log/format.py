@@ -1,7 +1,7 @@
 """The run log's format: channels, schemas, names, time stamps and the scan convention.
 
-Shared by the writer (:mod:`sim.mcap_log`) and the readers (:mod:`sim.mcap_records`,
-:mod:`sim.log_reader`), so both sides agree on one table.
+Shared by the writer (:mod:`sim.log.writer`) and the readers (:mod:`sim.log.records`,
+:mod:`sim.log.reader`), so both sides agree on one table.
 
 Channels (Foxglove well-known protobuf schemas unless said otherwise):
 

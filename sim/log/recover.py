@@ -9,7 +9,7 @@ from mcap.records import Message
 from mcap.writer import CompressionType, Writer
 
 from swarmnav.models.errors import ConfigError
-from swarmnav.sim.mcap_records import RawLog, read_records
+from swarmnav.sim.log.records import RawLog, read_records
 
 
 def recover_log(source: str | Path, target: str | Path) -> RawLog:

@@ -9,7 +9,7 @@ A damaged chunk inside a file whose summary is intact is therefore not noticed
 here; ``plot``, ``replay`` and ``log recover``, which read every message, report it.
 
 A file without a usable summary (cut off by a killed run, or written without one)
-is walked record by record instead (:func:`sim.mcap_records.read_records`),
+is walked record by record instead (:func:`sim.log.records.read_records`),
 decoding only its ``/events`` messages: what was recovered, with the file marked
 incomplete so the caller can warn.
 """
@@ -24,14 +24,14 @@ from typing import Any
 from mcap.reader import SeekingReader
 from mcap.records import Message
 
-from swarmnav.sim.log_format import EVENTS_TOPIC, metadata_value
-from swarmnav.sim.log_reader import check_channels, event_decoder
-from swarmnav.sim.mcap_records import LogError, RawLog, open_regular, read_records
+from swarmnav.sim.log.format import EVENTS_TOPIC, metadata_value
+from swarmnav.sim.log.reader import check_channels, event_decoder
+from swarmnav.sim.log.records import LogError, RawLog, open_regular, read_records
 
 
 @dataclass
 class LogSummary:
-    """The facts ``log info`` prints (the attributes :func:`sim.log_commands.describe` reads)."""
+    """The facts ``log info`` prints (the attributes :func:`sim.cli.log.describe` reads)."""
 
     raw: RawLog  # schemas, channels, metadata, counts; no messages
     events: list[tuple[float, str, dict[str, Any]]]

@@ -18,7 +18,7 @@ from swarmnav.sim.defaults import (  # noqa: F401  (re-exported: the CLI's own d
     BENCH_ENV_QUICK, BENCH_RENDER_QUICK_FRAMES, BENCH_PLANNERS_SCENARIOS, BENCH_PLANNERS_PLANNERS,
     BENCH_PLANNERS_SAMPLING, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
 from swarmnav.sim.options import add_trust_code_argument  # noqa: F401
-from swarmnav.sim.study import cli as study_cli
+from swarmnav.sim.cli import study as study_cli
 
 Adder = Callable[[argparse.ArgumentParser], None]
 Runner = Callable[[argparse.Namespace], int]
@@ -210,7 +210,7 @@ def add_log_info_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_log_info(args: argparse.Namespace) -> int:
-    from swarmnav.sim import log_commands
+    from swarmnav.sim.cli import log as log_commands
     return log_commands.run_info(args)
 
 
@@ -220,7 +220,7 @@ def add_log_recover_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_log_recover(args: argparse.Namespace) -> int:
-    from swarmnav.sim import log_commands
+    from swarmnav.sim.cli import log as log_commands
     return log_commands.run_recover(args)
 
 
@@ -244,7 +244,7 @@ def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_replay(args: argparse.Namespace) -> int:
-    from swarmnav.sim import replay
+    from swarmnav.sim.log import replay
     return replay.run(args)
 
 
@@ -264,7 +264,7 @@ def add_foxglove_layout_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_foxglove_layout(args: argparse.Namespace) -> int:
-    from swarmnav.sim import foxglove_layout
+    from swarmnav.sim.log import foxglove_layout
     return foxglove_layout.run(args)
 
 

@@ -1,6 +1,6 @@
 """``swarmnav foxglove-layout [-o FILE]``: the Foxglove layout for a run log.
 
-The layout (``sim/foxglove_layout.json``, shipped in the package) has a 3D panel
+The layout (``sim/log/foxglove_layout.json``, shipped in the package) has a 3D panel
 looking down on the scene (``/scene``'s arena and footprint, ``/obstacles``, the
 planned path, the range scan, what the navigator acted on), a plot of the wheel
 speeds, a plot of the range readings (their lower envelope is the clearance the
@@ -19,7 +19,7 @@ from importlib import resources
 from pathlib import Path
 
 from swarmnav.sim import palette
-from swarmnav.sim.log_format import EVENTS_TOPIC, NAVIGATOR_TOPIC, SCENE_TOPIC, WORLD_FRAME
+from swarmnav.sim.log.format import EVENTS_TOPIC, NAVIGATOR_TOPIC, SCENE_TOPIC, WORLD_FRAME
 
 LAYOUT_FILE = "foxglove_layout.json"
 WHEEL_SERIES = (("command_left_rad_s", "left commanded", "dashed", palette.PLANNERS[0]),
@@ -58,7 +58,7 @@ def build_layout() -> str:
 
 def shipped_layout() -> str:
     """The layout file of the installed package."""
-    return resources.files("swarmnav.sim").joinpath(LAYOUT_FILE).read_text()
+    return resources.files("swarmnav.sim.log").joinpath(LAYOUT_FILE).read_text()
 
 
 def run(args: argparse.Namespace) -> int:

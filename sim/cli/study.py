@@ -50,7 +50,7 @@ def _first_stop(exc: BaseException) -> BaseException:
     """The Ctrl-C or SIGTERM that stopped the study: a native library may turn the CLI's ``SystemExit(143)``
     into one of its own on the way out (Ray's ``wait`` raises ``SystemExit(1)`` when a signal interrupts it),
     so the signal the CLI's handler recorded wins."""
-    from swarmnav.sim import stop_signal
+    from swarmnav.sim.cli import stop_signal
     if isinstance(exc, SystemExit) and stop_signal.received is not None:
         return SystemExit(128 + stop_signal.received)
     return exc
