@@ -206,3 +206,20 @@ def test_cliffs_delta_counts_every_pair_with_ties():
         a, b = rng.integers(0, 6, n).astype(float), rng.integers(0, 6, m).astype(float)  # many ties
         pairs = [int(x > y) - int(x < y) for x in a for y in b]
         assert cliffs_delta(a, b) == pytest.approx(sum(pairs) / len(pairs), abs=1e-15)
+
+
+def test_a_batch_sent_to_a_worker_that_just_died_stays_queued_for_the_next_worker():
+    """The driver can send to a worker that died after its last wait (a broken pipe): the batch stays in the
+    worker's queue, where the death handling finds it, instead of ending the study with BrokenPipeError."""
+    import multiprocessing
+
+    from swarmnav.sim.study.engines import _LocalWorker
+    study = parse_study(PHYSICS.format(name="late", limit=2.0, seeds=1))
+    cells = list(expand(study))[:2]
+    worker = _LocalWorker(multiprocessing.get_context("spawn"), None)
+    worker.process.kill()
+    worker.process.join()
+    for _ in range(50):  # the first sends may still fill the pipe's buffer; a broken pipe comes soon
+        worker.send(cells)
+    assert len(worker.queued) == 100 and list(worker.queued)[:2] == cells
+    worker.stop(terminate=True)

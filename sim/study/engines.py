@@ -136,8 +136,14 @@ class _LocalWorker:
         self.queued: deque[Cell] = deque()  # sent, not yet returned, in the order the worker runs them
 
     def send(self, batch: list[Cell]) -> None:
+        """Queue ``batch`` on this worker.  A worker that died since the last wait (its pipe is broken) keeps
+        the batch in its queue: the driver's next wait sees its sentinel, makes the cell it was running an
+        ``error`` row and hands the rest, this batch included, to a fresh worker."""
         self.queued.extend(batch)
-        self.conn.send(batch)
+        try:
+            self.conn.send(batch)
+        except (BrokenPipeError, ConnectionResetError):
+            pass
 
     def receive(self) -> tuple[list[Result], bool]:
         """The results waiting on the pipe, and whether the worker is gone (its pipe closed)."""
