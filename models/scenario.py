@@ -189,7 +189,7 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
     planner_name, planner_params = _component(top.table("planner", {}), "astar")
     navigator_name, navigator_params = _component(top.table("navigator", {}), "follow")
     sim, cell_m, cell_given = _sim(top.table("sim", {}))
-    _check_run_size(time_limit_s, sim, source)
+    check_run_size(time_limit_s, sim, source)
 
     section = read_map_section(top, SCENARIO_DIR, width_m, height_m)
     if section is None:
@@ -288,8 +288,9 @@ def name_problem(name: str) -> str | None:
     return None
 
 
-def _check_run_size(time_limit_s: float, sim: SimSettings, source: str) -> None:
-    """The physics and control step counts of a run, against their stated maxima."""
+def check_run_size(time_limit_s: float, sim: SimSettings, source: str | None) -> None:
+    """The physics and control step counts of a run, against their stated maxima, and its time limit a whole
+    number of control periods (a study's ``time_limit_s`` override is checked against each scenario with it)."""
     physics_steps = time_limit_s / sim.timestep_s
     if not physics_steps <= MAX_PHYSICS_STEPS:
         raise ConfigError("time_limit_s", f"{time_limit_s:g} s at a {sim.timestep_s:g} s timestep needs "

@@ -122,6 +122,8 @@ MALFORMED = [
     ("study", ("planners", 0, "params", "iterations"), -3, "planners[0].params.iterations", "must be in"),
     ("study", ("paper", 0, "value"), "high", "paper[0].value", "expected a number"),
     ("study", ("colour",), 1, "colour", "unknown key"),
+    ("study", ("time_limit_s",), 0.051, "time_limit_s", "not a whole number of control periods (0.02 s) for scenario"),
+    ("study", ("time_limit_s",), 1e12, "time_limit_s", "physics steps (at most"),
     ("suite", ("version",), "one", "version", "expected an integer"),
     ("suite", ("defaults", "obstacles"), "three", "defaults.obstacles", "expected an integer"),
     ("suite", ("defaults", "arena_m"), 2.0, "defaults.arena_m", "must exceed"),

@@ -65,7 +65,7 @@ from swarmnav.models.toml_table import POSITIVE, TomlTable, above, parse_toml, r
 from swarmnav.planners.registry import make_planner
 from swarmnav.planners.swarm import Budget
 from swarmnav.sim.study.claim_spec import Claim, read_claims
-from swarmnav.sim.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, PaperValue,  # noqa: F401
+from swarmnav.sim.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, PaperValue, check_time_limit,  # noqa: F401
                                               read_budget, read_clearance, read_components, read_paper,
                                               read_scenarios, read_seeds, refuse_scenario_code)
 
@@ -176,6 +176,8 @@ def _read_study(top: TomlTable, default_name: str, trust_code: bool) -> Study:
     time_limit_s = top.number("time_limit_s", None, bounds=POSITIVE)
     planners = read_components(top, "planners", "planner", make_planner, trust_code)
     navigators = read_components(top, "navigators", "navigator", make_navigator, trust_code, [{"name": "follow"}])
+    if time_limit_s is not None:
+        check_time_limit(scenarios, time_limit_s, top.source)
     if not trust_code:
         refuse_scenario_code(scenarios, planners, navigators)
     labels = [p.label for p in planners]

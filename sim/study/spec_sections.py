@@ -14,7 +14,7 @@ from typing import Any, Callable
 from swarmnav.controllers.navigators import NAVIGATORS
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import refuse_code
-from swarmnav.models.scenario import list_scenarios, load_scenario, resolve_scenario_path
+from swarmnav.models.scenario import check_run_size, list_scenarios, load_scenario, resolve_scenario_path
 from swarmnav.models.toml_table import (NON_NEGATIVE, POSITIVE, TomlTable, check_array, check_integer,
                                         check_string, within)
 from swarmnav.planners.registry import PLANNERS
@@ -135,6 +135,17 @@ def read_components(top: TomlTable, key: str, kind: str, make: Callable[..., Any
         if label in labels[:i]:
             top.fail(f"{key}[{i}].label", f"label {label!r} is used twice (give each entry its own label)")
     return tuple(out)
+
+
+def check_time_limit(scenarios: tuple[str, ...], time_limit_s: float, source: str | None) -> None:
+    """The study's ``time_limit_s`` is refused up front, naming the study file, when it is not a whole number
+    of some scenario's control periods or exceeds its step maxima (it would be an error row in every cell)."""
+    for ref in scenarios:
+        scenario = load_scenario(ref)
+        try:
+            check_run_size(time_limit_s, scenario.sim, source)
+        except ConfigError as exc:
+            raise ConfigError("time_limit_s", f"{exc.problem} for scenario {scenario.name!r}", source) from None
 
 
 def refuse_scenario_code(scenarios: tuple[str, ...], planners: tuple[Component, ...],
