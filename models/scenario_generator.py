@@ -82,6 +82,12 @@ class GeneratorOptions:
             bad("sensor_count", f"must be at least 1, got {self.sensor_count}")
         if self.time_limit_s < 0:
             bad("time_limit_s", f"must not be negative, got {self.time_limit_s:g}")
+        if self.time_limit_s > 0:  # the file must load: whole control periods of the default sim settings
+            from swarmnav.models.scenario import SimSettings, check_run_size
+            try:
+                check_run_size(self.time_limit_s, SimSettings(), SOURCE)
+            except ConfigError as exc:
+                bad("time_limit_s", exc.problem)
         if self.arena_m <= 2 * ENDPOINT_INSET_M + 1.0:
             bad("arena_m", f"must exceed {2 * ENDPOINT_INSET_M + 1.0:g} m (start and goal sit "
                            f"{ENDPOINT_INSET_M:g} m in from the edges), got {self.arena_m:g}")
@@ -126,7 +132,7 @@ def generate(kind: str, seed: int, options: GeneratorOptions | None = None) -> s
         f'name = "{name}"',
         f'description = "Generated: {command_line(kind, seed, options)}"',
         f"seed = {seed}",
-        f"time_limit_s = {time_limit:g}",
+        f"time_limit_s = {time_limit:.12g}",
         f"arena = {{ width_m = {w:g}, height_m = {w:g}, walls = false }}",
         f"robot = {{ radius_m = 0.15, max_speed_m_s = {options.robot_speed_m_s:g} }}",
         f"start = {{ x = {start[0]:g}, y = {start[1]:g}, heading_deg = 0.0 }}",

@@ -147,11 +147,21 @@ def test_generator_is_a_function_of_kind_seed_and_options():
      "navigator.params.cell_m"),
     (["scenarios", "generate", "head_on", "--seed", "1", "--obstacles", "40"], "--obstacles"),
     (["scenarios", "generate", "sideways", "--seed", "1"], "KIND"),
+    (["scenarios", "generate", "crossing", "--seed", "1", "--time-limit-s", "30.051"], "--time-limit-s"),
 ])
 def test_bad_navigation_input_exits_2_with_one_line_naming_the_field(argv, field, capsys):
     assert main(argv) == 2
     out, err = capsys.readouterr()
     assert out == "" and len(err.strip().splitlines()) == 1 and field in err, err
+
+
+def test_a_generated_time_limit_is_written_as_given_and_the_file_loads(capsys):
+    assert main(["scenarios", "generate", "crossing", "--seed", "1", "--time-limit-s", "123.46"]) == 0
+    text = capsys.readouterr().out
+    assert parse_scenario(text).time_limit_s == 123.46
+    # Seven significant digits: written with `:g` it became 12345.7, not a whole number of 0.02 s periods.
+    assert main(["scenarios", "generate", "crossing", "--seed", "1", "--time-limit-s", "12345.68"]) == 0
+    assert parse_scenario(capsys.readouterr().out).time_limit_s == 12345.68
 
 
 def test_an_unknown_sensing_model_in_a_scenario_exits_2_naming_it(tmp_path, capsys):
