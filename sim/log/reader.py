@@ -32,14 +32,14 @@ from swarmnav.sim.log.format import (
     metadata_value,
 )
 from swarmnav.sim.log.columns import Rows
-from swarmnav.sim.log.records import LogError, RawLog, read_records
+from swarmnav.sim.log.records import LogError, RawLog, RawLogView, read_records
 
 
 # -- decoding into arrays ------------------------------------------------------
 
 
 @dataclass
-class RunLog:
+class RunLog(RawLogView):
     """A run log decoded into arrays (times in seconds of simulation).
 
     Attributes:
@@ -79,18 +79,6 @@ class RunLog:
     obstacle_tracks: dict[str, tuple[np.ndarray, np.ndarray]]
     events: list[tuple[float, str, dict[str, Any]]]
     outcome: dict[str, Any] | None
-
-    @property
-    def complete(self) -> bool:
-        return self.raw.complete
-
-    @property
-    def scenario_name(self) -> str:
-        return self.metadata.get("scenario", {}).get("name", "?")
-
-    @property
-    def duration_s(self) -> float:
-        return self.raw.last_time_s()
 
     def run_value(self, key: str, default: Any = None) -> Any:
         """A value of the ``run`` metadata record, JSON-decoded."""

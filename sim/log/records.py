@@ -97,6 +97,26 @@ class RawLog:
         )
 
 
+class RawLogView:
+    """What a log read either way (:class:`~swarmnav.sim.log.reader.RunLog`, the streamed
+    :class:`~swarmnav.sim.log.summary.LogSummary`) says from its :class:`RawLog` alone."""
+
+    raw: RawLog
+    metadata: dict[str, dict[str, str]]  # the run's metadata (a field of RunLog, read from ``raw`` by LogSummary)
+
+    @property
+    def complete(self) -> bool:
+        return self.raw.complete
+
+    @property
+    def scenario_name(self) -> str:
+        return self.metadata.get("scenario", {}).get("name", "?")
+
+    @property
+    def duration_s(self) -> float:
+        return self.raw.last_time_s()
+
+
 def open_regular(path: Path) -> BinaryIO:
     """Open a regular file for reading; anything else is a one-line LogError."""
     try:

@@ -26,11 +26,11 @@ from mcap.records import Message
 
 from swarmnav.sim.log.format import EVENTS_TOPIC, metadata_value
 from swarmnav.sim.log.reader import check_channels, event_decoder
-from swarmnav.sim.log.records import LogError, RawLog, open_regular, read_records
+from swarmnav.sim.log.records import LogError, RawLog, RawLogView, open_regular, read_records
 
 
 @dataclass
-class LogSummary:
+class LogSummary(RawLogView):
     """The facts ``log info`` prints (the attributes :func:`sim.cli.log.describe` reads)."""
 
     raw: RawLog  # schemas, channels, metadata, counts; no messages
@@ -41,18 +41,6 @@ class LogSummary:
     @property
     def metadata(self) -> dict[str, dict[str, str]]:
         return self.raw.metadata
-
-    @property
-    def complete(self) -> bool:
-        return self.raw.complete
-
-    @property
-    def scenario_name(self) -> str:
-        return self.metadata.get("scenario", {}).get("name", "?")
-
-    @property
-    def duration_s(self) -> float:
-        return self.raw.last_time_s()
 
     @property
     def counts(self) -> dict[str, int]:
