@@ -40,7 +40,8 @@ from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.kinematics import DriveGeometry, wheel_speeds
 from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.prediction import LocalObstacles, time_to_collision_s
-from swarmnav.models.geometry import segment_box_distances
+from swarmnav.controllers.velocity_candidates import (candidate_times_s, chosen_candidate, unicycle_command,
+                                                     world_to_robot)
 from swarmnav.models.world import Pose2D
 
 
@@ -90,8 +91,7 @@ class Evasion:
             self.active = False
             return command, False
         centres, velocities, radii, boxes = self.local.near(pose.x_m, pose.y_m, self.reach_m, detections)
-        c, s = math.cos(pose.heading_rad), math.sin(pose.heading_rad)
-        rotate = np.array([[c, -s], [s, c]])                                   # row @ rotate: world -> robot
+        rotate = world_to_robot(pose)                                          # row @ rotate: world -> robot
         local = (centres - (pose.x_m, pose.y_m)) @ rotate
         local_v = velocities @ rotate
         grown = radii + self.robot_radius_m + self.margin_m
@@ -101,22 +101,13 @@ class Evasion:
                                                    grown[moving]).min() >= self.trigger_s:
             self.active = False
             return command, False
-        ttc = time_to_collision_s(np.zeros(2), self.candidates, local, local_v, grown).min(axis=1)
-        if len(boxes):
-            p = np.array([pose.x_m, pose.y_m])
-            ends = p + (self.candidates * self.horizon_s) @ rotate.T
-            d = segment_box_distances(np.repeat(p[None, :], len(ends), axis=0), ends, boxes).min(axis=1)
-            ttc = np.where(d < self.robot_radius_m + self.margin_m, np.minimum(ttc, 0.5 * self.horizon_s), ttc)
+        ttc = candidate_times_s(pose, rotate, self.candidates, centres, velocities, grown, boxes,
+                                self.robot_radius_m + self.margin_m, self.horizon_s)
         cost = np.hypot(self.candidates[:, 0] - own[0, 0], self.candidates[:, 1])
-        admissible = ttc >= self.horizon_s
-        k = int(np.argmin(np.where(admissible, cost, np.inf))) if admissible.any() else int(np.argmax(ttc - 1e-6 * cost))
+        k = chosen_candidate(ttc, cost, self.horizon_s)
         self.chosen_m_s = self.candidates[k]                                  # robot frame, for the record
-        speed, error = float(self.speeds[k]), float(self.offsets[k])
-        if speed < 1e-9:
-            v, omega = 0.0, 0.0
-        else:
-            omega = min(max(self.heading_gain * error, -self.max_angular_rad_s), self.max_angular_rad_s)
-            v = speed * math.cos(error) if abs(error) < self.turn_in_place_rad else 0.0
+        v, omega = unicycle_command(float(self.speeds[k]), float(self.offsets[k]), self.heading_gain,
+                                    self.max_angular_rad_s, self.turn_in_place_rad)
         rising = not self.active
         self.active = True
         return ControlCommand(wheel_speeds(v, omega, self.geometry), v, omega, command.waypoint_index), rising

@@ -44,8 +44,7 @@ from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.replan import check_positive
-from swarmnav.controllers.prediction import time_to_collision_s
-from swarmnav.models.geometry import segment_box_distances
+from swarmnav.controllers.velocity_candidates import candidate_times_s, chosen_candidate, unicycle_command
 
 
 @dataclass
@@ -123,30 +122,13 @@ class VelocityObstacleNavigator:
         cost = np.hypot(candidates[:, 0] - preferred[0], candidates[:, 1] - preferred[1])
         centres, velocities, radii, boxes = self.local.near(pose.x_m, pose.y_m, self.reach, observation.detections)
         if len(centres) or len(boxes):
-            rotate = np.array([[c, -s], [s, c]])                                           # row @ rotate: world -> robot
-            ttc = np.full(len(candidates), np.inf)
-            if len(centres):
-                local = (centres - (pose.x_m, pose.y_m)) @ rotate
-                ttc = time_to_collision_s(np.zeros(2), candidates, local, velocities @ rotate,
-                                          radii + self.inflation).min(axis=1)
-            if len(boxes):
-                p = np.array([pose.x_m, pose.y_m])
-                ends = p + (candidates * self.time_horizon_s) @ rotate.T
-                d = segment_box_distances(np.repeat(p[None, :], len(ends), axis=0), ends, boxes).min(axis=1)
-                ttc = np.where(d < self.inflation, np.minimum(ttc, self.time_horizon_s * 0.5), ttc)
-            admissible = ttc >= self.time_horizon_s
-            if admissible.any():
-                k = int(np.argmin(np.where(admissible, cost, np.inf)))
-            else:
-                k = int(np.argmax(ttc - 1e-6 * cost))
+            ttc = candidate_times_s(pose, np.array([[c, -s], [s, c]]), candidates, centres, velocities,
+                                    radii + self.inflation, boxes, self.inflation, self.time_horizon_s)
+            k = chosen_candidate(ttc, cost, self.time_horizon_s)
         else:
             k = int(np.argmin(cost))
-        speed, error = float(self.speeds[k]), float(self.offsets[k])
-        if speed < 1e-9:
-            v, omega = 0.0, 0.0
-        else:
-            omega = min(max(self.heading_gain * error, -self.max_angular_rad_s), self.max_angular_rad_s)
-            v = speed * math.cos(error) if abs(error) < self.turn_in_place_rad else 0.0
+        v, omega = unicycle_command(float(self.speeds[k]), float(self.offsets[k]), self.heading_gain,
+                                    self.max_angular_rad_s, self.turn_in_place_rad)
         command = ControlCommand(wheel_speeds(v, omega, self.geometry), v, omega, 0)
         events = []
         if self.filter is not None:
