@@ -80,8 +80,8 @@ class GeneratorOptions:
             bad("sensor_model", f"unknown sensing model {self.sensor_model!r} (expected rangefinder or detector)")
         if self.sensor_count < 1:
             bad("sensor_count", f"must be at least 1, got {self.sensor_count}")
-        if self.time_limit_s < 0:
-            bad("time_limit_s", f"must not be negative, got {self.time_limit_s:g}")
+        if not self.time_limit_s >= 0:  # NaN too
+            bad("time_limit_s", f"must be a number not below 0, got {self.time_limit_s:g}")
         if self.time_limit_s > 0:  # the file must load: whole control periods of the default sim settings
             from swarmnav.models.scenario import SimSettings, check_run_size
             try:

@@ -148,6 +148,7 @@ def test_generator_is_a_function_of_kind_seed_and_options():
     (["scenarios", "generate", "head_on", "--seed", "1", "--obstacles", "40"], "--obstacles"),
     (["scenarios", "generate", "sideways", "--seed", "1"], "KIND"),
     (["scenarios", "generate", "crossing", "--seed", "1", "--time-limit-s", "30.051"], "--time-limit-s"),
+    (["scenarios", "generate", "crossing", "--seed", "1", "--time-limit-s", "nan"], "--time-limit-s"),
 ])
 def test_bad_navigation_input_exits_2_with_one_line_naming_the_field(argv, field, capsys):
     assert main(argv) == 2
