@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from swarmnav.controllers.hit_motion import fit_moving_disc
 from swarmnav.controllers.navigator import DetectedObstacle
 
 
@@ -60,6 +61,8 @@ class _Track:
     measured: bool = False  # the radius came from a circle fit (else a lower bound or the default)
     fits_m: list[float] = field(default_factory=list)  # the radii of its circle fits
     velocity_m_s: tuple[float, float] = (0.0, 0.0)
+    hit_times_s: list[float] = field(default_factory=list)  # every hit it took in the window, and when
+    hits_m: list[tuple[float, float]] = field(default_factory=list)
 
     def predicted(self, time_s: float) -> tuple[float, float]:
         x, y = self.centres_m[-1]
@@ -81,6 +84,10 @@ class HitTracker:
         max_radius_m: circle fits larger than this are discarded (nearly collinear hits: a wall-like arc).
         clear_m: how far inside a coasting track's rim a beam must pass unhindered to contradict it.
         jump_m: a new centre this far from the predicted one restarts the velocity window.
+        hit_motion: step 5 fits the centre and velocity to the window's raw hits
+            (:func:`controllers.hit_motion.fit_moving_disc`, ours) instead of regressing the steps' centres;
+            False: the regression alone.
+        hit_motion_rms_m: a hit fit whose rim residual exceeds this (the hits are not one disc) is not used.
     """
 
     default_radius_m: float = 0.3
@@ -92,6 +99,8 @@ class HitTracker:
     max_radius_m: float = 0.6
     clear_m: float = 0.05
     jump_m: float = 0.3
+    hit_motion: bool = True
+    hit_motion_rms_m: float = 0.03
 
     def __post_init__(self) -> None:
         self.reach_m = math.inf  # the beams' reach (set by the sensing); misses say nothing beyond it
@@ -210,13 +219,13 @@ class HitTracker:
                 fit = self._fit_one(hits[0], origins[0], track.predicted(time_s), track.radius_m)
             else:
                 fit = self._fit(hits, origins, track.radius_m)
-            self._observe(track, time_s, *fit)
+            self._observe(track, time_s, *fit, hits)
             seen.add(track.track_id)
         for di in range(len(clusters)):
             if di not in used_d:
                 track = _Track(self._next_id)
                 self._next_id += 1
-                self._observe(track, time_s, *self._fit(*clusters[di]))
+                self._observe(track, time_s, *self._fit(*clusters[di]), clusters[di][0])
                 self._tracks.append(track)
                 seen.add(track.track_id)
         return seen
@@ -266,7 +275,8 @@ class HitTracker:
                 keep.append(track)
         self._tracks = keep
 
-    def _observe(self, track: _Track, time_s: float, x: float, y: float, r: float, measured: bool) -> None:
+    def _observe(self, track: _Track, time_s: float, x: float, y: float, r: float, measured: bool,
+                 hits: np.ndarray) -> None:
         if track.times_s:
             px, py = track.predicted(time_s)
             if math.hypot(x - px, y - py) > self.jump_m:
@@ -274,9 +284,13 @@ class HitTracker:
                 # about the motion any more.
                 track.times_s.clear()
                 track.centres_m.clear()
+                track.hit_times_s.clear()
+                track.hits_m.clear()
                 track.velocity_m_s = (0.0, 0.0)
         track.times_s.append(time_s)
         track.centres_m.append((x, y))
+        track.hit_times_s.extend([time_s] * len(hits))
+        track.hits_m.extend(map(tuple, hits))
         if measured:
             track.fits_m.append(r)
             del track.fits_m[:-20]
@@ -286,13 +300,29 @@ class HitTracker:
         while track.times_s[0] < time_s - self.window_s:
             track.times_s.pop(0)
             track.centres_m.pop(0)
+        while track.hit_times_s[0] < time_s - self.window_s:
+            track.hit_times_s.pop(0)
+            track.hits_m.pop(0)
         t = np.array(track.times_s)
         if t[-1] - t[0] < self.min_span_s:
             return
         c = np.array(track.centres_m)
         tc = t - t.mean()
         v = (tc @ (c - c.mean(axis=0))) / float(tc @ tc)
+        if self.hit_motion:
+            v = self._hit_motion(track, time_s, v)
         speed = float(np.hypot(v[0], v[1]))
         if speed > self.max_speed_m_s:
             v *= self.max_speed_m_s / speed
         track.velocity_m_s = (float(v[0]), float(v[1]))
+
+    def _hit_motion(self, track: _Track, time_s: float, regressed_m_s: np.ndarray) -> np.ndarray:
+        """Step 5 with ``hit_motion``: the centre and velocity of the disc through the window's raw hits
+        (replacing the step's centre); the regressed velocity when the hits do not fit one moving disc."""
+        centre, velocity, rms = fit_moving_disc(np.array(track.hit_times_s), np.array(track.hits_m),
+                                                track.radius_m, time_s, np.array(track.centres_m[-1]),
+                                                np.array(track.velocity_m_s))
+        if rms > self.hit_motion_rms_m or math.hypot(*(centre - track.centres_m[-1])) > self.jump_m:
+            return regressed_m_s
+        track.centres_m[-1] = (float(centre[0]), float(centre[1]))
+        return velocity
