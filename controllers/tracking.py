@@ -5,7 +5,8 @@ every control step, each with the position of the sensor that saw it.  The
 tracker does only what the rays allow:
 
 1. **Clusters** the hits by single linkage: two hits closer than
-   ``2 * default_radius_m`` may lie on one disc, so they join one cluster.
+   ``2 * default_radius_m``, whose rays are less than ``max_link_angle_deg`` apart,
+   may lie on one disc, so they join one cluster.
 2. **Fits a disc** to each cluster.  With three hits or more the radius is
    measured by a least-squares circle fit (Kasa 1976); otherwise it is the
    track's radius so far, or ``default_radius_m`` (the assumed obstacle
@@ -24,7 +25,9 @@ tracker does only what the rays allow:
    centre, on the side the ray came from (the least change that explains the hit).
 5. **Estimates the velocity** of each track as the least-squares slope of its
    centres over the last ``window_s`` (zero until two samples span ``min_span_s``);
-   a centre more than ``jump_m`` from the predicted one restarts the window.
+   a centre more than ``jump_m`` from the predicted one restarts the window.  With
+   ``hit_motion`` (default) the velocity is instead that of the disc fitted to the
+   window's raw hits (:mod:`controllers.hit_motion`), when they fit one disc.
 6. **Coasts** an unseen track (position predicted with its velocity) for
    ``keep_s``, then forgets it: an obstacle that slips between two beams, or out
    of range, is still reported for a moment; but when the beams are given
@@ -88,6 +91,10 @@ class HitTracker:
             (:func:`controllers.hit_motion.fit_moving_disc`, ours) instead of regressing the steps' centres;
             False: the regression alone.
         hit_motion_rms_m: a hit fit whose rim residual exceeds this (the hits are not one disc) is not used.
+        max_link_angle_deg: step 1 links two hits only if their rays are less than this apart (ours; 180: off).
+            A disc the robot is not touching subtends less than 90 degrees unless it is over 2.4 times the
+            robot's radius; hits on two discs either side of the robot, closer than ``2 * default_radius_m``,
+            made one phantom disc between them, over the robot (dyn-overtake-2).
     """
 
     default_radius_m: float = 0.3
@@ -101,6 +108,7 @@ class HitTracker:
     jump_m: float = 0.3
     hit_motion: bool = True
     hit_motion_rms_m: float = 0.03
+    max_link_angle_deg: float = 90.0
 
     def __post_init__(self) -> None:
         self.reach_m = math.inf  # the beams' reach (set by the sensing); misses say nothing beyond it
@@ -121,7 +129,7 @@ class HitTracker:
         """
         hits = np.asarray(hits_m, dtype=float).reshape(-1, 2)
         origins = np.asarray(origins_m, dtype=float).reshape(-1, 2)
-        clusters = [(hits[idx], origins[idx]) for idx in self._clusters(hits)]
+        clusters = [(hits[idx], origins[idx]) for idx in self._clusters(hits, origins)]
         seen = self._associate(time_s, clusters)
         self._tracks = [t for t in self._tracks if time_s - t.times_s[-1] <= self.keep_s]
         if beams is not None:
@@ -133,11 +141,15 @@ class HitTracker:
             out.append(DetectedObstacle(x, y, t.radius_m, t.velocity_m_s[0], t.velocity_m_s[1], t.track_id))
         return tuple(out)
 
-    def _clusters(self, hits: np.ndarray) -> list[np.ndarray]:
+    def _clusters(self, hits: np.ndarray, origins: np.ndarray) -> list[np.ndarray]:
         n = len(hits)
         if n == 0:
             return []
         near = np.hypot(*(hits[:, None, :] - hits[None, :, :]).transpose(2, 0, 1)) < 2.0 * self.default_radius_m
+        if self.max_link_angle_deg < 180.0:
+            rays = hits - origins
+            rays /= np.maximum(np.linalg.norm(rays, axis=1, keepdims=True), 1e-12)
+            near &= rays @ rays.T > math.cos(math.radians(self.max_link_angle_deg))
         label = -np.ones(n, dtype=np.int64)
         clusters = []
         for i in range(n):
@@ -317,12 +329,12 @@ class HitTracker:
         track.velocity_m_s = (float(v[0]), float(v[1]))
 
     def _hit_motion(self, track: _Track, time_s: float, regressed_m_s: np.ndarray) -> np.ndarray:
-        """Step 5 with ``hit_motion``: the centre and velocity of the disc through the window's raw hits
-        (replacing the step's centre); the regressed velocity when the hits do not fit one moving disc."""
+        """Step 5 with ``hit_motion``: the velocity of the disc through the window's raw hits (the step's
+        centre stays: replacing it too changed little on dyn300 and lost dyn-overtake-2); the regressed velocity
+        when the hits do not fit one moving disc."""
         centre, velocity, rms = fit_moving_disc(np.array(track.hit_times_s), np.array(track.hits_m),
                                                 track.radius_m, time_s, np.array(track.centres_m[-1]),
                                                 np.array(track.velocity_m_s))
         if rms > self.hit_motion_rms_m or math.hypot(*(centre - track.centres_m[-1])) > self.jump_m:
             return regressed_m_s
-        track.centres_m[-1] = (float(centre[0]), float(centre[1]))
         return velocity
