@@ -128,6 +128,9 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", action="append", help="only these scenarios (repeatable; default: the dyn-* suite)")
     parser.add_argument("--navigator-set", action="append", metavar="KEY=VALUE",
                         help="a parameter for every navigator that has it (repeatable), e.g. policy=module:function")
+    parser.add_argument("--arm", action="append", metavar="LABEL:NAVIGATOR[:KEY=VALUE,...]",
+                        help="one more row: a navigator under its own label with its own parameters (repeatable), "
+                             "e.g. iaco_local+evade:iaco_local:evade=true")
     parser.add_argument("--by-scenario", action="store_true",
                         help="also one row per navigator and scenario, after the overall rows")
     parser.add_argument("--out", metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
