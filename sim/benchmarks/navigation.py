@@ -186,16 +186,19 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                          by_scenario: bool = False, out_dir: str | None = None, suite: str | None = None,
                          quick: bool = False, sensor_model: str | None = None,
                          workers: int = 1, speed: bool = True, per_group: int | None = None,
-                         arms: list[Arm] = ()) -> list[dict[str, Any]]:
+                         arms: list[Arm] = (), engine: str = "local", address: str | None = None
+                         ) -> list[dict[str, Any]]:
     """One row per navigator and the oracle's (see the module docstring); ``navigator_params``: per navigator
     name.  With ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key;
     the overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given;
     ``suite`` (e.g. ``dyn300``) runs a generated suite instead of ``scenarios``; ``arms``: more rows, each a
-    navigator under its own label with its own parameters (the rows are keyed by label)."""
+    navigator under its own label with its own parameters (the rows are keyed by label); ``engine="ray"``:
+    the runs on Ray (a local instance of ``workers`` CPUs, or the cluster at ``address``)."""
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
             return benchmark_navigation(seeds, navigators, scenarios, progress, navigator_params, by_scenario,
-                                        folder, suite, quick, sensor_model, workers, speed, per_group, arms)
+                                        folder, suite, quick, sensor_model, workers, speed, per_group, arms,
+                                        engine, address)
     from swarmnav.sim.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
@@ -209,7 +212,8 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     else:
         names, run_seeds = scenarios or suite_names(), seeds
     tables = navigation_study(run_seeds, contenders + [ORACLE], names, navigator_params, list(arms))
-    rows = run_study_tables(tables, out_dir, show_progress=progress, workers=workers)
+    rows = run_study_tables(tables, out_dir, show_progress=progress, workers=workers, engine=engine,
+                            address=address)
     verdicts = oracle_verdicts(rows)
     labels = contenders + [a.label for a in arms] + [ORACLE]
     runs = {label: [r for r in rows if r["navigator_label"] == label] for label in labels}
@@ -297,6 +301,8 @@ def run(args: argparse.Namespace) -> int:
         if name not in NAVIGATORS:
             raise ConfigError("--navigator", f"unknown navigator {name!r} (known: {', '.join(sorted(NAVIGATORS))})")
     if args.suite == "papers":
+        if getattr(args, "engine", "local") == "ray":
+            raise ConfigError("--engine", "ray applies to the dyn and dyn300 suites (papers runs in this process)")
         from swarmnav.sim.benchmarks.paper_navigation import (PAPER_SUITE, benchmark_paper_navigation,
                                                               print_table)
         paper_rows = benchmark_paper_navigation(args.seeds, tuple(args.scenario or PAPER_SUITE), args.out)
@@ -308,6 +314,8 @@ def run(args: argparse.Namespace) -> int:
     suite = None if args.suite == "dyn" else args.suite
     if suite is None and getattr(args, "sensor_model", None):
         raise ConfigError("--sensor-model", "applies to a generated suite (--suite dyn300) only")
+    if getattr(args, "address", None) and getattr(args, "engine", "local") != "ray":
+        raise ConfigError("--address", "applies to --engine ray only")
     if suite is None and getattr(args, "per_group", None):
         raise ConfigError("--per-group", "applies to a generated suite (--suite dyn300) only")
     arms = [parse_arm(text) for text in getattr(args, "arm", None) or []]
@@ -317,7 +325,8 @@ def run(args: argparse.Namespace) -> int:
                                 quick=bool(getattr(args, "quick", False)) and suite is not None,
                                 sensor_model=getattr(args, "sensor_model", None),
                                 workers=getattr(args, "workers", 1) or 1, per_group=getattr(args, "per_group", None),
-                                arms=arms)
+                                arms=arms, engine=getattr(args, "engine", "local"),
+                                address=getattr(args, "address", None))
     if args.json:
         print(json.dumps(rows))
         return 0

@@ -148,7 +148,11 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sensor-model", choices=("detector", "rangefinder"),
                         help="--suite dyn300 only: every scene with this sensing (rangefinder: 12 at 1 m)")
     parser.add_argument("--workers", type=options.positive_int, default=1,
-                        help="local worker processes for the runs (default 1: in this process)")
+                        help="local worker processes for the runs (default 1: in this process); with --engine "
+                             "ray: the local instance's CPUs")
+    parser.add_argument("--engine", choices=("local", "ray"), default="local",
+                        help="where the runs go: local processes (default) or Ray (the study engines)")
+    parser.add_argument("--address", help="with --engine ray: the cluster to join (default: a local instance)")
 
 
 def run_bench_navigation(args: argparse.Namespace) -> int:
