@@ -121,3 +121,26 @@ def test_bad_arms_are_one_line_and_exit_2(arm, message, capsys):
     assert main(["bench", "navigation", "--quick", "--navigator", "follow", "--arm", arm]) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
+
+
+def test_a_seed_offset_gives_held_out_scenes_of_the_same_groups():
+    from swarmnav.models.suites import load_suite
+    suite, held_out = load_suite("dyn300"), load_suite("dyn300", seed_offset=1000)
+    assert len(held_out.scenes) == len(suite.scenes) and held_out.verdicts == {}
+    assert not {s.name for s in suite.scenes} & {s.name for s in held_out.scenes}
+    own = {(s.group, s.seed): s for s in suite.scenes}
+    for scene in held_out.scenes:
+        twin = own[(scene.group, scene.seed - 1000)]
+        assert scene.kind == twin.kind and scene.name == f"d300-{scene.group}-{scene.seed}"
+        assert {k: v for k, v in vars(scene.options).items() if k != "name"} == \
+            {k: v for k, v in vars(twin.options).items() if k != "name"}
+    assert held_out.scenes[0].text() != own[(held_out.scenes[0].group, held_out.scenes[0].seed - 1000)].text()
+    with pytest.raises(ConfigError, match="--seed-offset"):
+        load_suite("dyn300", seed_offset=-1)
+
+
+def test_a_seed_offset_without_a_generated_suite_is_one_line_and_exit_2(capsys):
+    from swarmnav.sim.cli.main import main
+    assert main(["bench", "navigation", "--quick", "--seed-offset", "5"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--seed-offset" in err and len(err.splitlines()) == 1

@@ -163,12 +163,13 @@ def oracle_verdicts(rows: list[dict[str, Any]]) -> dict[tuple[str, int], dict[st
 
 
 def write_suite(suite_name: str, quick: bool, sensor_model: str | None, folder: str,
-                per_group: int | None = None) -> tuple[list[str], Any]:
+                per_group: int | None = None, seed_offset: int = 0) -> tuple[list[str], Any]:
     """The suite's scenes as TOML files under ``folder`` (paths, in order of difficulty) and the suite;
-    ``quick``: a stratified sample of 2 scenes per group, ``per_group``: of that many."""
+    ``quick``: a stratified sample of 2 scenes per group, ``per_group``: of that many; ``seed_offset``: the
+    held-out scenes of the same groups (:func:`models.suites.load_suite`)."""
     import os
     from swarmnav.models.suites import load_suite, stratified_sample
-    suite = load_suite(suite_name, sensor_model)
+    suite = load_suite(suite_name, sensor_model, seed_offset)
     scenes = (stratified_sample(suite, per_group) if per_group is not None
               else stratified_sample(suite) if quick else suite.scenes)
     os.makedirs(os.path.join(folder, "scenarios"), exist_ok=True)
@@ -186,8 +187,8 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                          by_scenario: bool = False, out_dir: str | None = None, suite: str | None = None,
                          quick: bool = False, sensor_model: str | None = None,
                          workers: int = 1, speed: bool = True, per_group: int | None = None,
-                         arms: list[Arm] = (), engine: str = "local", address: str | None = None
-                         ) -> list[dict[str, Any]]:
+                         arms: list[Arm] = (), engine: str = "local", address: str | None = None,
+                         seed_offset: int = 0) -> list[dict[str, Any]]:
     """One row per navigator and the oracle's (see the module docstring); ``navigator_params``: per navigator
     name.  With ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key;
     the overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given;
@@ -198,7 +199,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
             return benchmark_navigation(seeds, navigators, scenarios, progress, navigator_params, by_scenario,
                                         folder, suite, quick, sensor_model, workers, speed, per_group, arms,
-                                        engine, address)
+                                        engine, address, seed_offset)
     from swarmnav.sim.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
@@ -206,7 +207,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     check_arms(contenders, list(arms))
     shipped: dict[str, dict[str, Any]] = {}
     if suite is not None:
-        names, loaded = write_suite(suite, quick, sensor_model, out_dir, per_group)
+        names, loaded = write_suite(suite, quick, sensor_model, out_dir, per_group, seed_offset)
         shipped = loaded.verdicts
         run_seeds = None
     else:
@@ -316,6 +317,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("--sensor-model", "applies to a generated suite (--suite dyn300) only")
     if getattr(args, "address", None) and getattr(args, "engine", "local") != "ray":
         raise ConfigError("--address", "applies to --engine ray only")
+    if suite is None and getattr(args, "seed_offset", 0):
+        raise ConfigError("--seed-offset", "applies to a generated suite (--suite dyn300) only")
     if suite is None and getattr(args, "per_group", None):
         raise ConfigError("--per-group", "applies to a generated suite (--suite dyn300) only")
     arms = [parse_arm(text) for text in getattr(args, "arm", None) or []]
@@ -326,7 +329,8 @@ def run(args: argparse.Namespace) -> int:
                                 sensor_model=getattr(args, "sensor_model", None),
                                 workers=getattr(args, "workers", 1) or 1, per_group=getattr(args, "per_group", None),
                                 arms=arms, engine=getattr(args, "engine", "local"),
-                                address=getattr(args, "address", None))
+                                address=getattr(args, "address", None),
+                                seed_offset=getattr(args, "seed_offset", 0) or 0)
     if args.json:
         print(json.dumps(rows))
         return 0

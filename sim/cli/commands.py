@@ -145,6 +145,9 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
                              "with --suite dyn300: a stratified sample, 2 scenes per group")
     parser.add_argument("--per-group", type=options.positive_int, metavar="N",
                         help="--suite dyn300 only: a stratified sample of N scenes per group (--quick: 2)")
+    parser.add_argument("--seed-offset", type=options.non_negative_int, default=0, metavar="N",
+                        help="--suite dyn300 only: every group's seeds shifted by N, a held-out set of the same "
+                             "families (no shipped verdicts: the oracle decides each scene in the run)")
     parser.add_argument("--sensor-model", choices=("detector", "rangefinder"),
                         help="--suite dyn300 only: every scene with this sensing (rangefinder: 12 at 1 m)")
     parser.add_argument("--workers", type=options.positive_int, default=1,
