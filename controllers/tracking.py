@@ -87,7 +87,7 @@ class HitTracker:
         max_radius_m: circle fits larger than this are discarded (nearly collinear hits: a wall-like arc).
         clear_m: how far inside a coasting track's rim a beam must pass unhindered to contradict it.
         jump_m: a new centre this far from the predicted one restarts the velocity window.
-        hit_motion: step 5 fits the centre and velocity to the window's raw hits
+        hit_motion: step 5 takes the velocity of the moving disc fitted to the window's raw hits
             (:func:`controllers.hit_motion.fit_moving_disc`, ours) instead of regressing the steps' centres;
             False: the regression alone.
         hit_motion_rms_m: a hit fit whose rim residual exceeds this (the hits are not one disc) is not used.
