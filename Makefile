@@ -71,7 +71,7 @@ readme-table: $(STAMP)
 		cp studies/readme-table/$$s/claims.json models/studies/results/$$s/claims.json || exit 1; \
 	done
 	$(BIN)/swarmnav report --readme-table models/studies/results --readme README.md
-	for r in dyn300 dyn; do $(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/$$r.json --readme README.md || exit 1; done
+	for r in dyn300 dyn300-rangefinder dyn; do $(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/$$r.json --readme README.md || exit 1; done
 
 clean:
 	rm -rf $(VENV) build *.egg-info

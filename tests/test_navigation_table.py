@@ -95,3 +95,11 @@ def test_the_summary_under_a_table_is_computed_from_its_rows():
     ranged_lines = summary_lines(ranged)
     assert "target ≥ 0.85: not met" in ranged_lines[0]
     assert not any("Every online" in line for line in ranged_lines)   # no such target with rangefinders
+
+
+def test_the_committed_rangefinder_result_is_all_300_scenes_with_the_rangefinders():
+    from swarmnav.models.suites import load_suite
+    rows = read_rows(RESULTS[2])
+    assert {r["sensor_model"] for r in rows} == {"rangefinder"}
+    assert {r["runs"] for r in rows} == {len(load_suite("dyn300").scenes)}
+    assert rows[-1]["navigator"] == "oracle" and rows[-1]["verdict_mismatches"] == 0

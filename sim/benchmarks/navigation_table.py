@@ -4,7 +4,8 @@
 per navigator and the oracle's, from the overall rows of the JSON that ``swarmnav bench navigation [--suite
 dyn300] --json`` printed); with ``--readme FILE`` it replaces the lines between the markers that name that
 result (:func:`begin_marker`, :data:`END`) in FILE instead.  The committed results are :data:`RESULTS`
-(``models/suites/results/dyn300.json``: the 300-scene suite; ``dyn.json``: the bundled ``dyn-*`` scenes); ``make
+(``models/suites/results/dyn300.json``: the 300-scene suite; ``dyn.json``: the bundled ``dyn-*`` scenes;
+``dyn300-rangefinder.json``: the 300 scenes with the 12 rangefinders at 1 m); ``make
 readme-table`` regenerates the README's tables from them (the runs themselves are long and are not part of the
 target).
 """
@@ -22,7 +23,7 @@ from swarmnav.models.errors import ConfigError
 END = "<!-- end of navigation-table -->"
 RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results"
 RESULT = RESULTS_DIR / "dyn300.json"
-RESULTS = (RESULT, RESULTS_DIR / "dyn.json")
+RESULTS = (RESULT, RESULTS_DIR / "dyn.json", RESULTS_DIR / "dyn300-rangefinder.json")
 
 
 def begin_marker(result: FilePath) -> str:
