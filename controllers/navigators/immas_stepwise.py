@@ -56,6 +56,7 @@ from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.evasion import evaded, evasion_for
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, static_grid
+from swarmnav.controllers.navigators.immas_drive import DriveThrough
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.improved_max_min_ant_system import ImprovedMaxMinAntSystemPlanner, tour_scores
@@ -211,12 +212,18 @@ class ImmasStepwiseNavigator:
         reach_m: distance to a cell's centre at which the robot has reached it.
         evade, evade_trigger_s: the evasion layer of :mod:`controllers.evasion` (off by default: not the
             paper's; a named option beyond it) and its trigger.
+        lookahead_cells, carrot_m: beyond the paper, off by default (0: the paper's robot, which stops at
+            each cell): drive through the walk, the next cell still Eq. (3)'s choice at each cell reached,
+            the controller steering at a carrot ``carrot_m`` along the walk carried on ``lookahead_cells``
+            cells ahead (:mod:`controllers.navigators.immas_drive`, which says why: stopping at every cell
+            made most of its dyn300 runs time out).
     """
 
     name: ClassVar[str] = "immas_stepwise"
     parameter_ranges: ClassVar[dict[str, Range]] = {
         "alpha": within(0, 100), "beta": within(0, 100), "reach_m": above(0, 100),
-        "evade_trigger_s": within(0, 600)}  # models.parameters: checked on build
+        "evade_trigger_s": within(0, 600), "lookahead_cells": within(0, 1000),
+        "carrot_m": above(0, 100)}  # models.parameters: checked on build
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured
@@ -225,6 +232,8 @@ class ImmasStepwiseNavigator:
     reach_m: float = 0.1
     evade: bool = False
     evade_trigger_s: float = 2.0
+    lookahead_cells: int = 0
+    carrot_m: float = 0.4
 
     def __post_init__(self) -> None:
         for key, ok, problem in (("alpha", self.alpha is None or self.alpha >= 0, "must not be negative"),
@@ -259,6 +268,8 @@ class ImmasStepwiseNavigator:
         self.target: Cell | None = None
         self._diverted = False
         self._started = False
+        self.drive = (DriveThrough(self.walk, grid, setup.controller, self.lookahead_cells, self.carrot_m, start)
+                      if self.lookahead_cells > 0 else None)
 
     def _dynamic(self, observation: Observation, ahead_s: Iterable[float]) -> np.ndarray:
         """Cells an obstacle occupies now and (``ahead_s`` > 0) on its way to its next node.
@@ -288,7 +299,16 @@ class ImmasStepwiseNavigator:
     def step(self, observation: Observation) -> NavigationStep:
         """The paper's step; with ``evade`` (off by default: not the paper's) the evasion layer of
         :mod:`controllers.evasion` on its command."""
-        return evaded(self.evasion, observation, self._paper_step(observation))
+        return evaded(self.evasion, observation, self._paper_step(observation) if self.drive is None
+                      else self._drive_step(observation))
+
+    def _drive_step(self, observation: Observation) -> NavigationStep:
+        """``lookahead_cells`` > 0: driving through the walk (:class:`~controllers.navigators.immas_drive.DriveThrough`)."""
+        command, new_path, events = self.drive.step(
+            observation.pose, observation.twist,
+            lambda ahead: self._dynamic(observation, (0.0, self.step_s) if ahead else (0.0,)))
+        self.moves, self.arc_cost, self.diverts = self.drive.moves, self.drive.arc_cost, self.drive.diverts
+        return NavigationStep(command, new_path, tuple(events))
 
     def _paper_step(self, observation: Observation) -> NavigationStep:
         events: list[tuple[str, dict[str, Any]]] = []
