@@ -1,0 +1,99 @@
+"""``immas_stepwise``'s ``lookahead_cells`` and ``carrot_m`` (beyond Hasan et al. (2023), off by default):
+driving through the walk instead of stopping at each cell."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from swarmnav.controllers.navigators import make_navigator
+from swarmnav.controllers.navigators.cell_path import static_grid
+from swarmnav.controllers.navigators.immas_drive import carrot_on, nearest_index, walk_ahead
+from swarmnav.controllers.navigators.immas_stepwise import StepwiseWalk
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import load_scenario, parse_scenario
+from swarmnav.models.suites import load_suite
+from swarmnav.planners.pheromone_propagation import analyse_environment
+from swarmnav.planners.problem import scenario_problem
+from swarmnav.sim.episode import EpisodeSpec, run_episode
+
+EMPTY = """
+name = "empty-slant"
+seed = 1
+time_limit_s = 120
+arena = { width_m = 8, height_m = 8, walls = false }
+robot = { radius_m = 0.15, max_speed_m_s = 0.2 }
+start = { x = 1, y = 3, heading_deg = 0.0 }
+goal = { x = 7, y = 5, tolerance_m = 0.1 }
+sensors = { model = "detector", count = 12, range_m = 2 }
+planner = { name = "astar", params = {} }
+sim = { cell_m = 0.1 }
+"""
+
+
+def _run(scenario, **params):
+    return run_episode(EpisodeSpec(scenario, navigator="immas_stepwise", navigator_params=params)).result
+
+
+def test_the_walk_ahead_is_eq3s_choice_from_each_cell_in_turn():
+    base = load_scenario("immas-dynamic-10x10")
+    grid = static_grid(scenario_problem(base))
+    start = grid.cell_of(base.start.x_m, base.start.y_m)
+    goal = grid.cell_of(base.goal.x_m, base.goal.y_m)
+    walk = StepwiseWalk(analyse_environment(grid.occupied, start, goal), goal, 3.0, 1.0)
+    visited = np.zeros(grid.shape, dtype=bool)
+    dynamic = np.zeros(grid.shape, dtype=bool)
+    unblocked = walk.choose(start, visited, dynamic)
+    dynamic[unblocked] = True                                    # a sensed obstacle on the first choice
+    cells = walk_ahead(start, goal, 3, visited, dynamic, walk.choose, walk.choose)
+    assert len(cells) == 5 and not visited.any()                 # the next cell and 3 beyond; marks untouched
+    assert cells[1] != unblocked
+    marks = visited.copy()
+    for here, nxt in zip(cells, cells[1:]):
+        marks[here] = True
+        assert nxt == walk.choose(here, marks, dynamic) and not dynamic[nxt]
+    whole = walk_ahead(start, goal, 1000, visited, dynamic, walk.choose, walk.choose)
+    assert whole[-1] == goal and len(whole) < 1000               # stops at the goal
+
+
+def test_the_carrot_is_measured_along_the_walk_and_rounds_its_bends():
+    centres = np.array([[0.0, 0.0], [0.1, 0.0], [0.2, 0.1], [0.3, 0.2]])   # straight, then 45 degrees
+    d = math.hypot(0.1, 0.1)
+    assert np.allclose(carrot_on(centres, 0, 0.1 + d / 2), [0.15, 0.05])
+    assert np.allclose(carrot_on(centres, 1, 10.0), centres[-1])             # past the end: the end
+    assert nearest_index(centres, 0.05, 0.0) == 1 and nearest_index(centres, 0.04, 0.0) == 0  # a tie: the later
+
+
+def test_driving_through_the_walk_takes_half_the_time_of_stepping_and_a_short_carrot_crawls():
+    """No obstacle: stepping cell by cell (the paper's robot) slows into every cell and turns on the spot at
+    each bend of its 8-neighbour walk; driving through reaches the goal near the top speed."""
+    scenario = parse_scenario(EMPTY)
+    stepping = _run(scenario)
+    through = _run(scenario, lookahead_cells=6)
+    crawling = _run(scenario, lookahead_cells=6, carrot_m=0.1)   # the carrot inside the controller's slow-down
+    straight_s = math.hypot(6.0, 2.0) / 0.2
+    assert stepping.success and through.success and crawling.success
+    assert through.sim_time_s < 1.15 * straight_s < 0.6 * stepping.sim_time_s
+    assert crawling.sim_time_s > 2.0 * through.sim_time_s
+
+
+def test_a_walk_that_holds_its_cell_chooses_again_and_reaches_the_goal():
+    """dyn300's d300-cross5-11 with the evasion on: stepping, the walk found no free neighbour 0.8 m out and
+    held that cell for the rest of the run (it decides only on reaching a cell); driving through, it
+    chooses again while it holds and reaches the goal."""
+    scene = next(s for s in load_suite("dyn300").scenes if s.name == "d300-cross5-11")
+    scenario = parse_scenario(scene.text(), scene.name)
+    stepping = _run(scenario, evade=True)
+    through = _run(scenario, evade=True, lookahead_cells=6)
+    assert stepping.outcome == "timeout" and stepping.path_length_m < 2.0
+    assert through.success, through.summary()
+
+
+@pytest.mark.parametrize("key, value", [("lookahead_cells", -1), ("lookahead_cells", 2.5), ("lookahead_cells", 5000),
+                                        ("carrot_m", 0.0), ("carrot_m", float("nan"))])
+def test_bad_drive_options_name_the_field(key, value):
+    with pytest.raises(ConfigError) as err:
+        make_navigator("immas_stepwise", {key: value})
+    assert err.value.field == f"navigator.params.{key}"
