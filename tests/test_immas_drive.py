@@ -83,17 +83,39 @@ def test_a_walk_that_holds_its_cell_chooses_again_and_reaches_the_goal():
     """dyn300's d300-cross5-11 with the evasion on: stepping, the walk found no free neighbour 0.8 m out and
     held that cell for the rest of the run (it decides only on reaching a cell); driving through, it
     chooses again while it holds and reaches the goal."""
-    scene = next(s for s in load_suite("dyn300").scenes if s.name == "d300-cross5-11")
-    scenario = parse_scenario(scene.text(), scene.name)
+    scenario = _suite_scene("d300-cross5-11")
     stepping = _run(scenario, evade=True)
     through = _run(scenario, evade=True, lookahead_cells=6)
     assert stepping.outcome == "timeout" and stepping.path_length_m < 2.0
     assert through.success, through.summary()
 
 
+def _suite_scene(name: str):
+    scene = next(s for s in load_suite("dyn300").scenes if s.name == name)
+    return parse_scenario(scene.text(), scene.name)
+
+
+def test_looking_further_ahead_keeps_the_walk_out_of_a_fast_crossers_way():
+    """dyn300's d300-fast2-13 (crossers twice the robot's speed), driving through with the evasion on: with
+    the paper's Dobstacle (at most one cell move ahead) the walk went into a crosser's path and was run
+    into; with the sweeps over ``predict_s`` it keeps out of them."""
+    scenario = _suite_scene("d300-fast2-13")
+    near = _run(scenario, evade=True, lookahead_cells=6)
+    far = _run(scenario, evade=True, lookahead_cells=6, predict_s=1.0)
+    assert near.collisions >= 1
+    assert far.success, far.summary()
+
+
 @pytest.mark.parametrize("key, value", [("lookahead_cells", -1), ("lookahead_cells", 2.5), ("lookahead_cells", 5000),
-                                        ("carrot_m", 0.0), ("carrot_m", float("nan"))])
+                                        ("carrot_m", 0.0), ("carrot_m", float("nan")),
+                                        ("predict_s", -1.0), ("predict_s", 1e9)])
 def test_bad_drive_options_name_the_field(key, value):
     with pytest.raises(ConfigError) as err:
-        make_navigator("immas_stepwise", {key: value})
+        make_navigator("immas_stepwise", {key: value, "lookahead_cells": 6} if key == "predict_s" else {key: value})
     assert err.value.field == f"navigator.params.{key}"
+
+
+def test_predict_s_without_driving_through_is_refused():
+    with pytest.raises(ConfigError) as err:
+        make_navigator("immas_stepwise", {"predict_s": 1.0})
+    assert err.value.field == "navigator.params.predict_s" and "lookahead_cells" in str(err.value)

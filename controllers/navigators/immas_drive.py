@@ -1,5 +1,5 @@
-"""Driving through IMMAS's walk instead of stopping at each cell: the ``lookahead_cells`` option of
-``immas_stepwise`` (beyond Hasan, Abdullah & Saleh (2023); off by default).
+"""Driving through IMMAS's walk instead of stopping at each cell: the ``lookahead_cells`` and ``carrot_m``
+options of ``immas_stepwise`` (beyond Hasan, Abdullah & Saleh (2023); off by default).
 
 Why (measured on ``bench navigation --suite dyn300``, detector): the paper's robot occupies a cell and
 moves one cell per step; driven cell by cell in physics (:class:`~controllers.navigators.cell_path.CellWalker`
@@ -24,6 +24,8 @@ What it does (ours):
 * **Diverting**: when a sensed obstacle is now on the next cell, §4.1's divert chooses that cell instead (the
   paper's rule, :meth:`StepwiseWalk.divert`) and the walk is carried on from it; when one is on a later cell
   of the walk ahead, the walk ahead is chosen again.
+* **Looking further** (``predict_s``, in ``immas_stepwise``): the decision's Dobstacle swept along the sensed
+  velocities over ``predict_s`` instead of up to the obstacles' next node.
 * **Blocked**: when no neighbour is free the robot holds its cell and the walk is chosen again at every step
   (the paper's robot waits; it would wait for ever in the default stepping mode, which decides only on
   reaching a cell).
