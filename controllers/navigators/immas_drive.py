@@ -26,9 +26,8 @@ What it does (ours):
   of the walk ahead, the walk ahead is chosen again.
 * **Looking further** (``predict_s``, in ``immas_stepwise``): the decision's Dobstacle swept along the sensed
   velocities over ``predict_s`` instead of up to the obstacles' next node.
-* **Blocked**: when no neighbour is free the robot holds its cell and the walk is chosen again at every step
-  (the paper's robot waits; it would wait for ever in the default stepping mode, which decides only on
-  reaching a cell).
+* **Blocked**: when no neighbour is free the robot stops where it is (the paper's robot stays) and the walk is
+  chosen again at every step, from the cell the robot stands on (the evasion may have moved it off the walk).
 """
 
 from __future__ import annotations
@@ -44,7 +43,9 @@ from swarmnav.controllers.navigators.cell_path import Cell
 from swarmnav.models.world import OccupancyGrid, Pose2D
 from swarmnav.planners.problem import Path
 
-Occupancy = Callable[[bool], np.ndarray]   # (over the next step too?) -> the cells sensed obstacles occupy
+# "now": the cells sensed obstacles occupy now; "step": the paper's Dobstacle (now and up to their next node);
+# "decision": the Dobstacle a decision uses ("step", or the sweeps over ``predict_s``).
+Occupancy = Callable[[str], np.ndarray]
 
 
 def walk_ahead(here: Cell, goal: Cell, count: int, visited: np.ndarray, dynamic: np.ndarray,
@@ -95,6 +96,9 @@ class DriveThrough:
         lookahead_cells: cells of the walk ahead beyond the next one.
         carrot_m: the carrot's distance along the walk ahead.
         start: the robot's first cell.
+        looks_further: the "decision" Dobstacle is the sweeps over ``predict_s``: where it leaves no free
+            neighbour, the decision is taken again on the paper's Dobstacle (a sweep ahead must not freeze the
+            robot in front of the obstacle that sweeps it).
     """
 
     walk: Any
@@ -103,6 +107,7 @@ class DriveThrough:
     lookahead_cells: int
     carrot_m: float
     start: Cell
+    looks_further: bool = False
     moves: int = 0
     arc_cost: float = 0.0
     diverts: int = 0
@@ -114,13 +119,22 @@ class DriveThrough:
         self.cells: list[Cell] = []
         self._diverted = False
 
-    def _plan(self, here: Cell, dynamic: np.ndarray, first: Cell | None = None) -> Path:
+    def _plan(self, here: Cell, occupancy: Occupancy, first: Cell | None = None) -> Path:
         """The walk ahead from ``here`` (its next cell ``first`` when committed, else Eq. (3)'s choice)."""
         choose = self.walk.choose
         start = choose if first is None else (lambda _cell, _marks, _dyn: first)
-        self.cells = walk_ahead(here, self.walk.goal, self.lookahead_cells, self.visited, dynamic, start, choose)
+        ahead = self.lookahead_cells
+        self.cells = walk_ahead(here, self.walk.goal, ahead, self.visited, occupancy("decision"), start, choose)
+        if len(self.cells) == 1 and self.looks_further:
+            self.cells = walk_ahead(here, self.walk.goal, ahead, self.visited, occupancy("step"), start, choose)
         self.centres_m = self.grid.centres_m(np.array(self.cells))
         return Path.from_waypoints(self.centres_m, 0.0)
+
+    def _standing(self, pose: Pose2D, held: Cell) -> Cell:
+        """The cell the robot stands on (the evasion may have moved it off the walk), else the held one."""
+        cell = self.grid.cell_of(pose.x_m, pose.y_m)                   # clamped to the grid
+        analysis = self.walk.analysis
+        return cell if not analysis.blocked[cell] and math.isfinite(analysis.route_cost[cell]) else held
 
     def step(self, pose: Pose2D, twist: Twist, occupancy: Occupancy
              ) -> tuple[ControlCommand, Path | None, list[tuple[str, dict[str, Any]]]]:
@@ -128,7 +142,7 @@ class DriveThrough:
         events: list[tuple[str, dict[str, Any]]] = []
         new_path = None
         if not self.cells:
-            new_path = self._plan(self.start, occupancy(True))
+            new_path = self._plan(self.start, occupancy)
         reached = nearest_index(self.centres_m, pose.x_m, pose.y_m)
         if reached >= 1:
             for cell in self.cells[1:reached + 1]:
@@ -139,26 +153,32 @@ class DriveThrough:
                                               "total_arc_cost": round(self.arc_cost, 4),
                                               "diverted": self._diverted}))
                 self._diverted = False
-            new_path = self._plan(self.cells[reached], occupancy(True))
+            new_path = self._plan(self.cells[reached], occupancy)
         elif len(self.cells) == 1:
-            if self.cells[0] != self.walk.goal:
-                new_path = self._plan(self.cells[0], occupancy(True))
+            if self.cells[0] != self.walk.goal:                     # held: choose again, from where it stands
+                held = self.cells
+                new_path = self._plan(self._standing(pose, self.cells[0]), occupancy)
+                new_path = None if self.cells == held else new_path
         else:
-            now = occupancy(False)
+            now = occupancy("now")
             here, nxt = self.cells[0], self.cells[1]
             if now[nxt] and not self._diverted:
-                other = self.walk.divert(here, occupancy(True))
+                other = self.walk.divert(here, occupancy("decision"))
+                if other is None and self.looks_further:
+                    other = self.walk.divert(here, occupancy("step"))
                 self._diverted = True
                 self.diverts += 1
                 events.append(("immas_divert", {"from": list(here), "blocked": list(nxt),
                                                 "to": None if other is None else list(other)}))
                 if other is None:                                   # no free neighbour: hold the cell
-                    self.cells, self.centres_m = [here], self.centres_m[:1]
+                    self.cells, self.centres_m = [here], self.centres_m[:1].copy()
                     new_path = Path.from_waypoints(self.centres_m, 0.0)
                 else:
-                    new_path = self._plan(here, occupancy(True), other)
+                    new_path = self._plan(here, occupancy, other)
             elif any(now[cell] for cell in self.cells[2:]):
-                new_path = self._plan(here, occupancy(True), nxt)
+                new_path = self._plan(here, occupancy, nxt)
+        if len(self.cells) == 1 and self.cells[0] != self.walk.goal:
+            return ControlCommand.stop(), new_path, events              # no free neighbour: the robot stays
         index = nearest_index(self.centres_m, pose.x_m, pose.y_m)
         carrot = carrot_on(self.centres_m, index, self.carrot_m)
         self.controller.reset(Path.from_waypoints(np.array([[pose.x_m, pose.y_m], carrot]), 0.0))

@@ -282,7 +282,8 @@ class ImmasStepwiseNavigator:
         self.target: Cell | None = None
         self._diverted = False
         self._started = False
-        self.drive = (DriveThrough(self.walk, grid, setup.controller, self.lookahead_cells, self.carrot_m, start)
+        self.drive = (DriveThrough(self.walk, grid, setup.controller, self.lookahead_cells, self.carrot_m, start,
+                                   self.predict_s > 0)
                       if self.lookahead_cells > 0 else None)
 
     def _dynamic(self, observation: Observation, ahead_s: Iterable[float]) -> np.ndarray:
@@ -334,8 +335,8 @@ class ImmasStepwiseNavigator:
         """``lookahead_cells`` > 0: driving through the walk (:class:`~controllers.navigators.immas_drive.DriveThrough`)."""
         command, new_path, events = self.drive.step(
             observation.pose, observation.twist,
-            lambda ahead: self._dynamic(observation, (0.0, self.step_s) if ahead else (0.0,)) if not self.predict_s
-            else self._swept(observation, self.predict_s if ahead else 0.0))
+            lambda kind: self._swept(observation, self.predict_s) if kind == "decision" and self.predict_s
+            else self._dynamic(observation, (0.0,) if kind == "now" else (0.0, self.step_s)))
         self.moves, self.arc_cost, self.diverts = self.drive.moves, self.drive.arc_cost, self.drive.diverts
         return NavigationStep(command, new_path, tuple(events))
 
