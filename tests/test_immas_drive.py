@@ -119,3 +119,36 @@ def test_predict_s_without_driving_through_is_refused():
     with pytest.raises(ConfigError) as err:
         make_navigator("immas_stepwise", {"predict_s": 1.0})
     assert err.value.field == "navigator.params.predict_s" and "lookahead_cells" in str(err.value)
+
+
+def test_a_robot_with_no_free_neighbour_stops_where_it_is_and_walks_on_when_freed():
+    """Driving through, a walk with no free neighbour stops the robot (the paper's robot stays), instead of
+    steering it to its cell's centre; once the obstacle is gone, the walk goes on."""
+    from swarmnav.controllers.controller import Twist
+    from swarmnav.controllers.goal import GoalChecker
+    from swarmnav.controllers.kinematics import DriveGeometry
+    from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, Observation
+    from swarmnav.controllers.point_to_point import PointToPointController
+    from swarmnav.models.world import Pose2D
+    from swarmnav.planners.problem import map_problem
+    from swarmnav.planners.registry import make_planner
+
+    problem = map_problem(np.zeros((12, 20), dtype=bool), 0.4, (5, 2), (5, 18), robot_radius_m=0.15,
+                          clearance_m=0.05)
+    planner = make_planner("immas")
+    rng = np.random.default_rng(0)
+    setup = NavigationSetup(planner.plan(problem, rng), problem, planner, rng,
+                            PointToPointController(DriveGeometry(0.035, 0.23, 12.0), max_speed_m_s=0.2),
+                            GoalChecker(problem.goal.x_m, problem.goal.y_m, 0.1), 0.02, 0.2)
+    nav = make_navigator("immas_stepwise", {"lookahead_cells": 6})
+    nav.reset(setup)
+    off_centre = Pose2D(problem.start.x_m - 0.15, problem.start.y_m, 0.0)   # its cell's centre 0.15 m ahead
+    around = DetectedObstacle(problem.start.x_m, problem.start.y_m, 0.5, 0.0, 0.0, 1)  # covers every neighbour
+
+    def step(detections):
+        return nav.step(Observation(0.0, off_centre, Twist(), np.zeros(0), np.zeros(0), 0.0, tuple(detections)))
+
+    held = step([around])
+    assert held.command.wheels.left_rad_s == held.command.wheels.right_rad_s == 0.0
+    freed = step([])
+    assert freed.command.linear_m_s > 0.0 and nav.drive.cells[1] != nav.drive.cells[0]
