@@ -69,3 +69,29 @@ def test_per_group_writes_that_many_scenes_of_each_group_and_needs_a_generated_s
     assert all(sum(name.startswith(f"d300-{g}-") for name in names) == 3 for g in groups)
     assert main(["bench", "navigation", "--per-group", "3"]) == 2
     assert "--per-group" in capsys.readouterr().err
+
+
+def test_the_summary_under_a_table_is_computed_from_its_rows():
+    from swarmnav.sim.benchmarks.navigation_table import summary_lines, table_lines
+    rows = [dict(r, sensor_model="detector") for r in read_rows(RESULT)]
+    by_name = {r["navigator"]: r for r in rows}
+    arm = dict(by_name["iaco_local"], navigator="iaco_local+evade", arm_of="iaco_local",
+               arm_params={"evade": True}, solved_share=0.9)
+    rows.insert(-1, arm)
+    lines = summary_lines(rows)
+    best = max((r for r in rows if r["navigator"] != "oracle"), key=lambda r: (r["solved_share"], r["time_score"]))
+    assert f"`{best['navigator']}`, solves {best['solved_share']:.3f}" in lines[0]
+    assert (": met)" in lines[0]) == (best["solved_share"] >= 0.95) != (": not met)" in lines[0])
+    below = [r["navigator"] for r in rows if r["navigator"] not in ("oracle", "follow") and "arm_of" not in r
+             and r["solved_share"] < 0.80]
+    for name in below:
+        assert f"`{name}` {by_name[name]['solved_share']:.3f}" in lines[1]
+    assert "`follow`" not in lines[1]                                   # it never reads detections
+    assert "(as `iaco_local+evade`: 0.900)" in lines[1]
+    assert ("not met" in lines[1]) == bool(below) and lines[1].endswith(".")
+    assert any("| iaco_local+evade (iaco_local: evade=true) |" in line for line in table_lines(rows))
+    ranged = [dict(r, sensor_model="rangefinder", solved_share=0.5 if r["navigator"] != "oracle" else None)
+              for r in rows]
+    ranged_lines = summary_lines(ranged)
+    assert "target ≥ 0.85: not met" in ranged_lines[0]
+    assert not any("Every online" in line for line in ranged_lines)   # no such target with rangefinders

@@ -177,3 +177,18 @@ def test_sigterm_ends_a_ray_study_with_one_line_and_keeps_its_rows(tmp_path):
     subprocess.run(command + ["--workers", "2"], check=True, capture_output=True, timeout=300)
     rows = pd.read_parquet(out / "runs.parquet")
     assert len(rows) == 3000 and rows.config_hash.is_unique
+
+
+def test_bench_navigation_on_ray_gives_the_local_table(ray_start_log, tmp_path):
+    """``bench navigation --engine ray``: the same runs as the local engine, so the same table, timings aside."""
+    from swarmnav.sim.benchmarks.navigation import benchmark_navigation
+    from swarmnav.models.scenario_generator import GeneratorOptions, generate
+    path = tmp_path / "short.toml"
+    path.write_text(generate("crossing", 5, GeneratorOptions(obstacles=2, arena_m=5.0, sensor_model="detector")))
+    tables = [benchmark_navigation(1, ["follow", "velocity_obstacle"], [str(path)], out_dir=str(tmp_path / d),
+                                   speed=False, workers=2, engine=engine)
+              for d, engine in (("local", "local"), ("ray", "ray"))]
+    kept = ("navigator", "runs", "success_rate", "collision_rate", "timeout_rate", "mean_spl", "solved_share",
+            "time_score", "oracle_solvable_runs")
+    assert [{k: r.get(k) for k in kept} for r in tables[0]] == [{k: r.get(k) for k in kept} for r in tables[1]]
+    assert [r["navigator"] for r in tables[1]] == ["follow", "velocity_obstacle", "oracle"]

@@ -82,3 +82,65 @@ def test_the_mppi_speed_line_times_an_optimisation_at_every_control_step():
     assert (cost["samples"], cost["horizon_steps"]) == (1000, 30)
     assert cost["steps"] == 50 or cost["steps"] == 51            # 1 s at 50 Hz, every step timed
     assert cost["cpu_us_per_step"] > 0 and set(cost["cpu_us_per_step_by_scene"]) == {"dyn-crossing-3"}
+
+
+def test_arms_are_rows_under_their_own_labels_and_extend_a_kept_benchmark(tmp_path):
+    """``--arm``: a navigator under its own label with its own parameters is one more row; the same navigator
+    with the same (default) parameters under another label drives the same runs; a later run into the same
+    folder with one more arm runs only that arm's cells (the study resumes)."""
+    import pyarrow.parquet as pq
+    from swarmnav.sim.benchmarks.navigation import parse_arm
+    path = tmp_path / "short.toml"
+    path.write_text(generate("crossing", 5, GeneratorOptions(obstacles=2, arena_m=5.0, sensor_model="detector")))
+    out = tmp_path / "out"
+    first = benchmark_navigation(1, ["follow"], [str(path)], out_dir=str(out), speed=False,
+                                 arms=[parse_arm("follow-again:follow")])
+    assert pq.read_table(out / "runs.parquet").num_rows == 3
+    rows = benchmark_navigation(1, ["follow"], [str(path)], out_dir=str(out), speed=False,
+                                arms=[parse_arm("follow-again:follow"),
+                                      parse_arm("vo-wide:velocity_obstacle:time_horizon_s=3.0")])
+    assert pq.read_table(out / "runs.parquet").num_rows == 4     # only the new arm's run was added
+    by_label = {r["navigator"]: r for r in rows}
+    assert list(by_label) == ["follow", "follow-again", "vo-wide", ORACLE]
+    assert by_label["follow-again"]["mean_spl"] == by_label["follow"]["mean_spl"]
+    assert by_label["follow-again"]["success_rate"] == by_label["follow"]["success_rate"]
+    assert by_label["vo-wide"]["arm_of"] == "velocity_obstacle"
+    assert by_label["vo-wide"]["arm_params"] == {"time_horizon_s": 3.0}
+    assert {r["navigator"]: r["runs"] for r in first} == {"follow": 1, "follow-again": 1, ORACLE: 1}
+
+
+@pytest.mark.parametrize("arm, message", [
+    ("vo", "expected LABEL:NAVIGATOR"),
+    ("a:nope", "unknown navigator 'nope'"),
+    ("a:oracle", "the yardstick"),
+    ("follow:follow", "label 'follow' is already a row"),
+    ("a:velocity_obstacle:bogus=1", "--arm a: navigator.params.bogus: unknown parameter"),
+])
+def test_bad_arms_are_one_line_and_exit_2(arm, message, capsys):
+    from swarmnav.sim.cli.main import main
+    assert main(["bench", "navigation", "--quick", "--navigator", "follow", "--arm", arm]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1
+
+
+def test_a_seed_offset_gives_held_out_scenes_of_the_same_groups():
+    from swarmnav.models.suites import load_suite
+    suite, held_out = load_suite("dyn300"), load_suite("dyn300", seed_offset=1000)
+    assert len(held_out.scenes) == len(suite.scenes) and held_out.verdicts == {}
+    assert not {s.name for s in suite.scenes} & {s.name for s in held_out.scenes}
+    own = {(s.group, s.seed): s for s in suite.scenes}
+    for scene in held_out.scenes:
+        twin = own[(scene.group, scene.seed - 1000)]
+        assert scene.kind == twin.kind and scene.name == f"d300-{scene.group}-{scene.seed}"
+        assert {k: v for k, v in vars(scene.options).items() if k != "name"} == \
+            {k: v for k, v in vars(twin.options).items() if k != "name"}
+    assert held_out.scenes[0].text() != own[(held_out.scenes[0].group, held_out.scenes[0].seed - 1000)].text()
+    with pytest.raises(ConfigError, match="--seed-offset"):
+        load_suite("dyn300", seed_offset=-1)
+
+
+def test_a_seed_offset_without_a_generated_suite_is_one_line_and_exit_2(capsys):
+    from swarmnav.sim.cli.main import main
+    assert main(["bench", "navigation", "--quick", "--seed-offset", "5"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--seed-offset" in err and len(err.splitlines()) == 1

@@ -48,13 +48,18 @@ class Suite:
     verdicts: dict[str, dict[str, Any]]  # scene name -> the verdict file's entry (empty without the file)
 
 
+MAX_SEED_OFFSET = 10**9  # generator seeds stay far below the largest seed a scenario file holds
+
+
 def list_suites() -> list[str]:
     return sorted(p.stem for p in SUITE_DIR.glob("*.toml"))
 
 
-def load_suite(name: str, sensor_model: str | None = None) -> Suite:
+def load_suite(name: str, sensor_model: str | None = None, seed_offset: int = 0) -> Suite:
     """A suite by name (``models/suites/NAME.toml``) or path; ``sensor_model`` (``detector`` or ``rangefinder``:
-    12 rangefinders at 1 m) overrides every scene's sensing.
+    12 rangefinders at 1 m) overrides every scene's sensing; ``seed_offset`` shifts every group's seeds (a
+    held-out set: the same families and options, scenes nobody measured a navigator on; the shipped verdicts
+    and order apply to the suite's own seeds only, so a shifted suite has neither).
 
     Raises:
         ConfigError: an unknown suite, kind, option or sensing model, a bad option value or seed range
@@ -65,6 +70,8 @@ def load_suite(name: str, sensor_model: str | None = None) -> Suite:
         raise ConfigError("--suite", f"no suite {name!r} (bundled: {', '.join(list_suites())})")
     if sensor_model is not None and sensor_model not in SENSOR_OVERRIDES:
         raise ConfigError("--sensor-model", f"expected one of {', '.join(SENSOR_OVERRIDES)}, got {sensor_model!r}")
+    if not 0 <= seed_offset <= MAX_SEED_OFFSET:
+        raise ConfigError("--seed-offset", f"must be from 0 to {MAX_SEED_OFFSET:,}, got {seed_offset}")
     top = parse_toml(read_text(path, "suite"), str(path))
     suite_name = top.string("name", path.stem, non_empty=True)
     version = top.integer("version", 1, bounds=within(1))
@@ -87,7 +94,7 @@ def load_suite(name: str, sensor_model: str | None = None) -> Suite:
         except ConfigError as exc:  # the generator names its command-line option: name the file's field
             key = exc.field.removeprefix("--").replace("-", "_")
             (own if own.has(key) else defaults).fail(key, exc.problem)
-        for seed in range(first, end):
+        for seed in range(first + seed_offset, end + seed_offset):
             scene_name = f"{prefix}-{label}-{seed}"
             scenes.append(SuiteScene(scene_name, label, kind, seed, GeneratorOptions(**options, name=scene_name)))
     top.close()
@@ -95,7 +102,7 @@ def load_suite(name: str, sensor_model: str | None = None) -> Suite:
         top.fail("groups", "a suite needs at least one group")
     verdict_path = path.with_name(f"{path.stem}-verdicts.json")
     verdicts: dict[str, dict[str, Any]] = {}
-    if verdict_path.is_file():
+    if verdict_path.is_file() and seed_offset == 0:
         entries = json.loads(verdict_path.read_text(encoding="utf-8"))["scenes"]
         verdicts = {e["scenario"]: e for e in entries}
         rank = {e["scenario"]: k for k, e in enumerate(entries)}

@@ -39,6 +39,7 @@ often (the oracle row).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 import tempfile
@@ -90,16 +91,60 @@ def suite_names() -> list[str]:
     return [name for name in list_scenarios() if name.startswith(SUITE_PREFIX)]
 
 
+@dataclasses.dataclass(frozen=True)
+class Arm:
+    """One row of the benchmark: a navigator under a label with its parameters (a default row: label = name)."""
+    label: str
+    navigator: str
+    params: dict[str, Any]
+
+
+def parse_arm(text: str) -> Arm:
+    """``--arm LABEL:NAVIGATOR[:KEY=VALUE,KEY=VALUE...]``: a navigator under its own label with its own
+    parameters, a row of the table beside the defaults (e.g. ``iaco_local+evade:iaco_local:evade=true``)."""
+    from swarmnav.controllers.navigators import make_navigator
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.sim.options import parse_settings
+    label, sep, rest = text.partition(":")
+    name, _, settings = rest.partition(":")
+    label, name = label.strip(), name.strip()
+    if not sep or not label or not name:
+        raise ConfigError("--arm", f"expected LABEL:NAVIGATOR[:KEY=VALUE,...], got {text!r}")
+    if name not in NAVIGATORS:
+        raise ConfigError("--arm", f"unknown navigator {name!r} in {text!r} (known: {', '.join(sorted(NAVIGATORS))})")
+    if is_clairvoyant(name):
+        raise ConfigError("--arm", f"{name!r} is the yardstick, run beside every contender already")
+    params = parse_settings([p for p in settings.split(",") if p.strip()], "--arm") if settings else {}
+    try:
+        make_navigator(name, params)  # a bad key or value is refused here, naming the navigator's field
+    except ConfigError as exc:
+        raise ConfigError(f"--arm {label}: {exc.field}", exc.problem) from None
+    return Arm(label, name, params)
+
+
+def check_arms(contenders: list[str], arms: list[Arm]) -> None:
+    """Each row's label is its own: an arm's label is neither a default row's name, the oracle's, nor another
+    arm's."""
+    from swarmnav.models.errors import ConfigError
+    taken = set(contenders) | {ORACLE}
+    for arm in arms:
+        if arm.label in taken:
+            raise ConfigError("--arm", f"label {arm.label!r} is already a row of this benchmark (give it its own)")
+        taken.add(arm.label)
+
+
 def navigation_study(seeds: int | None, navigators: list[str], scenarios: list[str],
-                     navigator_params: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """The benchmark as a physics study: each scenario with its own planner, every navigator, run ``k`` with
-    world seed ``k`` and planner seed ``k`` (paired); ``seeds`` None: one run, the scenario's world seed."""
+                     navigator_params: dict[str, dict[str, Any]], arms: list[Arm] = ()) -> dict[str, Any]:
+    """The benchmark as a physics study: each scenario with its own planner, every navigator (and each arm
+    under its label), run ``k`` with world seed ``k`` and planner seed ``k`` (paired); ``seeds`` None: one run,
+    the scenario's world seed."""
     planners = list(dict.fromkeys(load_scenario(name).planner_name for name in scenarios))
     runs = ({"seeds": seeds, "world_seeds": list(range(seeds)), "paired_seeds": True} if seeds is not None
             else {"seeds": [0]})
     return {"name": "bench-navigation", "scenarios": scenarios, "mode": "physics", **runs,
             "planners": [{"name": p} for p in planners],
-            "navigators": [{"name": n, "params": navigator_params.get(n, {})} for n in navigators]}
+            "navigators": [{"name": n, "params": navigator_params.get(n, {})} for n in navigators]
+            + [{"name": a.navigator, "label": a.label, "params": a.params} for a in arms]}
 
 
 def is_clairvoyant(name: str) -> bool:
@@ -118,12 +163,13 @@ def oracle_verdicts(rows: list[dict[str, Any]]) -> dict[tuple[str, int], dict[st
 
 
 def write_suite(suite_name: str, quick: bool, sensor_model: str | None, folder: str,
-                per_group: int | None = None) -> tuple[list[str], Any]:
+                per_group: int | None = None, seed_offset: int = 0) -> tuple[list[str], Any]:
     """The suite's scenes as TOML files under ``folder`` (paths, in order of difficulty) and the suite;
-    ``quick``: a stratified sample of 2 scenes per group, ``per_group``: of that many."""
+    ``quick``: a stratified sample of 2 scenes per group, ``per_group``: of that many; ``seed_offset``: the
+    held-out scenes of the same groups (:func:`models.suites.load_suite`)."""
     import os
     from swarmnav.models.suites import load_suite, stratified_sample
-    suite = load_suite(suite_name, sensor_model)
+    suite = load_suite(suite_name, sensor_model, seed_offset)
     scenes = (stratified_sample(suite, per_group) if per_group is not None
               else stratified_sample(suite) if quick else suite.scenes)
     os.makedirs(os.path.join(folder, "scenarios"), exist_ok=True)
@@ -140,31 +186,42 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                          progress: bool = False, navigator_params: dict[str, dict[str, Any]] | None = None,
                          by_scenario: bool = False, out_dir: str | None = None, suite: str | None = None,
                          quick: bool = False, sensor_model: str | None = None,
-                         workers: int = 1, speed: bool = True, per_group: int | None = None) -> list[dict[str, Any]]:
+                         workers: int = 1, speed: bool = True, per_group: int | None = None,
+                         arms: list[Arm] = (), engine: str = "local", address: str | None = None,
+                         seed_offset: int = 0) -> list[dict[str, Any]]:
     """One row per navigator and the oracle's (see the module docstring); ``navigator_params``: per navigator
     name.  With ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key;
     the overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given;
-    ``suite`` (e.g. ``dyn300``) runs a generated suite instead of ``scenarios``."""
+    ``suite`` (e.g. ``dyn300``) runs a generated suite instead of ``scenarios``; ``arms``: more rows, each a
+    navigator under its own label with its own parameters (the rows are keyed by label); ``engine="ray"``:
+    the runs on Ray (a local instance of ``workers`` CPUs, or the cluster at ``address``)."""
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
             return benchmark_navigation(seeds, navigators, scenarios, progress, navigator_params, by_scenario,
-                                        folder, suite, quick, sensor_model, workers, speed, per_group)
+                                        folder, suite, quick, sensor_model, workers, speed, per_group, arms,
+                                        engine, address, seed_offset)
     from swarmnav.sim.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
     contenders = [n for n in (navigators or default_navigators(navigator_params)) if not is_clairvoyant(n)]
+    check_arms(contenders, list(arms))
     shipped: dict[str, dict[str, Any]] = {}
     if suite is not None:
-        names, loaded = write_suite(suite, quick, sensor_model, out_dir, per_group)
+        names, loaded = write_suite(suite, quick, sensor_model, out_dir, per_group, seed_offset)
         shipped = loaded.verdicts
         run_seeds = None
     else:
         names, run_seeds = scenarios or suite_names(), seeds
-    tables = navigation_study(run_seeds, contenders + [ORACLE], names, navigator_params)
-    rows = run_study_tables(tables, out_dir, show_progress=progress, workers=workers)
+    tables = navigation_study(run_seeds, contenders + [ORACLE], names, navigator_params, list(arms))
+    rows = run_study_tables(tables, out_dir, show_progress=progress, workers=workers, engine=engine,
+                            address=address)
     verdicts = oracle_verdicts(rows)
-    runs = {n: [r for r in rows if r["navigator"] == n] for n in contenders + [ORACLE]}
-    table = [{"scenario": None, **_row(nav, arm, verdicts, shipped)} for nav, arm in runs.items()]
+    labels = contenders + [a.label for a in arms] + [ORACLE]
+    runs = {label: [r for r in rows if r["navigator_label"] == label] for label in labels}
+    settings = {a.label: {"arm_of": a.navigator, "arm_params": a.params} for a in arms}
+    sensing = "+".join(sorted({load_scenario(name).sensor_model for name in names}))
+    table = [{"scenario": None, **_row(nav, arm, verdicts, shipped), "sensor_model": sensing,
+              **settings.get(nav, {})} for nav, arm in runs.items()]
     if speed:
         _add_speed(table, rows)
     if by_scenario:
@@ -245,6 +302,8 @@ def run(args: argparse.Namespace) -> int:
         if name not in NAVIGATORS:
             raise ConfigError("--navigator", f"unknown navigator {name!r} (known: {', '.join(sorted(NAVIGATORS))})")
     if args.suite == "papers":
+        if getattr(args, "engine", "local") == "ray":
+            raise ConfigError("--engine", "ray applies to the dyn and dyn300 suites (papers runs in this process)")
         from swarmnav.sim.benchmarks.paper_navigation import (PAPER_SUITE, benchmark_paper_navigation,
                                                               print_table)
         paper_rows = benchmark_paper_navigation(args.seeds, tuple(args.scenario or PAPER_SUITE), args.out)
@@ -256,14 +315,22 @@ def run(args: argparse.Namespace) -> int:
     suite = None if args.suite == "dyn" else args.suite
     if suite is None and getattr(args, "sensor_model", None):
         raise ConfigError("--sensor-model", "applies to a generated suite (--suite dyn300) only")
+    if getattr(args, "address", None) and getattr(args, "engine", "local") != "ray":
+        raise ConfigError("--address", "applies to --engine ray only")
+    if suite is None and getattr(args, "seed_offset", 0):
+        raise ConfigError("--seed-offset", "applies to a generated suite (--suite dyn300) only")
     if suite is None and getattr(args, "per_group", None):
         raise ConfigError("--per-group", "applies to a generated suite (--suite dyn300) only")
+    arms = [parse_arm(text) for text in getattr(args, "arm", None) or []]
     rows = benchmark_navigation(args.seeds, args.navigator, args.scenario,
                                 progress=not args.json and sys.stderr.isatty(), navigator_params=settings,
                                 by_scenario=args.by_scenario, out_dir=args.out, suite=suite,
                                 quick=bool(getattr(args, "quick", False)) and suite is not None,
                                 sensor_model=getattr(args, "sensor_model", None),
-                                workers=getattr(args, "workers", 1) or 1, per_group=getattr(args, "per_group", None))
+                                workers=getattr(args, "workers", 1) or 1, per_group=getattr(args, "per_group", None),
+                                arms=arms, engine=getattr(args, "engine", "local"),
+                                address=getattr(args, "address", None),
+                                seed_offset=getattr(args, "seed_offset", 0) or 0)
     if args.json:
         print(json.dumps(rows))
         return 0

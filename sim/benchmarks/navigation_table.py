@@ -53,7 +53,8 @@ def table_lines(rows: list[dict[str, Any]]) -> list[str]:
              "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         solved = r["success_on_solvable"] if r["navigator"] == ORACLE else r["solved_share"]
-        name = f"{r['navigator']} (clairvoyant yardstick)" if r["navigator"] == ORACLE else r["navigator"]
+        name = (f"{r['navigator']} (clairvoyant yardstick)" if r["navigator"] == ORACLE
+                else f"{r['navigator']} ({_arm_text(r)})" if r.get("arm_of") else r["navigator"])
         lines.append(f"| {name} | {r['runs']} | {_cell(r['success_rate'], '.3f')} | {_cell(r['collision_rate'], '.3f')} | "
                      f"{_cell(r['timeout_rate'], '.3f')} | {r['oracle_solvable_runs']} | **{_cell(solved, '.3f')}** | "
                      f"{_cell(r['time_score'], '.3f')} | {_cell(r['mean_spl'], '.3f')} | "
@@ -62,8 +63,62 @@ def table_lines(rows: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
+def _arm_text(row: dict[str, Any]) -> str:
+    """An arm's navigator and parameters, as ``--arm`` wrote them: ``iaco_local: evade=true``."""
+    params = ", ".join(f"{k}={json.dumps(v)}" for k, v in sorted((row.get("arm_params") or {}).items()))
+    return f"{row['arm_of']}: {params}" if params else row["arm_of"]
+
+
+# Issue 23's targets, by the sensing of the run: the best navigator's share of the oracle-solvable scenes
+# solved, and every online navigator's (one that reads detections; ``follow`` never does).
+BEST_TARGET = {"detector": 0.95, "rangefinder": 0.85}
+EVERY_ONLINE_TARGET = {"detector": 0.80}
+
+
+def _met(value: float, target: float) -> str:
+    return f"target ≥ {target:.2f}: {'met' if value >= target else 'not met'}"
+
+
+def summary_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """The sentences the README prints under a table, computed from its rows (never written by hand): the best
+    navigator's solved share, every online navigator's against its target (with its arms beside it), and the
+    oracle's validation."""
+    from swarmnav.controllers.navigators import NAVIGATORS
+    sensing = rows[0].get("sensor_model") if rows else None
+    contenders = [r for r in rows if r["navigator"] != ORACLE and r.get("solved_share") is not None]
+    if not contenders:
+        return []
+    best = max(contenders, key=lambda r: (r["solved_share"], r["time_score"] or 0.0))
+    text = (f"Sensing: {sensing or 'each scene its own'}. The best navigator, `{best['navigator']}`, solves "
+            f"{best['solved_share']:.3f} of the oracle-solvable runs")
+    if sensing in BEST_TARGET:
+        text += f" ({_met(best['solved_share'], BEST_TARGET[sensing])})"
+    lines = [text + "."]
+    online = [r for r in contenders if getattr(NAVIGATORS.get(r.get("arm_of") or r["navigator"]),
+                                               "uses_detections", True)]
+    target = EVERY_ONLINE_TARGET.get(sensing)
+    if target is not None:
+        below = [r for r in online if not r.get("arm_of") and r["solved_share"] < target]
+        parts = []
+        for r in below:
+            arms = [a for a in online if a.get("arm_of") == r["navigator"]]
+            best_arm = max(arms, key=lambda a: a["solved_share"]) if arms else None
+            parts.append(f"`{r['navigator']}` {r['solved_share']:.3f}" + (
+                f" (as `{best_arm['navigator']}`: {best_arm['solved_share']:.3f})" if best_arm else ""))
+        lines.append(f"Every online navigator at its defaults ≥ {target:.2f}: "
+                     + ("met." if not below else "not met: " + "; ".join(parts) + "."))
+    oracle = next((r for r in rows if r["navigator"] == ORACLE), None)
+    if oracle is not None and oracle.get("success_on_solvable") is not None:
+        lines.append(f"The oracle called {oracle['oracle_solvable_runs']} of {oracle['runs']} runs solvable and "
+                     f"succeeded in physics on {oracle['success_on_solvable']:.3f} of them "
+                     f"({_met(oracle['success_on_solvable'], 0.95)}).")
+    return lines
+
+
 def block(rows: list[dict[str, Any]], result: FilePath = RESULT) -> str:
-    return "\n".join([begin_marker(result), ""] + table_lines(rows) + ["", END])
+    summary = summary_lines(rows)
+    return "\n".join([begin_marker(result), ""] + table_lines(rows) + ([""] + summary if summary else [])
+                     + ["", END])
 
 
 def _span(text: str, result: FilePath) -> tuple[int, int]:

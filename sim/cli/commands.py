@@ -128,6 +128,9 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", action="append", help="only these scenarios (repeatable; default: the dyn-* suite)")
     parser.add_argument("--navigator-set", action="append", metavar="KEY=VALUE",
                         help="a parameter for every navigator that has it (repeatable), e.g. policy=module:function")
+    parser.add_argument("--arm", action="append", metavar="LABEL:NAVIGATOR[:KEY=VALUE,...]",
+                        help="one more row: a navigator under its own label with its own parameters (repeatable), "
+                             "e.g. iaco_local+evade:iaco_local:evade=true")
     parser.add_argument("--by-scenario", action="store_true",
                         help="also one row per navigator and scenario, after the overall rows")
     parser.add_argument("--out", metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
@@ -142,10 +145,17 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
                              "with --suite dyn300: a stratified sample, 2 scenes per group")
     parser.add_argument("--per-group", type=options.positive_int, metavar="N",
                         help="--suite dyn300 only: a stratified sample of N scenes per group (--quick: 2)")
+    parser.add_argument("--seed-offset", type=options.non_negative_int, default=0, metavar="N",
+                        help="--suite dyn300 only: every group's seeds shifted by N, a held-out set of the same "
+                             "families (no shipped verdicts: the oracle decides each scene in the run)")
     parser.add_argument("--sensor-model", choices=("detector", "rangefinder"),
                         help="--suite dyn300 only: every scene with this sensing (rangefinder: 12 at 1 m)")
     parser.add_argument("--workers", type=options.positive_int, default=1,
-                        help="local worker processes for the runs (default 1: in this process)")
+                        help="local worker processes for the runs (default 1: in this process); with --engine "
+                             "ray: the local instance's CPUs")
+    parser.add_argument("--engine", choices=("local", "ray"), default="local",
+                        help="where the runs go: local processes (default) or Ray (the study engines)")
+    parser.add_argument("--address", help="with --engine ray: the cluster to join (default: a local instance)")
 
 
 def run_bench_navigation(args: argparse.Namespace) -> int:

@@ -173,14 +173,19 @@ def _peak_rss_mb() -> float:
 
 
 def run_study_tables(tables: dict[str, Any], out_dir: str | os.PathLike, *, workers: int = 1,
-                     source: str = "swarmnav bench", show_progress: bool = False) -> list[dict[str, Any]]:
+                     source: str = "swarmnav bench", show_progress: bool = False, engine: str = "local",
+                     address: str | None = None) -> list[dict[str, Any]]:
     """Validate a study built in code (the tables its TOML file would hold), run it into ``out_dir`` (in this
-    process with ``workers=1``, else on that many local processes), and return every run row of the folder
-    (what the benchmarks tabulate)."""
+    process with ``workers=1``, else on that many local processes; ``engine="ray"``: on Ray, a local instance
+    of ``workers`` CPUs or the cluster at ``address``), and return every run row of the folder (what the
+    benchmarks tabulate)."""
     # Tables built in code from the command line's options (bench navigation's --navigator-set policy=...): their
     # code is the user's; the scenario files they name are still data (a cell whose file names code is an error).
     study = study_from_tables(tables, source, str(tables.get("name", "study")), trust_code=True)
     study = dataclasses.replace(study, trust_code=False)
-    run_study(study, out_dir, engine="inline" if workers == 1 else "local", workers=workers,
-              show_progress=show_progress)
+    if engine == "ray":
+        run_study(study, out_dir, engine="ray", workers=workers, address=address, show_progress=show_progress)
+    else:
+        run_study(study, out_dir, engine="inline" if workers == 1 else "local", workers=workers,
+                  show_progress=show_progress)
     return read_table(out_dir).to_pylist()
