@@ -79,10 +79,11 @@ def test_driving_through_the_walk_takes_half_the_time_of_stepping_and_a_short_ca
     assert crawling.sim_time_s > 2.0 * through.sim_time_s
 
 
-def test_a_walk_that_holds_its_cell_chooses_again_and_reaches_the_goal():
-    """dyn300's d300-cross5-11 with the evasion on: stepping, the walk found no free neighbour 0.8 m out and
-    held that cell for the rest of the run (it decides only on reaching a cell); driving through, it
-    chooses again while it holds and reaches the goal."""
+def test_driving_through_goes_on_where_stepping_stood_still_after_a_divert():
+    """dyn300's d300-cross5-11 with the evasion on: stepping, §4.1's divert chose the cell behind the robot,
+    which it already stood within ``reach_m`` of; that cell was reached inside the divert's own step, never
+    reported, and the robot never decided again (0.8 m out, for the rest of the run).  Driving through, the
+    walk goes on from the cell nearest the robot and reaches the goal."""
     scenario = _suite_scene("d300-cross5-11")
     stepping = _run(scenario, evade=True)
     through = _run(scenario, evade=True, lookahead_cells=6)
