@@ -221,13 +221,15 @@ class ImmasStepwiseNavigator:
             each cell): drive through the walk, the next cell still Eq. (3)'s choice at each cell reached,
             the controller steering at a carrot ``carrot_m`` along the walk carried on ``lookahead_cells``
             cells ahead (:mod:`controllers.navigators.immas_drive`, which says why: stopping at every cell
-            made most of its dyn300 runs time out).
+            made most of its dyn300 runs time out).  With ``evade``, dyn300's 55-scene sample (5 a group):
+            0.31 solved without it, 0.87 with ``lookahead_cells = 6``.
         predict_s: beyond the paper, off by default (0: the paper's Dobstacle, the obstacles' cells now and
             on their way to their next node, at most one cell move ahead); with ``lookahead_cells`` only: the
             cells each sensed obstacle sweeps along its velocity over ``predict_s`` (sampled every cell move,
             no node cap) are the decision's Dobstacle.  Why: on dyn300's 0.1-m cells the next node is at most
             0.5 s ahead, so the walk, driven at top speed, went into the path of crossers twice the robot's
-            speed and left the rest to ``evade`` (2 of the 5 ``fast2`` scenes of the 55-scene sample collided).
+            speed and left the rest to ``evade`` (2 of the 5 ``fast2`` scenes of the 55-scene sample collided;
+            with ``predict_s = 1`` none, and 0.87 -> 0.93 solved over the 55).
     """
 
     name: ClassVar[str] = "immas_stepwise"
