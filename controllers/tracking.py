@@ -5,7 +5,8 @@ every control step, each with the position of the sensor that saw it.  The
 tracker does only what the rays allow:
 
 1. **Clusters** the hits by single linkage: two hits closer than
-   ``2 * default_radius_m`` may lie on one disc, so they join one cluster.
+   ``2 * default_radius_m``, whose rays are less than ``max_link_angle_deg`` apart,
+   may lie on one disc, so they join one cluster.
 2. **Fits a disc** to each cluster.  With three hits or more the radius is
    measured by a least-squares circle fit (Kasa 1976); otherwise it is the
    track's radius so far, or ``default_radius_m`` (the assumed obstacle
@@ -24,7 +25,9 @@ tracker does only what the rays allow:
    centre, on the side the ray came from (the least change that explains the hit).
 5. **Estimates the velocity** of each track as the least-squares slope of its
    centres over the last ``window_s`` (zero until two samples span ``min_span_s``);
-   a centre more than ``jump_m`` from the predicted one restarts the window.
+   a centre more than ``jump_m`` from the predicted one restarts the window.  With
+   ``hit_motion`` (default) the velocity is instead that of the disc fitted to the
+   window's raw hits (:mod:`controllers.hit_motion`), when they fit one disc.
 6. **Coasts** an unseen track (position predicted with its velocity) for
    ``keep_s``, then forgets it: an obstacle that slips between two beams, or out
    of range, is still reported for a moment; but when the beams are given
@@ -48,6 +51,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from swarmnav.controllers.hit_motion import fit_moving_disc
 from swarmnav.controllers.navigator import DetectedObstacle
 
 
@@ -60,6 +64,8 @@ class _Track:
     measured: bool = False  # the radius came from a circle fit (else a lower bound or the default)
     fits_m: list[float] = field(default_factory=list)  # the radii of its circle fits
     velocity_m_s: tuple[float, float] = (0.0, 0.0)
+    hit_times_s: list[float] = field(default_factory=list)  # every hit it took in the window, and when
+    hits_m: list[tuple[float, float]] = field(default_factory=list)
 
     def predicted(self, time_s: float) -> tuple[float, float]:
         x, y = self.centres_m[-1]
@@ -81,6 +87,14 @@ class HitTracker:
         max_radius_m: circle fits larger than this are discarded (nearly collinear hits: a wall-like arc).
         clear_m: how far inside a coasting track's rim a beam must pass unhindered to contradict it.
         jump_m: a new centre this far from the predicted one restarts the velocity window.
+        hit_motion: step 5 takes the velocity of the moving disc fitted to the window's raw hits
+            (:func:`controllers.hit_motion.fit_moving_disc`, ours) instead of regressing the steps' centres;
+            False: the regression alone.
+        hit_motion_rms_m: a hit fit whose rim residual exceeds this (the hits are not one disc) is not used.
+        max_link_angle_deg: step 1 links two hits only if their rays are less than this apart (ours; 180: off).
+            A disc the robot is not touching subtends less than 90 degrees unless it is over 2.4 times the
+            robot's radius; hits on two discs either side of the robot, closer than ``2 * default_radius_m``,
+            made one phantom disc between them, over the robot (dyn-overtake-2).
     """
 
     default_radius_m: float = 0.3
@@ -92,6 +106,9 @@ class HitTracker:
     max_radius_m: float = 0.6
     clear_m: float = 0.05
     jump_m: float = 0.3
+    hit_motion: bool = True
+    hit_motion_rms_m: float = 0.03
+    max_link_angle_deg: float = 90.0
 
     def __post_init__(self) -> None:
         self.reach_m = math.inf  # the beams' reach (set by the sensing); misses say nothing beyond it
@@ -112,7 +129,7 @@ class HitTracker:
         """
         hits = np.asarray(hits_m, dtype=float).reshape(-1, 2)
         origins = np.asarray(origins_m, dtype=float).reshape(-1, 2)
-        clusters = [(hits[idx], origins[idx]) for idx in self._clusters(hits)]
+        clusters = [(hits[idx], origins[idx]) for idx in self._clusters(hits, origins)]
         seen = self._associate(time_s, clusters)
         self._tracks = [t for t in self._tracks if time_s - t.times_s[-1] <= self.keep_s]
         if beams is not None:
@@ -124,11 +141,15 @@ class HitTracker:
             out.append(DetectedObstacle(x, y, t.radius_m, t.velocity_m_s[0], t.velocity_m_s[1], t.track_id))
         return tuple(out)
 
-    def _clusters(self, hits: np.ndarray) -> list[np.ndarray]:
+    def _clusters(self, hits: np.ndarray, origins: np.ndarray) -> list[np.ndarray]:
         n = len(hits)
         if n == 0:
             return []
         near = np.hypot(*(hits[:, None, :] - hits[None, :, :]).transpose(2, 0, 1)) < 2.0 * self.default_radius_m
+        if self.max_link_angle_deg < 180.0:
+            rays = hits - origins
+            rays /= np.maximum(np.linalg.norm(rays, axis=1, keepdims=True), 1e-12)
+            near &= rays @ rays.T > math.cos(math.radians(self.max_link_angle_deg))
         label = -np.ones(n, dtype=np.int64)
         clusters = []
         for i in range(n):
@@ -210,13 +231,13 @@ class HitTracker:
                 fit = self._fit_one(hits[0], origins[0], track.predicted(time_s), track.radius_m)
             else:
                 fit = self._fit(hits, origins, track.radius_m)
-            self._observe(track, time_s, *fit)
+            self._observe(track, time_s, *fit, hits)
             seen.add(track.track_id)
         for di in range(len(clusters)):
             if di not in used_d:
                 track = _Track(self._next_id)
                 self._next_id += 1
-                self._observe(track, time_s, *self._fit(*clusters[di]))
+                self._observe(track, time_s, *self._fit(*clusters[di]), clusters[di][0])
                 self._tracks.append(track)
                 seen.add(track.track_id)
         return seen
@@ -266,7 +287,8 @@ class HitTracker:
                 keep.append(track)
         self._tracks = keep
 
-    def _observe(self, track: _Track, time_s: float, x: float, y: float, r: float, measured: bool) -> None:
+    def _observe(self, track: _Track, time_s: float, x: float, y: float, r: float, measured: bool,
+                 hits: np.ndarray) -> None:
         if track.times_s:
             px, py = track.predicted(time_s)
             if math.hypot(x - px, y - py) > self.jump_m:
@@ -274,9 +296,13 @@ class HitTracker:
                 # about the motion any more.
                 track.times_s.clear()
                 track.centres_m.clear()
+                track.hit_times_s.clear()
+                track.hits_m.clear()
                 track.velocity_m_s = (0.0, 0.0)
         track.times_s.append(time_s)
         track.centres_m.append((x, y))
+        track.hit_times_s.extend([time_s] * len(hits))
+        track.hits_m.extend(map(tuple, hits))
         if measured:
             track.fits_m.append(r)
             del track.fits_m[:-20]
@@ -286,13 +312,29 @@ class HitTracker:
         while track.times_s[0] < time_s - self.window_s:
             track.times_s.pop(0)
             track.centres_m.pop(0)
+        while track.hit_times_s[0] < time_s - self.window_s:
+            track.hit_times_s.pop(0)
+            track.hits_m.pop(0)
         t = np.array(track.times_s)
         if t[-1] - t[0] < self.min_span_s:
             return
         c = np.array(track.centres_m)
         tc = t - t.mean()
         v = (tc @ (c - c.mean(axis=0))) / float(tc @ tc)
+        if self.hit_motion:
+            v = self._hit_motion(track, time_s, v)
         speed = float(np.hypot(v[0], v[1]))
         if speed > self.max_speed_m_s:
             v *= self.max_speed_m_s / speed
         track.velocity_m_s = (float(v[0]), float(v[1]))
+
+    def _hit_motion(self, track: _Track, time_s: float, regressed_m_s: np.ndarray) -> np.ndarray:
+        """Step 5 with ``hit_motion``: the velocity of the disc through the window's raw hits (the step's
+        centre stays: replacing it too changed little on dyn300 and lost dyn-overtake-2); the regressed velocity
+        when the hits do not fit one moving disc."""
+        centre, velocity, rms = fit_moving_disc(np.array(track.hit_times_s), np.array(track.hits_m),
+                                                track.radius_m, time_s, np.array(track.centres_m[-1]),
+                                                np.array(track.velocity_m_s))
+        if rms > self.hit_motion_rms_m or math.hypot(*(centre - track.centres_m[-1])) > self.jump_m:
+            return regressed_m_s
+        return velocity
