@@ -284,6 +284,7 @@ class ImmasStepwiseNavigator:
         self.target: Cell | None = None
         self._diverted = False
         self._started = False
+        self._reached_unhandled = False  # a cell reached inside a step that then started a new move
         self.drive = (DriveThrough(self.walk, grid, setup.controller, self.lookahead_cells, self.carrot_m, start,
                                    self.predict_s > 0)
                       if self.lookahead_cells > 0 else None)
@@ -346,6 +347,7 @@ class ImmasStepwiseNavigator:
         events: list[tuple[str, dict[str, Any]]] = []
         new_path = None
         command, reached = self.walker.command(observation.pose, observation.twist)
+        reached, self._reached_unhandled = reached or self._reached_unhandled, False
         if reached or not self._started:
             if self._started:
                 here = self.walker.cell
@@ -362,7 +364,7 @@ class ImmasStepwiseNavigator:
                 nxt = self.walk.choose(here, self.visited, self._dynamic(observation, (0.0, self.step_s)))
                 if nxt is not None:
                     new_path = self._go(here, nxt)
-                    command, _ = self.walker.command(observation.pose, observation.twist)
+                    command, self._reached_unhandled = self.walker.command(observation.pose, observation.twist)
                 else:
                     self.walker.start([here])
                     command, _ = self.walker.command(observation.pose, observation.twist)
@@ -374,5 +376,7 @@ class ImmasStepwiseNavigator:
             events.append(("immas_divert", {"from": list(here), "blocked": list(self.target),
                                             "to": None if other is None else list(other)}))
             new_path = self._go(here, other if other is not None else here)
-            command, _ = self.walker.command(observation.pose, observation.twist)
+            # A divert onto a cell the robot already stands within reach_m of is reached at once: the next
+            # step decides from it (the walker reports a cell reached once; losing that report froze the walk)
+            command, self._reached_unhandled = self.walker.command(observation.pose, observation.twist)
         return NavigationStep(command, new_path, tuple(events))
