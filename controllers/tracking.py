@@ -95,6 +95,11 @@ class HitTracker:
             A disc the robot is not touching subtends less than 90 degrees unless it is over 2.4 times the
             robot's radius; hits on two discs either side of the robot, closer than ``2 * default_radius_m``,
             made one phantom disc between them, over the robot (dyn-overtake-2).
+        split_seen_gaps: step 1 never links two hits when a beam of the step (``beams``) crosses the segment
+            between them, by more than ``clear_m`` from its ends, with no hit before it (ours; False: off).
+            A disc with both hits on its rim contains that chord, so a free point on it means two obstacles:
+            hits on two discs 0.4 m apart made one phantom disc over the gap between them, where the goal
+            was (dyn-overtake-2).
     """
 
     default_radius_m: float = 0.3
@@ -109,6 +114,7 @@ class HitTracker:
     hit_motion: bool = True
     hit_motion_rms_m: float = 0.03
     max_link_angle_deg: float = 90.0
+    split_seen_gaps: bool = True
 
     def __post_init__(self) -> None:
         self.reach_m = math.inf  # the beams' reach (set by the sensing); misses say nothing beyond it
@@ -129,7 +135,7 @@ class HitTracker:
         """
         hits = np.asarray(hits_m, dtype=float).reshape(-1, 2)
         origins = np.asarray(origins_m, dtype=float).reshape(-1, 2)
-        clusters = [(hits[idx], origins[idx]) for idx in self._clusters(hits, origins)]
+        clusters = [(hits[idx], origins[idx]) for idx in self._clusters(hits, origins, beams)]
         seen = self._associate(time_s, clusters)
         self._tracks = [t for t in self._tracks if time_s - t.times_s[-1] <= self.keep_s]
         if beams is not None:
@@ -141,7 +147,8 @@ class HitTracker:
             out.append(DetectedObstacle(x, y, t.radius_m, t.velocity_m_s[0], t.velocity_m_s[1], t.track_id))
         return tuple(out)
 
-    def _clusters(self, hits: np.ndarray, origins: np.ndarray) -> list[np.ndarray]:
+    def _clusters(self, hits: np.ndarray, origins: np.ndarray,
+                  beams: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> list[np.ndarray]:
         n = len(hits)
         if n == 0:
             return []
@@ -150,6 +157,8 @@ class HitTracker:
             rays = hits - origins
             rays /= np.maximum(np.linalg.norm(rays, axis=1, keepdims=True), 1e-12)
             near &= rays @ rays.T > math.cos(math.radians(self.max_link_angle_deg))
+        if self.split_seen_gaps and beams is not None and len(beams[0]) and n > 1:
+            near &= ~self._chord_seen_through(hits, beams)
         label = -np.ones(n, dtype=np.int64)
         clusters = []
         for i in range(n):
@@ -165,6 +174,24 @@ class HitTracker:
                     frontier.append(int(k))
             clusters.append(np.array(sorted(members)))
         return clusters
+
+    def _chord_seen_through(self, hits: np.ndarray, beams: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
+        """(N, N): a beam crosses the segment between hits i and j, by more than ``clear_m``, with no hit
+        before it.  A disc through both hits contains that chord (it is convex), so they lie on two obstacles."""
+        origins, directions, ranges = (np.asarray(b, dtype=float) for b in beams)
+        p = hits[:, None, None, :]                              # (N, 1, 1, 2) one end
+        e = hits[None, :, None, :] - p                          # (N, N, 1, 2) the chord
+        w = p - origins[None, None, :, :]                       # (N, 1, K, 2)
+        d = directions[None, None, :, :]
+        det = d[..., 0] * e[..., 1] - d[..., 1] * e[..., 0]     # cross(d, e)
+        ok = np.abs(det) > 1e-9
+        safe = np.where(ok, det, 1.0)
+        s = (w[..., 0] * e[..., 1] - w[..., 1] * e[..., 0]) / safe  # along the beam
+        u = (w[..., 0] * d[..., 1] - w[..., 1] * d[..., 0]) / safe  # along the chord
+        length = np.maximum(np.linalg.norm(e, axis=-1), 1e-12)
+        margin = self.clear_m / length                          # keep clear of the chord's ends
+        crossed = ok & (s > 0.0) & (u > margin) & (u < 1.0 - margin) & (ranges[None, None, :] > s + self.clear_m)
+        return crossed.any(axis=2)
 
     def _fit(self, hits: np.ndarray, origins: np.ndarray, radius_m: float = 0.0
              ) -> tuple[float, float, float, bool]:
