@@ -197,3 +197,27 @@ def test_hits_on_two_discs_either_side_of_the_robot_are_not_one_disc_over_it(max
     over_robot = [d for d in found if math.hypot(d.x_m, d.y_m) < d.radius_m + 0.15]
     near_truth = all(min(math.hypot(d.x_m - c[0], d.y_m - c[1]) for d in found) < 0.1 for c, _ in discs)
     assert (not over_robot and near_truth and len(found) == 2) == (max_link_angle_deg < 180.0)
+
+
+@pytest.mark.parametrize("split_seen_gaps", [True, False])
+@pytest.mark.parametrize("heading_deg", [0.0, 10.0, 20.0])
+def test_hits_on_two_discs_with_a_seen_gap_between_them_are_not_one_disc_over_the_gap(split_seen_gaps, heading_deg):
+    """dyn-overtake-2 at 50.6 s: the robot waits above a 0.42 m gap between two discs (the goal lies in it),
+    12 beams; hits on both are closer than ``2 * default_radius_m`` and less than 90 degrees apart.  Linked,
+    they made one disc fitted over the gap (where a beam passes freely); with ``split_seen_gaps`` (the
+    default), a disc at each of the two and none over the gap's middle."""
+    angles = np.linspace(0.0, 2 * math.pi, 12, endpoint=False)
+    heading = math.radians(heading_deg)
+    dirs = np.column_stack([np.cos(angles + heading), np.sin(angles + heading)])
+    origins = 0.155 * dirs
+    discs = [(np.array([-0.47, -0.38]), 0.25), (np.array([0.55, -0.38]), 0.35)]
+    gap_middle = np.array([0.5 * (-0.47 + 0.25 + 0.55 - 0.35), -0.38])
+    ranges = np.min([[ray_disc_ranges(o, d[None, :], c, r, 1.0)[0] for o, d in zip(origins, dirs)]
+                     for c, r in discs], axis=0)
+    hits, hit_origins = hit_points(Pose2D(0.0, 0.0, heading), ranges, angles, 0.155)
+    tracker = HitTracker(split_seen_gaps=split_seen_gaps)
+    tracker.reach_m = 1.0
+    found = tracker.update(0.0, hits, hit_origins, (origins, dirs, ranges))
+    over_gap = [d for d in found if math.hypot(d.x_m - gap_middle[0], d.y_m - gap_middle[1]) < d.radius_m]
+    near_truth = all(min(math.hypot(d.x_m - c[0], d.y_m - c[1]) for d in found) < 0.1 for c, _ in discs)
+    assert (not over_gap and near_truth and len(found) == 2) == split_seen_gaps
