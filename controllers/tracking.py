@@ -6,7 +6,8 @@ tracker does only what the rays allow:
 
 1. **Clusters** the hits by single linkage: two hits closer than
    ``2 * default_radius_m``, whose rays are less than ``max_link_angle_deg`` apart,
-   may lie on one disc, so they join one cluster.
+   may lie on one disc, so they join one cluster; unless (``split_seen_gaps``) a
+   beam of the step crosses the segment between them with no hit before it.
 2. **Fits a disc** to each cluster.  With three hits or more the radius is
    measured by a least-squares circle fit (Kasa 1976); otherwise it is the
    track's radius so far, or ``default_radius_m`` (the assumed obstacle
