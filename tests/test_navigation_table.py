@@ -103,3 +103,17 @@ def test_the_committed_rangefinder_result_is_all_300_scenes_with_the_rangefinder
     assert {r["sensor_model"] for r in rows} == {"rangefinder"}
     assert {r["runs"] for r in rows} == {len(load_suite("dyn300").scenes)}
     assert rows[-1]["navigator"] == "oracle" and rows[-1]["verdict_mismatches"] == 0
+
+
+def test_the_speed_sentence_follows_the_run_figures():
+    from swarmnav.sim.benchmarks.navigation_table import summary_lines
+    rows = [dict(r) for r in read_rows(RESULT)]
+    speed = next(line for line in summary_lines(rows) if line.startswith("Speed"))
+    slowest = min((r for r in rows if r.get("realtime_factor_cpu") is not None), key=lambda r: r["realtime_factor_cpu"])
+    assert f"{slowest['realtime_factor_cpu']:.1f}× real time or more on CPU (`{slowest['navigator']}`" in speed
+    mppi = next(r for r in rows if r["navigator"] == "mppi")
+    mppi["mppi_every_step"] = dict(mppi["mppi_every_step"], cpu_us_per_step=1234.0)
+    assert "`mppi` 1234 µs of CPU" in next(line for line in summary_lines(rows) if line.startswith("Speed"))
+    bare = [{k: v for k, v in r.items() if k not in ("realtime_factor_cpu", "mppi_every_step", "oracle_search")}
+            for r in rows]
+    assert not any(line.startswith("Speed") for line in summary_lines(bare))

@@ -109,11 +109,30 @@ def summary_lines(rows: list[dict[str, Any]]) -> list[str]:
         lines.append(f"Every online navigator at its defaults ≥ {target:.2f}: "
                      + ("met." if not below else "not met: " + "; ".join(parts) + "."))
     oracle = next((r for r in rows if r["navigator"] == ORACLE), None)
+    lines += _speed_sentence(rows, oracle)
     if oracle is not None and oracle.get("success_on_solvable") is not None:
         lines.append(f"The oracle called {oracle['oracle_solvable_runs']} of {oracle['runs']} runs solvable and "
                      f"succeeded in physics on {oracle['success_on_solvable']:.3f} of them "
                      f"({_met(oracle['success_on_solvable'], 0.95)}).")
     return lines
+
+
+def _speed_sentence(rows: list[dict[str, Any]], oracle: dict[str, Any] | None) -> list[str]:
+    """The run's speed against issue 23's targets, from its speed figures (absent from a result without them):
+    the slowest row's real-time factor on CPU, MPPI's CPU per control step, the oracle's longest search."""
+    parts = []
+    timed = [r for r in rows if r.get("realtime_factor_cpu") is not None]
+    if timed:
+        slow = min(timed, key=lambda r: r["realtime_factor_cpu"])
+        parts.append(f"every row at {slow['realtime_factor_cpu']:.1f}× real time or more on CPU (`{slow['navigator']}` "
+                     f"the slowest; target ≥ 30×)")
+    mppi = next((r["mppi_every_step"] for r in rows if r.get("mppi_every_step")), None)
+    if mppi:
+        parts.append(f"`mppi` {mppi['cpu_us_per_step']:.0f} µs of CPU per control step optimising every step "
+                     "(target ≤ 1,000)")
+    if oracle is not None and oracle.get("oracle_search"):
+        parts.append(f"the oracle's search at most {oracle['oracle_search']['max_s']:.2f} s a scene (target < 2 s)")
+    return ["Speed (wall-clock figures depend on the load): " + "; ".join(parts) + "."] if parts else []
 
 
 def block(rows: list[dict[str, Any]], result: FilePath = RESULT) -> str:
