@@ -115,6 +115,7 @@ def test_arms_are_rows_under_their_own_labels_and_extend_a_kept_benchmark(tmp_pa
     ("a:oracle", "the yardstick"),
     ("follow:follow", "label 'follow' is already a row"),
     ("a:velocity_obstacle:bogus=1", "--arm a: navigator.params.bogus: unknown parameter"),
+    ("a:velocity_obstacle:margin_m=[1,2]", "--arm a: navigator.params.margin_m: expected a number"),
 ])
 def test_bad_arms_are_one_line_and_exit_2(arm, message, capsys):
     from swarmnav.sim.cli.main import main
@@ -144,3 +145,10 @@ def test_a_seed_offset_without_a_generated_suite_is_one_line_and_exit_2(capsys):
     assert main(["bench", "navigation", "--quick", "--seed-offset", "5"]) == 2
     err = capsys.readouterr().err.strip()
     assert "--seed-offset" in err and len(err.splitlines()) == 1
+
+
+def test_an_arms_settings_split_at_keys_only():
+    from swarmnav.sim.benchmarks.navigation import parse_arm
+    arm = parse_arm("drive:immas_stepwise:evade=true, lookahead_cells=6,predict_s=1")
+    assert arm.params == {"evade": True, "lookahead_cells": 6, "predict_s": 1}
+    assert parse_arm("plain:follow:").params == {}

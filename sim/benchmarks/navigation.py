@@ -41,6 +41,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import re
 import sys
 import tempfile
 from typing import Any
@@ -114,7 +115,9 @@ def parse_arm(text: str) -> Arm:
         raise ConfigError("--arm", f"unknown navigator {name!r} in {text!r} (known: {', '.join(sorted(NAVIGATORS))})")
     if is_clairvoyant(name):
         raise ConfigError("--arm", f"{name!r} is the yardstick, run beside every contender already")
-    params = parse_settings([p for p in settings.split(",") if p.strip()], "--arm") if settings else {}
+    # a comma starts a new KEY=VALUE only before a key, so a TOML array value keeps its commas
+    pairs = re.split(r",(?=\s*[A-Za-z_][A-Za-z0-9_]*\s*=)", settings) if settings else []
+    params = parse_settings([p.strip().rstrip(",") for p in pairs if p.strip(" ,")], "--arm")
     try:
         make_navigator(name, params)  # a bad key or value is refused here, naming the navigator's field
     except ConfigError as exc:
