@@ -33,7 +33,7 @@ What it does (ours):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
@@ -86,6 +86,27 @@ def carrot_on(centres_m: np.ndarray, index: int, distance_m: float) -> np.ndarra
 
 
 @dataclass
+class WalkTally:
+    """Algorithm 3's tally of one walk, kept by both ways of driving it: the cells visited (the robot does not
+    re-enter one while an unvisited candidate is left), the moves, their route cost k summed (line 25) and
+    the §4.1 diverts."""
+
+    visited: np.ndarray
+    route_cost: np.ndarray
+    moves: int = 0
+    arc_cost: float = 0.0
+    diverts: int = 0
+
+    def move(self, cell: Cell, diverted: bool) -> tuple[str, dict[str, Any]]:
+        """A cell reached: marked visited and counted; its ``immas_move`` event."""
+        self.visited[cell] = True
+        self.moves += 1
+        self.arc_cost += float(self.route_cost[cell])
+        return ("immas_move", {"cell": list(cell), "moves": self.moves, "total_arc_cost": round(self.arc_cost, 4),
+                               "diverted": diverted})
+
+
+@dataclass
 class DriveThrough:
     """The robot driving through the walk ahead (see the module's docstring); one per run.
 
@@ -107,15 +128,11 @@ class DriveThrough:
     lookahead_cells: int
     carrot_m: float
     start: Cell
+    tally: WalkTally
     looks_further: bool = False
-    moves: int = 0
-    arc_cost: float = 0.0
-    diverts: int = 0
-    visited: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        self.visited = np.zeros(self.grid.shape, dtype=bool)
-        self.visited[self.start] = True
+        self.visited = self.tally.visited
         self.cells: list[Cell] = []
         self._diverted = False
 
@@ -146,12 +163,7 @@ class DriveThrough:
         reached = nearest_index(self.centres_m, pose.x_m, pose.y_m)
         if reached >= 1:
             for cell in self.cells[1:reached + 1]:
-                self.visited[cell] = True
-                self.moves += 1
-                self.arc_cost += float(self.walk.analysis.route_cost[cell])
-                events.append(("immas_move", {"cell": list(cell), "moves": self.moves,
-                                              "total_arc_cost": round(self.arc_cost, 4),
-                                              "diverted": self._diverted}))
+                events.append(self.tally.move(cell, self._diverted))
                 self._diverted = False
             new_path = self._plan(self.cells[reached], occupancy)
         elif len(self.cells) == 1:
@@ -167,7 +179,7 @@ class DriveThrough:
                 if other is None and self.looks_further:
                     other = self.walk.divert(here, occupancy("step"))
                 self._diverted = True
-                self.diverts += 1
+                self.tally.diverts += 1
                 events.append(("immas_divert", {"from": list(here), "blocked": list(nxt),
                                                 "to": None if other is None else list(other)}))
                 if other is None:                                   # no free neighbour: hold the cell

@@ -61,7 +61,7 @@ from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.evasion import evaded, evasion_for
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, static_grid
-from swarmnav.controllers.navigators.immas_drive import DriveThrough
+from swarmnav.controllers.navigators.immas_drive import DriveThrough, WalkTally
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.improved_max_min_ant_system import ImprovedMaxMinAntSystemPlanner, tour_scores
@@ -274,19 +274,17 @@ class ImmasStepwiseNavigator:
         self.walk = StepwiseWalk(analysis, goal, alpha, beta)
         self.walker = CellWalker(setup.controller, grid, self.reach_m)
         self.walker.start([start])
-        self.visited = np.zeros(grid.shape, dtype=bool)
-        self.visited[start] = True
+        self.tally = WalkTally(np.zeros(grid.shape, dtype=bool), analysis.route_cost)
+        self.tally.visited[start] = True
+        self.visited = self.tally.visited
         self.inflation_m = problem.inflation_m
         self.step_s = grid.cell_m / setup.max_speed_m_s
-        self.moves = 0
-        self.arc_cost = 0.0
-        self.diverts = 0
         self.target: Cell | None = None
         self._diverted = False
         self._started = False
         self._reached_unhandled = False  # a cell reached inside a step that then started a new move
         self.drive = (DriveThrough(self.walk, grid, setup.controller, self.lookahead_cells, self.carrot_m, start,
-                                   self.predict_s > 0)
+                                   self.tally, self.predict_s > 0)
                       if self.lookahead_cells > 0 else None)
 
     def _dynamic(self, observation: Observation, ahead_s: Iterable[float]) -> np.ndarray:
@@ -340,7 +338,6 @@ class ImmasStepwiseNavigator:
             observation.pose, observation.twist,
             lambda kind: self._swept(observation, self.predict_s) if kind == "decision" and self.predict_s
             else self._dynamic(observation, (0.0,) if kind == "now" else (0.0, self.step_s)))
-        self.moves, self.arc_cost, self.diverts = self.drive.moves, self.drive.arc_cost, self.drive.diverts
         return NavigationStep(command, new_path, tuple(events))
 
     def _paper_step(self, observation: Observation) -> NavigationStep:
@@ -350,13 +347,7 @@ class ImmasStepwiseNavigator:
         reached, self._reached_unhandled = reached or self._reached_unhandled, False
         if reached or not self._started:
             if self._started:
-                here = self.walker.cell
-                self.visited[here] = True
-                self.moves += 1
-                self.arc_cost += float(self.walk.analysis.route_cost[here])
-                events.append(("immas_move", {"cell": list(here), "moves": self.moves,
-                                              "total_arc_cost": round(self.arc_cost, 4),
-                                              "diverted": self._diverted}))
+                events.append(self.tally.move(self.walker.cell, self._diverted))
             self._started = True
             self._diverted = False
             here = self.walker.cell
@@ -372,7 +363,7 @@ class ImmasStepwiseNavigator:
             here = self.walker.cells[0]
             other = self.walk.divert(here, self._dynamic(observation, (0.0, self.step_s)))
             self._diverted = True
-            self.diverts += 1
+            self.tally.diverts += 1
             events.append(("immas_divert", {"from": list(here), "blocked": list(self.target),
                                             "to": None if other is None else list(other)}))
             new_path = self._go(here, other if other is not None else here)
