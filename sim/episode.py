@@ -31,6 +31,7 @@ import numpy as np
 from swarmnav.controllers.navigator import NavigationSetup, Navigator
 from swarmnav.controllers.navigators import NAVIGATORS, make_navigator
 from swarmnav.controllers.point_to_point import PointToPointController
+from swarmnav.controllers.world_map import SensedMap
 from swarmnav.models.scenario import Scenario
 from swarmnav.models.parameters import refuse_code
 from swarmnav.models.seeds import Seeds
@@ -176,10 +177,17 @@ def plan_episode(spec: EpisodeSpec, scene: CompiledScene | None = None) -> Episo
     source = spec.scenario.source_path
     planner, budgeted = build_planner(spec)
     navigator = make_navigator(spec.navigator, spec.navigator_params, source)  # fails before planning
-    problem = scenario_problem(spec.scenario)
+    # With the map unknown the first plan sees no static obstacle (moving ones neither: nothing is sensed yet).
+    problem = scenario_problem(spec.scenario) if spec.scenario.map_knowledge == "known" \
+        else unknown_map_problem(spec.scenario)
     path = planner.plan(problem, np.random.default_rng(spec.seed))
     return Episode(spec, problem, path, planner, navigator, scene, planner_params=resolved_params(planner),
                    budgeted=budgeted)
+
+
+def unknown_map_problem(scenario: Scenario) -> Problem:
+    """What the robot knows at t = 0 with the map unknown: the arena, its start and goal, no obstacle."""
+    return scenario_problem(replace(scenario, obstacles=(), boxes=(), map_grid=None))
 
 
 def build_planner(spec: EpisodeSpec) -> tuple[Any, bool]:
@@ -210,13 +218,18 @@ def run_episode(episode: Episode | EpisodeSpec, recorders: Sequence[Recorder] = 
     spec, simulation = planned.spec, planned.simulation
     scenario = spec.scenario
     navigator = planned.navigator
+    unknown = scenario.map_knowledge == "unknown"
+    known_problem = static_problem(scenario) if not unknown else planned.problem
+    world_map = SensedMap(planned.problem, scenario.bounds, scenario.map_cell_m) if unknown else None
     setup = NavigationSetup(
-        path=planned.path, problem=planned.problem, planner=planned.planner if navigator.uses_planner else None,
+        path=planned.path, problem=planned.problem,
+        # With the map unknown every navigator that plans replans its (guidance) path on the sensed map.
+        planner=planned.planner if navigator.uses_planner or unknown else None,
         rng=np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(NAVIGATOR_STREAM,))),
         controller=PointToPointController(simulation.scene.drive, max_speed_m_s=scenario.max_speed_m_s),
         goal=simulation.goal_checker(), control_dt_s=simulation.control_dt_s,
-        max_speed_m_s=scenario.max_speed_m_s, known_problem=static_problem(scenario),
-        scenario=scenario)
+        max_speed_m_s=scenario.max_speed_m_s, known_problem=known_problem,
+        scenario=scenario, world_map=world_map)
     recorder = RecorderGroup(list(recorders)) if recorders else None
     # The log records every resolved parameter (replaying them builds the same planner).
     context = simulation.context(spec.planner, planned.planner_params or spec.planner_params, spec.seed,

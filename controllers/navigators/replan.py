@@ -58,6 +58,7 @@ from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationSt
 from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_discs
 from swarmnav.controllers.evasion import evasion_for
 from swarmnav.controllers.safety_filter import SafetyFilter
+from swarmnav.controllers.world_map import free_start
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import Disc, Pose2D, rasterise
 from swarmnav.planners.errors import PlanningError, StartBlocked
@@ -149,9 +150,14 @@ class ReplanNavigator:
         check_positive(self, ("lookahead_m", "horizon_s", "retry_s", "time_before_collision_s"),
                        ("margin_m", "cooldown_s", "planning_latency_s"))
 
+    @property
+    def known(self) -> Problem:
+        """The map it plans on (``NavigationSetup.map_problem``: the known map, or the sensed map's latest)."""
+        return self.setup.map_problem
+
     def reset(self, setup: NavigationSetup) -> None:
         self.setup = setup
-        self.known = setup.map_problem
+        self.checked_revision = setup.map_revision
         self.controller = setup.controller
         self.path = setup.path
         self.controller.reset(setup.path)
@@ -194,10 +200,15 @@ class ReplanNavigator:
         return self._finish(observation, command, events, new_path)
 
     def blocked(self, observation: Observation) -> str:
-        """A reason to replan ("blocked by sensed obstacle") or ""."""
+        """A reason to replan ("blocked by sensed obstacle", "blocked on the sensed map") or ""."""
+        pose = observation.pose
+        if self.setup.map_revision != self.checked_revision:  # the sensed map changed (never with a known map)
+            self.checked_revision = self.setup.map_revision
+            rest = path_ahead(pose, self.path.waypoints, self.controller.waypoint_index, math.inf)
+            if self.setup.world_map.blocks(rest):
+                return "blocked on the sensed map"
         if not observation.detections:
             return ""
-        pose = observation.pose
         ahead = path_ahead(pose, self.path.waypoints, self.controller.waypoint_index, self.lookahead_m)
         # The same discs a replan would plan around (kept off the robot), so a fresh path is not blocked at once.
         sweeps = keep_outside(swept_discs(observation.detections, self.horizon_s), [(pose.x_m, pose.y_m)],
@@ -220,8 +231,9 @@ class ReplanNavigator:
             try:
                 path = self.setup.planner.plan(problem, self.setup.rng)
             except StartBlocked:
-                # The robot has cut within the clearance of a known obstacle: plan with no clearance.
-                problem = replace(problem, clearance_m=0.0)
+                # The robot has cut within the clearance of a known obstacle: plan with no clearance
+                # (and, on a sensed map, whose cells are coarser than the obstacles, from the nearest free point).
+                problem = replace(problem, clearance_m=0.0) if self.setup.world_map is None else free_start(problem)
                 path = self.setup.planner.plan(problem, self.setup.rng)
             ok = problem.is_collision_free(path.waypoints, tolerance_m=1e-6)
             why = "" if ok else "the planner's path is not collision-free"

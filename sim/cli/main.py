@@ -57,7 +57,10 @@ class OneLineParser(argparse.ArgumentParser):
 def _load(args: argparse.Namespace):
     """The scenario, as the API loads it (plugins' too); ``--trust-code``: its code parameters may run."""
     from swarmnav.calls import load_scenario
-    return load_scenario(args.scenario, trust_code=args.trust_code)
+    scenario = load_scenario(args.scenario, trust_code=args.trust_code)
+    if getattr(args, "map", None) or getattr(args, "pose", None):  # run's --map / --pose over [knowledge]
+        scenario = scenario.with_knowledge(getattr(args, "map", None), getattr(args, "pose", None))
+    return scenario
 
 
 def _episode_spec(args: argparse.Namespace):
@@ -291,6 +294,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--height", type=int, default=480)
     p.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 0.1..240")
     p.add_argument("--stop-on-collision", action="store_true", help="stop at the first collision")
+    p.add_argument("--map", choices=("known", "unknown"),
+                   help="the static map given in advance (known) or built from the laser as the robot drives "
+                   "(unknown); default: the scenario's knowledge.map")
+    p.add_argument("--pose", choices=("truth", "odometry"),
+                   help="the pose the navigator sees: the simulator's (truth) or integrated wheel speeds "
+                   "(odometry); default: the scenario's knowledge.pose")
     p.add_argument("--waypoints", metavar="FILE", help="drive this path instead of planning: CSV with x,y columns, "
                    "a JSON list of [x, y] pairs, or the output of `plan --json`")
     p.add_argument("--json-out", metavar="FILE", help="also write the `--json` object to FILE")

@@ -19,7 +19,7 @@ from importlib import resources
 from pathlib import Path
 
 from swarmnav.sim import palette
-from swarmnav.sim.log.format import EVENTS_TOPIC, NAVIGATOR_TOPIC, SCENE_TOPIC, WORLD_FRAME
+from swarmnav.sim.log.format import EVENTS_TOPIC, MAP_TOPIC, NAVIGATOR_TOPIC, ODOM_TOPIC, SCENE_TOPIC, WORLD_FRAME
 
 LAYOUT_FILE = "foxglove_layout.json"
 WHEEL_SERIES = (("command_left_rad_s", "left commanded", "dashed", palette.PLANNERS[0]),
@@ -37,6 +37,11 @@ def build_layout() -> str:
     topics["/planner/path"] = fl.BaseRendererPosesTopicSettings(visible=True, type="line", line_width=0.04,
                                                                gradient=(palette.PLANNED, palette.PLANNED))
     topics["/range/scan"] = fl.BaseRendererLaserScanTopicSettings(visible=True)
+    # The sensed map (only in logs with the map unknown): occupancy percent, grey from free to occupied.
+    topics[MAP_TOPIC] = fl.BaseRendererGridTopicSettings(visible=True, color_mode="gradient", color_field="occupancy",
+                                                         gradient=("#ffffff20", "#000000c0"), min_value=0.0,
+                                                         max_value=100.0, draw_behind=True)
+    topics[ODOM_TOPIC] = fl.BaseRendererPoseTopicSettings(visible=True)  # the odometry pose (only with it)
     scene = fl.ThreeDeePanel(title="scene (top view)", config=fl.ThreeDeeConfig(
         fixed_frame=WORLD_FRAME, follow_tf=WORLD_FRAME, follow_mode="follow-none", topics=topics,
         camera_state=fl.ThreeDeeCameraState(perspective=False, distance=16.0, target_offset=(5.0, 5.0, 0.0))))

@@ -41,6 +41,7 @@ from foxglove.messages import (
     Vector3,
 )
 
+from swarmnav.sim.log.map_channel import MapChannel
 from swarmnav.sim.log.live_view import DEFAULT_LIVE_HOST, DEFAULT_LIVE_PORT, LiveServer
 from swarmnav.sim.log.encoding import SceneEncoder, StepEncoder, timestamp_field
 from swarmnav.sim.log.file import LogFile
@@ -160,6 +161,7 @@ class McapRecorder:
         self._json_channels: list[foxglove.Channel] = []
         self._navigator: SceneUpdateChannel | None = None  # made at the first belief with obstacles
         self._belief_drawn = False
+        self._map: MapChannel | None = None
 
     # -- Recorder protocol -------------------------------------------------
 
@@ -277,6 +279,14 @@ class McapRecorder:
         self._after_write(t_ns, written)
         if self._pacer is not None:
             self._pacer.step(frame)
+
+    def occupancy(self, time_s: float, grid: Any) -> None:
+        """Log the sensed map on ``/map`` (:mod:`sim.log.map_channel`; the channel made at the first)."""
+        t_ns = time_ns(time_s)
+        if self._map is None:
+            self._map = MapChannel(self._fox)
+        self._map.log(t_ns, grid)
+        self._after_write(t_ns, 1)
 
     def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
         """Log a discrete event and flush, so it survives a crash right after."""

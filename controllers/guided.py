@@ -1,0 +1,101 @@
+"""The local navigators' guidance on a sensed map (``knowledge = { map = "unknown" }``): what
+:func:`controllers.guidance.local_setup` gives ``dwa``, ``velocity_obstacle`` and ``mppi`` instead of the
+fixed carrot and map obstacles, so that none of them has map code of its own.
+
+* :class:`SensedLocalObstacles`: the map's boxes near the robot, refreshed whenever the sensed map
+  publishes a change (``NavigationSetup.map_revision``).
+* :class:`GuidedCarrot`: the carrot on a guidance path that is replanned, with the run's planner, on the
+  sensed map (from the robot, ``free_start`` when its position is blocked; with one map cell more clearance
+  than the scenario's, so the local navigators' own margins fit beside it) whenever a publication blocks
+  the rest of it, at most once per ``cooldown_s`` of simulated time (a failed replan keeps the old path and
+  is retried at the next publication).  The new guidance paths are not logged (the navigators return none).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from swarmnav.controllers.guidance import PathCarrot
+from swarmnav.controllers.navigator import NavigationSetup
+from swarmnav.controllers.prediction import LocalObstacles
+from swarmnav.controllers.world_map import free_start
+from swarmnav.models.world import Pose2D
+from swarmnav.planners.errors import PlanningError, StartBlocked
+from dataclasses import replace
+
+GUIDANCE_COOLDOWN_S = 0.5  # as the replan navigator's default cooldown_s
+
+
+class SensedLocalObstacles(LocalObstacles):
+    """:class:`~controllers.prediction.LocalObstacles` of the sensed map's latest publication."""
+
+    def __init__(self, setup: NavigationSetup):
+        self.setup = setup
+        self.revision = -1
+        self._refresh()
+
+    def _refresh(self) -> None:
+        if self.setup.map_revision != self.revision:
+            self.revision = self.setup.map_revision
+            known = self.setup.map_problem
+            super().__init__(known.disc_centres_m, known.disc_radii_m, known.box_array_m)
+
+    def near(self, x_m: float, y_m: float, reach_m: float, detections):
+        self._refresh()
+        return super().near(x_m, y_m, reach_m, detections)
+
+
+class GuidedCarrot(PathCarrot):
+    """A :class:`~controllers.guidance.PathCarrot` whose path is replanned on the sensed map (see above)."""
+
+    def __init__(self, setup: NavigationSetup, lookahead_m: float, cooldown_s: float = GUIDANCE_COOLDOWN_S):
+        super().__init__(setup.path.waypoints, lookahead_m)
+        self.setup, self.cooldown_s = setup, cooldown_s
+        self.revision = setup.map_revision
+        self.next_replan_s = 0.0
+        self.time_s = 0.0
+        self.replans = 0
+        self._sight_radius_m: float | None = None
+
+    def keep_in_sight(self, disc_centres_m, disc_radii_m, boxes_m, radius_m: float, samples: int = 8) -> None:
+        self._sight_radius_m, self._sight_samples = float(radius_m), samples
+        super().keep_in_sight(disc_centres_m, disc_radii_m, boxes_m, radius_m, samples)
+
+    def update(self, pose: Pose2D, window_m: float = 2.0) -> np.ndarray:
+        revision = self.setup.map_revision
+        if revision != self.revision and self.time_s >= self.next_replan_s - 1e-9:
+            self.revision = revision
+            known = self.setup.map_problem
+            if self._sight_radius_m is not None:  # the sight test sees the current map
+                self.sight = None
+                super().keep_in_sight(known.disc_centres_m, known.disc_radii_m, known.box_array_m,
+                                      self._sight_radius_m, self._sight_samples)
+            rest = np.vstack([[pose.x_m, pose.y_m], self.points[self._segment(self.progress_m) + 1:]])
+            if self.setup.world_map.blocks(rest):
+                self.next_replan_s = self.time_s + self.cooldown_s
+                self._replan(known, pose)
+        self.time_s += self.setup.control_dt_s
+        return super().update(pose, window_m)
+
+    def _replan(self, known, pose: Pose2D) -> None:
+        # A cell more clearance than the map asks for: the local navigators keep their own margin from the
+        # cells' edges, and a guidance path that grazes them at exactly that margin leaves them no room.
+        problem = replace(known, start=Pose2D(pose.x_m, pose.y_m, pose.heading_rad),
+                          clearance_m=known.clearance_m + known.cell_m)
+        planner = self.setup.planner
+        try:
+            try:
+                path = planner.plan(problem, self.setup.rng)
+            except StartBlocked:
+                problem = free_start(problem)
+                path = planner.plan(problem, self.setup.rng)
+        except PlanningError:
+            self.revision = -1  # try again at the next update after the cooldown
+            return
+        if not problem.is_collision_free(path.waypoints, tolerance_m=1e-6):
+            self.revision = -1
+            return
+        sight, samples = self.sight, getattr(self, "sight_samples", 8)
+        PathCarrot.__init__(self, np.vstack([[pose.x_m, pose.y_m], path.waypoints]), self.lookahead_m)
+        self.sight, self.sight_samples = sight, samples
+        self.replans += 1
