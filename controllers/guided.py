@@ -2,8 +2,13 @@
 :func:`controllers.guidance.local_setup` gives ``dwa``, ``velocity_obstacle`` and ``mppi`` instead of the
 fixed carrot and map obstacles, so that none of them has map code of its own.
 
-* :class:`SensedLocalObstacles`: the map's boxes near the robot, refreshed whenever the sensed map
-  publishes a change (``NavigationSetup.map_revision``).
+* :class:`SensedLocalObstacles`: the map's occupied cells near the robot, refreshed whenever the sensed
+  map publishes a change (``NavigationSetup.map_revision``), each as the point at its centre (Nav2's
+  controllers likewise score a costmap cell at its centre): a cell holds a hit anywhere in it, so the disc
+  that covers it stands up to a cell out from the surface; its centre is within half a cell diagonal of
+  it, inside the local navigators' own ``margin_m`` at the default 0.05 m cells.  Measured: with whole
+  cells ``dwa`` froze beside the first obstacle it mapped on gwo-scenario-1 (the map grew under it, and
+  every arc, standing still included, then started inside its margin).
 * :class:`GuidedCarrot`: the carrot on a guidance path that is replanned, with the run's planner, on the
   sensed map (from the robot, ``free_start`` when its position is blocked; with one map cell more clearance
   than the scenario's, so the local navigators' own margins fit beside it) whenever a publication blocks
@@ -38,7 +43,7 @@ class SensedLocalObstacles(LocalObstacles):
         if self.setup.map_revision != self.revision:
             self.revision = self.setup.map_revision
             known = self.setup.map_problem
-            super().__init__(known.disc_centres_m, known.disc_radii_m, known.box_array_m)
+            super().__init__(known.disc_centres_m, np.zeros(len(known.obstacles)), known.box_array_m)
 
     def near(self, x_m: float, y_m: float, reach_m: float, detections):
         self._refresh()
@@ -58,8 +63,10 @@ class GuidedCarrot(PathCarrot):
         self._sight_radius_m: float | None = None
 
     def keep_in_sight(self, disc_centres_m, disc_radii_m, boxes_m, radius_m: float, samples: int = 8) -> None:
-        self._sight_radius_m, self._sight_samples = float(radius_m), samples
-        super().keep_in_sight(disc_centres_m, disc_radii_m, boxes_m, radius_m, samples)
+        # In sight for the robot with the same extra cell of clearance as the guidance path (see _replan).
+        self._sight_radius_m = float(radius_m) + self.setup.map_problem.cell_m
+        self._sight_samples = samples
+        super().keep_in_sight(disc_centres_m, disc_radii_m, boxes_m, self._sight_radius_m, samples)
 
     def update(self, pose: Pose2D, window_m: float = 2.0) -> np.ndarray:
         revision = self.setup.map_revision

@@ -6,9 +6,10 @@ obstacles, fixed for the run.  With ``knowledge = { map = "unknown" }`` the setu
 :class:`SensedMap` instead, Nav2's costmap in small: the runner (``sim.runner``) feeds it every
 observation before the navigator's step (the obstacle layer: a log-odds grid from the laser,
 :mod:`models.occupancy`), and at ``publish_hz`` it publishes the occupied cells as the map problem:
-the cells as boxes (merged, :func:`models.grid_map.merge_boxes`), which every planner already understands:
-grid planners rasterise them grown by the robot radius and the clearance (``Problem.grid``, the inflation
-layer), the continuous ones measure segments against them.  ``revision`` grows with every publication that changed the occupied cells:
+each cell a disc about its centre that covers it (radius half its diagonal), the one obstacle kind every
+planner handles, the swarm planners included (several support no boxes): grid planners rasterise them grown
+by the robot radius and the clearance (``Problem.grid``, the inflation layer), the continuous ones measure
+segments against them.  ``revision`` grows with every publication that changed the occupied cells:
 a navigator that cached something of the map checks it.  Unknown cells are free (Nav2's ``allow_unknown``).
 
 The oracle and the SPL's L* keep the true map.  No MuJoCo here.
@@ -21,9 +22,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from swarmnav.models.grid_map import merge_boxes
 from swarmnav.models.occupancy import LogOddsGrid, SensorModel
-from swarmnav.models.world import OccupancyGrid, Pose2D, Rect
+from swarmnav.models.world import Disc, OccupancyGrid, Pose2D, Rect
 from swarmnav.planners.problem import Problem
 
 PUBLISH_HZ = 5.0  # Nav2's local costmap update_frequency (5 Hz)
@@ -48,6 +48,7 @@ class SensedMap:
         self._next_publish_s = 0.0
         self._occupied = np.zeros((self.grid.rows, self.grid.cols), dtype=bool)
         self._problem = self._build(self._occupied)
+        self._inflated_revision = -1
 
     def update(self, time_s: float, pose, ranges_m: np.ndarray, angles_rad: np.ndarray, offset_m: float,
                range_m: float) -> bool:
@@ -76,16 +77,32 @@ class SensedMap:
         return self._problem
 
     def _build(self, occupied: np.ndarray) -> Problem:
-        return replace(self.empty, boxes=merge_boxes(occupied, self.grid.cell_m, self.grid.origin_m),
-                       cell_m=self.grid.cell_m)
+        cell = self.grid.cell_m
+        centres = (np.argwhere(occupied)[:, ::-1] + 0.5) * cell + np.array(self.grid.origin_m)
+        radius = cell * math.sqrt(0.5)
+        return replace(self.empty, obstacles=tuple(Disc(float(x), float(y), radius) for x, y in centres.tolist()),
+                       cell_m=cell)
+
+    def inflated(self) -> OccupancyGrid:
+        """The published cells grown by the robot radius and the clearance (the inflation layer): cells whose
+        centre lies within the inflation of a published cell's disc (a Euclidean distance transform)."""
+        if self._inflated_revision != self.revision:
+            from scipy.ndimage import distance_transform_edt
+            cell = self.grid.cell_m
+            reach = self.empty.inflation_m + cell * math.sqrt(0.5)
+            near = distance_transform_edt(~self._occupied) * cell < reach if self._occupied.any() \
+                else np.zeros_like(self._occupied)
+            self._inflated = OccupancyGrid(near, cell, self.grid.origin_m)
+            self._inflated_revision = self.revision
+        return self._inflated
 
     def blocks(self, waypoints_m: np.ndarray) -> bool:
-        """Whether a polyline (from the robot on) comes within the inflation of a published occupied cell;
-        the part within the inflation plus a cell of its first point (the robot) is not judged, so a robot
-        that passes close by an obstacle is not sent to replan by its own position."""
-        problem = self.problem()
+        """Whether a polyline (from the robot on), sampled every half cell, enters :meth:`inflated`; the part
+        within the inflation plus a cell of its first point (the robot) is not judged, so a robot that passes
+        close by an obstacle is not sent to replan by its own position."""
+        problem = self.empty
         pts = np.asarray(waypoints_m, dtype=float).reshape(-1, 2)
-        if len(pts) < 2 or not problem.boxes:
+        if len(pts) < 2 or not self._occupied.any():
             return False
         seg = np.diff(pts, axis=0)
         lengths = np.hypot(seg[:, 0], seg[:, 1])
@@ -96,8 +113,7 @@ class SensedMap:
             samples.append(a + np.outer(np.arange(1, n + 1) / n, d))
         points = np.vstack(samples)
         away = np.hypot(points[:, 0] - pts[0, 0], points[:, 1] - pts[0, 1]) > problem.inflation_m + self.grid.cell_m
-        points = points[away]
-        return bool(len(points)) and bool(np.min(problem.segment_clearances_m(points, points, 0.0)) < 0.0)
+        return bool(grid_hits(self.inflated(), points[away]).any())
 
 
 def free_start(problem: Problem, search_m: float = 0.4) -> Problem:
