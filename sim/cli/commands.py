@@ -214,6 +214,18 @@ def run_bench_log(args: argparse.Namespace) -> int:
     return log.run(args)
 
 
+def add_bench_defaults_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--seeds", type=options.positive_int, default=10, help="seeds 0..N-1 per case (default 10)")
+    parser.add_argument("--planners", nargs="+", metavar="NAME", help="only these planners (default: every paper's)")
+    parser.add_argument("--quick", action="store_true", help="3 seeds per case")
+    parser.add_argument("--json", action="store_true")
+
+
+def run_bench_defaults(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import paper_defaults
+    return paper_defaults.run(args)
+
+
 def add_log_info_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", help="an .mcap run log")
     parser.add_argument("--json", action="store_true", help="print the facts as JSON")
@@ -295,6 +307,8 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
      "start-up of `swarmnav scenarios` against a bare `python -c pass`"),
     (("bench", "log"), add_bench_log_arguments, run_bench_log,
      "write a long run log, then time and peak memory of each reader beside the mcap library's"),
+    (("bench", "defaults"), add_bench_defaults_arguments, run_bench_defaults,
+     "each paper's planners at their defaults on its scenarios: collision-free plans over N seeds"),
     (("log", "info"), add_log_info_arguments, run_log_info, "what a log holds"),
     (("log", "recover"), add_log_recover_arguments, run_log_recover, "rewrite a truncated log as a complete one"),
     (("replay",), add_replay_arguments, run_replay, "re-render or re-simulate a log"),
