@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from swarmnav.models.crowd_agents import reseed_agents
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.obstacle_motion import RandomWalkMotion
 from swarmnav.models.scenario_limits import (MAX_CONTROL_STEPS, MAX_GRID_CELLS, MAX_NAME_CHARS,  # noqa: F401
@@ -99,8 +100,9 @@ class Scenario:
 
     def with_world_seed(self, world_seed: int) -> "Scenario":
         """This scenario with every random obstacle motion drawn from ``world_seed``."""
-        obstacles = tuple(replace(ob, motion=ob.motion.reseeded(world_seed))
-                          if isinstance(ob.motion, RandomWalkMotion) else ob for ob in self.obstacles)
+        obstacles = reseed_agents(tuple(replace(ob, motion=ob.motion.reseeded(world_seed))
+                                        if isinstance(ob.motion, RandomWalkMotion) else ob
+                                        for ob in self.obstacles), world_seed)
         return replace(self, obstacles=obstacles, world_seed=int(world_seed))
 
     def with_clearance(self, clearance_m: float, field_name: str = "clearance_m") -> "Scenario":
@@ -196,7 +198,7 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
         check_grid_size(width_m, height_m, cell_m, "sim.cell_m" if cell_given else "arena", source)
     boxes = section.boxes if section is not None else ()
     obstacles = read_obstacles(top, ObstacleWorld(width_m, height_m, walls, seed, time_limit_s, sim.control_hz,
-                                                  boxes, section is not None))
+                                                  boxes, section is not None, sim.timestep_s))
     top.close()
     map_grid = None
     if section is not None:
