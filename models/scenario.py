@@ -14,11 +14,13 @@ from typing import Any
 
 import numpy as np
 
+from swarmnav.models.crowd_agents import reseed_agents
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.obstacle_motion import RandomWalkMotion
 from swarmnav.models.scenario_limits import (MAX_CONTROL_STEPS, MAX_GRID_CELLS, MAX_NAME_CHARS,  # noqa: F401
                                              MAX_PHYSICS_STEPS, MAX_SENSORS, MAX_TRACK_SAMPLES, MAX_WALK_STEPS,
                                              MIN_LENGTH_M, MIN_ROBOT_RADIUS_M, MIN_TIMESTEP_S)
+from swarmnav.models.scenario_boxes import read_boxes
 from swarmnav.models.scenario_map import check_grid_size, read_map_section
 from swarmnav.models.scenario_obstacles import MOTION_KINDS, Obstacle, ObstacleWorld, read_obstacles  # noqa: F401
 from swarmnav.models.seeds import Seeds
@@ -105,8 +107,9 @@ class Scenario:
 
     def with_world_seed(self, world_seed: int) -> "Scenario":
         """This scenario with every random obstacle motion drawn from ``world_seed``."""
-        obstacles = tuple(replace(ob, motion=ob.motion.reseeded(world_seed))
-                          if isinstance(ob.motion, RandomWalkMotion) else ob for ob in self.obstacles)
+        obstacles = reseed_agents(tuple(replace(ob, motion=ob.motion.reseeded(world_seed))
+                                        if isinstance(ob.motion, RandomWalkMotion) else ob
+                                        for ob in self.obstacles), world_seed)
         return replace(self, obstacles=obstacles, world_seed=int(world_seed))
 
     def with_clearance(self, clearance_m: float, field_name: str = "clearance_m") -> "Scenario":
@@ -201,9 +204,9 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
     section = read_map_section(top, SCENARIO_DIR, width_m, height_m)
     if section is None:
         check_grid_size(width_m, height_m, cell_m, "sim.cell_m" if cell_given else "arena", source)
-    boxes = section.boxes if section is not None else ()
+    boxes = (section.boxes if section is not None else ()) + read_boxes(top, width_m, height_m)
     obstacles = read_obstacles(top, ObstacleWorld(width_m, height_m, walls, seed, time_limit_s, sim.control_hz,
-                                                  boxes, section is not None))
+                                                  boxes, section is not None, sim.timestep_s))
     top.close()
     map_grid = None
     if section is not None:
