@@ -24,6 +24,7 @@ from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.study.engines import run_inline, run_local
 from swarmnav.sim.study.grid import Cell, count_cells, iter_cells
 from swarmnav.sim.study.lock import FolderLock
+from swarmnav.sim.study.main_guard import check_main_guard
 from swarmnav.sim.study.rows import RowWriter, compact, done_hashes, read_table
 from swarmnav.sim.study.spec import Study, study_from_tables
 from swarmnav.sim.study.yardstick import Yardstick
@@ -120,6 +121,8 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
     The folder is locked while the study runs (a second study into it is refused, naming this one's PID);
     when every cell has a row, the parts are compacted."""
     out_dir = FilePath(out_dir)
+    if engine == "local":
+        check_main_guard()  # a script's unguarded top level: each spawned worker would run it again
     if engine == "ray" and address:
         from swarmnav.sim.study.ray_engine import check_reachable
         check_reachable(address)  # before anything is written

@@ -64,6 +64,7 @@ from swarmnav.models.scenario import SCENARIO_DIR
 from swarmnav.models.toml_table import POSITIVE, TomlTable, above, parse_toml, read_text, within
 from swarmnav.planners.registry import make_planner
 from swarmnav.planners.swarm import Budget
+from swarmnav.sim.plugins import load_plugins
 from swarmnav.sim.study.claim_spec import Claim, read_claims
 from swarmnav.sim.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, PaperValue, check_time_limit,  # noqa: F401
                                               read_budget, read_clearance, read_components, read_paper,
@@ -164,6 +165,7 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
 
 
 def _read_study(top: TomlTable, default_name: str, trust_code: bool) -> Study:
+    load_plugins()  # the names of installed plugins' planners, navigators and scenarios are valid here too
     top.only(TOP_KEYS)
     name = top.string("name", default_name, non_empty=True)
     description = top.string("description", "")
