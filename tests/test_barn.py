@@ -72,3 +72,29 @@ def test_barn_options_are_checked(tmp_path, capsys):
     assert main(["bench", "navigation", "--suite", "barn", "--barn-dir", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--barn-dir: no BARN data" in err
+
+
+def test_barn_like_worlds_are_seeded_passable_and_barn_shaped():
+    from swarmnav.sim.benchmarks.barn_difficulty import c_space, field_grid
+    from swarmnav.sim.benchmarks.barn_like import FILLS, SMOOTHINGS, generate, parameters
+    assert {parameters(s) for s in range(12)} == {(f, k) for f in FILLS for k in SMOOTHINGS}
+    world, cells, _ = generate(7)
+    again, cells_again, _ = generate(7)
+    assert world == again and np.array_equal(cells, cells_again) and generate(8)[0] != world
+    xy = np.array([[c.x_m, c.y_m] for c in world.cylinders])
+    space = c_space(field_grid(xy))
+    assert not space[cells[:, 1], cells[:, 0]].any()      # the reference path runs over free C-space cells
+    assert cells[0, 1] == 0 and cells[-1, 1] == 29 and np.abs(np.diff(cells, axis=0)).max() == 1
+    assert all(c.radius_m == 0.075 for c in world.cylinders)
+    assert {round(c.x_m, 3) for c in world.cylinders if c.y_m < 5} == {-4.425, -0.075} | {
+        round(0.15 * k - 4.575, 3) for k in range(2, 30)}  # the entry corridor's walls, as in BARN's files
+
+
+def test_barn_like_suite_files(tmp_path):
+    from swarmnav.models.scenario import load_scenario
+    paths, meta, setup = barn.write_barn_suite(str(tmp_path), False, (3, 4), 2, generated=True)
+    assert sorted(meta) == ["barnlike-3-r0", "barnlike-3-r1", "barnlike-4-r0", "barnlike-4-r1"]
+    first, jittered = load_scenario(paths[0]), load_scenario(paths[1])
+    assert first.sim.stop_on_collision and first.time_limit_s == 100.0 and first.goal_tolerance_m == 1.0
+    assert len(first.obstacles) == len(jittered.obstacles) and first.start != jittered.start
+    assert meta["barnlike-3-r0"].optimal_time_s == meta["barnlike-3-r1"].optimal_time_s > 10.0 / 2.0

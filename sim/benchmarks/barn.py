@@ -81,7 +81,11 @@ def barn_dir(given: str | None = None) -> FilePath:
 
 def reference_length_m(folder: FilePath, world: int) -> float:
     """The challenge's reference path length of ``world``: start -> the path's cells -> goal."""
-    from swarmnav.models.world_scenario import BARN_GOAL, BARN_START
+    return cells_length_m(reference_cells(folder, world))
+
+
+def reference_cells(folder: FilePath, world: int) -> np.ndarray:
+    """``paths/path_N.npy``: the (n, 2) cells of the reference path."""
     path = folder / "paths" / f"path_{world}.npy"
     try:
         cells = np.load(path, allow_pickle=False)
@@ -89,6 +93,12 @@ def reference_length_m(folder: FilePath, world: int) -> float:
         raise ConfigError("paths", f"cannot read a reference path ({exc})", str(path)) from None
     if cells.ndim != 2 or cells.shape[1] != 2 or not 1 <= len(cells) <= 10_000:
         raise ConfigError("paths", f"expected an (n, 2) array of cells, got shape {cells.shape}", str(path))
+    return cells
+
+
+def cells_length_m(cells: np.ndarray) -> float:
+    """The polyline start -> the cells (x = 0.15 a - 4.575, y = 0.15 b + 5.075) -> goal, in metres."""
+    from swarmnav.models.world_scenario import BARN_GOAL, BARN_START
     points = cells.astype(float) * CELL_M + np.array(CELL_ORIGIN_M)
     polyline = np.vstack([BARN_START[:2], points, BARN_GOAL[:2]])
     return float(np.linalg.norm(np.diff(polyline, axis=0), axis=1).sum())
@@ -132,16 +142,35 @@ class BarnRun:
     world: int
     run: int
     reference_length_m: float
+    generated: bool = False
 
     @property
     def optimal_time_s(self) -> float:
         return self.reference_length_m / REFERENCE_SPEED_M_S
 
 
-def parse_worlds(text: str | None) -> tuple[int, ...] | None:
-    """``--barn-worlds``: ``test`` (the 50), ``all``, ``A:B[:STEP]`` or a comma list; None when not given."""
+def world_source(world: int, generated: bool, barn: str | None = None):
+    """A world's obstacles (:class:`models.gazebo_world.GazeboWorld`) and reference path cells: BARN's world
+    ``world`` from the data, or the BARN-like world of seed ``world`` (:mod:`sim.benchmarks.barn_like`)."""
+    if generated:
+        from swarmnav.sim.benchmarks.barn_like import generate
+        parsed, cells, _ = generate(world)
+        return parsed, cells
+    from swarmnav.models.gazebo_world import read_world
+    folder = barn_dir(barn)
+    return read_world(folder / "worlds" / f"world_{world}.world.gz"), reference_cells(folder, world)
+
+
+MAX_GENERATED_SEED = 10**6
+
+
+def parse_worlds(text: str | None, generated: bool = False) -> tuple[int, ...] | None:
+    """``--barn-worlds``: ``test`` (the 50), ``all``, ``A:B[:STEP]`` or a comma list; None when not given
+    (``generated``: seeds of BARN-like worlds, 0 .. 10^6, as ``A:B[:STEP]`` or a list)."""
     if text is None:
         return None
+    if generated:
+        return _seeds(text)
     if text == "test":
         return TEST_WORLDS
     if text == "all":
@@ -159,35 +188,52 @@ def parse_worlds(text: str | None) -> tuple[int, ...] | None:
     return worlds
 
 
+def _seeds(text: str) -> tuple[int, ...]:
+    try:
+        parts = [int(p) for p in text.split(":" if ":" in text else ",")]
+        seeds = tuple(range(*parts)) if ":" in text and len(parts) in (2, 3) else tuple(parts) if ":" not in text else ()
+    except ValueError:
+        seeds = ()
+    if not seeds or not all(0 <= s <= MAX_GENERATED_SEED for s in seeds) or len(set(seeds)) != len(seeds) \
+            or len(seeds) > 10_000:
+        raise ConfigError("--barn-worlds", f"expected A:B[:STEP] or distinct seeds 0..{MAX_GENERATED_SEED:,} "
+                                           f"(at most 10,000) for --suite barn-like, got {text!r}")
+    return seeds
+
+
+GENERATED_DEFAULT = tuple(range(50))  # --suite barn-like: seeds 0..49 (never run before this suite existed)
+
+
 def write_barn_suite(folder: str, quick: bool, worlds: tuple[int, ...] | None = None, runs: int | None = None,
-                     barn: str | None = None) -> tuple[list[str], dict[str, BarnRun], str]:
+                     barn: str | None = None, generated: bool = False) -> tuple[list[str], dict[str, BarnRun], str]:
     """The suite's scenario files under ``folder/scenarios``, their :class:`BarnRun` by scenario name, and the
-    setup's label (:func:`protocol_tables`)."""
-    from swarmnav.models.gazebo_world import read_world
+    setup's label (:func:`protocol_tables`); ``generated``: BARN-like worlds of those seeds."""
     from swarmnav.models.world_scenario import ImportSettings, scenario_from_world, BARN_START, BARN_GOAL
-    data = barn_dir(barn)
-    worlds = worlds if worlds is not None else TEST_WORLDS if quick else tuple(range(WORLD_COUNT))
+    if not generated:
+        barn_dir(barn)
+    worlds = worlds if worlds is not None else GENERATED_DEFAULT if generated else TEST_WORLDS if quick \
+        else tuple(range(WORLD_COUNT))
     runs = runs if runs is not None else QUICK_RUNS if quick else 1
     tables, setup = protocol_tables()
     os.makedirs(os.path.join(folder, "scenarios"), exist_ok=True)
     paths, meta = [], {}
     for world in worlds:
-        parsed = read_world(data / "worlds" / f"world_{world}.world.gz")
-        length_m = reference_length_m(data, world)
+        parsed, cells = world_source(world, generated, barn)
+        length_m = cells_length_m(cells)
         for run in range(runs):
             dx, dy, dh = start_jitter(world, run)
-            name = f"barn-{world:03d}-r{run}"
+            name = f"barnlike-{world}-r{run}" if generated else f"barn-{world:03d}-r{run}"
             start = (BARN_START[0] + dx, BARN_START[1] + dy, BARN_START[2] + dh)
             settings = ImportSettings(
                 name=name, start=start, goal=BARN_GOAL, seed=run,
-                description=f"BARN world {world}, run {run} (start moved by ({dx:+.4f}, {dy:+.4f}) m, "
+                description=f"{'BARN-like seed' if generated else 'BARN world'} {world}, run {run} (start moved by ({dx:+.4f}, {dy:+.4f}) m, "
                             f"{dh:+.3f} deg); {setup}",
                 tables={**tables, "sim": {"stop_on_collision": True}})
             path = os.path.join(folder, "scenarios", f"{name}.toml")
             with open(path, "w", encoding="utf-8") as out:
                 out.write(scenario_from_world(parsed, settings).text)
             paths.append(path)
-            meta[name] = BarnRun(name, world, run, length_m)
+            meta[name] = BarnRun(name, world, run, length_m, generated)
     return paths, meta, setup
 
 
@@ -199,9 +245,12 @@ def add_scores(table: list[dict[str, Any]], rows: list[dict[str, Any]], meta: di
     (:mod:`sim.benchmarks.barn_difficulty`) as ``difficulty``."""
     difficulty = None
     if with_difficulty:
-        from swarmnav.sim.benchmarks.barn_difficulty import barn_world_metrics
-        folder = barn_dir(barn)
-        difficulty = {w: barn_world_metrics(folder, w) for w in sorted({m.world for m in meta.values()})}
+        from swarmnav.sim.benchmarks.barn_difficulty import world_metrics
+        difficulty = {}
+        for world, generated in sorted({(m.world, m.generated) for m in meta.values()}):
+            parsed, cells = world_source(world, generated, barn)
+            xy = np.array([[c.x_m, c.y_m] for c in parsed.cylinders]).reshape(-1, 2)
+            difficulty[world] = world_metrics(xy, cells)
     scores: dict[tuple[str, str], float] = {}
     times: dict[tuple[str, str], float] = {}
     for r in rows:

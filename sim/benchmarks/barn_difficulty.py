@@ -22,8 +22,6 @@ paper's and its generator's (dperille/jackal-map-creation, ``difficulty_quant.py
 from __future__ import annotations
 
 import math
-from pathlib import Path as FilePath
-
 import numpy as np
 
 CELL_M = 0.15
@@ -96,14 +94,6 @@ def world_metrics(cylinders_xy: np.ndarray, path_cells: np.ndarray) -> dict[str,
     means = per_cell.mean(axis=0)
     return {**{k: round(float(v), 6) for k, v in zip(METRICS[:4], means)},
             "tortuosity": round(arc / chord, 6) if chord > 0 else 1.0}
-
-
-def barn_world_metrics(folder: FilePath, world: int) -> dict[str, float]:
-    """:func:`world_metrics` of BARN world ``world`` from its world file and reference path."""
-    from swarmnav.models.gazebo_world import read_world
-    parsed = read_world(folder / "worlds" / f"world_{world}.world.gz")
-    xy = np.array([[c.x_m, c.y_m] for c in parsed.cylinders]).reshape(-1, 2)
-    return world_metrics(xy, np.load(folder / "paths" / f"path_{world}.npy", allow_pickle=False))
 
 
 def spearman(a: list[float], b: list[float]) -> float | None:

@@ -211,10 +211,11 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     check_arms(contenders, list(arms))
     shipped: dict[str, dict[str, Any]] = {}
     barn_meta = None
-    if suite == "barn":
+    if suite in ("barn", "barn-like"):
         from swarmnav.sim.benchmarks import barn as barn_suite
         names, barn_meta, barn_setup = barn_suite.write_barn_suite(out_dir, quick, (barn or {}).get("worlds"),
-                                                                   (barn or {}).get("runs"), (barn or {}).get("dir"))
+                                                                   (barn or {}).get("runs"), (barn or {}).get("dir"),
+                                                                   generated=suite == "barn-like")
         run_seeds, speed = None, False  # the speed figures re-run every scene's oracle search: not here
     elif suite is not None:
         names, loaded = write_suite(suite, quick, sensor_model, out_dir, per_group, seed_offset)
@@ -349,7 +350,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     overall = [r for r in rows if r["scenario"] is None]
     _print_table(overall, "")
-    if suite == "barn":
+    if suite in ("barn", "barn-like"):
         from swarmnav.sim.benchmarks.barn import print_scores
         print_scores(overall)
     if args.by_scenario:
@@ -366,10 +367,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _barn_options(args: argparse.Namespace, suite: str | None) -> dict[str, Any] | None:
-    """``--barn-dir``, ``--barn-runs``, ``--barn-worlds`` (``--suite barn`` only; the dyn300 options refused there)."""
+    """``--barn-dir``, ``--barn-runs``, ``--barn-worlds`` (``--suite barn`` and ``barn-like`` only; the dyn300
+    options refused there)."""
     from swarmnav.models.errors import ConfigError
     given = {k: getattr(args, f"barn_{k}", None) for k in ("dir", "runs", "worlds")}
-    if suite != "barn":
+    if suite not in ("barn", "barn-like"):
         for key, value in given.items():
             if value is not None:
                 raise ConfigError(f"--barn-{key}", "applies to --suite barn only")
@@ -378,8 +380,9 @@ def _barn_options(args: argparse.Namespace, suite: str | None) -> dict[str, Any]
         if getattr(args, option, None):
             raise ConfigError(f"--{option.replace('_', '-')}", "applies to --suite dyn300 only")
     from swarmnav.sim.benchmarks.barn import barn_dir, parse_worlds
-    barn_dir(given["dir"])  # no data: one line before anything runs
-    return {"dir": given["dir"], "runs": given["runs"], "worlds": parse_worlds(given["worlds"])}
+    if suite == "barn":
+        barn_dir(given["dir"])  # no data: one line before anything runs
+    return {"dir": given["dir"], "runs": given["runs"], "worlds": parse_worlds(given["worlds"], suite == "barn-like")}
 
 
 def _print_table(rows: list[dict[str, Any]], title: str) -> None:
