@@ -98,3 +98,15 @@ def test_barn_like_suite_files(tmp_path):
     assert first.sim.stop_on_collision and first.time_limit_s == 100.0 and first.goal_tolerance_m == 1.0
     assert len(first.obstacles) == len(jittered.obstacles) and first.start != jittered.start
     assert meta["barnlike-3-r0"].optimal_time_s == meta["barnlike-3-r1"].optimal_time_s > 10.0 / 2.0
+
+
+def test_known_map_track_planner_is_written_and_checked(tmp_path):
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.models.scenario import load_scenario
+    planner = barn.parse_planner("mmas:cell_m=0.15")
+    paths, _, setup = barn.write_barn_suite(str(tmp_path), False, (5,), 1, generated=True, planner=planner)
+    scenario = load_scenario(paths[0])
+    assert scenario.planner_name == "mmas" and scenario.planner_params == {"cell_m": 0.15}
+    assert setup.startswith("known-map track: planner mmas (cell_m=0.15)")
+    with pytest.raises(ConfigError, match="--barn-planner"):
+        barn.parse_planner("mmas:cell_m=-1")

@@ -204,10 +204,27 @@ def _seeds(text: str) -> tuple[int, ...]:
 GENERATED_DEFAULT = tuple(range(50))  # --suite barn-like: seeds 0..49 (never run before this suite existed)
 
 
+def parse_planner(text: str | None) -> dict[str, Any] | None:
+    """``--barn-planner NAME[:KEY=VALUE,...]``: the known-map track's planner table (checked by building it)."""
+    if text is None:
+        return None
+    from swarmnav.planners.registry import make_planner
+    from swarmnav.sim.options import parse_settings
+    name, _, settings = text.partition(":")
+    params = parse_settings([p for p in settings.split(",") if p.strip()], "--barn-planner")
+    try:
+        make_planner(name.strip(), params)
+    except ConfigError as exc:
+        raise ConfigError("--barn-planner", f"{exc.field}: {exc.problem}") from None
+    return {"name": name.strip(), "params": params}
+
+
 def write_barn_suite(folder: str, quick: bool, worlds: tuple[int, ...] | None = None, runs: int | None = None,
-                     barn: str | None = None, generated: bool = False) -> tuple[list[str], dict[str, BarnRun], str]:
+                     barn: str | None = None, generated: bool = False, planner: dict[str, Any] | None = None
+                     ) -> tuple[list[str], dict[str, BarnRun], str]:
     """The suite's scenario files under ``folder/scenarios``, their :class:`BarnRun` by scenario name, and the
-    setup's label (:func:`protocol_tables`); ``generated``: BARN-like worlds of those seeds."""
+    setup's label (:func:`protocol_tables`); ``generated``: BARN-like worlds of those seeds; ``planner`` (a
+    planner table): the known-map track, every run planned by it on the map given."""
     from swarmnav.models.world_scenario import ImportSettings, scenario_from_world, BARN_START, BARN_GOAL
     if not generated:
         barn_dir(barn)
@@ -215,6 +232,13 @@ def write_barn_suite(folder: str, quick: bool, worlds: tuple[int, ...] | None = 
         else tuple(range(WORLD_COUNT))
     runs = runs if runs is not None else QUICK_RUNS if quick else 1
     tables, setup = protocol_tables()
+    if planner is not None:
+        tables = {**tables, "planner": planner}
+        if "knowledge" in tables:
+            tables["knowledge"] = {**tables["knowledge"], "map": "known"}
+        params = ", ".join(f"{k}={v}" for k, v in planner["params"].items())
+        setup = (f"known-map track: planner {planner['name']}" + (f" ({params})" if params else "")
+                 + f"; {setup.replace('map unknown', 'map known')}")
     os.makedirs(os.path.join(folder, "scenarios"), exist_ok=True)
     paths, meta = [], {}
     for world in worlds:
@@ -253,15 +277,21 @@ def add_scores(table: list[dict[str, Any]], rows: list[dict[str, Any]], meta: di
             difficulty[world] = world_metrics(xy, cells)
     scores: dict[tuple[str, str], float] = {}
     times: dict[tuple[str, str], float] = {}
+    ratios: dict[tuple[str, str], float] = {}
     for r in rows:
         run = meta[r["scenario"]]
         time_s = r.get("sim_time_s")
         scores[(r["navigator_label"], r["scenario"])] = run_score(bool(r["success"]), time_s, run.optimal_time_s)
         times[(r["navigator_label"], r["scenario"])] = time_s
+        if r.get("plan_length_m") and r.get("plan_collision_free"):
+            ratios[(r["navigator_label"], r["scenario"])] = r["plan_length_m"] / run.reference_length_m
     for row in table:
         label = row["navigator"]
         mine = [s for (lab, scen), s in scores.items() if lab == label and row["scenario"] in (None, scen)]
         row["barn_score"] = sum(mine) / len(mine) if mine else None
+        planned = [v for (lab, scen), v in ratios.items() if lab == label and row["scenario"] in (None, scen)]
+        # the plan against the reference path (a yardstick): its length over the reference's, collision-free plans
+        row["mean_plan_over_reference"] = sum(planned) / len(planned) if planned else None
         row["barn_setup"] = setup
         if row["scenario"] is not None:
             run = meta[row["scenario"]]

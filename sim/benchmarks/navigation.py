@@ -215,7 +215,8 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
         from swarmnav.sim.benchmarks import barn as barn_suite
         names, barn_meta, barn_setup = barn_suite.write_barn_suite(out_dir, quick, (barn or {}).get("worlds"),
                                                                    (barn or {}).get("runs"), (barn or {}).get("dir"),
-                                                                   generated=suite == "barn-like")
+                                                                   generated=suite == "barn-like",
+                                                                   planner=(barn or {}).get("planner"))
         run_seeds, speed = None, False  # the speed figures re-run every scene's oracle search: not here
     elif suite is not None:
         names, loaded = write_suite(suite, quick, sensor_model, out_dir, per_group, seed_offset)
@@ -370,7 +371,7 @@ def _barn_options(args: argparse.Namespace, suite: str | None) -> dict[str, Any]
     """``--barn-dir``, ``--barn-runs``, ``--barn-worlds`` (``--suite barn`` and ``barn-like`` only; the dyn300
     options refused there)."""
     from swarmnav.models.errors import ConfigError
-    given = {k: getattr(args, f"barn_{k}", None) for k in ("dir", "runs", "worlds")}
+    given = {k: getattr(args, f"barn_{k}", None) for k in ("dir", "runs", "worlds", "planner")}
     if suite not in ("barn", "barn-like"):
         for key, value in given.items():
             if value is not None:
@@ -379,10 +380,11 @@ def _barn_options(args: argparse.Namespace, suite: str | None) -> dict[str, Any]
     for option in ("sensor_model", "per_group", "seed_offset"):
         if getattr(args, option, None):
             raise ConfigError(f"--{option.replace('_', '-')}", "applies to --suite dyn300 only")
-    from swarmnav.sim.benchmarks.barn import barn_dir, parse_worlds
+    from swarmnav.sim.benchmarks.barn import barn_dir, parse_planner, parse_worlds
     if suite == "barn":
         barn_dir(given["dir"])  # no data: one line before anything runs
-    return {"dir": given["dir"], "runs": given["runs"], "worlds": parse_worlds(given["worlds"], suite == "barn-like")}
+    return {"dir": given["dir"], "runs": given["runs"], "worlds": parse_worlds(given["worlds"], suite == "barn-like"),
+            "planner": parse_planner(given["planner"])}
 
 
 def _print_table(rows: list[dict[str, Any]], title: str) -> None:
