@@ -98,3 +98,26 @@ def test_bad_generator_options_are_one_line_and_exit_2(argv, message, capsys):
     assert main(["scenarios", "generate", "crowdnav_circle", "--seed", "1"] + argv) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
+
+
+def test_the_crowdnav_suite_reads_each_setting_apart_and_the_visible_one_without_a_yardstick(tmp_path):
+    from swarmnav.controllers.oracle_search import NoClairvoyantYardstick, search
+    from swarmnav.models.suites import load_suite
+    from swarmnav.sim.benchmarks.navigation import benchmark_navigation
+    suite = load_suite("crowdnav")
+    assert [len([s for s in suite.scenes if s.group == g]) for g in ("circle-invisible", "circle-visible")] == \
+        [500, 500]
+    visible = parse_scenario(next(s for s in suite.scenes if s.group == "circle-visible").text(), "<t>")
+    with pytest.raises(NoClairvoyantYardstick):
+        search(visible)
+    rows = benchmark_navigation(navigators=["follow"], suite="crowdnav", per_group=1, out_dir=str(tmp_path),
+                                speed=False)
+    by = {(r["navigator"], r["robot_visible"]): r for r in rows if r["scenario"] is None}
+    assert set(by) == {("follow", False), ("oracle", False), ("follow", True)}  # no oracle where it cannot be one
+    assert by[("oracle", False)]["oracle_solvable_runs"] == 1 and by[("oracle", False)]["yardstick"] == "oracle"
+    assert by[("follow", True)]["oracle_solvable_runs"] == 0 and by[("follow", True)]["solved_share"] is None
+    assert by[("follow", True)]["yardstick"].startswith("none")
+    for r in by.values():
+        assert r["runs"] == 1 and 0.0 <= r["discomfort_frequency"] <= 1.0
+    # the blind follower meets the humans closer than the oracle does
+    assert by[("follow", False)]["discomfort_frequency"] > by[("oracle", False)]["discomfort_frequency"]

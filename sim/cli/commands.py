@@ -136,7 +136,7 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
                         "default: a temporary folder")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
-    parser.add_argument("--suite", choices=("dyn", "papers", "dyn300"), default="dyn",
+    parser.add_argument("--suite", choices=("dyn", "papers", "dyn300", "crowdnav"), default="dyn",
                         help="dyn: the dyn-* suite (default); papers: the papers' strategies beside replan + iaco "
                              "and dstar_replan, one row per run (sim/benchmarks/paper_navigation.py); dyn300: the "
                              "300 generated scenes of models/suites/dyn300.toml, by difficulty")
