@@ -47,7 +47,7 @@ from swarmnav.planners.problem import Path
 from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
 from swarmnav.sim.contact import ContactMonitor
 from swarmnav.sim.control_period import control_periods, steps_per_control
-from swarmnav.sim.crowd_stepping import ReactiveCrowd
+from swarmnav.sim.crowd_stepping import ReactiveCrowd, crowd_metrics, human_columns
 from swarmnav.sim.detector import ObstacleSensing
 from swarmnav.sim.laser import LaserCaster
 from swarmnav.sim.recording import Recorder, RunContext, StepFrame
@@ -141,6 +141,7 @@ class EpisodeStepper:
         self._moves = bool(moving)
         self.obstacle_track_m = obstacle_positions(scenario, scene, self.times_s)  # (T, M, 2)
         self._radii_m = np.array([scenario.obstacles[ob.scenario_index].radius_m for ob in moving])
+        self._humans = human_columns(scenario, moving)  # agents: the crowd metrics of the result
         # How far the moving obstacles can have moved: obstacle_shift_m[j] - obstacle_shift_m[i]
         # bounds every obstacle's displacement between control steps i and j (for clearance skips).
         track = self.obstacle_track_m
@@ -398,7 +399,10 @@ class EpisodeStepper:
             wheel_command_rad_s=self.wheel_cmd[:step + 1].copy(),
             collision_points_m=np.array(monitor.points, dtype=float).reshape(-1, 2),
             time_in_danger_s=self.danger_steps * self.dt_s, stopped_s=self.stopped_steps * self.dt_s,
-            replans=self.replans, safety_triggers=self.safety_triggers, reference_length_m=self.reference_length_m)
+            replans=self.replans, safety_triggers=self.safety_triggers, reference_length_m=self.reference_length_m,
+            crowd=crowd_metrics(self.poses[:step + 1], self.obstacle_track_m[:step + 1, self._humans],
+                                self._radii_m[self._humans], self.scenario.robot_radius_m, self.length_m)
+            if len(self._humans) else None)
         if self._unfinished:
             self._unfinished = False
             recorder.finish(self.result.log_summary())

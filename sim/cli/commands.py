@@ -136,13 +136,15 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
                         "default: a temporary folder")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
-    parser.add_argument("--suite", choices=("dyn", "papers", "dyn300", "barn", "barn-like"), default="dyn",
+    parser.add_argument("--suite", choices=("dyn", "papers", "dyn300", "barn", "barn-like", "crowdnav"),
+                        default="dyn",
                         help="dyn: the dyn-* suite (default); papers: the papers' strategies beside replan + iaco "
                              "and dstar_replan, one row per run (sim/benchmarks/paper_navigation.py); dyn300: the "
                              "300 generated scenes of models/suites/dyn300.toml, by difficulty; barn: the 300 BARN "
                              "worlds under the challenge's protocol and score (sim/benchmarks/barn.py; --quick: its "
                              "50 test worlds x 10 runs); barn-like: BARN-like worlds at fresh seeds "
-                             "(sim/benchmarks/barn_like.py; --barn-worlds A:B seeds, default 0:50)")
+                             "(sim/benchmarks/barn_like.py; --barn-worlds A:B seeds, default 0:50); crowdnav: CrowdNav's "
+                             "circle-crossing test cases, robot invisible and visible to the humans")
     parser.add_argument("--barn-dir", metavar="DIR", help="--suite barn: the BARN data (default: $SWARMNAV_BARN_DIR, "
                         "else ../shared/benchmarks/barn)")
     parser.add_argument("--barn-runs", type=options.positive_int, metavar="N",

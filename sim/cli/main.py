@@ -165,9 +165,11 @@ def _add_generate_options(p: argparse.ArgumentParser) -> None:
     for name, kind in (("obstacles", int), ("speed_ratio", float), ("radius_min_m", float),
                        ("radius_max_m", float), ("arena_m", float), ("sensor_model", str), ("range_m", float),
                        ("sensor_count", int), ("robot_speed_m_s", float), ("time_limit_s", float),
-                       ("planner", str), ("navigator", str), ("name", str)):
+                       ("planner", str), ("navigator", str), ("name", str), ("humans", int)):
         p.add_argument(f"--{name.replace('_', '-')}", dest=name, type=kind,
                        help=f"default: {getattr(GeneratorOptions(), name)!r}")
+    p.add_argument("--robot-visible", dest="robot_visible", action="store_true", default=None,
+                   help="crowdnav_* kinds: the humans see the robot and avoid it (default: they do not)")
 
 
 def cmd_plan(args: argparse.Namespace) -> int:

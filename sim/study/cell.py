@@ -77,7 +77,7 @@ class WallLimitExceeded(BaseException):
 
 # The navigation metrics of ``run --json`` kept as columns of their own.
 NAVIGATION_METRICS = ("time_to_goal_s", "spl", "time_in_danger_s", "replans", "replan_wall_s", "stopped_s",
-                      "safety_triggers")
+                      "safety_triggers", "discomfort_frequency", "min_separation_m", "path_irregularity_rad_m")
 
 
 class _WallLimit:
