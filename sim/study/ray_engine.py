@@ -31,6 +31,7 @@ from itertools import islice
 from pathlib import Path as FilePath
 from typing import Any, Iterable, Iterator
 
+from swarmnav.models.contained_files import check_no_link, folder as contained_folder, open_in_folder
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim.plugins import distributions
 from swarmnav.sim.study.cell import ComponentMissing, _versions_json, run_cell
@@ -136,9 +137,11 @@ def _check_versions(answer: dict[str, Any], driver: str) -> None:
 
 def _save_log(logs_dir: str, config_hash: str, data: bytes) -> str:
     final = FilePath(logs_dir) / f"{config_hash}.mcap"
-    final.parent.mkdir(parents=True, exist_ok=True)
+    contained_folder(final.parent, "--out")
     temporary = final.with_name(f".{final.name}.tmp")
-    temporary.write_bytes(data)
+    with os.fdopen(open_in_folder(temporary, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, "--out"), "wb") as out:
+        out.write(data)
+    check_no_link(final, "--out")
     os.replace(temporary, final)
     return str(final)
 
