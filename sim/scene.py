@@ -1,7 +1,8 @@
 """Compose the MuJoCo scene for a scenario with ``MjSpec``.
 
-``models/diff_drive/scene.xml`` (which includes ``robot.xml``) is the base.  We
-resize the robot to the scenario's radius and rangefinder setup, then add the
+The scenario's robot of the catalogue (:mod:`models.robots`: ``models/<robot>/scene.xml``, which includes
+its ``robot.xml``) is the base.  We resize the disc robot to the scenario's radius, lay out the
+rangefinders (the disc's ring on its rim, or a laser's fan from one site), then add the
 arena: walls, static cylinders (plain geoms), moving cylinders (mocap bodies,
 moved kinematically by the runner) and box obstacles from grid maps.  Every
 element gets a name.
@@ -17,11 +18,12 @@ import mujoco
 import numpy as np
 
 from swarmnav.controllers.kinematics import DriveGeometry
+from swarmnav.models.robots import ROBOTS
 from swarmnav.models.scenario import Scenario
 
 MODEL_DIR = FilePath(__file__).resolve().parent.parent / "models" / "diff_drive"
 SCENE_XML = MODEL_DIR / "scene.xml"
-ROBOT_BODIES = ("base_link", "left_wheel", "right_wheel")
+ROBOT_ROOT = "base_link"  # every body under it is the robot's
 STATIC_RGBA = (0.55, 0.45, 0.38, 1.0)
 MOVING_RGBA = (0.95, 0.55, 0.1, 1.0)
 WALL_RGBA = (0.4, 0.4, 0.45, 1.0)
@@ -63,13 +65,19 @@ class CompiledScene:
 
 def build_spec(scenario: Scenario) -> mujoco.MjSpec:
     """The scene for a scenario as an editable spec (not yet compiled)."""
-    spec = mujoco.MjSpec.from_file(str(SCENE_XML))
+    robot = ROBOTS[scenario.robot_model]
+    spec = mujoco.MjSpec.from_file(str(robot.scene_xml))
     spec.modelname = f"swarmnav_{scenario.name}"
     spec.option.timestep = scenario.sim.timestep_s
 
     radius = scenario.robot_radius_m
-    _fit_base(spec, radius)
-    _set_rangefinders(spec, scenario.sensor_count, radius, scenario.sensor_range_m)
+    if robot.round_chassis:
+        _fit_base(spec, radius)
+    if robot.ring_sensors and scenario.sensor_fov_deg == 360.0:
+        _set_rangefinders(spec, scenario.sensor_count, radius, scenario.sensor_range_m)
+    else:
+        _set_laser(spec, scenario.sensor_count, scenario.sensor_fov_deg, scenario.sensor_range_m,
+                   radius if robot.ring_sensors else 0.0)
 
     width, height = scenario.arena_width_m, scenario.arena_height_m
     floor = spec.geom("floor")
@@ -123,7 +131,7 @@ def _fit_base(spec: mujoco.MjSpec, radius_m: float) -> None:
     base_radius_m = float(chassis.size[0])
     if radius_m < base_radius_m:
         scale = radius_m / base_radius_m
-        for body in (spec.body(name) for name in ROBOT_BODIES):
+        for body in (spec.body(name) for name in ("base_link", "left_wheel", "right_wheel")):
             if body.name != "base_link":
                 body.pos = np.asarray(body.pos) * scale
             for geom in body.geoms:
@@ -140,27 +148,58 @@ def _set_rangefinders(spec: mujoco.MjSpec, count: int, body_radius_m: float, cut
     """Place ``count`` rangefinders evenly on the rim, pointing outward, above the wheels."""
     template = spec.site("range_site_00")
     z = float(template.pos[2])
-    base = spec.body("base_link")
-    existing = [s for s in spec.sites if s.name.startswith("range_site_")]
-    if len(existing) != count:
-        # The XML's own sensor is the template (what it measures lives in intprm).
-        data_spec = np.array(spec.sensor("range_00").intprm)
-        for sensor in [s for s in spec.sensors if s.name.startswith("range_")]:
-            spec.delete(sensor)
-        for site in existing:
-            spec.delete(site)
-        site_class = spec.find_default("range")
-        for k in range(count):
-            base.add_site(name=f"range_site_{k:02d}", default=site_class)
-            sensor = spec.add_sensor(name=f"range_{k:02d}", type=mujoco.mjtSensor.mjSENS_RANGEFINDER,
-                                     objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"range_site_{k:02d}")
-            sensor.intprm = data_spec
+    # The XML's own sensor is the template (what it measures lives in intprm).
+    _replace_rangefinders(spec, count)
     rim = body_radius_m + 0.005
     for k in range(count):
         angle = 2.0 * math.pi * k / count
         site = spec.site(f"range_site_{k:02d}")
         site.pos = [rim * math.cos(angle), rim * math.sin(angle), z]
         # z axis outward: rotate +z onto (cos a, sin a, 0).
+        quat = np.zeros(4)
+        mujoco.mju_quatZ2Vec(quat, np.array([math.cos(angle), math.sin(angle), 0.0]))
+        site.quat = quat
+        spec.sensor(f"range_{k:02d}").cutoff = cutoff_m
+
+
+def laser_angles_rad(count: int, fov_deg: float) -> np.ndarray:
+    """Beam directions of a laser: a full circle from straight ahead counter-clockwise (fov 360: no beam twice),
+    else ``count`` beams evenly from -fov/2 to +fov/2 (a LaserScan's angle_min to angle_max)."""
+    if fov_deg >= 360.0:
+        return 2.0 * math.pi * np.arange(count) / count
+    fov = math.radians(fov_deg)
+    return -fov / 2 + fov * np.arange(count) / max(count - 1, 1) if count > 1 else np.zeros(1)
+
+
+def _replace_rangefinders(spec: mujoco.MjSpec, count: int) -> None:
+    """``count`` rangefinder sites and sensors in place of the file's (the first is the template)."""
+    existing = [s for s in spec.sites if s.name.startswith("range_site_")]
+    if len(existing) == count:
+        return
+    data_spec = np.array(spec.sensor("range_00").intprm)
+    for sensor in [s for s in spec.sensors if s.name.startswith("range_")]:
+        spec.delete(sensor)
+    for site in existing:
+        spec.delete(site)
+    site_class = spec.find_default("range")
+    base = spec.body("base_link")
+    for k in range(count):
+        base.add_site(name=f"range_site_{k:02d}", default=site_class)
+        sensor = spec.add_sensor(name=f"range_{k:02d}", type=mujoco.mjtSensor.mjSENS_RANGEFINDER,
+                                 objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"range_site_{k:02d}")
+        sensor.intprm = data_spec
+
+
+def _set_laser(spec: mujoco.MjSpec, count: int, fov_deg: float, cutoff_m: float, rim_m: float) -> None:
+    """A laser: ``count`` beams over ``fov_deg`` (:func:`laser_angles_rad`), every one from the template
+    site's position (``rim_m`` = 0) or, for the disc robot's fan, from its rim (``rim_m`` = its radius)."""
+    template = spec.site("range_site_00")
+    x, y, z = (float(v) for v in template.pos)
+    _replace_rangefinders(spec, count)
+    rim = rim_m + 0.005 if rim_m > 0 else 0.0
+    for k, angle in enumerate(laser_angles_rad(count, fov_deg).tolist()):
+        site = spec.site(f"range_site_{k:02d}")
+        site.pos = [x + rim * math.cos(angle), y + rim * math.sin(angle), z]
         quat = np.zeros(4)
         mujoco.mju_quatZ2Vec(quat, np.array([math.cos(angle), math.sin(angle), 0.0]))
         site.quat = quat
@@ -199,13 +238,23 @@ def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
     for i in range_ids:
         site = model.sensor_objid[i]
         p = model.site_pos[site]
-        angles.append(math.atan2(p[1], p[0]) % (2.0 * math.pi))
-        offsets.append(math.hypot(p[0], p[1]))
+        offset = math.hypot(p[0], p[1])
+        if offset > 0.0:  # on a rim, pointing outward: the direction of its position
+            angles.append(math.atan2(p[1], p[0]) % (2.0 * math.pi))
+        else:  # at the laser's centre: the direction of its z axis (the beam)
+            zaxis = np.zeros(3)
+            mujoco.mju_rotVecQuat(zaxis, np.array([0.0, 0.0, 1.0]), model.site_quat[site])
+            angles.append(math.atan2(zaxis[1], zaxis[0]) % (2.0 * math.pi))
+        offsets.append(offset)
         heights.append(float(p[2]))
     cutoff = float(model.sensor_cutoff[range_ids[0]]) if range_ids else 0.0
 
-    robot_bodies = {model.body(n).id for n in ROBOT_BODIES}
-    is_robot = np.array([model.geom_bodyid[g] in robot_bodies and model.geom_contype[g] + model.geom_conaffinity[g] > 0
+    root = model.body(ROBOT_ROOT).id
+    robot_bodies = {b for b in range(model.nbody) if model.body_rootid[b] == root}
+    # A robot geom that can touch an obstacle (contype / conaffinity 1, the obstacles' bit): wheels that
+    # touch only the floor (bit 2, the catalogue's box robots) are not.
+    is_robot = np.array([model.geom_bodyid[g] in robot_bodies and bool((model.geom_contype[g]
+                                                                        | model.geom_conaffinity[g]) & 1)
                          for g in range(model.ngeom)])
     obstacles = []
     is_obstacle = np.zeros(model.ngeom, dtype=bool)

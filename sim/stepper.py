@@ -47,6 +47,7 @@ from swarmnav.planners.problem import Path
 from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
 from swarmnav.sim.contact import ContactMonitor
 from swarmnav.sim.control_period import control_periods, steps_per_control
+from swarmnav.sim.crowd_stepping import ReactiveCrowd
 from swarmnav.sim.detector import ObstacleSensing
 from swarmnav.sim.recording import Recorder, RunContext, StepFrame
 from swarmnav.sim.reference import reference_length_m as shortest_static_length_m
@@ -144,6 +145,8 @@ class EpisodeStepper:
         track = self.obstacle_track_m
         hops = np.hypot(*np.moveaxis(np.diff(track, axis=0), 2, 0)).max(axis=1) if track.shape[1] else \
             np.zeros(max(len(track) - 1, 0))
+        self._crowd = ReactiveCrowd.of(scenario, moving, self.dt_s) if moving else None  # agents that see the robot
+        hops = hops if self._crowd is None else np.maximum(hops, self._crowd.max_hop_m())  # bounded by top speed
         self.obstacle_shift_m = np.concatenate([[0.0], np.cumsum(hops)]).tolist()
         # Farther than this from every obstacle, no contact can begin within one control period:
         # twice the distance the base covers at full wheel speed, plus a centimetre.
@@ -269,6 +272,8 @@ class EpisodeStepper:
         self._range_raw = data.sensordata[adr[0]:adr[0] + len(adr)] if contiguous else None
         self.sensing = ObstacleSensing(self.scenario, self.obstacle_track_m, self._radii_m, self.dt_s,
                                        scene.range_angles_rad, scene.range_offset_m)
+        if self._crowd is not None:
+            self._crowd.reset(self.obstacle_track_m, self.sensing.velocity_m_s)
         self._shift_at_measure_m = 0.0
         self._observed_step = -1
         self.poses = np.zeros((self.n_max + 1, 3))
@@ -303,6 +308,8 @@ class EpisodeStepper:
         """Obstacles to the new time, the observation, the outcome; the end of the episode when there is one."""
         step = self.step_index
         if self._moves:
+            if self._crowd is not None:  # agents that see the robot: their step s -> s + 1 from its state now
+                self._crowd.advance(step, self._base_qpos, self._base_qvel)
             self._mocap_pos[self.mocap_index, :2] = self.obstacle_track_m[step]
         self.observation = observation = self._observe()
         pose = observation.pose

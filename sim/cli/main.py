@@ -87,6 +87,8 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
         return cmd_generate(args)
     if getattr(args, "scenarios_command", None) == "info":
         return cmd_scenario_info(args)
+    if getattr(args, "scenarios_command", None) == "import":
+        return args.scenario_run(args)
     rows = []
     for name in list_scenarios():
         s = load_scenario(name)
@@ -266,13 +268,17 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("scenarios", help="list the bundled scenarios, or generate one")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_scenarios)
-    scenario_commands = p.add_subparsers(dest="scenarios_command", metavar="generate|info")
+    scenario_commands = p.add_subparsers(dest="scenarios_command", metavar="generate|info|import")
     gen = scenario_commands.add_parser("generate", help="write a dynamic scenario (crossing, head_on, ...) from a seed")
     _add_generate_options(gen)
     info = scenario_commands.add_parser("info", help="difficulty metrics and the clairvoyant oracle's verdict")
     info.add_argument("scenario", metavar="SCENARIO", help="a bundled name or a .toml path")
     info.add_argument("--world-seed", type=int, help="seed of the random obstacle motions (default: the scenario's)")
     info.add_argument("--json", action="store_true", help="print one JSON object")
+    from swarmnav.sim.cli import world_import
+    imp = scenario_commands.add_parser("import", help="a Gazebo world's static cylinders and boxes as a scenario file")
+    world_import.add_arguments(imp)
+    imp.set_defaults(scenario_run=world_import.run)
 
     p = sub.add_parser("plan", help="plan a path for a scenario")
     _add_run_options(p)
