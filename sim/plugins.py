@@ -165,10 +165,18 @@ def describe_components(kind: str) -> list[dict[str, Any]]:
             hints = {}
         ranges = {k: str(v) for k, v in parameter_ranges(cls).items()}  # merged along the class hierarchy
         params = []
-        for f in (dataclasses.fields(cls) if dataclasses.is_dataclass(cls) else ()):
+        fields = list(dataclasses.fields(cls) if dataclasses.is_dataclass(cls) else ())
+        layer: dict[str, Any] = {}
+        if kind == "navigator":  # the safety layer's switches it offers, with its defaults (controllers.safety_layer)
+            from swarmnav.controllers.safety_layer import SafetyLayer, layer_settings, offered
+            layer = layer_settings(cls, {})[1]
+            fields += [f for f in dataclasses.fields(SafetyLayer) if f.name in offered(cls)]
+            hints = {**typing.get_type_hints(SafetyLayer), **hints}
+            ranges = {**{k: str(v) for k, v in SafetyLayer.parameter_ranges.items()}, **ranges}
+        for f in fields:
             if not f.init:
                 continue
-            default = f.default if f.default is not dataclasses.MISSING else (
+            default = layer[f.name] if f.name in layer else f.default if f.default is not dataclasses.MISSING else (
                 f.default_factory() if f.default_factory is not dataclasses.MISSING else None)
             annotation = hints.get(f.name, f.type)
             entry = {"name": f.name, "type": getattr(annotation, "__name__", str(annotation)),

@@ -75,11 +75,11 @@ def default_navigators(settings: dict[str, dict[str, Any]] | None = None) -> lis
 
 def navigator_settings(pairs: dict[str, Any], navigators: list[str]) -> dict[str, dict[str, Any]]:
     """``--navigator-set KEY=VALUE``: each navigator gets the keys it has as parameters; a key none has is an error."""
-    import dataclasses
+    from swarmnav.controllers.navigators import navigator_parameters
     from swarmnav.models.errors import ConfigError
     out: dict[str, dict[str, Any]] = {}
     for key, value in pairs.items():
-        takers = [n for n in navigators if key in {f.name for f in dataclasses.fields(NAVIGATORS[n]) if f.init}]
+        takers = [n for n in navigators if key in navigator_parameters(n)]
         if not takers:
             raise ConfigError("--navigator-set", f"no navigator of this benchmark has a parameter {key!r}")
         for name in takers:
