@@ -120,7 +120,8 @@ def base_row(cell: Cell) -> dict[str, Any]:
             "budget_time_s": (cell.budget or {}).get("time_s")}
 
 
-def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+def run_cell(cell: Cell, logs_dir: str | None = None,
+             log_format: str = "swarmnav") -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """Run one cell; return its run row and its best-cost history rows (``progress``)."""
     row = base_row(cell)
     row["versions"] = _versions_json()
@@ -145,7 +146,7 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
                 if logs_dir is not None:
                     from swarmnav.sim.log.writer import McapRecorder
                     log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
-                    recorders.append(McapRecorder(log_path, overwrite=True))
+                    recorders.append(McapRecorder(log_path, overwrite=True, log_format=log_format))
                     row["log"] = str(log_path)
                 cpu0 = time.thread_time()
                 episode = run_episode(episode, recorders, time_limit_s=cell.time_limit_s)

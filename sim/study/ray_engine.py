@@ -77,15 +77,15 @@ def start_ray(address: str | None, workers: int | None) -> None:
         signal.signal(signal.SIGTERM, previous)
 
 
-def run_batch(cells: list[Cell], keep_logs: bool) -> dict[str, Any]:
+def run_batch(cells: list[Cell], keep_logs: str | None) -> dict[str, Any]:
     """A task: run the cells in order; return the node, its versions, and each cell's row, progress and log
-    bytes (``None`` without ``--logs`` or in plan-only mode)."""
+    bytes (``None`` without ``--logs`` or in plan-only mode); ``keep_logs``: the logs' format, None for none."""
     import ray
     results = []
     for cell in cells:
         if keep_logs and cell.physics:
             with tempfile.TemporaryDirectory(prefix="swarmnav-log-") as folder:
-                row, progress = run_cell(cell, folder)
+                row, progress = run_cell(cell, folder, keep_logs)
                 log = FilePath(folder) / f"{cell.config_hash}.mcap"
                 data = log.read_bytes() if log.exists() else None
         else:
@@ -122,7 +122,7 @@ def _failure(exc: Exception) -> str:
 
 
 def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | None = None,
-            logs_dir: str | None = None, nodes: set[str] | None = None) -> Iterator[Result]:
+            logs_dir: str | None = None, nodes: set[str] | None = None, log_format: str = "swarmnav") -> Iterator[Result]:
     """Run the cells as Ray tasks (one CPU each) on a local instance or the cluster at ``address``; the ids of
     the nodes that ran them are added to ``nodes``."""
     import ray
@@ -138,7 +138,7 @@ def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | No
                 batch = [solo.popleft()] if solo else list(islice(source, sizer.size()))
                 if not batch:
                     break
-                inflight[task.remote(batch, logs_dir is not None)] = batch
+                inflight[task.remote(batch, log_format if logs_dir is not None else None)] = batch
             if not inflight:
                 break
             done, _ = ray.wait(list(inflight), num_returns=1)
