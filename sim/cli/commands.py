@@ -14,7 +14,7 @@ from typing import Callable
 
 from swarmnav.sim import options
 from swarmnav.sim.defaults import (  # noqa: F401  (re-exported: the CLI's own defaults)
-    SINGLE_THREAD_ENVIRONMENT, DEFAULT_FPS, MIN_FPS, MAX_FPS, MIN_DPI, MAX_DPI, BENCH_SIM_QUICK,
+    SINGLE_THREAD_ENVIRONMENT, DEFAULT_FPS, LOG_FORMATS, MIN_FPS, MAX_FPS, MIN_DPI, MAX_DPI, BENCH_SIM_QUICK,
     BENCH_ENV_QUICK, BENCH_RENDER_QUICK_FRAMES, BENCH_PLANNERS_SCENARIOS, BENCH_PLANNERS_PLANNERS,
     BENCH_PLANNERS_SAMPLING, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
 from swarmnav.sim.options import add_trust_code_argument  # noqa: F401
@@ -298,6 +298,8 @@ def run_plot(args: argparse.Namespace) -> int:
 
 def add_foxglove_layout_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--out", metavar="FILE", help="write the layout to FILE (default: print it)")
+    parser.add_argument("--log-format", choices=LOG_FORMATS, default="swarmnav",
+                        help="the layout for logs of this format (run --log-format)")
 
 
 def run_foxglove_layout(args: argparse.Namespace) -> int:

@@ -153,8 +153,10 @@ def check_components(cell: Cell) -> None:
                                "names (install the plugin that provides it where the workers run)")
 
 
-def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """Run one cell; return its run row and its best-cost history rows (``progress``).
+def run_cell(cell: Cell, logs_dir: str | None = None,
+             log_format: str = "swarmnav") -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """Run one cell; return its run row and its best-cost history rows (``progress``); its log (in
+    ``logs_dir``) of format ``log_format``.
 
     Raises:
         ComponentMissing: the cell names a component unknown in this process (no row: the study ends).
@@ -183,7 +185,7 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
                 if logs_dir is not None:
                     from swarmnav.sim.log.writer import McapRecorder
                     log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
-                    recorders.append(McapRecorder(log_path, overwrite=True))
+                    recorders.append(McapRecorder(log_path, overwrite=True, log_format=log_format))
                     row["log"] = str(log_path)
                 cpu0 = time.thread_time()
                 episode = run_episode(episode, recorders, time_limit_s=cell.time_limit_s)

@@ -115,12 +115,13 @@ def pending_cells(study: Study, out_dir: FilePath, retry_errors: bool = False) -
 
 
 def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local", workers: int | None = None,
-              address: str | None = None, logs: bool = False, show_progress: bool = False,
+              address: str | None = None, logs: bool | str = False, show_progress: bool = False,
               retry_errors: bool = False) -> dict[str, Any]:
     """Run every cell of ``study`` that ``out_dir`` does not hold yet; return a summary of this invocation.
 
     The folder is locked while the study runs (a second study into it is refused, naming this one's PID);
-    when every cell has a row, the parts are compacted."""
+    when every cell has a row, the parts are compacted.  ``logs``: keep each physics run's MCAP log in
+    ``out_dir/logs``, of format ``swarmnav`` (``True``) or the format named (``"ros2"``)."""
     out_dir = FilePath(out_dir)
     if engine == "local":
         check_main_guard()  # a script's unguarded top level: each spawned worker would run it again
@@ -132,19 +133,20 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
 
 
 def _run_locked(study: Study, out_dir: FilePath, engine: str, workers: int | None, address: str | None,
-                logs: bool, show_progress: bool, retry_errors: bool) -> dict[str, Any]:
+                logs: bool | str, show_progress: bool, retry_errors: bool) -> dict[str, Any]:
     _write_metadata(study, out_dir)
     todo, pending, total = pending_cells(study, out_dir, retry_errors)
     workers = workers or os.cpu_count() or 1
     logs_dir = str(contained_folder(out_dir / "logs", "--out").resolve()) if logs else None
+    log_format = logs if isinstance(logs, str) else "swarmnav"
     nodes: set[str] = set()
     if engine == "ray":
         from swarmnav.sim.study.ray_engine import run_ray
-        results: Iterator = run_ray(todo, address, None if address else workers, logs_dir, nodes)
+        results: Iterator = run_ray(todo, address, None if address else workers, logs_dir, nodes, log_format)
     elif engine == "inline":
-        results = run_inline(todo, logs_dir)
+        results = run_inline(todo, logs_dir, log_format)
     else:
-        results = run_local(todo, workers, logs_dir)
+        results = run_local(todo, workers, logs_dir, log_format)
     writer = RowWriter(out_dir)
     yardstick = Yardstick(out_dir, study.time_limit_s, study.trust_code)
     bar = ProgressBar(pending, sys.stderr) if show_progress and pending else None

@@ -81,9 +81,9 @@ def start_ray(address: str | None, workers: int | None) -> None:
         signal.signal(signal.SIGTERM, previous)
 
 
-def run_batch(cells: list[Cell], keep_logs: bool) -> dict[str, Any]:
+def run_batch(cells: list[Cell], keep_logs: str | None) -> dict[str, Any]:
     """A task: run the cells in order; return the node, its versions, and each cell's row, progress and log
-    bytes (``None`` without ``--logs`` or in plan-only mode)."""
+    bytes (``None`` without ``--logs`` or in plan-only mode); ``keep_logs``: the logs' format, None for none."""
     import ray
     context = ray.get_runtime_context()
     answer: dict[str, Any] = {"node": ray.util.get_node_ip_address(), "node_id": context.get_node_id(),
@@ -98,13 +98,13 @@ def run_batch(cells: list[Cell], keep_logs: bool) -> dict[str, Any]:
     return {**answer, "results": results}
 
 
-def _run_one(cell: Cell, keep_logs: bool) -> tuple[dict[str, Any], list[dict[str, Any]], bytes | None]:
+def _run_one(cell: Cell, keep_logs: str | None) -> tuple[dict[str, Any], list[dict[str, Any]], bytes | None]:
     """One cell's row, progress and log bytes (see :func:`run_batch`)."""
     if not (keep_logs and cell.physics):
         row, progress = run_cell(cell)
         return row, progress, None
     with tempfile.TemporaryDirectory(prefix="swarmnav-log-") as folder:
-        row, progress = run_cell(cell, folder)
+        row, progress = run_cell(cell, folder, keep_logs)
         log = FilePath(folder) / f"{cell.config_hash}.mcap"
         return row, progress, log.read_bytes() if log.exists() else None
 
@@ -153,7 +153,7 @@ def _failure(exc: Exception) -> str:
 
 
 def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | None = None,
-            logs_dir: str | None = None, nodes: set[str] | None = None) -> Iterator[Result]:
+            logs_dir: str | None = None, nodes: set[str] | None = None, log_format: str = "swarmnav") -> Iterator[Result]:
     """Run the cells as Ray tasks (one CPU each) on a local instance or the cluster at ``address``; the ids of
     the nodes that ran them are added to ``nodes``."""
     import ray
@@ -169,7 +169,7 @@ def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | No
                 batch = [solo.popleft()] if solo else list(islice(source, sizer.size()))
                 if not batch:
                     break
-                inflight[task.remote(batch, logs_dir is not None)] = batch
+                inflight[task.remote(batch, log_format if logs_dir is not None else None)] = batch
             if not inflight:
                 break
             done, _ = ray.wait(list(inflight), num_returns=1)
