@@ -54,8 +54,9 @@ def _scenario_entry(ref: str, world_seed: int | None, study: Study) -> dict[str,
 
 
 def study_metadata(study: Study) -> dict[str, Any]:
+    from swarmnav.sim.study.provenance import study_inputs
     world_seed = study.world_seeds[0]
-    return {"claims": [c.as_dict() for c in study.claims],"name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
+    return {"inputs": study_inputs(study), "claims": [c.as_dict() for c in study.claims], "name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
             "reference": study.reference, "planners": [p.label for p in study.planners],
             "navigators": [n.label for n in study.navigators],
             "paper": [dataclasses.asdict(p) for p in study.paper],
