@@ -148,3 +148,16 @@ def test_equal_single_values_are_equal_not_inconclusive():
     from swarmnav.sim.study.claims import EQUAL
     rows = _rows("A", [5.0] * 10, planner="immas") + _rows("B", [5.0] * 10, planner="immas")
     assert verdicts([_claim()], rows)[0]["verdict"] == EQUAL
+
+
+def test_a_resume_after_a_source_change_keeps_the_old_inputs_so_the_verdicts_read_stale(tmp_path, capsys):
+    from swarmnav.sim.study.execute import resumed_inputs
+    (tmp_path / "runs.parquet").mkdir()
+    old = {"study_file": {"path": "s.toml", "sha256": "a"}, "sources": {"planners/gwo.py": "1"},
+           "scenarios": {"x.toml": "s"}, "versions": {"swarmnav": "0.1.0"}}
+    same = dict(old, study_file={"path": "s.toml", "sha256": "b"}, sources={"planners/gwo.py": "1", "planners/new.py": "3"})
+    assert resumed_inputs(old, same, tmp_path)["sources"] == same["sources"]  # a claim added, a new arm: fine
+    changed = dict(old, sources={"planners/gwo.py": "2"})
+    kept = resumed_inputs(old, changed, tmp_path)
+    assert kept["sources"] == old["sources"] and "planners/gwo.py changed" in capsys.readouterr().err
+    assert resumed_inputs(old, changed, tmp_path / "empty") == changed  # no rows yet: today's inputs

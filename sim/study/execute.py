@@ -74,6 +74,7 @@ def _write_metadata(study: Study, out_dir: FilePath) -> None:
         previous = old.get("name")
         # rows of an earlier version of the study stay in the folder: keep the geometry of their scenarios
         metadata["scenarios"] = {**old.get("scenarios", {}), **metadata["scenarios"]}
+        metadata["inputs"] = resumed_inputs(old.get("inputs"), metadata["inputs"], out_dir)
         if previous != study.name:
             raise ConfigError("--out", f"holds the rows of study {previous!r}, not {study.name!r} "
                                        "(choose another directory)", str(out_dir))
@@ -81,6 +82,26 @@ def _write_metadata(study: Study, out_dir: FilePath) -> None:
     temporary = out_dir / f".{METADATA}.tmp"
     temporary.write_text(json.dumps(metadata, indent=2) + "\n", encoding="utf-8")
     os.replace(temporary, path)
+
+
+def resumed_inputs(old: dict[str, Any] | None, new: dict[str, Any], out_dir: FilePath) -> dict[str, Any]:
+    """The inputs a resumed folder records: today's, unless rows already there were made by sources,
+    scenarios or a swarmnav version that have changed since; then the old record stays (with today's study
+    file, whose claims and comments decide no row, and the files of newly used components added), so that
+    ``report --check-fresh`` calls the mixed rows stale, and a warning says to start the folder afresh."""
+    from swarmnav.sim.study.provenance import stale_inputs
+    if not old or not (out_dir / "runs.parquet").exists():
+        return new
+    changes = [c for c in stale_inputs(old, new)[0] if not c.startswith("study file")
+               and not c.endswith("newly used") and not c.endswith("no longer used")]
+    if not changes:
+        return {**new, "sources": {**old.get("sources", {}), **new["sources"]},
+                "scenarios": {**old.get("scenarios", {}), **new["scenarios"]}}
+    print(f"swarmnav: warning: {out_dir} holds rows made before {'; '.join(changes)}: its verdicts will be stale "
+          "(delete the folder to rerun the study afresh)", file=sys.stderr)
+    return {**old, "study_file": new["study_file"],
+            "sources": {**new["sources"], **old.get("sources", {})},
+            "scenarios": {**new["scenarios"], **old.get("scenarios", {})}}
 
 
 class ProgressBar:
