@@ -14,14 +14,26 @@ export MUJOCO_GL ?= egl
 
 STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin)))")
 
-.PHONY: demo test bench install clean studies readme-table rerun-stale
+.PHONY: demo test bench install clean studies readme-table rerun-stale typing-path
 
 $(STAMP): pyproject.toml Makefile planners/_colony_walk.c planners/_grid_search.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	@echo "installing swarmnav into $(VENV) (pip's output: $(VENV)/install.log)"
 	@$(BIN)/python -m pip install --quiet --upgrade pip > $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
 	@$(BIN)/python -m pip install --quiet -e '.[test,bench,rl]' >> $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
+	@$(MAKE) --no-print-directory typing-path
 	@touch $(STAMP)
+
+# The editable install maps swarmnav, swarmnav.sim, ... to their folders with an import hook, which type checkers
+# do not run: mypy would not find swarmnav at all. A folder of symbolic links, $(VENV)/typing/swarmnav (the files
+# of sim/api/ and the folders models, planners, controllers and sim, so a module added later is there too), put on
+# the path by a static .pth file, is the package as a wheel lays it out, py.typed included.
+TYPING_TREE := $(CURDIR)/$(VENV)/typing
+typing-path:
+	@rm -rf $(TYPING_TREE) && mkdir -p $(TYPING_TREE)/swarmnav
+	@for f in sim/api/*.py sim/api/py.typed; do ln -s $(CURDIR)/$$f $(TYPING_TREE)/swarmnav/; done
+	@for d in models planners controllers sim; do ln -s $(CURDIR)/$$d $(TYPING_TREE)/swarmnav/$$d; done
+	@$(BIN)/python -c "import sys, sysconfig; open(sysconfig.get_paths()['purelib'] + '/swarmnav_typing.pth', 'w').write(sys.argv[1] + '\n')" $(TYPING_TREE)
 
 install: $(STAMP)
 

@@ -302,6 +302,7 @@ def _plain_row(navigator: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
         "success_rate": sum(bool(r["success"]) for r in rows) / n,
         "collision_rate": sum(bool(r["collisions"]) for r in drove) / n,
         "timeout_rate": sum(r["run_outcome"] == "timeout" for r in drove) / n,
+        "left_arena_rate": sum(r["run_outcome"] == "left_arena" for r in drove) / n,
         "mean_time_to_goal_s": _mean(reached),
         "mean_spl": _mean([r["spl"] or 0.0 for r in drove]),
         "mean_time_in_danger_s": _mean([r["time_in_danger_s"] for r in drove]),
