@@ -110,3 +110,10 @@ def test_known_map_track_planner_is_written_and_checked(tmp_path):
     assert setup.startswith("known-map track: planner mmas (cell_m=0.15)")
     with pytest.raises(ConfigError, match="--barn-planner"):
         barn.parse_planner("mmas:cell_m=-1")
+
+
+def test_setup_is_the_most_of_the_protocol_installed_or_the_forced_stand_in():
+    tables, text = barn.protocol_tables()
+    assert text in (barn.PROTOCOL_TEXT, barn.PARTIAL_TEXT, barn.STAND_IN_TEXT)
+    assert barn._loads(tables)  # whatever was chosen loads in this installation
+    assert barn.protocol_tables("stand-in") == (barn.STAND_IN, barn.STAND_IN_TEXT)

@@ -216,7 +216,8 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
         names, barn_meta, barn_setup = barn_suite.write_barn_suite(out_dir, quick, (barn or {}).get("worlds"),
                                                                    (barn or {}).get("runs"), (barn or {}).get("dir"),
                                                                    generated=suite == "barn-like",
-                                                                   planner=(barn or {}).get("planner"))
+                                                                   planner=(barn or {}).get("planner"),
+                                                                   setup_name=(barn or {}).get("setup") or "auto")
         run_seeds, speed = None, False  # the speed figures re-run every scene's oracle search: not here
     elif suite is not None:
         names, loaded = write_suite(suite, quick, sensor_model, out_dir, per_group, seed_offset)
@@ -371,7 +372,7 @@ def _barn_options(args: argparse.Namespace, suite: str | None) -> dict[str, Any]
     """``--barn-dir``, ``--barn-runs``, ``--barn-worlds`` (``--suite barn`` and ``barn-like`` only; the dyn300
     options refused there)."""
     from swarmnav.models.errors import ConfigError
-    given = {k: getattr(args, f"barn_{k}", None) for k in ("dir", "runs", "worlds", "planner")}
+    given = {k: getattr(args, f"barn_{k}", None) for k in ("dir", "runs", "worlds", "planner", "setup")}
     if suite not in ("barn", "barn-like"):
         for key, value in given.items():
             if value is not None:
@@ -384,7 +385,7 @@ def _barn_options(args: argparse.Namespace, suite: str | None) -> dict[str, Any]
     if suite == "barn":
         barn_dir(given["dir"])  # no data: one line before anything runs
     return {"dir": given["dir"], "runs": given["runs"], "worlds": parse_worlds(given["worlds"], suite == "barn-like"),
-            "planner": parse_planner(given["planner"])}
+            "planner": parse_planner(given["planner"]), "setup": given["setup"]}
 
 
 def _print_table(rows: list[dict[str, Any]], title: str) -> None:
