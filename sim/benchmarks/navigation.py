@@ -75,11 +75,11 @@ def default_navigators(settings: dict[str, dict[str, Any]] | None = None) -> lis
 
 def navigator_settings(pairs: dict[str, Any], navigators: list[str]) -> dict[str, dict[str, Any]]:
     """``--navigator-set KEY=VALUE``: each navigator gets the keys it has as parameters; a key none has is an error."""
-    import dataclasses
+    from swarmnav.controllers.navigators import navigator_parameters
     from swarmnav.models.errors import ConfigError
     out: dict[str, dict[str, Any]] = {}
     for key, value in pairs.items():
-        takers = [n for n in navigators if key in {f.name for f in dataclasses.fields(NAVIGATORS[n]) if f.init}]
+        takers = [n for n in navigators if key in navigator_parameters(n)]
         if not takers:
             raise ConfigError("--navigator-set", f"no navigator of this benchmark has a parameter {key!r}")
         for name in takers:
@@ -233,8 +233,13 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     runs = {label: [r for r in rows if r["navigator_label"] == label] for label in labels}
     settings = {a.label: {"arm_of": a.navigator, "arm_params": a.params} for a in arms}
     sensing = "+".join(sorted({load_scenario(name).sensor_model for name in names}))
-    table = [{"scenario": None, **_row(nav, arm, verdicts, shipped), "sensor_model": sensing,
-              **settings.get(nav, {})} for nav, arm in runs.items()]
+    from swarmnav.sim.benchmarks.crowd_rows import crowd_rows, robot_visible
+    visible = robot_visible(names)
+    if visible:  # scenes among agents: one table per setting (CrowdNav's invisible and visible robot)
+        table = crowd_rows(runs, visible, verdicts, shipped, sensing, settings, _row, ORACLE)
+    else:
+        table = [{"scenario": None, **_row(nav, arm, verdicts, shipped), "sensor_model": sensing,
+                  **settings.get(nav, {})} for nav, arm in runs.items()]
     if speed:
         _add_speed(table, rows)
     if by_scenario:
@@ -351,7 +356,17 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(rows))
         return 0
     overall = [r for r in rows if r["scenario"] is None]
-    _print_table(overall, "")
+    if any("robot_visible" in r for r in overall):  # among agents: CrowdNav's two settings apart
+        from swarmnav.sim.benchmarks.crowd_rows import print_crowd_lines
+        for seen in (False, True):
+            part = [r for r in overall if r.get("robot_visible") is seen]
+            if part:
+                _print_table(part, f"robot {'visible' if seen else 'invisible'} to the humans"
+                             + (" (no clairvoyant yardstick)" if seen else ""))
+                print_crowd_lines(part)
+                print()
+    else:
+        _print_table(overall, "")
     if suite in ("barn", "barn-like"):
         from swarmnav.sim.benchmarks.barn import print_scores
         print_scores(overall)
