@@ -49,6 +49,7 @@ from swarmnav.sim.contact import ContactMonitor
 from swarmnav.sim.control_period import control_periods, steps_per_control
 from swarmnav.sim.crowd_stepping import ReactiveCrowd, crowd_metrics, human_columns
 from swarmnav.sim.detector import ObstacleSensing
+from swarmnav.sim.laser import LaserCaster
 from swarmnav.sim.recording import Recorder, RunContext, StepFrame
 from swarmnav.sim.reference import reference_length_m as shortest_static_length_m
 from swarmnav.sim.run_result import RunResult
@@ -271,6 +272,7 @@ class EpisodeStepper:
         adr = np.asarray(scene.range_sensor_adr)
         contiguous = len(adr) > 0 and np.array_equal(adr, np.arange(adr[0], adr[0] + len(adr)))
         self._range_raw = data.sensordata[adr[0]:adr[0] + len(adr)] if contiguous else None
+        self._laser = LaserCaster(scene, data) if scene.laser_site_id >= 0 else None
         self.sensing = ObstacleSensing(self.scenario, self.obstacle_track_m, self._radii_m, self.dt_s,
                                        scene.range_angles_rad, scene.range_offset_m)
         if self._crowd is not None:
@@ -364,8 +366,11 @@ class EpisodeStepper:
         vx, vy, _, _, _, omega = self._base_qvel.tolist()
         pose = Pose2D(x, y, heading)
         scene = self.scene
-        raw = self._range_raw if self._range_raw is not None else self.data.sensordata[scene.range_sensor_adr]
-        ranges = ranges_from_sensors(raw, scene.range_cutoff_m)
+        if self._laser is not None:
+            ranges = self._laser.scan(heading)
+        else:
+            raw = self._range_raw if self._range_raw is not None else self.data.sensordata[scene.range_sensor_adr]
+            ranges = ranges_from_sensors(raw, scene.range_cutoff_m)
         time_s = step * self.dt_s
         linear_m_s, angular_rad_s = base_twist(vx, vy, omega, heading)
         return Observation(time_s, pose, Twist(linear_m_s, angular_rad_s), ranges, scene.range_angles_rad,

@@ -66,15 +66,15 @@ def plan(scenario: Any, planner: str | None = None, params: dict[str, Any] | Non
 def given_episode(spec, waypoints: "np.ndarray", source: str):
     """An episode whose path is the given waypoints instead of a plan (``run --waypoints``): the spec's planner
     still serves a navigator that replans."""
-    from swarmnav.controllers.navigators import make_navigator
+    from swarmnav.controllers.navigators import make_driver
     from swarmnav.planners.registry import make_planner
     from swarmnav.sim.episode import Episode
     from swarmnav.sim.given_path import given_path
     spec = spec.resolved()
     planner = make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)  # bad names fail early
-    navigator = make_navigator(spec.navigator, spec.navigator_params, spec.scenario.source_path)
+    navigator, safety = make_driver(spec.navigator, spec.navigator_params, spec.scenario.source_path)
     problem, path = given_path(spec.scenario, waypoints, source)
-    return Episode(spec, problem, path, planner, navigator)
+    return Episode(spec, problem, path, planner, navigator, safety=safety)
 
 
 def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
@@ -84,7 +84,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
         log: "str | os.PathLike | bool | None" = None, overwrite: bool = False,
         video: "str | os.PathLike | None" = None, camera: str = "top", width: int = 640, height: int = 480,
         fps: float | None = None, stop_on_collision: bool | None = None, live: bool = False,
-        on_live: Callable[[str], None] | None = None) -> RunOutcome:
+        on_live: Callable[[str], None] | None = None, log_format: str = "swarmnav") -> RunOutcome:
     """Plan (or take ``waypoints``) and drive the scenario in MuJoCo.
 
     Args:
@@ -93,6 +93,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
         log: an MCAP path, ``True`` for ``logs/<scenario>_<planner>_seed<N>_<stamp>.mcap``, or ``None``/``False``
             for no log.
         video: an MP4 path rendered offscreen while running.
+        log_format: ``swarmnav`` (Foxglove's schemas) or ``ros2`` (CDR messages of the standard ROS 2 types).
 
     Raises:
         ConfigError: bad input (naming the field); the log or video file exists without ``overwrite``.
@@ -119,7 +120,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
             raise ConfigError("--out", "Is a directory (give a file path)", str(log_path))
         if log_path.exists() and not overwrite:
             raise ConfigError("--out", "file exists (use --overwrite)", str(log_path))
-        recorders.append(McapRecorder(log_path, live=live, overwrite=True, on_live=on_live))
+        recorders.append(McapRecorder(log_path, live=live, overwrite=True, on_live=on_live, log_format=log_format))
     elif live:
         raise ConfigError("--live", "needs the log (drop --no-log)")
     if video:

@@ -27,6 +27,7 @@ from swarmnav.planners.errors import PlanningError
 from swarmnav.sim import options
 from swarmnav.sim.cli import stop_signal
 from swarmnav.sim.options import parse_settings
+from swarmnav.sim.defaults import LOG_FORMATS
 from swarmnav.sim.cli.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
 
 # As sim.video.render does, before any subcommand imports mujoco (which reads it once, on import).
@@ -87,6 +88,8 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
         return cmd_generate(args)
     if getattr(args, "scenarios_command", None) == "info":
         return cmd_scenario_info(args)
+    if getattr(args, "scenarios_command", None) == "import":
+        return args.scenario_run(args)
     rows = []
     for name in list_scenarios():
         s = load_scenario(name)
@@ -201,7 +204,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                       waypoints=args.waypoints, log=False if args.no_log else (args.out or True),
                       overwrite=args.overwrite, video=args.video, camera=args.camera, width=args.width,
                       height=args.height, fps=args.fps, stop_on_collision=True if args.stop_on_collision else None,
-                      live=args.live,
+                      live=args.live, log_format=args.log_format,
                       on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove WebSocket)",
                                                 file=sys.stderr))
     except ConfigError as exc:
@@ -268,13 +271,17 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("scenarios", help="list the bundled scenarios, or generate one")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_scenarios)
-    scenario_commands = p.add_subparsers(dest="scenarios_command", metavar="generate|info")
+    scenario_commands = p.add_subparsers(dest="scenarios_command", metavar="generate|info|import")
     gen = scenario_commands.add_parser("generate", help="write a dynamic scenario (crossing, head_on, ...) from a seed")
     _add_generate_options(gen)
     info = scenario_commands.add_parser("info", help="difficulty metrics and the clairvoyant oracle's verdict")
     info.add_argument("scenario", metavar="SCENARIO", help="a bundled name or a .toml path")
     info.add_argument("--world-seed", type=int, help="seed of the random obstacle motions (default: the scenario's)")
     info.add_argument("--json", action="store_true", help="print one JSON object")
+    from swarmnav.sim.cli import world_import
+    imp = scenario_commands.add_parser("import", help="a Gazebo world's static cylinders and boxes as a scenario file")
+    world_import.add_arguments(imp)
+    imp.set_defaults(scenario_run=world_import.run)
 
     p = sub.add_parser("plan", help="plan a path for a scenario")
     _add_run_options(p)
@@ -285,6 +292,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="MCAP log path (default: logs/<scenario>_<planner>_seed<N>_<stamp>.mcap)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
     p.add_argument("--no-log", action="store_true", help="write no MCAP log")
+    p.add_argument("--log-format", choices=LOG_FORMATS, default="swarmnav",
+                   help="swarmnav (Foxglove's schemas, the default) or ros2 (CDR, the standard ROS 2 types)")
     p.add_argument("--live", action="store_true", help="also serve the channels to Foxglove on 127.0.0.1")
     p.add_argument("--video", help="render an MP4 while running (offscreen EGL)")
     p.add_argument("--camera", default="top", choices=("top", "chase", "follow"),

@@ -33,6 +33,8 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
+from swarmnav.models.contained_files import check_no_link, folder as contained_folder
+
 RUNS = "runs.parquet"
 PROGRESS = "progress.parquet"
 
@@ -129,6 +131,7 @@ def set_aside(path: FilePath, reason: str) -> None:
     folder = path.parent.parent / DAMAGED
     target = folder / f"{path.parent.name}-{path.name}"
     try:
+        check_no_link(folder, "--out")  # a planted link would carry the part out of the study folder
         folder.mkdir(exist_ok=True)
         os.replace(path, target)
         where = f"moved to {target}"
@@ -238,7 +241,7 @@ class RowWriter:
         self.token = uuid.uuid4().hex[:8]
         self.parts = 0
         for name in (RUNS, PROGRESS):
-            (self.out_dir / name).mkdir(parents=True, exist_ok=True)
+            contained_folder(self.out_dir / name, "--out")  # a planted link is refused, never written through
 
     def add(self, row: dict[str, Any], progress: list[dict[str, Any]]) -> None:
         self.runs.append(row)

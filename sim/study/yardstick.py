@@ -32,6 +32,8 @@ import os
 from pathlib import Path as FilePath
 from typing import Any
 
+from swarmnav.models.contained_files import check_no_link, loads_json, replace_file
+
 FILE = "difficulty.json"
 METRICS = ("static_density", "dispersion", "survivability", "dynamic_traversability", "t_star_ratio")
 COLUMNS = ("oracle_verdict", "oracle_reason", "oracle_t_star_s", "oracle_cell_m", "time_score", *METRICS,
@@ -89,9 +91,15 @@ class Yardstick:
         self.digests: dict[str, str] = {}
         self.computed = 0  # scenes measured by this instance (not read from the file)
         try:
-            self.scenes = json.loads(self.path.read_text(encoding="utf-8")).get("scenes", {})
-        except (OSError, ValueError, AttributeError):
+            check_no_link(self.path, "--out")  # a link planted in the folder is neither read nor written through
+            self.scenes = loads_json(self.path.read_text(encoding="utf-8"), str(self.path)).get("scenes", {})
+        except (OSError, AttributeError):
             self.scenes = {}
+        except ValueError as exc:  # unreadable JSON: measured again; a planted link: refused
+            if "symbolic link" in str(exc):
+                raise
+            self.scenes = {}
+        self.scenes = self.scenes if isinstance(self.scenes, dict) else {}
 
     def _digest(self, ref: str) -> str:
         if ref not in self.digests:
@@ -121,9 +129,7 @@ class Yardstick:
         return self.scenes[key]
 
     def _save(self) -> None:
-        temporary = self.path.with_name(f".{FILE}.tmp")
-        temporary.write_text(json.dumps({"scenes": self.scenes}, indent=1, sort_keys=True) + "\n", encoding="utf-8")
-        os.replace(temporary, self.path)
+        replace_file(self.path, json.dumps({"scenes": self.scenes}, indent=1, sort_keys=True) + "\n", "--out")
 
     def annotate(self, row: dict[str, Any]) -> dict[str, Any]:
         """``row`` with the columns of the module docstring (left alone for plan-only rows)."""
