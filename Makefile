@@ -72,6 +72,7 @@ readme-table: $(STAMP)
 	done
 	$(BIN)/swarmnav report --readme-table models/studies/results --readme README.md
 	for r in dyn300 dyn300-rangefinder dyn; do $(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/$$r.json --readme README.md || exit 1; done
+	$(BIN)/python -m swarmnav.sim.benchmarks.crowd_table models/suites/results/crowdnav.json --readme README.md
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -66,12 +66,51 @@ def table_lines(rows: list[dict[str, Any]], seen: bool) -> list[str]:
     return lines
 
 
+BEST_TARGET = 0.99  # issue 35: the best navigator's success, with discomfort below DISCOMFORT_TARGET
+DISCOMFORT_TARGET = 0.05
+ONLINE_TARGET = 0.90  # every online navigator's success
+CROWD_TARGET_US = 50.0
+REALTIME_TARGET = 30.0
+
+
+def summary_lines(part: list[dict[str, Any]], seen: bool) -> list[str]:
+    """The targets of one setting, computed from its rows (never written by hand)."""
+    from swarmnav.controllers.navigators import NAVIGATORS
+    contenders = [r for r in part if r["navigator"] != ORACLE]
+    if not contenders:
+        return []
+    best = max(contenders, key=lambda r: (r["success_rate"], -(r["discomfort_frequency"] or 0.0)))
+    met = best["success_rate"] >= BEST_TARGET and (best["discomfort_frequency"] or 0.0) < DISCOMFORT_TARGET
+    lines = [f"Robot {'visible' if seen else 'invisible'}: the best, `{best['navigator']}`, succeeds in "
+             f"{best['success_rate']:.3f} of its {best['runs']} runs with discomfort {best['discomfort_frequency']:.4f} "
+             f"(target ≥ {BEST_TARGET:.2f} with discomfort < {DISCOMFORT_TARGET:.2f}: {'met' if met else 'not met'})."]
+    online = [r for r in contenders if not r.get("arm_of")
+              and getattr(NAVIGATORS.get(r["navigator"]), "uses_detections", True)]
+    below = [r for r in online if r["success_rate"] < ONLINE_TARGET]
+    lines.append(f"Every online navigator at its defaults ≥ {ONLINE_TARGET:.2f}: " + (
+        "met." if not below else "not met: " + ", ".join(f"`{r['navigator']}` {r['success_rate']:.3f}"
+                                                         for r in below) + "."))
+    timed = [r for r in part if r.get("realtime_factor_cpu") is not None]
+    if timed:
+        slow = min(timed, key=lambda r: r["realtime_factor_cpu"])
+        lines.append(f"Real time on CPU: every row at {slow['realtime_factor_cpu']:.1f}× or more (`{slow['navigator']}` "
+                     f"the slowest; target ≥ {REALTIME_TARGET:g}×: {'met' if slow['realtime_factor_cpu'] >= REALTIME_TARGET else 'not met'}).")
+    crowd = next((r["crowd_step"] for r in part if r.get("crowd_step")), None)
+    if crowd:
+        worst = max(crowd[k]["cpu_us_per_agent_step"] for k in ("orca", "social_force"))
+        lines.append(f"Agents: {crowd['orca']['cpu_us_per_agent_step']:.1f} µs (ORCA) and "
+                     f"{crowd['social_force']['cpu_us_per_agent_step']:.1f} µs (social force) of CPU per agent per "
+                     f"control step with {crowd['agents']} agents (target ≤ {CROWD_TARGET_US:g} µs: "
+                     f"{'met' if worst <= CROWD_TARGET_US else 'not met'}).")
+    return lines
+
+
 def block(rows: list[dict[str, Any]]) -> str:
     out = [BEGIN, ""]
     for seen in (False, True):
         part = [r for r in rows if r.get("robot_visible") is seen]
         if part:
-            out += table_lines(part, seen) + [""]
+            out += table_lines(part, seen) + [""] + summary_lines(part, seen) + [""]
     out += [f"Published figures: {PUBLISHED_SOURCE}; their robot is holonomic, ours a differential drive in "
             "MuJoCo.", "", END]
     return "\n".join(out)
