@@ -110,7 +110,8 @@ def test_agents_that_see_the_robot_go_round_it_and_others_walk_into_it(tmp_path,
     ('{ kind = "orca", goal = [2, 2], tau_s = 1 }', "obstacles[0].motion.tau_s"),
 ])
 def test_bad_agent_fields_name_the_field(tmp_path, motion, field):
-    text = HEAD.format(name="bad", limit=4, rx=5, ry=5) + f"\n[[obstacles]]\nx = 1\ny = 1\nradius_m = 0.3\nmotion = {motion}\n"
+    text = (HEAD.format(name="bad", limit=4, rx=5, ry=5)
+            + f"\n[[obstacles]]\nx = 1\ny = 1\nradius_m = 0.3\nmotion = {motion}\n")
     with pytest.raises(ConfigError) as info:
         load_scenario(str(write(tmp_path, text)))
     assert info.value.field == field
