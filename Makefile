@@ -87,6 +87,7 @@ readme-table: $(STAMP)
 	$(BIN)/swarmnav report --readme-table models/studies/results --readme README.md
 	for r in dyn300 dyn300-rangefinder dyn; do $(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/$$r.json --readme README.md || exit 1; done
 	$(BIN)/python -m swarmnav.sim.benchmarks.barn_table --readme README.md
+	$(BIN)/python -m swarmnav.sim.benchmarks.crowd_table models/suites/results/crowdnav.json --readme README.md
 
 rerun-stale: $(STAMP)
 	$(MAKE) readme-table CLAIM_STUDIES="$$($(BIN)/swarmnav report --check-fresh models/studies/results --names)"

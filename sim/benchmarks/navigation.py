@@ -245,6 +245,9 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                   **settings.get(nav, {})} for nav, arm in runs.items()]
     if speed:
         _add_speed(table, rows)
+        if visible:  # the agents' own cost (navigation_speed.crowd_step_cost), on the oracle's row
+            from swarmnav.sim.benchmarks.navigation_speed import crowd_step_cost
+            next(r for r in table if r["navigator"] == ORACLE)["crowd_step"] = crowd_step_cost()
     if by_scenario:
         for name in dict.fromkeys(r["scenario"] for r in rows):
             extra = {"difficulty": {k: shipped[name][k] for k in DIFFICULTY_KEYS}} if name in shipped else {}
@@ -384,6 +387,10 @@ def run(args: argparse.Namespace) -> int:
     mppi = next((r.get("mppi_every_step") for r in overall if r["navigator"] == "mppi"), None)
     for line in speed_lines(overall, oracle or {}, mppi):
         print(line)
+    crowd = next((r["crowd_step"] for r in overall if r.get("crowd_step")), None)
+    if crowd:
+        from swarmnav.sim.benchmarks.navigation_speed import crowd_line
+        print(crowd_line(crowd))
     return 0
 
 
