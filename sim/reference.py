@@ -13,6 +13,7 @@ from dataclasses import replace
 import numpy as np
 
 from swarmnav.models.scenario import Scenario
+from swarmnav.models.scenario_limits import MAX_TANGENT_GRAPH_DISCS
 from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.theta_star import ThetaStarPlanner
 from swarmnav.planners.optimal import OptimalPlanner
@@ -36,7 +37,8 @@ def _static_key(scenario: Scenario) -> tuple:
 
 
 def reference_length_m(scenario: Scenario) -> float | None:
-    """L* for SPL (see the module docstring); None when there is no path among the static obstacles.
+    """L* for SPL (see the module docstring); None when there is no path among the static obstacles, or when
+    they are more discs than an exact tangent graph takes (:data:`MAX_TANGENT_GRAPH_DISCS`).
 
     Cached by the static geometry (:func:`_static_key`).
     """
@@ -44,6 +46,9 @@ def reference_length_m(scenario: Scenario) -> float | None:
     if key not in _REFERENCE_LENGTHS:
         problem = static_problem(scenario)
         planner = ThetaStarPlanner() if problem.boxes or problem.grid_override is not None else OptimalPlanner()
+        if isinstance(planner, OptimalPlanner) and len(problem.obstacles) > MAX_TANGENT_GRAPH_DISCS:
+            _REFERENCE_LENGTHS[key] = None  # not computed: beyond the stated maximum of an exact graph
+            return None
         try:
             stats = planner.plan(problem, np.random.default_rng(0)).stats
             _REFERENCE_LENGTHS[key] = float(stats.extra.get("optimum_length_m", stats.length_m))
