@@ -127,7 +127,7 @@ MALFORMED = [
     ("suite", ("version",), "one", "version", "expected an integer"),
     ("suite", ("defaults", "obstacles"), "three", "defaults.obstacles", "expected an integer"),
     ("suite", ("defaults", "arena_m"), 2.0, "defaults.arena_m", "must exceed"),
-    ("suite", ("groups", 0, "options", "speed_ratio"), -1.0, "groups[0].options.speed_ratio", "must be positive"),
+    ("suite", ("groups", 0, "options", "speed_ratio"), -1.0, "groups[0].options.speed_ratio", "must be in (0, 100]"),
     ("suite", ("groups", 0, "options", "wolves"), 3, "groups[0].options.wolves", "unknown generator option"),
     ("suite", ("groups", 0, "seeds"), [5, 2], "groups[0].seeds", "first < end"),
     ("suite", ("groups", 0, "colour"), 1, "groups[0].colour", "unknown key"),

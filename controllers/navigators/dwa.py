@@ -52,6 +52,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import Range, above, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
@@ -115,6 +116,9 @@ class DynamicWindowNavigator:
                               "sim_step_s", "dist_cap_m", "lookahead_m"),
                        ("alpha", "beta", "gamma", "margin_m"))
         check_positive(self, ("v_samples", "omega_samples"))
+        if self.horizon_s < self.sim_step_s:  # no rollout step at all
+            raise ConfigError("navigator.params.horizon_s", f"must be at least sim_step_s ({self.sim_step_s:g} s), "
+                                                            f"got {self.horizon_s!r}")
 
     def reset(self, setup: NavigationSetup) -> None:
         (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(

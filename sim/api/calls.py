@@ -34,7 +34,22 @@ def load_scenario(name_or_path: str | os.PathLike[str], trust_code: bool = False
     from swarmnav.models.scenario import load_scenario as load
     from swarmnav.sim.plugins import load_plugins
     load_plugins()
-    return load(str(name_or_path), trust_code)
+    scenario = load(str(name_or_path), trust_code)
+    check_components(scenario, trust_code)
+    return scenario
+
+
+def check_components(scenario: "Scenario", trust_code: bool = False) -> None:
+    """The scenario's ``planner`` and ``navigator`` tables built once, so a file naming an unknown component or
+    parameter is refused on load (naming the field), whatever ``--planner`` later overrides.
+
+    Raises:
+        ConfigError: ``planner.name``, ``planner.params.KEY`` (or the navigator's) and the file.
+    """
+    from swarmnav.controllers.navigators import make_navigator
+    from swarmnav.planners.registry import make_planner
+    make_planner(scenario.planner_name, scenario.planner_params, scenario.source_path, trust_code=trust_code)
+    make_navigator(scenario.navigator_name, scenario.navigator_params, scenario.source_path, trust_code=trust_code)
 
 
 def _scenario(scenario: str | os.PathLike[str] | Scenario) -> Scenario:

@@ -61,11 +61,11 @@ def _load(args: argparse.Namespace):
     return load_scenario(args.scenario, trust_code=args.trust_code)
 
 
-def _episode_spec(args: argparse.Namespace):
+def _episode_spec(args: argparse.Namespace, scenario):
     """The episode the command line asks for: the scenario, then ``--planner``/``--set``, ``--navigator``/
     ``--navigator-set`` and the two seeds on top."""
     from swarmnav.sim.episode import EpisodeSpec
-    return EpisodeSpec(_load(args), planner=args.planner, planner_params=parse_settings(args.set, "--set"),
+    return EpisodeSpec(scenario, planner=args.planner, planner_params=parse_settings(args.set, "--set"),
                        navigator=args.navigator,
                        navigator_params=parse_settings(args.navigator_set, "--navigator-set"),
                        seed=args.seed, world_seed=args.world_seed)
@@ -145,8 +145,13 @@ def cmd_generate(args: argparse.Namespace) -> int:
     from swarmnav.models.scenario_generator import GeneratorOptions, generate
     options = GeneratorOptions(**{f.name: getattr(args, f.name) for f in fields(GeneratorOptions)
                                   if getattr(args, f.name, None) is not None})
+    from swarmnav.sim.api.calls import check_components
     text = generate(args.kind, args.seed, options)
-    parse_scenario(text, args.out or "<generated>")
+    try:  # it must load back, its planner and navigator too
+        check_components(parse_scenario(text, args.out or "<generated>"))
+    except ConfigError as exc:
+        option = {"planner.name": "--planner", "navigator.name": "--navigator"}.get(exc.field)
+        raise ConfigError(option, exc.problem) if option else exc from None
     if args.out:
         out = FilePath(args.out)
         if out.exists() and not args.overwrite:
@@ -160,7 +165,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
 def _add_generate_options(p: argparse.ArgumentParser) -> None:
     from swarmnav.models.scenario_generator import KINDS, GeneratorOptions
     p.add_argument("kind", metavar="KIND", help=f"one of: {', '.join(KINDS)}")
-    p.add_argument("--seed", type=int, required=True, help="the layout's seed (same seed, same file)")
+    p.add_argument("--seed", type=options.seed, required=True, help="the layout's seed (same seed, same file)")
     p.add_argument("--out", help="write the TOML here (default: print it)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
     for name, kind in (("obstacles", int), ("speed_ratio", float), ("radius_min_m", float),
@@ -175,8 +180,9 @@ def _add_generate_options(p: argparse.ArgumentParser) -> None:
 
 def cmd_plan(args: argparse.Namespace) -> int:
     from swarmnav.sim.episode import plan_episode
+    scenario = _load(args)  # the file's own errors name the file, never an option
     try:
-        episode = plan_episode(_episode_spec(args))
+        episode = plan_episode(_episode_spec(args, scenario))
     except ConfigError as exc:
         raise _blame_options(args, exc) from None
     out = episode.plan_summary()
@@ -198,8 +204,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.video:
         from swarmnav.sim.video.render import check_video_size
         check_video_size(args.width, args.height, args.fps)  # before the plan: bad options fail at once
+    scenario = _load(args)  # the file's own errors name the file, never an option
     try:
-        outcome = run(_load(args), args.planner, parse_settings(args.set, "--set"), args.navigator,
+        outcome = run(scenario, args.planner, parse_settings(args.set, "--set"), args.navigator,
                       parse_settings(args.navigator_set, "--navigator-set"), args.seed, args.world_seed,
                       waypoints=args.waypoints, log=False if args.no_log else (args.out or True),
                       overwrite=args.overwrite, video=args.video, camera=args.camera, width=args.width,
@@ -280,7 +287,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_generate_options(gen)
     info = scenario_commands.add_parser("info", help="difficulty metrics and the clairvoyant oracle's verdict")
     info.add_argument("scenario", metavar="SCENARIO", help="a bundled name or a .toml path")
-    info.add_argument("--world-seed", type=int, help="seed of the random obstacle motions (default: the scenario's)")
+    info.add_argument("--world-seed", type=options.seed, help="seed of the random obstacle motions (default: the scenario's)")
     info.add_argument("--json", action="store_true", help="print one JSON object")
     from swarmnav.sim.cli import world_import
     imp = scenario_commands.add_parser("import", help="a Gazebo world's static cylinders and boxes as a scenario file")

@@ -62,6 +62,7 @@ from swarmnav.controllers.navigators import make_navigator
 from swarmnav.models.contained_files import is_input_path, name_problem
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR
+from swarmnav.models.scenario_limits import MAX_STUDY_RUNS
 from swarmnav.models.toml_table import POSITIVE, TomlTable, above, parse_toml, read_text, within
 from swarmnav.planners.registry import make_planner
 from swarmnav.planners.swarm import Budget
@@ -71,7 +72,7 @@ from swarmnav.sim.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, Pa
                                               read_budget, read_clearance, read_components, read_paper,
                                               read_scenarios, read_seeds, refuse_scenario_code)
 
-MAX_CELLS = 2_000_000  # runs of one study (scenarios x settings x seed pairs), each a row
+MAX_CELLS = MAX_STUDY_RUNS  # runs of one study (scenarios x settings x seed pairs), each a row
 MAX_WALL_LIMIT_S = 1e6
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
@@ -210,7 +211,7 @@ def _read_study(top: TomlTable, default_name: str, trust_code: bool) -> Study:
     if paired and len(world_seeds) != len(seeds):
         top.fail("paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                  f"{len(world_seeds) if top.has('world_seeds') else 'no'} world seeds")
-    settings = sum(len(c.settings()) for c in planners) * sum(len(c.settings()) for c in navigators)
+    settings = sum(c.count() for c in planners) * sum(c.count() for c in navigators)
     cells = len(scenarios) * settings * (len(seeds) if paired else len(seeds) * len(world_seeds))
     if cells > MAX_CELLS:
         top.fail("seeds", f"the grid has {cells:,} runs (scenarios x settings x seeds), at most {MAX_CELLS:,}")
