@@ -132,7 +132,8 @@ def cmd_components(args: argparse.Namespace) -> int:
         origin = "" if row["package"] == "swarmnav" else f"  [{row['package']}]"
         print(f"{row['name']:<20} {row['description']}{origin}")
         for param in row["parameters"]:
-            bounds = f" in {param['range']}" if "range" in param else ""
+            bounds = f" in {param['range']}" if "range" in param else \
+                f" one of {', '.join(param['choices'])}" if "choices" in param else ""
             print(f"    {param['name']} = {param['default']!r} ({param['type']}{bounds})")
     return EXIT_OK
 
