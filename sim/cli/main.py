@@ -55,14 +55,15 @@ class OneLineParser(argparse.ArgumentParser):
 
 
 def _load(args: argparse.Namespace):
-    """The scenario, as the API loads it (plugins' too); ``--trust-code``: its code parameters may run."""
-    from swarmnav.calls import load_scenario
-    return load_scenario(args.scenario, trust_code=args.trust_code)
+    """The scenario (a bundled one, a plugin's: :func:`main` has loaded the plugins once for the command);
+    ``--trust-code``: its code parameters may run."""
+    from swarmnav.models.scenario import load_scenario
+    return load_scenario(args.scenario, args.trust_code)
 
 
 def _episode_spec(args: argparse.Namespace):
-    """The episode the command line asks for: the scenario, then ``--planner``/``--set``, ``--navigator``/
-    ``--navigator-set`` and the two seeds on top."""
+    """The episode the command line asks for (``plan`` and ``run`` alike): the scenario, then ``--planner``/
+    ``--set``, ``--navigator``/``--navigator-set`` and the two seeds on top."""
     from swarmnav.sim.episode import EpisodeSpec
     return EpisodeSpec(_load(args), planner=args.planner, planner_params=parse_settings(args.set, "--set"),
                        navigator=args.navigator,
@@ -191,20 +192,18 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from swarmnav.calls import run
+    from swarmnav.calls import run_spec
     options.check_output_file(args.json_out, "--json-out")
     if args.video:
         from swarmnav.sim.video.render import check_video_size
         check_video_size(args.width, args.height, args.fps)  # before the plan: bad options fail at once
     try:
-        outcome = run(_load(args), args.planner, parse_settings(args.set, "--set"), args.navigator,
-                      parse_settings(args.navigator_set, "--navigator-set"), args.seed, args.world_seed,
-                      waypoints=args.waypoints, log=False if args.no_log else (args.out or True),
-                      overwrite=args.overwrite, video=args.video, camera=args.camera, width=args.width,
-                      height=args.height, fps=args.fps, stop_on_collision=True if args.stop_on_collision else None,
-                      live=args.live,
-                      on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove WebSocket)",
-                                                file=sys.stderr))
+        outcome = run_spec(_episode_spec(args), waypoints=args.waypoints,
+                           log=False if args.no_log else (args.out or True), overwrite=args.overwrite,
+                           video=args.video, camera=args.camera, width=args.width, height=args.height, fps=args.fps,
+                           stop_on_collision=True if args.stop_on_collision else None, live=args.live,
+                           on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove "
+                                                     "WebSocket)", file=sys.stderr))
     except ConfigError as exc:
         raise _blame_options(args, exc) from None
     out = outcome.to_dict()
