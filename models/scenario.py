@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from swarmnav.models.contained_files import is_input_path, name_problem  # noqa: F401 (name_problem: re-exported)
 from swarmnav.models.crowd_agents import reseed_agents
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.obstacle_motion import RandomWalkMotion
@@ -152,10 +153,8 @@ def list_scenarios() -> list[str]:
 def resolve_scenario_path(name_or_path: str) -> FilePath:
     """A bundled scenario name, or a path to a .toml file."""
     candidate = FilePath(name_or_path)
-    if candidate.suffix == ".toml" or candidate.exists() or "/" in name_or_path:
-        if not candidate.is_file():
-            raise ConfigError("scenario", "file does not exist", str(candidate))
-        return candidate
+    if candidate.suffix == ".toml" or is_input_path(candidate) or "/" in name_or_path:
+        return candidate  # read_text says what is wrong with anything but a regular file
     bundled = next((folder / f"{name_or_path}.toml" for folder in (SCENARIO_DIR, *EXTRA_SCENARIO_DIRS)
                     if (folder / f"{name_or_path}.toml").is_file()), SCENARIO_DIR / f"{name_or_path}.toml")
     if not bundled.is_file():
@@ -278,27 +277,6 @@ def _sim(t: TomlTable) -> tuple[SimSettings, float, bool]:
     cell_m = t.number("cell_m", 0.05, bounds=POSITIVE)
     t.close()
     return sim, cell_m, t.has("cell_m")
-
-
-def name_problem(name: str) -> str | None:
-    """Why a scenario name cannot be part of a file name, or None.
-
-    The name is used in the default log path, so it must be a plain file-name
-    part: printable, no path separator, not ``.`` or ``..``, at most
-    :data:`MAX_NAME_CHARS` characters.
-    """
-    if not name.strip():
-        return "must not be empty"
-    if len(name) > MAX_NAME_CHARS:
-        return f"must be at most {MAX_NAME_CHARS} characters, got {len(name)}"
-    bad = next((ch for ch in name if not ch.isprintable()), None)
-    if bad is not None:
-        return f"must be printable, has {bad!r}"
-    if "/" in name or "\\" in name:
-        return f"must not contain a path separator ('/' or '\\'), got {name!r}"
-    if name in (".", ".."):
-        return f"must name a file, got {name!r}"
-    return None
 
 
 def check_run_size(time_limit_s: float, sim: SimSettings, source: str | None) -> None:

@@ -54,3 +54,35 @@ class ReactiveCrowd:
         now = self.session.positions_m.copy()
         self.track_m[step + 1, self.columns] = self.session.advance(step, robot)
         self.velocity_m_s[step, self.columns] = (self.track_m[step + 1, self.columns] - now) / self.dt_s
+
+
+def human_columns(scenario, moving: list) -> np.ndarray:
+    """The columns of the stepper's track that are agents (CrowdNav's humans), in track order."""
+    return np.array([col for col, ob in enumerate(moving)
+                     if isinstance(scenario.obstacles[ob.scenario_index].motion, AgentMotion)], dtype=np.int64)
+
+
+DISCOMFORT_M = 0.2  # Chen et al. (2019)'s discomfort distance, rim to rim
+
+
+def crowd_metrics(poses: np.ndarray, track_m: np.ndarray, radii_m: np.ndarray, robot_radius_m: float,
+                  path_length_m: float) -> dict[str, float]:
+    """The crowd-navigation metrics of a run among agents (``poses``, ``track_m``: its control steps, start first;
+    ``track_m`` and ``radii_m`` of the agents only).
+
+    * ``discomfort_frequency``: the share of control steps after the start whose observation has a human within
+      ``DISCOMFORT_M`` of the robot's rim (CrowdNav's "frequency of being in danger": steps with the closest
+      rim-to-rim distance below the discomfort distance, over all steps).
+    * ``min_separation_m``: the smallest rim-to-rim distance to a human over the run's observations (negative:
+      overlap).
+    * ``path_irregularity_rad_m``: all turning of the robot's heading along the run (rad) per metre driven; our
+      reading of Guzzi et al. (2013)'s "unnecessary turning per unit path length" (the robot starts facing its
+      goal, so a straight run needs none); 0 for a run that did not move.
+    """
+    gap = np.hypot(*np.moveaxis(track_m - poses[:, None, :2], 2, 0)) - radii_m[None, :] - robot_radius_m
+    closest = gap.min(axis=1)
+    after = closest[1:]
+    turning = float(np.abs((np.diff(poses[:, 2]) + np.pi) % (2.0 * np.pi) - np.pi).sum())
+    return {"discomfort_frequency": float(np.mean(after < DISCOMFORT_M)) if len(after) else 0.0,
+            "min_separation_m": float(closest.min()),
+            "path_irregularity_rad_m": turning / path_length_m if path_length_m > 0 else 0.0}

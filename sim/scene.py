@@ -24,6 +24,7 @@ from swarmnav.models.scenario import Scenario
 MODEL_DIR = FilePath(__file__).resolve().parent.parent / "models" / "diff_drive"
 SCENE_XML = MODEL_DIR / "scene.xml"
 ROBOT_ROOT = "base_link"  # every body under it is the robot's
+LASER_SITE = "laser"  # the origin of a scanning laser's beams (see _set_laser)
 STATIC_RGBA = (0.55, 0.45, 0.38, 1.0)
 MOVING_RGBA = (0.95, 0.55, 0.1, 1.0)
 WALL_RGBA = (0.4, 0.4, 0.45, 1.0)
@@ -51,7 +52,7 @@ class CompiledScene:
     free_qpos_adr: int
     free_qvel_adr: int
     wheel_qvel_adr: tuple[int, int]
-    range_sensor_adr: np.ndarray   # (K,) sensordata indices of the rangefinders
+    range_sensor_adr: np.ndarray   # (K,) sensordata indices of the rangefinders (empty with a laser)
     range_angles_rad: np.ndarray   # (K,) beam directions in base_link, in [0, 2 pi), CCW from +x
     range_cutoff_m: float
     range_offset_m: float          # distance of the rangefinder sites from the base origin
@@ -61,6 +62,7 @@ class CompiledScene:
     obstacles: tuple[ObstacleGeom, ...]
     is_robot_geom: np.ndarray      # (ngeom,) bool
     is_obstacle_geom: np.ndarray   # (ngeom,) bool
+    laser_site_id: int = -1        # a scanning laser's origin site (sim.laser casts its beams), -1 with rangefinders
 
 
 def build_spec(scenario: Scenario) -> mujoco.MjSpec:
@@ -73,11 +75,12 @@ def build_spec(scenario: Scenario) -> mujoco.MjSpec:
     radius = scenario.robot_radius_m
     if robot.round_chassis:
         _fit_base(spec, radius)
+        _fit_top_speed(spec, scenario.max_speed_m_s)
     if robot.ring_sensors and scenario.sensor_fov_deg == 360.0:
         _set_rangefinders(spec, scenario.sensor_count, radius, scenario.sensor_range_m)
     else:
         _set_laser(spec, scenario.sensor_count, scenario.sensor_fov_deg, scenario.sensor_range_m,
-                   radius if robot.ring_sensors else 0.0)
+                   robot.ring_sensors)
 
     width, height = scenario.arena_width_m, scenario.arena_height_m
     floor = spec.geom("floor")
@@ -144,6 +147,20 @@ def _fit_base(spec: mujoco.MjSpec, radius_m: float) -> None:
     chassis.size = [radius_m, chassis.size[1], 0.0]
 
 
+def _fit_top_speed(spec: mujoco.MjSpec, max_speed_m_s: float) -> None:
+    """Let the wheels turn fast enough for the scenario's top speed when the base's own limit is below it.
+
+    The base's wheel speed limit (10 rad/s on 0.04 m tyres: 0.4 m/s) stays as it is for every robot at or
+    below it; a faster robot (CrowdNav's, 1 m/s) gets the wheel speed ``max_speed_m_s / wheel radius``.
+    """
+    wheel_radius_m = float(spec.geom("left_wheel_tyre").size[0])
+    need_rad_s = max_speed_m_s / wheel_radius_m
+    for actuator in spec.actuators:
+        limit = float(np.abs(np.asarray(actuator.ctrlrange)).min())
+        if need_rad_s > limit:
+            actuator.ctrlrange = np.array([-need_rad_s, need_rad_s])
+
+
 def _set_rangefinders(spec: mujoco.MjSpec, count: int, body_radius_m: float, cutoff_m: float) -> None:
     """Place ``count`` rangefinders evenly on the rim, pointing outward, above the wheels."""
     template = spec.site("range_site_00")
@@ -190,20 +207,26 @@ def _replace_rangefinders(spec: mujoco.MjSpec, count: int) -> None:
         sensor.intprm = data_spec
 
 
-def _set_laser(spec: mujoco.MjSpec, count: int, fov_deg: float, cutoff_m: float, rim_m: float) -> None:
-    """A laser: ``count`` beams over ``fov_deg`` (:func:`laser_angles_rad`), every one from the template
-    site's position (``rim_m`` = 0) or, for the disc robot's fan, from its rim (``rim_m`` = its radius)."""
+def _set_laser(spec: mujoco.MjSpec, count: int, fov_deg: float, cutoff_m: float, centred: bool) -> None:
+    """A scanning laser: ``count`` beams over ``fov_deg`` (:func:`laser_angles_rad`) from one origin, the site
+    ``laser`` (the robot file's ``range_site_00``; put on the base's axis when ``centred``, as for the disc
+    robot's fan), declared by the numerics ``laser_count``, ``laser_fov_deg`` and ``laser_range_m``.
+
+    No rangefinder sensor remains: MuJoCo computes sensors at every physics step, and ``sim.laser`` casts
+    the beams once per control step with ``mj_multiRay`` instead (``bench sim`` measures both).
+    """
     template = spec.site("range_site_00")
     x, y, z = (float(v) for v in template.pos)
-    _replace_rangefinders(spec, count)
-    rim = rim_m + 0.005 if rim_m > 0 else 0.0
-    for k, angle in enumerate(laser_angles_rad(count, fov_deg).tolist()):
-        site = spec.site(f"range_site_{k:02d}")
-        site.pos = [x + rim * math.cos(angle), y + rim * math.sin(angle), z]
-        quat = np.zeros(4)
-        mujoco.mju_quatZ2Vec(quat, np.array([math.cos(angle), math.sin(angle), 0.0]))
-        site.quat = quat
-        spec.sensor(f"range_{k:02d}").cutoff = cutoff_m
+    for sensor in [s for s in spec.sensors if s.name.startswith("range_")]:
+        spec.delete(sensor)
+    for site in [s for s in spec.sites if s.name.startswith("range_site_") and s.name != "range_site_00"]:
+        spec.delete(site)
+    template.name = LASER_SITE
+    template.pos = [0.0, 0.0, z] if centred else [x, y, z]
+    template.quat = [1.0, 0.0, 0.0, 0.0]
+    for name, value in (("laser_count", float(count)), ("laser_fov_deg", float(fov_deg)),
+                        ("laser_range_m", float(cutoff_m))):
+        spec.add_numeric(name=name, data=[value])
 
 
 def compile_scene(scenario: Scenario) -> CompiledScene:
@@ -238,16 +261,18 @@ def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
     for i in range_ids:
         site = model.sensor_objid[i]
         p = model.site_pos[site]
-        offset = math.hypot(p[0], p[1])
-        if offset > 0.0:  # on a rim, pointing outward: the direction of its position
-            angles.append(math.atan2(p[1], p[0]) % (2.0 * math.pi))
-        else:  # at the laser's centre: the direction of its z axis (the beam)
-            zaxis = np.zeros(3)
-            mujoco.mju_rotVecQuat(zaxis, np.array([0.0, 0.0, 1.0]), model.site_quat[site])
-            angles.append(math.atan2(zaxis[1], zaxis[0]) % (2.0 * math.pi))
-        offsets.append(offset)
+        angles.append(math.atan2(p[1], p[0]) % (2.0 * math.pi))
+        offsets.append(math.hypot(p[0], p[1]))
         heights.append(float(p[2]))
     cutoff = float(model.sensor_cutoff[range_ids[0]]) if range_ids else 0.0
+    laser_site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, LASER_SITE)
+    if laser_site >= 0:
+        numeric = {name: float(model.numeric(name).data[0]) for name in ("laser_count", "laser_fov_deg",
+                                                                          "laser_range_m")}
+        angles = laser_angles_rad(int(round(numeric["laser_count"])), numeric["laser_fov_deg"]).tolist()
+        offsets = [0.0]
+        heights = [float(model.site_pos[laser_site][2])]
+        cutoff = numeric["laser_range_m"]
 
     root = model.body(ROBOT_ROOT).id
     robot_bodies = {b for b in range(model.nbody) if model.body_rootid[b] == root}
@@ -274,4 +299,4 @@ def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
         range_offset_m=float(np.mean(offsets)) if offsets else 0.0,
         range_height_m=float(np.mean(heights)) if heights else 0.0,
         robot_geom_ids=np.flatnonzero(is_robot), chassis_geom_id=gid("chassis"),
-        obstacles=tuple(obstacles), is_robot_geom=is_robot, is_obstacle_geom=is_obstacle)
+        obstacles=tuple(obstacles), is_robot_geom=is_robot, is_obstacle_geom=is_obstacle, laser_site_id=laser_site)

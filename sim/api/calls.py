@@ -80,7 +80,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
         log: "str | os.PathLike | bool | None" = None, overwrite: bool = False,
         video: "str | os.PathLike | None" = None, camera: str = "top", width: int = 640, height: int = 480,
         fps: float | None = None, stop_on_collision: bool | None = None, live: bool = False,
-        on_live: Callable[[str], None] | None = None) -> RunOutcome:
+        on_live: Callable[[str], None] | None = None, log_format: str = "swarmnav") -> RunOutcome:
     """Plan (or take ``waypoints``) and drive the scenario in MuJoCo (:func:`run_spec` of :func:`episode_spec`).
 
     Args:
@@ -89,6 +89,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
         log: an MCAP path, ``True`` for ``logs/<scenario>_<planner>_seed<N>_<stamp>.mcap``, or ``None``/``False``
             for no log.
         video: an MP4 path rendered offscreen while running.
+        log_format: ``swarmnav`` (Foxglove's schemas) or ``ros2`` (CDR messages of the standard ROS 2 types).
 
     Raises:
         ConfigError: bad input (naming the field); the log or video file exists without ``overwrite``.
@@ -96,14 +97,15 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
     """
     spec = episode_spec(scenario, planner, params, navigator, navigator_params, seed, world_seed, clearance_m)
     return run_spec(spec, waypoints=waypoints, log=log, overwrite=overwrite, video=video, camera=camera, width=width,
-                    height=height, fps=fps, stop_on_collision=stop_on_collision, live=live, on_live=on_live)
+                    height=height, fps=fps, stop_on_collision=stop_on_collision, live=live, on_live=on_live,
+                    log_format=log_format)
 
 
 def run_spec(spec: Any, *, waypoints: "Sequence[Sequence[float]] | np.ndarray | str | os.PathLike | None" = None,
              log: "str | os.PathLike | bool | None" = None, overwrite: bool = False,
              video: "str | os.PathLike | None" = None, camera: str = "top", width: int = 640, height: int = 480,
              fps: float | None = None, stop_on_collision: bool | None = None, live: bool = False,
-             on_live: Callable[[str], None] | None = None) -> RunOutcome:
+             on_live: Callable[[str], None] | None = None, log_format: str = "swarmnav") -> RunOutcome:
     """Plan (or take ``waypoints``) and drive an :class:`~swarmnav.sim.episode.EpisodeSpec` (the command line's
     ``run`` builds its spec as ``plan`` does, then comes here); the outputs as :func:`run` takes them."""
     from swarmnav.models.errors import ConfigError
@@ -126,7 +128,7 @@ def run_spec(spec: Any, *, waypoints: "Sequence[Sequence[float]] | np.ndarray | 
             raise ConfigError("--out", "Is a directory (give a file path)", str(log_path))
         if log_path.exists() and not overwrite:
             raise ConfigError("--out", "file exists (use --overwrite)", str(log_path))
-        recorders.append(McapRecorder(log_path, live=live, overwrite=True, on_live=on_live))
+        recorders.append(McapRecorder(log_path, live=live, overwrite=True, on_live=on_live, log_format=log_format))
     elif live:
         raise ConfigError("--live", "needs the log (drop --no-log)")
     if video:

@@ -27,6 +27,7 @@ from swarmnav.planners.errors import PlanningError
 from swarmnav.sim import options
 from swarmnav.sim.cli import stop_signal
 from swarmnav.sim.options import parse_settings
+from swarmnav.sim.defaults import LOG_FORMATS
 from swarmnav.sim.cli.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
 
 # As sim.video.render does, before any subcommand imports mujoco (which reads it once, on import).
@@ -167,9 +168,11 @@ def _add_generate_options(p: argparse.ArgumentParser) -> None:
     for name, kind in (("obstacles", int), ("speed_ratio", float), ("radius_min_m", float),
                        ("radius_max_m", float), ("arena_m", float), ("sensor_model", str), ("range_m", float),
                        ("sensor_count", int), ("robot_speed_m_s", float), ("time_limit_s", float),
-                       ("planner", str), ("navigator", str), ("name", str)):
+                       ("planner", str), ("navigator", str), ("name", str), ("humans", int)):
         p.add_argument(f"--{name.replace('_', '-')}", dest=name, type=kind,
                        help=f"default: {getattr(GeneratorOptions(), name)!r}")
+    p.add_argument("--robot-visible", dest="robot_visible", action="store_true", default=None,
+                   help="crowdnav_* kinds: the humans see the robot and avoid it (default: they do not)")
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
@@ -202,6 +205,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                            log=False if args.no_log else (args.out or True), overwrite=args.overwrite,
                            video=args.video, camera=args.camera, width=args.width, height=args.height, fps=args.fps,
                            stop_on_collision=True if args.stop_on_collision else None, live=args.live,
+                           log_format=args.log_format,
                            on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove "
                                                      "WebSocket)", file=sys.stderr))
     except ConfigError as exc:
@@ -289,6 +293,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="MCAP log path (default: logs/<scenario>_<planner>_seed<N>_<stamp>.mcap)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
     p.add_argument("--no-log", action="store_true", help="write no MCAP log")
+    p.add_argument("--log-format", choices=LOG_FORMATS, default="swarmnav",
+                   help="swarmnav (Foxglove's schemas, the default) or ros2 (CDR, the standard ROS 2 types)")
     p.add_argument("--live", action="store_true", help="also serve the channels to Foxglove on 127.0.0.1")
     p.add_argument("--video", help="render an MP4 while running (offscreen EGL)")
     p.add_argument("--camera", default="top", choices=("top", "chase", "follow"),

@@ -12,6 +12,8 @@ import os
 import sys
 from pathlib import Path as FilePath
 
+from swarmnav.sim.defaults import LOG_FORMATS
+
 WORKERS_PER_CORE = 8  # --workers at most this many per core of the machine
 
 
@@ -23,6 +25,8 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
                    help="local processes, or Ray tasks (needs the ray extra: pip install 'swarmnav[ray]')")
     p.add_argument("--address", help="with --engine ray: the cluster to join (default: a local instance)")
     p.add_argument("--logs", action="store_true", help="keep the MCAP log of every physics run in DIR/logs/")
+    p.add_argument("--log-format", choices=LOG_FORMATS, default="swarmnav",
+                   help="with --logs: swarmnav (Foxglove's schemas) or ros2 (CDR, standard ROS 2 types)")
     p.add_argument("--quick", action="store_true",
                    help="only the study's first quick_seeds seeds (a later full run into the same --out resumes)")
     p.add_argument("--retry-errors", action="store_true",
@@ -83,7 +87,8 @@ def run_study(args: argparse.Namespace) -> int:
     from swarmnav.sim.study.execute import run_study as execute
     out = args.out or str(FilePath("studies") / study.name)
     try:
-        summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address, logs=args.logs,
+        summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address,
+                          logs=args.log_format if args.logs else False,
                           show_progress=not args.json and sys.stderr.isatty(), retry_errors=args.retry_errors)
     except (KeyboardInterrupt, SystemExit) as exc:  # Ctrl-C, or SIGTERM (the CLI's handler raises SystemExit)
         exc = _first_stop(exc)
