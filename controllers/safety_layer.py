@@ -27,7 +27,7 @@ from typing import Any, ClassVar
 from swarmnav.controllers.evasion import Evasion, evaded, evasion_for
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.safety_filter import SafetyFilter
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 
 SWITCHES = {"safety_filter": "time_before_collision_s", "evade": "evade_trigger_s"}  # switch -> its threshold
 
@@ -50,12 +50,10 @@ class SafetyLayer:
     """
 
     name: ClassVar[str] = "safety"
-    parameter_ranges: ClassVar[dict[str, Range]] = {"time_before_collision_s": above(0, 600),
-                                                    "evade_trigger_s": within(0, 600)}
     safety_filter: bool = False
-    time_before_collision_s: float = 1.0
+    time_before_collision_s: float = param(1.0, above(0, 600))
     evade: bool = False
-    evade_trigger_s: float = 2.0
+    evade_trigger_s: float = param(2.0, within(0, 600))
 
     def __post_init__(self) -> None:
         self.filter: SafetyFilter | None = None

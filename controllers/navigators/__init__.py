@@ -5,7 +5,6 @@ No module in this package imports MuJoCo.
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any, TypeVar
 
 from swarmnav.controllers.navigator import Navigator, check_declarations
@@ -20,7 +19,7 @@ from swarmnav.controllers.navigators.oracle import ClairvoyantOracleNavigator
 from swarmnav.controllers.navigators.replan import ReplanNavigator
 from swarmnav.controllers.navigators.velocity_obstacle import VelocityObstacleNavigator
 from swarmnav.controllers.safety_layer import SafetyLayer, layer_settings, offered
-from swarmnav.models.parameters import build_component, register_component
+from swarmnav.models.parameters import build_component, parameter_table, register_component
 
 NAVIGATORS: dict[str, type[Navigator]] = {}
 NavigatorClass = TypeVar("NavigatorClass", bound=type)
@@ -53,7 +52,7 @@ def make_driver(name: str, params: dict[str, Any] | None = None, source: str | N
     ``trust_code``: see :func:`models.parameters.build_component`)."""
     cls = NAVIGATORS.get(name)
     own, layer = layer_settings(cls, params) if cls is not None else (params, {})
-    navigator = build_component(NAVIGATORS, "navigator", name, own, source, trust_code)
+    navigator = build_component(NAVIGATORS, "navigator", name, own, source, trust_code, offered(cls))
     return navigator, build_component({name: SafetyLayer}, "navigator", name, layer, source)
 
 
@@ -63,10 +62,16 @@ def make_navigator(name: str, params: dict[str, Any] | None = None, source: str 
     return make_driver(name, params, source, trust_code)[0]
 
 
-def navigator_parameters(name: str) -> tuple[str, ...]:
-    """Every parameter a registered navigator takes: its own init fields, then its safety layer's."""
+def navigator_table(name: str) -> list[dict[str, Any]]:
+    """The parameters a registered navigator takes (:func:`models.parameters.parameter_table`): its own, then
+    the safety layer's switches it offers, with its defaults."""
     cls = NAVIGATORS[name]
-    return tuple(f.name for f in dataclasses.fields(cls) if f.init) + offered(cls)
+    return parameter_table(cls, (SafetyLayer, offered(cls), layer_settings(cls, {})[1]))
 
 
-__all__ = ["NAVIGATORS", "make_driver", "make_navigator", "navigator_parameters", "register"]
+def navigator_parameters(name: str) -> tuple[str, ...]:
+    """The names of every parameter a registered navigator takes (:func:`navigator_table`)."""
+    return tuple(row["name"] for row in navigator_table(name))
+
+
+__all__ = ["NAVIGATORS", "make_driver", "make_navigator", "navigator_parameters", "navigator_table", "register"]

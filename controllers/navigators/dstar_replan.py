@@ -71,12 +71,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.navigators.replan import check_positive, keep_outside
+from swarmnav.controllers.navigators.replan import keep_outside
 from swarmnav.controllers.prediction import swept_discs
-from swarmnav.models.errors import ConfigError
 from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
 from swarmnav.models.scenario_limits import MAX_GRID_CELLS
 from swarmnav.models.world import rasterise
@@ -102,27 +101,17 @@ class DStarReplanNavigator:
     """
 
     name: ClassVar[str] = "dstar_replan"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "horizon_s": within(0, 600), "margin_m": within(0, 100), "cell_m": within(0, 100),
-        "improvement_m": within(0, 1e6), "update_period_s": within(0, 1e6)}  # models.parameters: checked on build
     safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False, "evade": True}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: float = field(default=0.0, init=False, repr=False)
 
-    horizon_s: float = 3.0
-    margin_m: float = 0.1
-    cell_m: float = 0.0
-    improvement_m: float = 0.5
-    update_period_s: float = 0.2
-    planner: str = "dstar_lite"
-
-    def __post_init__(self) -> None:
-        check_positive(self, ("horizon_s",),
-                       ("margin_m", "cell_m", "improvement_m", "update_period_s"))
-        if self.planner != "dstar_lite":
-            raise ConfigError("navigator.params.planner",
-                              f"must be 'dstar_lite' (this navigator repairs D* Lite's own paths), got {self.planner!r}")
+    horizon_s: float = param(3.0, above(0, 600))
+    margin_m: float = param(0.1, within(0, 100))
+    cell_m: float = param(0.0, within(0, 100))
+    improvement_m: float = param(0.5, within(0, 1e6))
+    update_period_s: float = param(0.2, within(0, 1e6))
+    planner: str = param("dstar_lite", choices=("dstar_lite",))  # it repairs D* Lite's own paths
 
     def reset(self, setup: NavigationSetup) -> None:
         known = setup.map_problem

@@ -53,12 +53,11 @@ from typing import ClassVar
 import numpy as np
 
 from swarmnav.models.errors import ConfigError
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.navigators.replan import check_positive
 from swarmnav.models.world import wrap_angle_rad
 
 
@@ -83,39 +82,29 @@ class DynamicWindowNavigator:
     """
 
     name: ClassVar[str] = "dwa"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        # v_samples x omega_samples x horizon_s / sim_step_s rollout points: at most 50 x 100 x 500
-        "alpha": within(0, 1e6), "beta": within(0, 1e6), "gamma": within(0, 1e6), "accel_m_s2": above(0, 1000),
-        "angular_accel_rad_s2": above(0, 1000), "window_s": above(0, 10), "max_angular_rad_s": above(0, 100),
-        "v_samples": within(1, 50), "omega_samples": within(1, 100), "horizon_s": above(0, 10),
-        "sim_step_s": within(0.02, 1), "dist_cap_m": above(0, 1000), "margin_m": within(0, 100),
-        "lookahead_m": above(0, 1000)}  # models.parameters: checked on build
     safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
 
-    alpha: float = 1.0
-    beta: float = 1.2
-    gamma: float = 0.3
-    accel_m_s2: float = 0.5
-    angular_accel_rad_s2: float = 3.0
-    window_s: float = 0.25
-    max_angular_rad_s: float = 1.2
-    v_samples: int = 7
-    omega_samples: int = 25
-    horizon_s: float = 3.0
-    sim_step_s: float = 0.15
-    dist_cap_m: float = 1.0
-    margin_m: float = 0.05
-    lookahead_m: float = 1.0
+    # v_samples x omega_samples x horizon_s / sim_step_s rollout points: at most 50 x 100 x 500
+    alpha: float = param(1.0, within(0, 1e6))
+    beta: float = param(1.2, within(0, 1e6))
+    gamma: float = param(0.3, within(0, 1e6))
+    accel_m_s2: float = param(0.5, above(0, 1000))
+    angular_accel_rad_s2: float = param(3.0, above(0, 1000))
+    window_s: float = param(0.25, above(0, 10))
+    max_angular_rad_s: float = param(1.2, above(0, 100))
+    v_samples: int = param(7, within(1, 50))
+    omega_samples: int = param(25, within(1, 100))
+    horizon_s: float = param(3.0, above(0, 10))
+    sim_step_s: float = param(0.15, within(0.02, 1))
+    dist_cap_m: float = param(1.0, above(0, 1000))
+    margin_m: float = param(0.05, within(0, 100))
+    lookahead_m: float = param(1.0, above(0, 1000))
     carrot_in_sight: bool = True
 
     def __post_init__(self) -> None:
-        check_positive(self, ("accel_m_s2", "angular_accel_rad_s2", "window_s", "max_angular_rad_s", "horizon_s",
-                              "sim_step_s", "dist_cap_m", "lookahead_m"),
-                       ("alpha", "beta", "gamma", "margin_m"))
-        check_positive(self, ("v_samples", "omega_samples"))
         if self.horizon_s < self.sim_step_s:  # no rollout step at all
             raise ConfigError("navigator.params.horizon_s", f"must be at least sim_step_s ({self.sim_step_s:g} s), "
                                                             f"got {self.horizon_s!r}")

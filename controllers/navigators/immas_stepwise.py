@@ -57,7 +57,7 @@ from typing import Any, Callable, ClassVar, Iterable
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, static_grid
 from swarmnav.controllers.navigators.immas_drive import DriveThrough, WalkTally
@@ -230,30 +230,22 @@ class ImmasStepwiseNavigator:
     """
 
     name: ClassVar[str] = "immas_stepwise"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "alpha": within(0, 100), "beta": within(0, 100), "reach_m": above(0, 100),
-        "lookahead_cells": within(0, 1000),
-        "carrot_m": above(0, 100), "predict_s": within(0, 600)}  # models.parameters: checked on build
     # The safety layer's evasion (controllers.safety_layer, after the step): off by default, not the paper's.
     safety_layer: ClassVar[dict[str, bool]] = {"evade": False}
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured
-    alpha: float | None = None
-    beta: float | None = None
-    reach_m: float = 0.1
-    lookahead_cells: int = 0
-    carrot_m: float = 0.4
-    predict_s: float = 0.0
+    alpha: float | None = param(None, within(0, 100))
+    beta: float | None = param(None, within(0, 100))
+    reach_m: float = param(0.1, above(0, 100))
+    lookahead_cells: int = param(0, within(0, 1000))
+    carrot_m: float = param(0.4, above(0, 100))
+    predict_s: float = param(0.0, within(0, 600))
 
     def __post_init__(self) -> None:
-        for key, ok, problem in (("alpha", self.alpha is None or self.alpha >= 0, "must not be negative"),
-                                 ("beta", self.beta is None or self.beta >= 0, "must not be negative"),
-                                 ("reach_m", self.reach_m > 0, "must be positive"),
-                                 ("predict_s", not self.predict_s or self.lookahead_cells > 0,
-                                  "needs lookahead_cells > 0 (it changes the walk driven through)")):
-            if not ok:
-                raise ConfigError(f"navigator.params.{key}", f"{problem}, got {getattr(self, key)!r}")
+        if self.predict_s and not self.lookahead_cells > 0:  # a rule between two fields (each one's range: param)
+            raise ConfigError("navigator.params.predict_s", "needs lookahead_cells > 0 (it changes the walk driven "
+                                                            f"through), got {self.predict_s!r}")
 
     def reset(self, setup: NavigationSetup) -> None:
         problem = setup.map_problem  # static obstacles only: the moving ones are sensed

@@ -52,24 +52,13 @@ import time
 from dataclasses import dataclass, replace, field
 from typing import Any, ClassVar
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_discs
-from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import Disc, Pose2D, rasterise
 from swarmnav.planners.errors import PlanningError, StartBlocked
 from swarmnav.planners.problem import Path, Problem
-
-
-def check_positive(owner: Any, names: tuple[str, ...], non_negative: tuple[str, ...] = ()) -> None:
-    """ConfigError naming ``navigator.params.NAME`` for a parameter that must be positive (or >= 0)."""
-    for name in names:
-        if not getattr(owner, name) > 0:
-            raise ConfigError(f"navigator.params.{name}", f"must be positive, got {getattr(owner, name)!r}")
-    for name in non_negative:
-        if not getattr(owner, name) >= 0:
-            raise ConfigError(f"navigator.params.{name}", f"must not be negative, got {getattr(owner, name)!r}")
 
 
 def keep_outside(discs: list[Disc], points: list[tuple[float, float]], inflation_m: float) -> list[Disc]:
@@ -119,24 +108,17 @@ class ReplanNavigator:
     """
 
     name: ClassVar[str] = "replan"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "lookahead_m": within(0, 1000), "horizon_s": within(0, 600), "margin_m": within(0, 100),
-        "cooldown_s": within(0, 1e6), "retry_s": within(0, 1e6), "planning_latency_s": within(0, 1e6)}  # models.parameters: checked on build
     safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False, "evade": True}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: float = field(default=0.0, init=False, repr=False)
 
-    lookahead_m: float = 2.5
-    horizon_s: float = 6.0
-    margin_m: float = 0.05
-    cooldown_s: float = 0.5
-    retry_s: float = 0.5
-    planning_latency_s: float = 0.0
-
-    def __post_init__(self) -> None:
-        check_positive(self, ("lookahead_m", "horizon_s", "retry_s"),
-                       ("margin_m", "cooldown_s", "planning_latency_s"))
+    lookahead_m: float = param(2.5, above(0, 1000))
+    horizon_s: float = param(6.0, above(0, 600))
+    margin_m: float = param(0.05, within(0, 100))
+    cooldown_s: float = param(0.5, within(0, 1e6))
+    retry_s: float = param(0.5, above(0, 1e6))
+    planning_latency_s: float = param(0.0, within(0, 1e6))
 
     def reset(self, setup: NavigationSetup) -> None:
         self.setup = setup

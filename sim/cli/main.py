@@ -56,14 +56,19 @@ class OneLineParser(argparse.ArgumentParser):
 
 
 def _load(args: argparse.Namespace):
-    """The scenario, as the API loads it (plugins' too); ``--trust-code``: its code parameters may run."""
-    from swarmnav.calls import load_scenario
-    return load_scenario(args.scenario, trust_code=args.trust_code)
+    """The scenario (a bundled one, a plugin's: :func:`main` has loaded the plugins once for the command);
+    ``--trust-code``: its code parameters may run; its own planner and navigator tables are checked on load,
+    whatever ``--planner`` overrides."""
+    from swarmnav.calls import check_components
+    from swarmnav.models.scenario import load_scenario
+    scenario = load_scenario(args.scenario, args.trust_code)
+    check_components(scenario, args.trust_code)
+    return scenario
 
 
 def _episode_spec(args: argparse.Namespace, scenario):
-    """The episode the command line asks for: the scenario, then ``--planner``/``--set``, ``--navigator``/
-    ``--navigator-set`` and the two seeds on top."""
+    """The episode the command line asks for (``plan`` and ``run`` alike): the scenario, then ``--planner``/
+    ``--set``, ``--navigator``/``--navigator-set`` and the two seeds on top."""
     from swarmnav.sim.episode import EpisodeSpec
     return EpisodeSpec(scenario, planner=args.planner, planner_params=parse_settings(args.set, "--set"),
                        navigator=args.navigator,
@@ -133,7 +138,8 @@ def cmd_components(args: argparse.Namespace) -> int:
         origin = "" if row["package"] == "swarmnav" else f"  [{row['package']}]"
         print(f"{row['name']:<20} {row['description']}{origin}")
         for param in row["parameters"]:
-            bounds = f" in {param['range']}" if "range" in param else ""
+            bounds = f" in {param['range']}" if "range" in param else \
+                f" one of {', '.join(param['choices'])}" if "choices" in param else ""
             print(f"    {param['name']} = {param['default']!r} ({param['type']}{bounds})")
     return EXIT_OK
 
@@ -199,21 +205,20 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from swarmnav.calls import run
+    from swarmnav.calls import run_spec
     options.check_output_file(args.json_out, "--json-out")
     if args.video:
         from swarmnav.sim.video.render import check_video_size
         check_video_size(args.width, args.height, args.fps)  # before the plan: bad options fail at once
     scenario = _load(args)  # the file's own errors name the file, never an option
     try:
-        outcome = run(scenario, args.planner, parse_settings(args.set, "--set"), args.navigator,
-                      parse_settings(args.navigator_set, "--navigator-set"), args.seed, args.world_seed,
-                      waypoints=args.waypoints, log=False if args.no_log else (args.out or True),
-                      overwrite=args.overwrite, video=args.video, camera=args.camera, width=args.width,
-                      height=args.height, fps=args.fps, stop_on_collision=True if args.stop_on_collision else None,
-                      live=args.live, log_format=args.log_format,
-                      on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove WebSocket)",
-                                                file=sys.stderr))
+        outcome = run_spec(_episode_spec(args, scenario), waypoints=args.waypoints,
+                           log=False if args.no_log else (args.out or True), overwrite=args.overwrite,
+                           video=args.video, camera=args.camera, width=args.width, height=args.height, fps=args.fps,
+                           stop_on_collision=True if args.stop_on_collision else None, live=args.live,
+                           log_format=args.log_format,
+                           on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove "
+                                                     "WebSocket)", file=sys.stderr))
     except ConfigError as exc:
         raise _blame_options(args, exc) from None
     out = outcome.to_dict()

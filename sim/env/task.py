@@ -182,9 +182,7 @@ class NavigationTask(control.Task):
         self.scene = index_scene(physics.model.ptr, xml)  # the indices, on the physics' own model
         self.simulation = Simulation(scenario, self.scene)
         check_time_limit(options.time_limit_s, self.simulation.control_dt_s)
-        fallback = scenario.seeds
-        self.set_seeds(Seeds(fallback.planner if options.seed is None else int(options.seed),
-                             fallback.world if options.world_seed is None else int(options.world_seed)))
+        self.set_seeds(EpisodeSpec(scenario, seed=options.seed, world_seed=options.world_seed).seeds)
         self.layout = layout or task_layout(scenario, options, self.scene.drive)
         self.episode = -1
         self.stepper: EpisodeStepper | None = None
@@ -210,7 +208,7 @@ class NavigationTask(control.Task):
         if self._planned is None or self._planned[0] != self.seeds:
             spec = EpisodeSpec(self.scenario, planner=self.options.path_planner, seed=self.seeds.planner,
                                world_seed=self.seeds.world)
-            self._planned = (self.seeds, plan_episode(spec))
+            self._planned = (self.seeds, plan_episode(spec, drive=False))  # a path: no navigator to build
         return self._planned[1]
 
     # --- dm_control.rl.control.Task ---------------------------------------------------------------

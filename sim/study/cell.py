@@ -31,7 +31,7 @@ from swarmnav.models.scenario import load_scenario, resolve_scenario_path
 from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.swarm import Budget
 from swarmnav.sim.plugins import load_plugins
-from swarmnav.sim.episode import EpisodeSpec, build_planner, json_safe, plan_episode, resolved_params, run_episode
+from swarmnav.sim.episode import EpisodeSpec, compose, json_safe, plan_episode, resolved_params, run_episode
 from swarmnav.sim.study.grid import Cell
 from swarmnav.sim.trajectory_metrics import bends, count_turns
 from swarmnav.sim.versions import software_versions
@@ -175,10 +175,10 @@ def run_cell(cell: Cell, logs_dir: str | None = None,
                                seed=cell.seed, world_seed=cell.world_seed, clearance_m=cell.clearance_m,
                                budget=None if cell.budget is None else Budget(**cell.budget))
             row["clearance_m"] = scenario.clearance_m if cell.clearance_m is None else cell.clearance_m
-            planner, budgeted = build_planner(spec.resolved())   # recorded for every row, failed ones too
-            row.update(planner_resolved=json.dumps(resolved_params(planner), sort_keys=True), budgeted=budgeted,
-                       plan_mode=getattr(planner, "mode", None))
-            episode = plan_episode(spec)
+            parts = compose(spec)   # its planner recorded for every row, failed ones too; built once
+            row.update(planner_resolved=json.dumps(resolved_params(parts.planner), sort_keys=True),
+                       budgeted=parts.budgeted, plan_mode=getattr(parts.planner, "mode", None))
+            episode = plan_episode(parts)
             if cell.physics:
                 tally = EventTally()
                 recorders = [tally]
