@@ -16,13 +16,13 @@ table of the file (a ``--set`` value, a planner's own consistency check).
 from __future__ import annotations
 
 import math
-import tomllib
 import types
 import typing
 from dataclasses import dataclass
 from pathlib import Path as FilePath
 from typing import Any, Iterable, NoReturn
 
+from swarmnav.models.contained_files import loads_toml, read_input_text
 from swarmnav.models.errors import ConfigError
 
 #: The default of a required key: reading it when it is absent is an error ("is required").
@@ -138,20 +138,14 @@ def check_array(value: Any, field: str, source: str | None = None, what: str = "
 
 
 def read_text(path: FilePath, field: str) -> str:
-    """A file's UTF-8 text; unreadable is a ConfigError naming ``field`` (``scenario``, ``study``) and the file."""
-    try:
-        return path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        fail(field, f"cannot be read ({exc})", str(path))
+    """A regular file's UTF-8 text, bounded (:func:`~swarmnav.models.contained_files.read_input_text`);
+    anything else is a ConfigError naming ``field`` (``scenario``, ``study``) and the file."""
+    return read_input_text(path, field)
 
 
 def parse_toml(text: str, source: str) -> "TomlTable":
-    """The top table of a TOML document; malformed TOML is a ConfigError naming the field ``toml``."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        fail("toml", f"malformed TOML ({exc})", source)
-    return TomlTable(data, "", source)
+    """The top table of a TOML document; malformed or too deeply nested TOML is a ConfigError naming ``toml``."""
+    return TomlTable(loads_toml(text, source), "", source)
 
 
 def _brief(value: Any, limit: int = 60) -> str:

@@ -29,8 +29,9 @@ from typing import Any, Sequence
 import numpy as np
 
 from swarmnav.controllers.navigator import NavigationSetup, Navigator
-from swarmnav.controllers.navigators import NAVIGATORS, make_navigator
+from swarmnav.controllers.navigators import NAVIGATORS, make_driver
 from swarmnav.controllers.point_to_point import PointToPointController
+from swarmnav.controllers.safety_layer import SafetyLayer
 from swarmnav.models.scenario import Scenario
 from swarmnav.models.parameters import refuse_code
 from swarmnav.models.seeds import Seeds
@@ -118,7 +119,7 @@ class EpisodeSpec:
 @dataclass(eq=False)
 class Episode:
     """A planned (and, once run, simulated) episode: the resolved spec, its problem and path, and the
-    planner and navigator built for it (once: :func:`run_episode` uses these)."""
+    planner, navigator and safety layer built for it (once: :func:`run_episode` uses these)."""
 
     spec: EpisodeSpec  # resolved
     problem: Problem
@@ -130,6 +131,7 @@ class Episode:
     _simulation: Simulation | None = field(default=None, repr=False)
     planner_params: dict[str, Any] = field(default_factory=dict)  # every parameter of the planner, resolved
     budgeted: bool = False  # the planner runs under ``spec.budget``
+    safety: SafetyLayer | None = None  # the layer after the navigator (controllers.safety_layer); None: none
 
     @property
     def simulation(self) -> Simulation:
@@ -175,11 +177,11 @@ def plan_episode(spec: EpisodeSpec, scene: CompiledScene | None = None) -> Episo
     spec = spec.resolved()
     source = spec.scenario.source_path
     planner, budgeted = build_planner(spec)
-    navigator = make_navigator(spec.navigator, spec.navigator_params, source)  # fails before planning
+    navigator, safety = make_driver(spec.navigator, spec.navigator_params, source)  # fails before planning
     problem = scenario_problem(spec.scenario)
     path = planner.plan(problem, np.random.default_rng(spec.seed))
     return Episode(spec, problem, path, planner, navigator, scene, planner_params=resolved_params(planner),
-                   budgeted=budgeted)
+                   budgeted=budgeted, safety=safety)
 
 
 def build_planner(spec: EpisodeSpec) -> tuple[Any, bool]:
@@ -222,7 +224,8 @@ def run_episode(episode: Episode | EpisodeSpec, recorders: Sequence[Recorder] = 
     context = simulation.context(spec.planner, planned.planner_params or spec.planner_params, spec.seed,
                                  spec.navigator, spec.navigator_params) if recorder is not None else None
     result = simulation.run(navigator, setup, recorder=recorder, context=context,
-                            time_limit_s=time_limit_s, stop_on_collision=stop_on_collision)
+                            time_limit_s=time_limit_s, stop_on_collision=stop_on_collision,
+                            safety=planned.safety)
     return replace(planned, result=result)
 
 

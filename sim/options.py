@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import argparse
 import math
-import tomllib
 from typing import Any
 
+from swarmnav.models.contained_files import loads_toml
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario_limits import MAX_SETTING_CHARS
 
 MAX_SEED = 2**63 - 1  # the largest integer a TOML scenario can hold, so --seed and ``seed`` agree
 
@@ -88,10 +89,15 @@ def parse_settings(pairs: list[str] | None, option: str = "--set") -> dict[str, 
         key, sep, text = pair.partition("=")
         key = key.strip()
         if not sep or not key:
-            raise ConfigError(option, f"expected key=value, got {pair!r}")
+            raise ConfigError(option, f"expected key=value, got {pair[:60]!r}")
+        if len(pair) > MAX_SETTING_CHARS:
+            raise ConfigError(f"{option} {key[:40]}", f"{len(pair):,} characters, more than the maximum "
+                                                      f"{MAX_SETTING_CHARS:,} (MAX_SETTING_CHARS)")
         try:
-            value = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
+            value = loads_toml(f"v = {text}", None, f"{option} {key}")["v"]
+        except ConfigError as exc:
+            if "malformed TOML" not in exc.problem:
+                raise
             value = text
         params[key] = value
     return params

@@ -6,17 +6,18 @@ import json
 import os
 import subprocess
 import sys
-import tomllib
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 import swarmnav
 from swarmnav.sim.cli.main import EXIT_EXPECTATION, main
 
+from plugin_dist import PLUGIN_STUDY, dist_info, example_plugin, python_path
+
 ROOT = Path(__file__).resolve().parent.parent
-EXAMPLE = ROOT / "examples" / "swarmnav_plugin_example"
 WALL_CLOCK = {"wall_time_s", "replan_wall_s", "plan_time_s"}
 
 
@@ -105,25 +106,16 @@ def test_bad_waypoint_files_are_one_line(tmp_path, capsys, text, where):
 
 
 def _plugin_path(tmp_path: Path, broken: bool = False) -> dict[str, str]:
-    """The example package importable and its distribution metadata (entry points) on the path, as an
-    installed distribution would have them, without a build."""
-    info = tmp_path / "swarmnav_plugin_example-0.1.0.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: swarmnav-plugin-example\nVersion: 0.1.0\n")
-    groups = tomllib.loads((EXAMPLE / "pyproject.toml").read_text())["project"]["entry-points"]
-    (info / "entry_points.txt").write_text("".join(
-        f"[{group}]\n" + "".join(f"{name} = {value}\n" for name, value in entries.items())
-        for group, entries in groups.items()))
+    """The example plugin installed as far as the path goes (``plugin_dist``), with a broken and a clashing
+    plugin beside it if ``broken``."""
+    entries = example_plugin(tmp_path)
     if broken:
-        broken_info = tmp_path / "broken_plugin-1.0.dist-info"
-        broken_info.mkdir()
-        (broken_info / "METADATA").write_text("Metadata-Version: 2.1\nName: broken-plugin\nVersion: 1.0\n")
-        (broken_info / "entry_points.txt").write_text("[swarmnav.planners]\nbroken = no_such_module_here:Planner\n"
-                                                      "[swarmnav.navigators]\nfollow = clashing_plugin:Follow\n")
+        dist_info(tmp_path, "broken-plugin", "1.0", {"swarmnav.planners": {"broken": "no_such_module_here:Planner"},
+                                                     "swarmnav.navigators": {"follow": "clashing_plugin:Follow"}})
         (tmp_path / "clashing_plugin.py").write_text(
             "from swarmnav.controllers.navigators.follow import FollowNavigator\n\n"
             "class Follow(FollowNavigator):\n    pass\n")
-    return {"PYTHONPATH": os.pathsep.join([str(tmp_path), str(EXAMPLE / "src"), os.environ.get("PYTHONPATH", "")])}
+    return python_path(*entries)
 
 
 def test_an_installed_plugin_is_listed_and_runs(tmp_path):
@@ -141,12 +133,16 @@ def test_an_installed_plugin_is_listed_and_runs(tmp_path):
     out = json.loads(run.stdout)
     assert out["planner"] == "random_detour" and out["success"] is True and out["plan"]["collision_free"]
     study = tmp_path / "plugin-study.toml"
-    study.write_text('name = "plugin-study"\nscenarios = ["gwo-scenario-3", "plugin-corridor"]\nmode = "plan"\n'
-                     'seeds = 2\n[[planners]]\nname = "random_detour"\n[[planners]]\nname = "astar"\n')
-    done = _swarmnav("study", str(study), "--out", str(tmp_path / "rows"), "--workers", "1", "--json",
+    study.write_text(PLUGIN_STUDY)
+    # spawned workers (two: the batches split) know the plugin's planner and scenario: no error row
+    done = _swarmnav("study", str(study), "--out", str(tmp_path / "rows"), "--workers", "2", "--json",
                      "--junit", str(tmp_path / "junit.xml"), env=env)
     assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout)["ran"] == 8
+    assert json.loads(done.stdout)["outcomes"] == {"ok": 8}
+    rows = pd.read_parquet(tmp_path / "rows" / "runs.parquet")
+    assert rows.groupby(["planner", "scenario", "outcome"]).size().to_dict() == {
+        (planner, scenario, "ok"): 2 for planner in ("astar", "random_detour")
+        for scenario in ("gwo-scenario-3", "plugin-corridor")}
     cases = ElementTree.parse(tmp_path / "junit.xml").getroot().iter("testcase")
     assert sum("random_detour" in case.get("name") for case in cases) == 4
 

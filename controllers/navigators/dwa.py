@@ -75,7 +75,6 @@ class DynamicWindowNavigator:
         dist_cap_m: ``dist`` beyond this counts as free.
         margin_m: extra distance kept beyond the robot radius.
         lookahead_m: the carrot's distance along the path.
-        safety_filter, time_before_collision_s: the optional Nav2-style filter.
         carrot_in_sight: the carrot is the farthest point of the lookahead the robot can reach straight past
             the known map (:meth:`controllers.guidance.PathCarrot.keep_in_sight`; ours, on by default: on
             dyn300's door scenes the carrot behind a wall held the robot still against it; false: the plain
@@ -89,7 +88,8 @@ class DynamicWindowNavigator:
         "angular_accel_rad_s2": above(0, 1000), "window_s": above(0, 10), "max_angular_rad_s": above(0, 100),
         "v_samples": within(1, 50), "omega_samples": within(1, 100), "horizon_s": above(0, 10),
         "sim_step_s": within(0.02, 1), "dist_cap_m": above(0, 1000), "margin_m": within(0, 100),
-        "lookahead_m": above(0, 1000), "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
+        "lookahead_m": above(0, 1000)}  # models.parameters: checked on build
+    safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
@@ -108,20 +108,17 @@ class DynamicWindowNavigator:
     dist_cap_m: float = 1.0
     margin_m: float = 0.05
     lookahead_m: float = 1.0
-    safety_filter: bool = False
-    time_before_collision_s: float = 1.0
     carrot_in_sight: bool = True
 
     def __post_init__(self) -> None:
         check_positive(self, ("accel_m_s2", "angular_accel_rad_s2", "window_s", "max_angular_rad_s", "horizon_s",
-                              "sim_step_s", "dist_cap_m", "lookahead_m", "time_before_collision_s"),
+                              "sim_step_s", "dist_cap_m", "lookahead_m"),
                        ("alpha", "beta", "gamma", "margin_m"))
         check_positive(self, ("v_samples", "omega_samples"))
 
     def reset(self, setup: NavigationSetup) -> None:
-        (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal,
-         self.filter) = local_setup(setup, self.margin_m, self.lookahead_m, self.safety_filter,
-                                    self.time_before_collision_s, self.carrot_in_sight)
+        (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(
+            setup, self.margin_m, self.lookahead_m, self.carrot_in_sight)
         self.goal_tolerance_m = setup.goal.tolerance_m
         self.times = np.arange(1, int(round(self.horizon_s / self.sim_step_s)) + 1) * self.sim_step_s  # (T,)
         self.reach = self.max_speed * self.horizon_s + 1.0
@@ -191,12 +188,7 @@ class DynamicWindowNavigator:
             err = wrap_angle_rad(math.atan2(ry, rx) - pose.heading_rad)
             w_cmd = float(np.clip(2.0 * err, -self.max_angular_rad_s, self.max_angular_rad_s))
         command = ControlCommand(wheel_speeds(v_cmd, w_cmd, self.geometry), v_cmd, w_cmd, 0)
-        events = []
-        if self.filter is not None:
-            command, triggered = self.filter.apply(pose, command, observation.detections)
-            if triggered:
-                events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
-        return NavigationStep(command, None, tuple(events), Belief(observation.detections, self.horizon_s))
+        return NavigationStep(command, None, (), Belief(observation.detections, self.horizon_s))
 
     def _gaps(self, x0: float, y0: float, c: float, s: float, x: np.ndarray, y: np.ndarray,
               observation: Observation) -> np.ndarray | None:

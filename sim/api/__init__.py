@@ -17,6 +17,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from swarmnav.calls import load_scenario, plan, register_navigator, register_planner, run, run_study
+from swarmnav.models.world_scenario import ImportSettings, import_world
 from swarmnav.results import PlanResult, RunOutcome
 
 if TYPE_CHECKING:
@@ -29,7 +30,8 @@ if TYPE_CHECKING:
 _SEAMS = ("Scenario", "ConfigError", "Problem", "Path", "Planner", "PlanStats", "PlanningError", "NoPathFound",
           "Navigator", "Observation", "NavigationSetup", "NavigationStep")
 
-__all__ = ["load_scenario", "plan", "run", "run_study", "register_planner", "register_navigator",
+__all__ = ["load_scenario", "plan", "run", "run_study", "register_planner", "register_navigator", "import_world",
+           "ImportSettings",
            "PlanResult", "RunOutcome", *_SEAMS]
 
 

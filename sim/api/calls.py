@@ -66,15 +66,15 @@ def plan(scenario: Any, planner: str | None = None, params: dict[str, Any] | Non
 def given_episode(spec, waypoints: "np.ndarray", source: str):
     """An episode whose path is the given waypoints instead of a plan (``run --waypoints``): the spec's planner
     still serves a navigator that replans."""
-    from swarmnav.controllers.navigators import make_navigator
+    from swarmnav.controllers.navigators import make_driver
     from swarmnav.planners.registry import make_planner
     from swarmnav.sim.episode import Episode
     from swarmnav.sim.given_path import given_path
     spec = spec.resolved()
     planner = make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)  # bad names fail early
-    navigator = make_navigator(spec.navigator, spec.navigator_params, spec.scenario.source_path)
+    navigator, safety = make_driver(spec.navigator, spec.navigator_params, spec.scenario.source_path)
     problem, path = given_path(spec.scenario, waypoints, source)
-    return Episode(spec, problem, path, planner, navigator)
+    return Episode(spec, problem, path, planner, navigator, safety=safety)
 
 
 def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,

@@ -38,7 +38,7 @@ def load_average() -> float:
 
 def oracle_search_times(scenes: list[tuple[str, int | None]]) -> dict[str, Any]:
     """Wall and CPU seconds of the oracle's search on each (scenario ref, world seed)."""
-    from swarmnav.controllers.oracle_search import search
+    from swarmnav.controllers.oracle_search import reactive_agents, search
     from swarmnav.models.scenario import load_scenario
     wall, cpu, names = [], [], []
     load = load_average()
@@ -46,6 +46,8 @@ def oracle_search_times(scenes: list[tuple[str, int | None]]) -> dict[str, Any]:
         scenario = load_scenario(ref)
         if world_seed is not None:
             scenario = scenario.with_world_seed(world_seed)
+        if reactive_agents(scenario):  # no yardstick there: the oracle does not search
+            continue
         w0, c0 = time.perf_counter(), time.thread_time()
         search(scenario)
         cpu.append(time.thread_time() - c0)

@@ -136,10 +136,25 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
                         "default: a temporary folder")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
-    parser.add_argument("--suite", choices=("dyn", "papers", "dyn300"), default="dyn",
+    parser.add_argument("--suite", choices=("dyn", "papers", "dyn300", "barn", "barn-like", "crowdnav"),
+                        default="dyn",
                         help="dyn: the dyn-* suite (default); papers: the papers' strategies beside replan + iaco "
                              "and dstar_replan, one row per run (sim/benchmarks/paper_navigation.py); dyn300: the "
-                             "300 generated scenes of models/suites/dyn300.toml, by difficulty")
+                             "300 generated scenes of models/suites/dyn300.toml, by difficulty; barn: the 300 BARN "
+                             "worlds under the challenge's protocol and score (sim/benchmarks/barn.py; --quick: its "
+                             "50 test worlds x 10 runs); barn-like: BARN-like worlds at fresh seeds "
+                             "(sim/benchmarks/barn_like.py; --barn-worlds A:B seeds, default 0:50); crowdnav: CrowdNav's "
+                             "circle-crossing test cases, robot invisible and visible to the humans")
+    parser.add_argument("--barn-dir", metavar="DIR", help="--suite barn: the BARN data (default: $SWARMNAV_BARN_DIR, "
+                        "else ../shared/benchmarks/barn)")
+    parser.add_argument("--barn-runs", type=options.positive_int, metavar="N",
+                        help="--suite barn: runs per world (default 1; --quick: 10), run j >= 1 from a seeded start "
+                             "jitter")
+    parser.add_argument("--barn-worlds", metavar="test|all|A:B[:STEP]|I,J,...",
+                        help="--suite barn: these worlds (default all 300; --quick: test, the 50 worlds 0, 6, ..., 294)")
+    parser.add_argument("--barn-planner", metavar="NAME[:KEY=VALUE,...]",
+                        help="--suite barn / barn-like: the known-map track, every run planned by this planner on the "
+                             "map given (e.g. gwo:mode=robust, mmas:cell_m=0.15)")
     parser.add_argument("--quick", action="store_true",
                         help=f"1 world seed on {', '.join(BENCH_NAVIGATION_QUICK_SCENARIOS)} (under a minute); "
                              "with --suite dyn300: a stratified sample, 2 scenes per group")
@@ -160,7 +175,7 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_bench_navigation(args: argparse.Namespace) -> int:
     from swarmnav.sim.benchmarks import navigation
-    if args.quick and args.suite != "dyn300":
+    if args.quick and args.suite not in ("dyn300", "barn", "barn-like"):
         args.seeds, args.scenario = 1, args.scenario or list(BENCH_NAVIGATION_QUICK_SCENARIOS)
     return navigation.run(args)
 
@@ -212,6 +227,18 @@ def add_bench_log_arguments(parser: argparse.ArgumentParser) -> None:
 def run_bench_log(args: argparse.Namespace) -> int:
     from swarmnav.sim.benchmarks import log
     return log.run(args)
+
+
+def add_bench_defaults_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--seeds", type=options.positive_int, default=10, help="seeds 0..N-1 per case (default 10)")
+    parser.add_argument("--planners", nargs="+", metavar="NAME", help="only these planners (default: every paper's)")
+    parser.add_argument("--quick", action="store_true", help="3 seeds per case")
+    parser.add_argument("--json", action="store_true")
+
+
+def run_bench_defaults(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import paper_defaults
+    return paper_defaults.run(args)
 
 
 def add_log_info_arguments(parser: argparse.ArgumentParser) -> None:
@@ -297,6 +324,8 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
      "start-up of `swarmnav scenarios` against a bare `python -c pass`"),
     (("bench", "log"), add_bench_log_arguments, run_bench_log,
      "write a long run log, then time and peak memory of each reader beside the mcap library's"),
+    (("bench", "defaults"), add_bench_defaults_arguments, run_bench_defaults,
+     "each paper's planners at their defaults on its scenarios: collision-free plans over N seeds"),
     (("log", "info"), add_log_info_arguments, run_log_info, "what a log holds"),
     (("log", "recover"), add_log_recover_arguments, run_log_recover, "rewrite a truncated log as a complete one"),
     (("replay",), add_replay_arguments, run_replay, "re-render or re-simulate a log"),

@@ -88,6 +88,8 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
         return cmd_generate(args)
     if getattr(args, "scenarios_command", None) == "info":
         return cmd_scenario_info(args)
+    if getattr(args, "scenarios_command", None) == "import":
+        return args.scenario_run(args)
     rows = []
     for name in list_scenarios():
         s = load_scenario(name)
@@ -164,9 +166,11 @@ def _add_generate_options(p: argparse.ArgumentParser) -> None:
     for name, kind in (("obstacles", int), ("speed_ratio", float), ("radius_min_m", float),
                        ("radius_max_m", float), ("arena_m", float), ("sensor_model", str), ("range_m", float),
                        ("sensor_count", int), ("robot_speed_m_s", float), ("time_limit_s", float),
-                       ("planner", str), ("navigator", str), ("name", str)):
+                       ("planner", str), ("navigator", str), ("name", str), ("humans", int)):
         p.add_argument(f"--{name.replace('_', '-')}", dest=name, type=kind,
                        help=f"default: {getattr(GeneratorOptions(), name)!r}")
+    p.add_argument("--robot-visible", dest="robot_visible", action="store_true", default=None,
+                   help="crowdnav_* kinds: the humans see the robot and avoid it (default: they do not)")
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
@@ -267,13 +271,17 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("scenarios", help="list the bundled scenarios, or generate one")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_scenarios)
-    scenario_commands = p.add_subparsers(dest="scenarios_command", metavar="generate|info")
+    scenario_commands = p.add_subparsers(dest="scenarios_command", metavar="generate|info|import")
     gen = scenario_commands.add_parser("generate", help="write a dynamic scenario (crossing, head_on, ...) from a seed")
     _add_generate_options(gen)
     info = scenario_commands.add_parser("info", help="difficulty metrics and the clairvoyant oracle's verdict")
     info.add_argument("scenario", metavar="SCENARIO", help="a bundled name or a .toml path")
     info.add_argument("--world-seed", type=int, help="seed of the random obstacle motions (default: the scenario's)")
     info.add_argument("--json", action="store_true", help="print one JSON object")
+    from swarmnav.sim.cli import world_import
+    imp = scenario_commands.add_parser("import", help="a Gazebo world's static cylinders and boxes as a scenario file")
+    world_import.add_arguments(imp)
+    imp.set_defaults(scenario_run=world_import.run)
 
     p = sub.add_parser("plan", help="plan a path for a scenario")
     _add_run_options(p)

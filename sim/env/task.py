@@ -54,6 +54,7 @@ from swarmnav.sim.defaults import LOG_FORMATS
 from swarmnav.models.scenario import Scenario, load_scenario
 from swarmnav.models.seeds import Seeds
 from swarmnav.sim.episode import EpisodeSpec, plan_episode
+from swarmnav.sim.plugins import load_plugins
 from swarmnav.sim.control_period import control_periods
 from swarmnav.sim.env.observations import action_spec, observation_specs
 from swarmnav.sim.env.reward import RewardWeights
@@ -331,8 +332,9 @@ def make_environment(scenario: Scenario | str, options: EnvOptions | None = None
 
     ``kwargs`` are :class:`EnvOptions` fields when ``options`` is not given; ``layout`` fixes the
     observation's entries and bounds (:mod:`sim.env.worlds`: the same spaces across scenarios), else the
-    scenario's own.
+    scenario's own.  Installed plugins' scenarios and planners are known here (:mod:`swarmnav.sim.plugins`).
     """
+    load_plugins()
     if isinstance(scenario, (str, FilePath)):
         scenario = load_scenario(str(scenario))
     options = options or EnvOptions(**kwargs)

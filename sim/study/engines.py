@@ -13,7 +13,9 @@ one pipe and one process sentinel per worker (``multiprocessing.connection.wait`
 so each completion costs the same whatever the size of the study.  Short cells
 travel in batches sized from the measured cell time (:class:`BatchSizer`); every
 cell's result comes back on its own, so the driver always knows which cell a
-worker is running.  A worker that dies (killed, a segfault, ``os._exit``) turns
+worker is running.  A worker that does not know a component a cell names (a plugin
+the driver has and the worker cannot find) answers :class:`ComponentMissing`
+instead of a row, and the driver ends the study with it (exit 2), no error rows.  A worker that dies (killed, a segfault, ``os._exit``) turns
 that cell into an ``error`` row naming the signal or exit code; the rest of its
 queue goes to a fresh worker.
 """
@@ -32,7 +34,7 @@ from multiprocessing.connection import wait as wait_any
 from typing import Any, Iterable, Iterator
 
 from swarmnav.sim.defaults import SINGLE_THREAD_ENVIRONMENT
-from swarmnav.sim.study.cell import _versions_json, base_row, run_cell
+from swarmnav.sim.study.cell import ComponentMissing, _versions_json, base_row, run_cell
 from swarmnav.sim.study.grid import Cell
 
 PARENT_POLL_S = 0.5
@@ -124,7 +126,11 @@ def _worker_main(conn, parent_pid: int, logs_dir: str | None, log_format: str = 
     threading.Thread(target=receive, daemon=True).start()
     while (batch := inbox.get()) is not None:
         for cell in batch:
-            conn.send(run_cell(cell, logs_dir, log_format))
+            try:
+                result: Result | ComponentMissing = run_cell(cell, logs_dir, log_format)
+            except ComponentMissing as exc:
+                result = exc
+            conn.send(result)
 
 
 class _LocalWorker:
@@ -211,15 +217,20 @@ def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None,
                 if worker.conn not in ready and worker.process.sentinel not in ready:
                     continue
                 results, gone = worker.receive()
-                for row, progress in results:
+                for result in results:
+                    if isinstance(result, ComponentMissing):
+                        raise result
+                    row, progress = result
                     worker.queued.popleft()
                     sizer.observe(row)
                     yield row, progress
                 if gone or not worker.process.is_alive():
                     worker.process.join()
-                    for row, progress in worker.receive()[0]:  # what it sent before it died
+                    for result in worker.receive()[0]:  # what it sent before it died
+                        if isinstance(result, ComponentMissing):
+                            raise result
                         worker.queued.popleft()
-                        yield row, progress
+                        yield result
                     if worker.queued:
                         yield died_row(worker.queued.popleft(), exit_description(worker.process.exitcode))
                         retry.extendleft(reversed(worker.queued))

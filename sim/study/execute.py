@@ -19,11 +19,13 @@ import time
 from pathlib import Path as FilePath
 from typing import Any, Iterator, TextIO
 
+from swarmnav.models.contained_files import check_no_link, folder as contained_folder, loads_json, replace_file
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.study.engines import run_inline, run_local
 from swarmnav.sim.study.grid import Cell, count_cells, iter_cells
 from swarmnav.sim.study.lock import FolderLock
+from swarmnav.sim.study.main_guard import check_main_guard
 from swarmnav.sim.study.rows import RowWriter, compact, done_hashes, read_table
 from swarmnav.sim.study.spec import Study, study_from_tables
 from swarmnav.sim.study.yardstick import Yardstick
@@ -65,11 +67,13 @@ def study_metadata(study: Study) -> dict[str, Any]:
 def _write_metadata(study: Study, out_dir: FilePath) -> None:
     path = out_dir / METADATA
     metadata = study_metadata(study)
+    check_no_link(path, "--out")  # a link planted in the folder is neither read nor written through
     if path.exists():
         try:
-            old = json.loads(path.read_text(encoding="utf-8"))
+            old = loads_json(path.read_text(encoding="utf-8"), str(path))
         except (OSError, ValueError):
             old = {}
+        old = old if isinstance(old, dict) else {}
         previous = old.get("name")
         # rows of an earlier version of the study stay in the folder: keep the geometry of their scenarios
         metadata["scenarios"] = {**old.get("scenarios", {}), **metadata["scenarios"]}
@@ -77,9 +81,7 @@ def _write_metadata(study: Study, out_dir: FilePath) -> None:
             raise ConfigError("--out", f"holds the rows of study {previous!r}, not {study.name!r} "
                                        "(choose another directory)", str(out_dir))
     out_dir.mkdir(parents=True, exist_ok=True)
-    temporary = out_dir / f".{METADATA}.tmp"
-    temporary.write_text(json.dumps(metadata, indent=2) + "\n", encoding="utf-8")
-    os.replace(temporary, path)
+    replace_file(path, json.dumps(metadata, indent=2) + "\n", "--out")
 
 
 class ProgressBar:
@@ -121,6 +123,8 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
     when every cell has a row, the parts are compacted.  ``logs``: keep each physics run's MCAP log in
     ``out_dir/logs``, of format ``swarmnav`` (``True``) or the format named (``"ros2"``)."""
     out_dir = FilePath(out_dir)
+    if engine == "local":
+        check_main_guard()  # a script's unguarded top level: each spawned worker would run it again
     if engine == "ray" and address:
         from swarmnav.sim.study.ray_engine import check_reachable
         check_reachable(address)  # before anything is written
@@ -133,7 +137,7 @@ def _run_locked(study: Study, out_dir: FilePath, engine: str, workers: int | Non
     _write_metadata(study, out_dir)
     todo, pending, total = pending_cells(study, out_dir, retry_errors)
     workers = workers or os.cpu_count() or 1
-    logs_dir = str((out_dir / "logs").resolve()) if logs else None
+    logs_dir = str(contained_folder(out_dir / "logs", "--out").resolve()) if logs else None
     log_format = logs if isinstance(logs, str) else "swarmnav"
     nodes: set[str] = set()
     if engine == "ray":

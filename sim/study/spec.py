@@ -59,11 +59,13 @@ from pathlib import Path as FilePath
 from typing import Any
 
 from swarmnav.controllers.navigators import make_navigator
+from swarmnav.models.contained_files import is_input_path, name_problem
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR
 from swarmnav.models.toml_table import POSITIVE, TomlTable, above, parse_toml, read_text, within
 from swarmnav.planners.registry import make_planner
 from swarmnav.planners.swarm import Budget
+from swarmnav.sim.plugins import load_plugins
 from swarmnav.sim.study.claim_spec import Claim, read_claims
 from swarmnav.sim.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, PaperValue, check_time_limit,  # noqa: F401
                                               read_budget, read_clearance, read_components, read_paper,
@@ -131,10 +133,8 @@ def list_studies() -> list[str]:
 
 def resolve_study_path(name_or_path: str) -> FilePath:
     candidate = FilePath(name_or_path)
-    if candidate.suffix == ".toml" or candidate.is_file() or "/" in name_or_path:
-        if not candidate.is_file():
-            raise ConfigError("study", "file does not exist", str(candidate))
-        return candidate
+    if candidate.suffix == ".toml" or is_input_path(candidate) or "/" in name_or_path:
+        return candidate  # read_text says what is wrong with anything but a regular file
     bundled = STUDY_DIR / f"{name_or_path}.toml"
     if not bundled.is_file():
         raise ConfigError("study", f"no bundled study named {name_or_path!r} (see `swarmnav studies`)", name_or_path)
@@ -164,8 +164,12 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
 
 
 def _read_study(top: TomlTable, default_name: str, trust_code: bool) -> Study:
+    load_plugins()  # the names of installed plugins' planners, navigators and scenarios are valid here too
     top.only(TOP_KEYS)
     name = top.string("name", default_name, non_empty=True)
+    problem = name_problem(name)  # the default --out is studies/<name>: a name is never a path
+    if problem:
+        top.fail("name", problem)
     description = top.string("description", "")
     scenarios = read_scenarios(top)
     mode = top.string("mode", "plan", choices=MODES)
