@@ -10,6 +10,7 @@ the live view are the recorder's, the same as for profile ``swarmnav``.
 
 from __future__ import annotations
 
+import importlib.metadata
 import math
 from typing import Any, Callable
 
@@ -276,6 +277,10 @@ class Ros2Channels:
         self._log(ROS2_EVENTS_TOPIC, {"stamp": stamp(t_ns), "level": _LEVELS[event_severity(kind)], "name": "swarmnav",
                                       "msg": event_text(kind, details), "file": "", "function": "", "line": 0}, t_ns)
         return 1
+
+    def versions(self) -> dict[str, str]:
+        """The serialiser's version, recorded in the ``versions`` metadata beside the writer's."""
+        return {"mcap_ros2_support": importlib.metadata.version("mcap-ros2-support")}
 
     def close(self) -> None:
         """Nothing to release: the channels are the context's."""
