@@ -43,6 +43,10 @@ def _decoded(path: Path) -> dict[str, list]:
     out: dict[str, list] = {}
     with AnyReader([path], default_typestore=HUMBLE) as reader:
         assert all(c.msgtype == ROS2_CHANNELS[c.topic][1] for c in reader.connections)
+        for c in reader.connections:  # each channel's offered QoS, as rosbags reads it: latched topics transient-local
+            (qos,) = c.ext.offered_qos_profiles
+            assert qos.durability.name == ("TRANSIENT_LOCAL" if c.topic in ("/tf_static", "/map") else "VOLATILE")
+            assert qos.reliability.name == "RELIABLE"
         for connection, _, raw in reader.messages():
             out.setdefault(connection.topic, []).append(HUMBLE.deserialize_cdr(raw, connection.msgtype))
     return out
