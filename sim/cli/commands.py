@@ -152,6 +152,12 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
                              "jitter")
     parser.add_argument("--barn-worlds", metavar="test|all|A:B[:STEP]|I,J,...",
                         help="--suite barn: these worlds (default all 300; --quick: test, the 50 worlds 0, 6, ..., 294)")
+    parser.add_argument("--barn-setup", choices=("auto", "stand-in"),
+                        help="--suite barn / barn-like: auto (default): the protocol's Jackal, laser and unknown map "
+                             "as far as installed; stand-in: a disc of the Jackal's inscribed radius, map known")
+    parser.add_argument("--barn-oracle", action="store_true", default=None,
+                        help="--suite barn / barn-like: also run the clairvoyant oracle (off by default there: it "
+                             "collided in every stand-in run on BARN's worlds)")
     parser.add_argument("--barn-planner", metavar="NAME[:KEY=VALUE,...]",
                         help="--suite barn / barn-like: the known-map track, every run planned by this planner on the "
                              "map given (e.g. gwo:mode=robust, mmas:cell_m=0.15)")

@@ -217,10 +217,14 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(json.dumps(out))
     else:
         status = "reached the goal" if result.reached else f"did not reach the goal ({result.outcome})"
-        print(f"{out['scenario']}: {out['planner']} + {out['navigator']} (seed {out['seed']}, world seed "
+        if result.reached and result.outcome != "goal_reached":
+            status += f", but {result.outcome}"
+        given = out["plan"]["details"].get("given")  # a given path: nothing was planned
+        print(f"{out['scenario']}: {'given path ' + repr(given) if given else out['planner']} + {out['navigator']} "
+              f"(seed {out['seed']}, world seed "
               f"{out['world_seed']}) {status} in {result.sim_time_s:.2f} s sim "
               f"({result.wall_time_s:.2f} s wall); driven {result.path_length_m:.3f} m "
-              f"(planned {path.stats.length_m:.3f} m); collisions {result.collisions}"
+              f"({'given' if given else 'planned'} {path.stats.length_m:.3f} m); collisions {result.collisions}"
               + (f", first at {result.first_collision_s:.2f} s with {result.first_contact['obstacle']} at "
                  f"({result.first_contact['x_m']:.2f}, {result.first_contact['y_m']:.2f})"
                  if result.first_contact is not None else "")
