@@ -14,7 +14,7 @@ export MUJOCO_GL ?= egl
 
 STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin)))")
 
-.PHONY: demo test bench install clean studies readme-table rerun-stale typing-path
+.PHONY: demo test bench install clean studies readme-table rerun-stale typing-path docs
 
 $(STAMP): pyproject.toml Makefile planners/_colony_walk.c planners/_grid_search.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -46,6 +46,13 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
+
+# The documentation site (mkdocs.yml, docs/): built with --strict into site/, then served on
+# http://127.0.0.1:$(DOCS_PORT) (rebuilt as pages change; Ctrl-C stops it).
+DOCS_PORT ?= 8000
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict -d site
+	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs serve --strict -a 127.0.0.1:$(DOCS_PORT)
 
 # Every benchmark; `make bench BENCH_FLAGS=--quick` runs each in under a minute.
 BENCH_FLAGS ?=
@@ -93,4 +100,4 @@ rerun-stale: $(STAMP)
 	$(MAKE) readme-table CLAIM_STUDIES="$$($(BIN)/swarmnav report --check-fresh models/studies/results --names)"
 
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) build site *.egg-info

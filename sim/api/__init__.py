@@ -1,6 +1,6 @@
 """swarmnav's Python API: plan and run scenarios, run studies, bring your own planner and navigator.
 
-::
+For example:
 
     import swarmnav
     result = swarmnav.run("gwo-scenario-1", planner="astar", seed=0)

@@ -46,7 +46,8 @@ class _Document:
     """Builds the HTML and the Markdown side by side; writes figures and tables into ``files_dir``."""
 
     def __init__(self, title: str, files_dir: FilePath):
-        self.html = [f"<!doctype html><html><head><meta charset='utf-8'>"
+        # An empty icon: served over HTTP a page without one makes the browser ask for /favicon.ico (a 404).
+        self.html = [f"<!doctype html><html><head><meta charset='utf-8'><link rel='icon' href='data:,'>"
                      "<meta name='viewport' content='width=device-width, initial-scale=1'>"
                      f"<title>{html.escape(title)}</title><style>{STYLE}</style></head><body>",
                      f"<h1>{html.escape(title)}</h1>"]
