@@ -14,11 +14,14 @@ from typing import Any
 
 import numpy as np
 
+from swarmnav.models.contained_files import is_input_path, name_problem  # noqa: F401 (name_problem: re-exported)
+from swarmnav.models.crowd_agents import reseed_agents
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.obstacle_motion import RandomWalkMotion
 from swarmnav.models.scenario_limits import (MAX_CONTROL_STEPS, MAX_GRID_CELLS, MAX_NAME_CHARS,  # noqa: F401
                                              MAX_PHYSICS_STEPS, MAX_SENSORS, MAX_TRACK_SAMPLES, MAX_WALK_STEPS,
                                              MIN_LENGTH_M, MIN_ROBOT_RADIUS_M, MIN_TIMESTEP_S)
+from swarmnav.models.scenario_boxes import read_boxes
 from swarmnav.models.scenario_map import check_grid_size, read_map_section
 from swarmnav.models.scenario_obstacles import MOTION_KINDS, Obstacle, ObstacleWorld, read_obstacles  # noqa: F401
 from swarmnav.models.seeds import Seeds
@@ -129,8 +132,9 @@ class Scenario:
 
     def with_world_seed(self, world_seed: int) -> "Scenario":
         """This scenario with every random obstacle motion drawn from ``world_seed``."""
-        obstacles = tuple(replace(ob, motion=ob.motion.reseeded(world_seed))
-                          if isinstance(ob.motion, RandomWalkMotion) else ob for ob in self.obstacles)
+        obstacles = reseed_agents(tuple(replace(ob, motion=ob.motion.reseeded(world_seed))
+                                        if isinstance(ob.motion, RandomWalkMotion) else ob
+                                        for ob in self.obstacles), world_seed)
         return replace(self, obstacles=obstacles, world_seed=int(world_seed))
 
     def with_clearance(self, clearance_m: float, field_name: str = "clearance_m") -> "Scenario":
@@ -173,10 +177,8 @@ def list_scenarios() -> list[str]:
 def resolve_scenario_path(name_or_path: str) -> FilePath:
     """A bundled scenario name, or a path to a .toml file."""
     candidate = FilePath(name_or_path)
-    if candidate.suffix == ".toml" or candidate.exists() or "/" in name_or_path:
-        if not candidate.is_file():
-            raise ConfigError("scenario", "file does not exist", str(candidate))
-        return candidate
+    if candidate.suffix == ".toml" or is_input_path(candidate) or "/" in name_or_path:
+        return candidate  # read_text says what is wrong with anything but a regular file
     bundled = next((folder / f"{name_or_path}.toml" for folder in (SCENARIO_DIR, *EXTRA_SCENARIO_DIRS)
                     if (folder / f"{name_or_path}.toml").is_file()), SCENARIO_DIR / f"{name_or_path}.toml")
     if not bundled.is_file():
@@ -233,9 +235,9 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
     section = read_map_section(top, SCENARIO_DIR, width_m, height_m)
     if section is None:
         check_grid_size(width_m, height_m, cell_m, "sim.cell_m" if cell_given else "arena", source)
-    boxes = section.boxes if section is not None else ()
+    boxes = (section.boxes if section is not None else ()) + read_boxes(top, width_m, height_m)
     obstacles = read_obstacles(top, ObstacleWorld(width_m, height_m, walls, seed, time_limit_s, sim.control_hz,
-                                                  boxes, section is not None))
+                                                  boxes, section is not None, sim.timestep_s))
     top.close()
     map_grid = None
     if section is not None:
@@ -308,27 +310,6 @@ def _sim(t: TomlTable) -> tuple[SimSettings, float, bool]:
     cell_m = t.number("cell_m", 0.05, bounds=POSITIVE)
     t.close()
     return sim, cell_m, t.has("cell_m")
-
-
-def name_problem(name: str) -> str | None:
-    """Why a scenario name cannot be part of a file name, or None.
-
-    The name is used in the default log path, so it must be a plain file-name
-    part: printable, no path separator, not ``.`` or ``..``, at most
-    :data:`MAX_NAME_CHARS` characters.
-    """
-    if not name.strip():
-        return "must not be empty"
-    if len(name) > MAX_NAME_CHARS:
-        return f"must be at most {MAX_NAME_CHARS} characters, got {len(name)}"
-    bad = next((ch for ch in name if not ch.isprintable()), None)
-    if bad is not None:
-        return f"must be printable, has {bad!r}"
-    if "/" in name or "\\" in name:
-        return f"must not contain a path separator ('/' or '\\'), got {name!r}"
-    if name in (".", ".."):
-        return f"must name a file, got {name!r}"
-    return None
 
 
 def check_run_size(time_limit_s: float, sim: SimSettings, source: str | None) -> None:

@@ -75,6 +75,7 @@ def build_spec(scenario: Scenario) -> mujoco.MjSpec:
     radius = scenario.robot_radius_m
     if robot.round_chassis:
         _fit_base(spec, radius)
+        _fit_top_speed(spec, scenario.max_speed_m_s)
     if robot.ring_sensors and scenario.sensor_fov_deg == 360.0:
         _set_rangefinders(spec, scenario.sensor_count, radius, scenario.sensor_range_m)
     else:
@@ -144,6 +145,20 @@ def _fit_base(spec: mujoco.MjSpec, radius_m: float) -> None:
         for actuator in spec.actuators:
             actuator.ctrlrange = np.asarray(actuator.ctrlrange) / scale
     chassis.size = [radius_m, chassis.size[1], 0.0]
+
+
+def _fit_top_speed(spec: mujoco.MjSpec, max_speed_m_s: float) -> None:
+    """Let the wheels turn fast enough for the scenario's top speed when the base's own limit is below it.
+
+    The base's wheel speed limit (10 rad/s on 0.04 m tyres: 0.4 m/s) stays as it is for every robot at or
+    below it; a faster robot (CrowdNav's, 1 m/s) gets the wheel speed ``max_speed_m_s / wheel radius``.
+    """
+    wheel_radius_m = float(spec.geom("left_wheel_tyre").size[0])
+    need_rad_s = max_speed_m_s / wheel_radius_m
+    for actuator in spec.actuators:
+        limit = float(np.abs(np.asarray(actuator.ctrlrange)).min())
+        if need_rad_s > limit:
+            actuator.ctrlrange = np.array([-need_rad_s, need_rad_s])
 
 
 def _set_rangefinders(spec: mujoco.MjSpec, count: int, body_radius_m: float, cutoff_m: float) -> None:
