@@ -18,15 +18,17 @@ fixed carrot and map obstacles, so that none of them has map code of its own.
 
 from __future__ import annotations
 
+import math
+from dataclasses import replace
+
 import numpy as np
 
 from swarmnav.controllers.guidance import PathCarrot
 from swarmnav.controllers.navigator import NavigationSetup
 from swarmnav.controllers.prediction import LocalObstacles
-from swarmnav.controllers.world_map import free_start
-from swarmnav.models.world import Pose2D
+from swarmnav.models.world import OccupancyGrid, Pose2D
 from swarmnav.planners.errors import PlanningError, StartBlocked
-from dataclasses import replace
+from swarmnav.planners.problem import Problem
 
 GUIDANCE_COOLDOWN_S = 0.5  # as the replan navigator's default cooldown_s
 
@@ -106,3 +108,36 @@ class GuidedCarrot(PathCarrot):
         PathCarrot.__init__(self, np.vstack([[pose.x_m, pose.y_m], path.waypoints]), self.lookahead_m)
         self.sight, self.sight_samples = sight, samples
         self.replans += 1
+
+
+def free_start(problem: Problem, search_m: float = 0.4) -> Problem:
+    """``problem`` from the nearest start that is not blocked (outside every grown box and disc and in a
+    free cell of its grid: a sensed map's cells are coarser than the obstacles, so a robot that kept its
+    distance can still stand in a blocked cell): the robot's own position if it is free, else the nearest of
+    rings of 16 points 1 cm apart within ``search_m``; first with the problem's clearance, then with none
+    (the start unchanged, no clearance, if no point is free).  What a replanning navigator plans from after
+    ``StartBlocked`` (Nav2's planners fail there; ``dstar_replan`` takes the nearest free cell likewise)."""
+    start = problem.start
+    angles = 2.0 * math.pi * np.arange(16) / 16
+    rings = np.arange(0.0, search_m + 1e-9, 0.01)
+    for clearance_m in dict.fromkeys((problem.clearance_m, 0.0)):
+        candidate = replace(problem, clearance_m=clearance_m)
+        grid = candidate.grid
+        for ring_m in rings:
+            pts = start.xy + ring_m * np.column_stack([np.cos(angles), np.sin(angles)])
+            ok = (candidate.segment_clearances_m(pts, pts) >= 1e-6) & candidate.in_bounds(pts) & ~grid_hits(grid, pts)
+            if ok.any():
+                x, y = pts[int(np.argmax(ok))]
+                return replace(candidate, start=Pose2D(float(x), float(y), start.heading_rad))
+    return replace(problem, clearance_m=0.0)
+
+
+def grid_hits(grid: OccupancyGrid, points_m: np.ndarray) -> np.ndarray:
+    """(N,) whether each point lies in an occupied cell (points off the grid: not occupied)."""
+    rows, cols = grid.occupied.shape
+    col = np.floor((points_m[:, 0] - grid.origin_m[0]) / grid.cell_m).astype(np.int64)
+    row = np.floor((points_m[:, 1] - grid.origin_m[1]) / grid.cell_m).astype(np.int64)
+    inside = (col >= 0) & (col < cols) & (row >= 0) & (row < rows)
+    out = np.zeros(len(points_m), dtype=bool)
+    out[inside] = grid.occupied[row[inside], col[inside]]
+    return out

@@ -22,8 +22,9 @@ from dataclasses import replace
 
 import numpy as np
 
+from swarmnav.controllers.guided import GuidedCarrot, SensedLocalObstacles, grid_hits
 from swarmnav.models.occupancy import LogOddsGrid, SensorModel
-from swarmnav.models.world import Disc, OccupancyGrid, Pose2D, Rect
+from swarmnav.models.world import Disc, OccupancyGrid, Rect
 from swarmnav.planners.problem import Problem
 
 PUBLISH_HZ = 5.0  # Nav2's local costmap update_frequency (5 Hz)
@@ -85,16 +86,23 @@ class SensedMap:
 
     def inflated(self) -> OccupancyGrid:
         """The published cells grown by the robot radius and the clearance (the inflation layer): cells whose
-        centre lies within the inflation of a published cell's disc (a Euclidean distance transform)."""
+        centre lies within the inflation of a published cell's centre (a Euclidean distance transform).  Not
+        of its covering disc: a point is judged by its cell's centre, up to half a cell diagonal (the disc's
+        radius) off, and a path planned at exactly the inflation from the discs must not read as blocked."""
         if self._inflated_revision != self.revision:
             from scipy.ndimage import distance_transform_edt
             cell = self.grid.cell_m
-            reach = self.empty.inflation_m + cell * math.sqrt(0.5)
+            reach = self.empty.inflation_m
             near = distance_transform_edt(~self._occupied) * cell < reach if self._occupied.any() \
                 else np.zeros_like(self._occupied)
             self._inflated = OccupancyGrid(near, cell, self.grid.origin_m)
             self._inflated_revision = self.revision
         return self._inflated
+
+    def local_guidance(self, setup, lookahead_m: float):
+        """What :func:`controllers.guidance.local_setup` gives the local navigators on this map: (a carrot on a
+        guidance path replanned on it, its obstacles near the robot) (:mod:`controllers.guided`)."""
+        return GuidedCarrot(setup, lookahead_m), SensedLocalObstacles(setup)
 
     def blocks(self, waypoints_m: np.ndarray) -> bool:
         """Whether a polyline (from the robot on), sampled every half cell, enters :meth:`inflated`; the part
@@ -114,36 +122,3 @@ class SensedMap:
         points = np.vstack(samples)
         away = np.hypot(points[:, 0] - pts[0, 0], points[:, 1] - pts[0, 1]) > problem.inflation_m + self.grid.cell_m
         return bool(grid_hits(self.inflated(), points[away]).any())
-
-
-def free_start(problem: Problem, search_m: float = 0.4) -> Problem:
-    """``problem`` from the nearest start that is not blocked (outside every grown box and disc and in a
-    free cell of its grid: a sensed map's cells are coarser than the obstacles, so a robot that kept its
-    distance can still stand in a blocked cell): the robot's own position if it is free, else the nearest of
-    rings of 16 points 1 cm apart within ``search_m``; first with the problem's clearance, then with none
-    (the start unchanged, no clearance, if no point is free).  What a replanning navigator plans from after
-    ``StartBlocked`` (Nav2's planners fail there; ``dstar_replan`` takes the nearest free cell likewise)."""
-    start = problem.start
-    angles = 2.0 * math.pi * np.arange(16) / 16
-    rings = np.arange(0.0, search_m + 1e-9, 0.01)
-    for clearance_m in dict.fromkeys((problem.clearance_m, 0.0)):
-        candidate = replace(problem, clearance_m=clearance_m)
-        grid = candidate.grid
-        for ring_m in rings:
-            pts = start.xy + ring_m * np.column_stack([np.cos(angles), np.sin(angles)])
-            ok = (candidate.segment_clearances_m(pts, pts) >= 1e-6) & candidate.in_bounds(pts) & ~grid_hits(grid, pts)
-            if ok.any():
-                x, y = pts[int(np.argmax(ok))]
-                return replace(candidate, start=Pose2D(float(x), float(y), start.heading_rad))
-    return replace(problem, clearance_m=0.0)
-
-
-def grid_hits(grid: OccupancyGrid, points_m: np.ndarray) -> np.ndarray:
-    """(N,) whether each point lies in an occupied cell (points off the grid: not occupied)."""
-    rows, cols = grid.occupied.shape
-    col = np.floor((points_m[:, 0] - grid.origin_m[0]) / grid.cell_m).astype(np.int64)
-    row = np.floor((points_m[:, 1] - grid.origin_m[1]) / grid.cell_m).astype(np.int64)
-    inside = (col >= 0) & (col < cols) & (row >= 0) & (row < rows)
-    out = np.zeros(len(points_m), dtype=bool)
-    out[inside] = grid.occupied[row[inside], col[inside]]
-    return out

@@ -56,7 +56,7 @@ from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_discs
-from swarmnav.controllers.world_map import free_start
+from swarmnav.controllers.guided import free_start
 from swarmnav.models.world import Disc, Pose2D, rasterise
 from swarmnav.planners.errors import PlanningError, StartBlocked
 from swarmnav.planners.problem import Path, Problem
