@@ -16,17 +16,15 @@ import numpy as np
 
 from swarmnav.controllers.navigator import NavigationSetup
 from swarmnav.controllers.prediction import LocalObstacles
-from swarmnav.controllers.safety_filter import SafetyFilter
 from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
 from swarmnav.models.world import Pose2D
 
 
-def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, safety_filter: bool,
-                time_before_collision_s: float, carrot_in_sight: bool = False):
-    """What the local navigators (``dwa``, ``velocity_obstacle``) build alike at reset, from a
+def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, carrot_in_sight: bool = False):
+    """What the local navigators (``dwa``, ``velocity_obstacle``, ``mppi``) build alike at reset, from a
     :class:`~controllers.navigator.NavigationSetup`: (drive geometry, top speed in m/s, the radius kept from
     obstacle centres beyond theirs (robot radius + ``margin_m``), the known static obstacles, the path's
-    carrot, the goal as an (x, y) array, the safety filter or None).  ``carrot_in_sight``: the carrot is kept
+    carrot, the goal as an (x, y) array).  ``carrot_in_sight``: the carrot is kept
     where the robot can drive to it straight past the known map (:class:`PathCarrot`)."""
     known = setup.map_problem
     geometry = setup.controller.geometry
@@ -35,8 +33,7 @@ def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, saf
         carrot.keep_in_sight(known.disc_centres_m, known.disc_radii_m, known.box_array_m, known.robot_radius_m)
     return (geometry, setup.max_speed_m_s, known.robot_radius_m + margin_m,
             LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m),
-            carrot, np.array([setup.goal.x_m, setup.goal.y_m]),
-            SafetyFilter(geometry, known.robot_radius_m, time_before_collision_s) if safety_filter else None)
+            carrot, np.array([setup.goal.x_m, setup.goal.y_m]))
 
 
 class PathCarrot:

@@ -16,13 +16,13 @@ table of the file (a ``--set`` value, a planner's own consistency check).
 from __future__ import annotations
 
 import math
-import tomllib
 import types
 import typing
 from dataclasses import dataclass
 from pathlib import Path as FilePath
 from typing import Any, Iterable, NoReturn
 
+from swarmnav.models.contained_files import loads_toml, read_input_text
 from swarmnav.models.errors import ConfigError
 
 #: The default of a required key: reading it when it is absent is an error ("is required").
@@ -31,11 +31,13 @@ REQUIRED: Any = ...
 
 @dataclass(frozen=True)
 class Range:
-    """The values a number may take: ``low``..``high``, ``low`` itself excluded when ``low_open``."""
+    """The values a number may take: ``low``..``high``, ``low`` (``high``) itself excluded when ``low_open``
+    (``high_open``)."""
 
     low: float
     high: float
     low_open: bool = False
+    high_open: bool = False
 
     def holds(self, value: float) -> bool:
         try:
@@ -43,21 +45,23 @@ class Range:
                 return False
         except OverflowError:  # an integer beyond any float
             return False
-        return (self.low < value if self.low_open else self.low <= value) and value <= self.high
+        return (self.low < value if self.low_open else self.low <= value) and \
+            (value < self.high if self.high_open else value <= self.high)
 
     def requirement(self) -> str:
         """What a value outside the range must be, in words (``must be positive``, ``must be in [0, 1]``)."""
-        if self.high == math.inf:
+        if self.high == math.inf and not self.high_open:
             if self.low == 0.0:
                 return "must be positive" if self.low_open else "must not be negative"
             if not self.low_open:
                 return f"must be at least {_shown_number(self.low)}"
-        if self.low == -math.inf and not self.low_open:
+        if self.low == -math.inf and not self.low_open and not self.high_open:
             return f"must be at most {_shown_number(self.high)}"
         return f"must be in {self}"
 
     def __str__(self) -> str:
-        return f"{'(' if self.low_open else '['}{_shown_number(self.low)}, {_shown_number(self.high)}]"
+        return (f"{'(' if self.low_open else '['}{_shown_number(self.low)}, {_shown_number(self.high)}"
+                f"{')' if self.high_open else ']'}")
 
 
 def _shown_number(value: float) -> str:
@@ -138,20 +142,14 @@ def check_array(value: Any, field: str, source: str | None = None, what: str = "
 
 
 def read_text(path: FilePath, field: str) -> str:
-    """A file's UTF-8 text; unreadable is a ConfigError naming ``field`` (``scenario``, ``study``) and the file."""
-    try:
-        return path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        fail(field, f"cannot be read ({exc})", str(path))
+    """A regular file's UTF-8 text, bounded (:func:`~swarmnav.models.contained_files.read_input_text`);
+    anything else is a ConfigError naming ``field`` (``scenario``, ``study``) and the file."""
+    return read_input_text(path, field)
 
 
 def parse_toml(text: str, source: str) -> "TomlTable":
-    """The top table of a TOML document; malformed TOML is a ConfigError naming the field ``toml``."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        fail("toml", f"malformed TOML ({exc})", source)
-    return TomlTable(data, "", source)
+    """The top table of a TOML document; malformed or too deeply nested TOML is a ConfigError naming ``toml``."""
+    return TomlTable(loads_toml(text, source), "", source)
 
 
 def _brief(value: Any, limit: int = 60) -> str:

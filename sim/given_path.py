@@ -21,6 +21,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from swarmnav.models.contained_files import loads_json, read_input_text
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.problem import Path, scenario_problem
 
@@ -53,27 +54,35 @@ def _from_json(data: Any, source: str) -> list[tuple[float, float]]:
 
 
 def _from_csv(text: str, source: str) -> list[tuple[float, float]]:
-    reader = csv.reader(io.StringIO(text))
-    header = next(reader, None)
-    columns = [c.strip().lower() for c in header or []]
-    if "x" not in columns or "y" not in columns:
+    rows = csv.reader(io.StringIO(text))
+    out: list[tuple[float, float]] = []
+    number, ix, iy = 0, 0, 0
+    try:  # csv.Error: a cell over the csv module's field limit, a NUL byte
+        for number, row in enumerate(rows, start=1):
+            if number == 1:
+                columns = [c.strip().lower() for c in row]
+                if "x" not in columns or "y" not in columns:
+                    raise ConfigError("row 1", "a CSV file needs a header naming its x and y columns", source)
+                ix, iy = columns.index("x"), columns.index("y")
+            elif row and any(cell.strip() for cell in row):
+                if len(out) >= MAX_WAYPOINTS:
+                    raise ConfigError(f"row {number}", f"more than {MAX_WAYPOINTS:,} waypoints", source)
+                out.append(_csv_pair(row, ix, iy, f"row {number}", source))
+    except csv.Error as exc:
+        raise ConfigError(f"row {number + 1}", f"not a CSV row ({exc})", source) from None
+    if number == 0:
         raise ConfigError("row 1", "a CSV file needs a header naming its x and y columns", source)
-    ix, iy = columns.index("x"), columns.index("y")
-    out = []
-    for number, row in enumerate(reader, start=2):
-        if not row or all(not cell.strip() for cell in row):
-            continue
-        if len(out) >= MAX_WAYPOINTS:
-            raise ConfigError(f"row {number}", f"more than {MAX_WAYPOINTS:,} waypoints", source)
-        try:
-            x, y = float(row[ix]), float(row[iy])
-        except (IndexError, ValueError):
-            raise ConfigError(f"row {number}", f"expected numbers in columns x and y, got {row!r}"[:200],
-                              source) from None
-        if not (math.isfinite(x) and math.isfinite(y)):
-            raise ConfigError(f"row {number}", f"must be finite, got {x}, {y}", source)
-        out.append((x, y))
     return out
+
+
+def _csv_pair(row: list[str], ix: int, iy: int, where: str, source: str) -> tuple[float, float]:
+    try:
+        x, y = float(row[ix]), float(row[iy])
+    except (IndexError, ValueError):
+        raise ConfigError(where, f"expected numbers in columns x and y, got {row!r}"[:200], source) from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise ConfigError(where, f"must be finite, got {x}, {y}", source)
+    return x, y
 
 
 def read_waypoints(file: str | FilePath) -> np.ndarray:
@@ -83,17 +92,10 @@ def read_waypoints(file: str | FilePath) -> np.ndarray:
         ConfigError: unreadable file, unknown format, a bad row, or fewer than two waypoints.
     """
     source = str(file)
-    try:
-        text = FilePath(file).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(FIELD, f"cannot be read ({getattr(exc, 'strerror', None) or exc})", source) from None
+    text = read_input_text(file, FIELD)  # a regular file of at most MAX_INPUT_FILE_BYTES, never a FIFO or device
     stripped = text.lstrip()
     if stripped.startswith(("[", "{")):
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise ConfigError(f"line {exc.lineno}", f"malformed JSON ({exc.msg})", source) from None
-        points = _from_json(data, source)
+        points = _from_json(loads_json(text, source), source)
     else:
         points = _from_csv(text, source)
     return as_waypoints(points, source)

@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import argparse
 import math
-import tomllib
 from typing import Any
 
+from swarmnav.models.contained_files import loads_toml
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario_limits import MAX_SETTING_CHARS
 
 MAX_SEED = 2**63 - 1  # the largest integer a TOML scenario can hold, so --seed and ``seed`` agree
 
@@ -57,18 +58,41 @@ def non_negative_float(text: str) -> float:
     return value
 
 
+def int_in(low: int, high: int):
+    """An argument type: an integer from ``low`` to ``high`` (a count with its stated maximum)."""
+    def count(text: str) -> int:
+        value = _integer(text)
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"must be an integer from {low:,} to {high:,}, got {text[:40]}")
+        return value
+    count.__name__ = "integer"
+    return count
+
+
+def float_in(low: float, high: float, low_open: bool = True):
+    """An argument type: a finite number above ``low`` (or from it, without ``low_open``) up to ``high``."""
+    def number(text: str) -> float:
+        value = _number(text)
+        if not ((value > low if low_open else value >= low) and value <= high):
+            raise argparse.ArgumentTypeError(f"must be {'above' if low_open else 'at least'} {low:g} and at most "
+                                             f"{high:g}, got {text[:40]}")
+        return value
+    number.__name__ = "number"
+    return number
+
+
 def _integer(text: str) -> int:
     try:
         return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+    except ValueError:  # also a string of more than 4,300 digits
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text[:40]!r}") from None
 
 
 def _number(text: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"expected a number, got {text[:40]!r}") from None
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"must be finite, got {text}")
     return value
@@ -88,10 +112,15 @@ def parse_settings(pairs: list[str] | None, option: str = "--set") -> dict[str, 
         key, sep, text = pair.partition("=")
         key = key.strip()
         if not sep or not key:
-            raise ConfigError(option, f"expected key=value, got {pair!r}")
+            raise ConfigError(option, f"expected key=value, got {pair[:60]!r}")
+        if len(pair) > MAX_SETTING_CHARS:
+            raise ConfigError(f"{option} {key[:40]}", f"{len(pair):,} characters, more than the maximum "
+                                                      f"{MAX_SETTING_CHARS:,} (MAX_SETTING_CHARS)")
         try:
-            value = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
+            value = loads_toml(f"v = {text}", None, f"{option} {key}")["v"]
+        except ConfigError as exc:
+            if "malformed TOML" not in exc.problem:
+                raise
             value = text
         params[key] = value
     return params

@@ -144,38 +144,24 @@ def origin(kind: str, name: str) -> str:
 
 
 def describe_components(kind: str) -> list[dict[str, Any]]:
-    """Every registered planner or navigator with its parameters (name, type, default, documented range if the
-    component declares one), its one-line description and its package: what ``swarmnav planners`` lists."""
-    import dataclasses
-    import typing
-
-    from swarmnav.models.parameters import parameter_ranges
+    """Every registered planner or navigator with its parameters (name, type, default, and its range or choices
+    where it declares them: :func:`models.parameters.parameter_table`, a navigator's safety layer switches
+    included), its one-line description and its package: what ``swarmnav planners`` lists."""
+    from swarmnav.models.parameters import parameter_table
     load_plugins()
     if kind == "planner":
         from swarmnav.planners.registry import PLANNERS as registry_map
+        table = lambda name: parameter_table(registry_map[name])  # noqa: E731
     else:
         from swarmnav.controllers.navigators import NAVIGATORS as registry_map
+        from swarmnav.controllers.navigators import navigator_table as table
     out = []
     for name in sorted(registry_map):
         cls = registry_map[name]
         doc = (cls.__doc__ or "").strip().splitlines()
-        try:
-            hints = typing.get_type_hints(cls)
-        except Exception:
-            hints = {}
-        ranges = {k: str(v) for k, v in parameter_ranges(cls).items()}  # merged along the class hierarchy
-        params = []
-        for f in (dataclasses.fields(cls) if dataclasses.is_dataclass(cls) else ()):
-            if not f.init:
-                continue
-            default = f.default if f.default is not dataclasses.MISSING else (
-                f.default_factory() if f.default_factory is not dataclasses.MISSING else None)
-            annotation = hints.get(f.name, f.type)
-            entry = {"name": f.name, "type": getattr(annotation, "__name__", str(annotation)),
-                     "default": _json_value(default)}
-            if f.name in ranges:
-                entry["range"] = _json_value(ranges[f.name])
-            params.append(entry)
+        params = [{"name": row["name"], "type": row["type"], "default": _json_value(row["default"]),
+                   **{key: _json_value(row[key]) for key in ("range", "choices") if row[key] is not None}}
+                  for row in table(name)]
         out.append({"name": name, "description": doc[0] if doc else "", "package": origin(kind, name),
                     "parameters": params})
     return out

@@ -42,6 +42,9 @@ class RunResult:
     navigator_wall_s: float = 0.0  # wall time spent in navigator.step (not in summary(): benchmarks read it)
     # Where the first collision began (time_s, x_m, y_m of the base, the obstacle geom's name, the robot geom's).
     first_contact: dict[str, Any] | None = None
+    # Among agents (orca / social_force obstacles) only: discomfort_frequency, min_separation_m,
+    # path_irregularity_rad_m (sim.crowd_stepping.crowd_metrics); None without agents (and not in the summary).
+    crowd: dict[str, float] | None = None
 
     @property
     def success(self) -> bool:
@@ -72,7 +75,7 @@ class RunResult:
                 "success": self.success, "time_to_goal_s": round(self.sim_time_s, 6) if self.reached else None,
                 "spl": self.spl, "time_in_danger_s": round(self.time_in_danger_s, 6), "replans": self.replans,
                 "replan_wall_s": round(self.replan_wall_s, 4), "stopped_s": round(self.stopped_s, 6),
-                "safety_triggers": self.safety_triggers}
+                "safety_triggers": self.safety_triggers, **(self.crowd or {})}
 
     def log_summary(self) -> dict[str, Any]:
         """:meth:`summary` without wall-clock figures other than ``wall_*`` (which the log writer drops)."""

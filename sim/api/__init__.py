@@ -1,6 +1,6 @@
 """swarmnav's Python API: plan and run scenarios, run studies, bring your own planner and navigator.
 
-::
+For example:
 
     import swarmnav
     result = swarmnav.run("gwo-scenario-1", planner="astar", seed=0)
@@ -22,6 +22,8 @@ from swarmnav.calls import register_navigator as register_navigator
 from swarmnav.calls import register_planner as register_planner
 from swarmnav.calls import run as run
 from swarmnav.calls import run_study as run_study
+from swarmnav.models.world_scenario import ImportSettings as ImportSettings
+from swarmnav.models.world_scenario import import_world as import_world
 from swarmnav.results import PlanResult as PlanResult
 from swarmnav.results import RunOutcome as RunOutcome
 
@@ -44,7 +46,7 @@ _SEAMS = ("Scenario", "ConfigError", "Problem", "Path", "Planner", "PlanStats", 
 
 # A literal list (type checkers read it as it is written): the calls, their results, then _SEAMS.
 __all__ = ["load_scenario", "plan", "run", "run_study", "register_planner", "register_navigator",
-           "PlanResult", "RunOutcome",
+           "import_world", "ImportSettings", "PlanResult", "RunOutcome",
            "Scenario", "ConfigError", "Problem", "Path", "Planner", "PlanStats", "PlanningError", "NoPathFound",
            "Navigator", "Observation", "NavigationSetup", "NavigationStep"]
 

@@ -34,19 +34,42 @@ def load_scenario(name_or_path: str | os.PathLike[str], trust_code: bool = False
     from swarmnav.models.scenario import load_scenario as load
     from swarmnav.sim.plugins import load_plugins
     load_plugins()
-    return load(str(name_or_path), trust_code)
+    scenario = load(str(name_or_path), trust_code)
+    check_components(scenario, trust_code)
+    return scenario
+
+
+def check_components(scenario: "Scenario", trust_code: bool = False) -> None:
+    """The scenario's ``planner`` and ``navigator`` tables built once, so a file naming an unknown component or
+    parameter is refused on load (naming the field), whatever ``--planner`` later overrides.
+
+    Raises:
+        ConfigError: ``planner.name``, ``planner.params.KEY`` (or the navigator's) and the file.
+    """
+    from swarmnav.controllers.navigators import make_navigator
+    from swarmnav.planners.registry import make_planner
+    make_planner(scenario.planner_name, scenario.planner_params, scenario.source_path, trust_code=trust_code)
+    make_navigator(scenario.navigator_name, scenario.navigator_params, scenario.source_path, trust_code=trust_code)
 
 
 def _scenario(scenario: str | os.PathLike[str] | Scenario) -> Scenario:
+    """A scenario as given, or loaded by name or path and its components checked (the caller has loaded the
+    plugins)."""
     from swarmnav.models.scenario import Scenario
-    return scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    from swarmnav.models.scenario import load_scenario as load
+    if isinstance(scenario, Scenario):
+        return scenario
+    loaded = load(str(scenario))
+    check_components(loaded)
+    return loaded
 
 
 def episode_spec(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
                  params: Mapping[str, Any] | None = None, navigator: str | None = None,
                  navigator_params: Mapping[str, Any] | None = None, seed: int | None = None,
                  world_seed: int | None = None, clearance_m: float | None = None) -> EpisodeSpec:
-    """The :class:`swarmnav.sim.episode.EpisodeSpec` of these arguments (``None``: the scenario's)."""
+    """The :class:`swarmnav.sim.episode.EpisodeSpec` of these arguments (``None``: the scenario's); the
+    plugins are loaded here, once per call."""
     from swarmnav.sim.episode import EpisodeSpec
     from swarmnav.sim.plugins import load_plugins
     load_plugins()
@@ -69,17 +92,10 @@ def plan(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None
 
 
 def given_episode(spec: EpisodeSpec, waypoints: np.ndarray, source: str) -> Any:
-    """An episode whose path is the given waypoints instead of a plan (``run --waypoints``): the spec's planner
-    still serves a navigator that replans."""
-    from swarmnav.controllers.navigators import make_navigator
-    from swarmnav.planners.registry import make_planner
-    from swarmnav.sim.episode import Episode
-    from swarmnav.sim.given_path import given_path
-    spec = spec.resolved()
-    planner = make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)  # bad names fail early
-    navigator = make_navigator(spec.navigator, spec.navigator_params, spec.scenario.source_path)
-    problem, path = given_path(spec.scenario, waypoints, source)
-    return Episode(spec, problem, path, planner, navigator)
+    """An episode whose path is the given waypoints instead of a plan (``run --waypoints``), composed as every
+    run is (:func:`swarmnav.sim.episode.given_episode`)."""
+    from swarmnav.sim.episode import given_episode as composed
+    return composed(spec, waypoints, source)
 
 
 def run(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
@@ -90,8 +106,8 @@ def run(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
         log: str | os.PathLike[str] | bool | None = None, overwrite: bool = False,
         video: str | os.PathLike[str] | None = None, camera: str = "top", width: int = 640, height: int = 480,
         fps: float | None = None, stop_on_collision: bool | None = None, live: bool = False,
-        on_live: Callable[[str], None] | None = None) -> RunOutcome:
-    """Plan (or take ``waypoints``) and drive the scenario in MuJoCo.
+        on_live: Callable[[str], None] | None = None, log_format: str = "swarmnav") -> RunOutcome:
+    """Plan (or take ``waypoints``) and drive the scenario in MuJoCo (:func:`run_spec` of :func:`episode_spec`).
 
     Args:
         waypoints: a path to drive instead of planning: ``(N, 2)`` metres, or a CSV/JSON file
@@ -99,14 +115,27 @@ def run(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
         log: an MCAP path, ``True`` for ``logs/<scenario>_<planner>_seed<N>_<stamp>.mcap``, or ``None``/``False``
             for no log.
         video: an MP4 path rendered offscreen while running.
+        log_format: ``swarmnav`` (Foxglove's schemas) or ``ros2`` (CDR messages of the standard ROS 2 types).
 
     Raises:
         ConfigError: bad input (naming the field); the log or video file exists without ``overwrite``.
         PlanningError: no path.
     """
-    from swarmnav.models.errors import ConfigError
-    from swarmnav.sim.episode import plan_episode, run_episode
     spec = episode_spec(scenario, planner, params, navigator, navigator_params, seed, world_seed, clearance_m)
+    return run_spec(spec, waypoints=waypoints, log=log, overwrite=overwrite, video=video, camera=camera, width=width,
+                    height=height, fps=fps, stop_on_collision=stop_on_collision, live=live, on_live=on_live,
+                    log_format=log_format)
+
+
+def run_spec(spec: Any, *, waypoints: "Sequence[Sequence[float]] | np.ndarray | str | os.PathLike | None" = None,
+             log: "str | os.PathLike | bool | None" = None, overwrite: bool = False,
+             video: "str | os.PathLike | None" = None, camera: str = "top", width: int = 640, height: int = 480,
+             fps: float | None = None, stop_on_collision: bool | None = None, live: bool = False,
+             on_live: Callable[[str], None] | None = None, log_format: str = "swarmnav") -> RunOutcome:
+    """Plan (or take ``waypoints``) and drive an :class:`~swarmnav.sim.episode.EpisodeSpec` (the command line's
+    ``run`` builds its spec as ``plan`` does, then comes here); the outputs as :func:`run` takes them."""
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.sim.episode import given_episode, plan_episode, run_episode
     if waypoints is not None:
         from swarmnav.sim.given_path import as_waypoints, read_waypoints
         if isinstance(waypoints, (str, os.PathLike)):
@@ -125,7 +154,7 @@ def run(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
             raise ConfigError("--out", "Is a directory (give a file path)", str(log_path))
         if log_path.exists() and not overwrite:
             raise ConfigError("--out", "file exists (use --overwrite)", str(log_path))
-        recorders.append(McapRecorder(log_path, live=live, overwrite=True, on_live=on_live))
+        recorders.append(McapRecorder(log_path, live=live, overwrite=True, on_live=on_live, log_format=log_format))
     elif live:
         raise ConfigError("--live", "needs the log (drop --no-log)")
     if video:

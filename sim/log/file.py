@@ -15,6 +15,8 @@ import errno
 import os
 from pathlib import Path
 
+from swarmnav.models.contained_files import open_in_folder
+
 
 class LogFile:
     """An unbuffered binary file that remembers the first write error.
@@ -39,7 +41,9 @@ class LogFile:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as error:
             raise type(error)(error.errno, error.strerror, str(self.path.parent)) from None
-        self._file = open(self.path, "wb" if overwrite else "xb", buffering=0)
+        # never through a symbolic link (a link planted in a study's logs/ would redirect the write)
+        flags = os.O_WRONLY | os.O_CREAT | (os.O_TRUNC if overwrite else os.O_EXCL)
+        self._file = os.fdopen(open_in_folder(self.path, flags, "log"), "wb", buffering=0)
 
     def write(self, data: bytes) -> int:
         """Write all of ``data`` (a full disk keeps what fitted and raises)."""

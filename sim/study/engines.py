@@ -109,7 +109,7 @@ def _exit_with_parent(parent_pid: int) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
-def _worker_main(conn, parent_pid: int, logs_dir: str | None) -> None:
+def _worker_main(conn, parent_pid: int, logs_dir: str | None, log_format: str = "swarmnav") -> None:
     """A local worker: batches arrive on ``conn`` (read by a thread, so the driver's sends never wait on a
     running cell), each cell runs on this process's main thread (where the wall limit's timer works) and its
     result goes back at once.  Ctrl-C is the driver's to handle: it terminates its workers."""
@@ -127,16 +127,17 @@ def _worker_main(conn, parent_pid: int, logs_dir: str | None) -> None:
     while (batch := inbox.get()) is not None:
         for cell in batch:
             try:
-                result: Result | ComponentMissing = run_cell(cell, logs_dir)
+                result: Result | ComponentMissing = run_cell(cell, logs_dir, log_format)
             except ComponentMissing as exc:
                 result = exc
             conn.send(result)
 
 
 class _LocalWorker:
-    def __init__(self, context, logs_dir: str | None):
+    def __init__(self, context, logs_dir: str | None, log_format: str = "swarmnav"):
         self.conn, child = context.Pipe()
-        self.process = context.Process(target=_worker_main, args=(child, os.getpid(), logs_dir), daemon=True)
+        self.process = context.Process(target=_worker_main, args=(child, os.getpid(), logs_dir, log_format),
+                                       daemon=True)
         self.process.start()
         child.close()
         self.queued: deque[Cell] = deque()  # sent, not yet returned, in the order the worker runs them
@@ -174,7 +175,8 @@ class _LocalWorker:
         self.conn.close()
 
 
-def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None) -> Iterator[Result]:
+def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None,
+              log_format: str = "swarmnav") -> Iterator[Result]:
     """Run the cells on ``workers`` spawned processes; on an early exit (Ctrl-C, SIGTERM) the workers
     this engine started are terminated."""
     source = iter(cells)
@@ -205,7 +207,7 @@ def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None) 
                         break
                     if worker is None:
                         with _environment(worker_environment()):
-                            worker = pool[slot] = _LocalWorker(context, logs_dir)
+                            worker = pool[slot] = _LocalWorker(context, logs_dir, log_format)
                     worker.send(batch)
             busy = [w for w in pool if w is not None and w.queued]
             if not busy:
@@ -242,8 +244,8 @@ def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None) 
                 worker.stop(terminate=not finished)
 
 
-def run_inline(cells: Iterable[Cell], logs_dir: str | None = None) -> Iterator[Result]:
+def run_inline(cells: Iterable[Cell], logs_dir: str | None = None, log_format: str = "swarmnav") -> Iterator[Result]:
     """Run the cells one after another in this process (the benchmarks' engine: plan times are measured
     alone and warm, as their own timing loops measure them; no worker start-up)."""
     for cell in cells:
-        yield run_cell(cell, logs_dir)
+        yield run_cell(cell, logs_dir, log_format)

@@ -12,6 +12,7 @@ import fcntl
 import os
 from pathlib import Path as FilePath
 
+from swarmnav.models.contained_files import open_in_folder
 from swarmnav.models.errors import ConfigError
 
 LOCK_NAME = ".lock"
@@ -26,7 +27,7 @@ class FolderLock:
 
     def __enter__(self) -> "FolderLock":
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        fd = open_in_folder(self.path, os.O_RDWR | os.O_CREAT, "--out")  # a planted link is refused
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:

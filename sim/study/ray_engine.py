@@ -31,6 +31,7 @@ from itertools import islice
 from pathlib import Path as FilePath
 from typing import Any, Iterable, Iterator
 
+from swarmnav.models.contained_files import check_no_link, folder as contained_folder, open_in_folder
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim.plugins import distributions
 from swarmnav.sim.study.cell import ComponentMissing, _versions_json, run_cell
@@ -80,9 +81,9 @@ def start_ray(address: str | None, workers: int | None) -> None:
         signal.signal(signal.SIGTERM, previous)
 
 
-def run_batch(cells: list[Cell], keep_logs: bool) -> dict[str, Any]:
+def run_batch(cells: list[Cell], keep_logs: str | None) -> dict[str, Any]:
     """A task: run the cells in order; return the node, its versions, and each cell's row, progress and log
-    bytes (``None`` without ``--logs`` or in plan-only mode)."""
+    bytes (``None`` without ``--logs`` or in plan-only mode); ``keep_logs``: the logs' format, None for none."""
     import ray
     context = ray.get_runtime_context()
     answer: dict[str, Any] = {"node": ray.util.get_node_ip_address(), "node_id": context.get_node_id(),
@@ -97,13 +98,13 @@ def run_batch(cells: list[Cell], keep_logs: bool) -> dict[str, Any]:
     return {**answer, "results": results}
 
 
-def _run_one(cell: Cell, keep_logs: bool) -> tuple[dict[str, Any], list[dict[str, Any]], bytes | None]:
+def _run_one(cell: Cell, keep_logs: str | None) -> tuple[dict[str, Any], list[dict[str, Any]], bytes | None]:
     """One cell's row, progress and log bytes (see :func:`run_batch`)."""
     if not (keep_logs and cell.physics):
         row, progress = run_cell(cell)
         return row, progress, None
     with tempfile.TemporaryDirectory(prefix="swarmnav-log-") as folder:
-        row, progress = run_cell(cell, folder)
+        row, progress = run_cell(cell, folder, keep_logs)
         log = FilePath(folder) / f"{cell.config_hash}.mcap"
         return row, progress, log.read_bytes() if log.exists() else None
 
@@ -136,9 +137,11 @@ def _check_versions(answer: dict[str, Any], driver: str) -> None:
 
 def _save_log(logs_dir: str, config_hash: str, data: bytes) -> str:
     final = FilePath(logs_dir) / f"{config_hash}.mcap"
-    final.parent.mkdir(parents=True, exist_ok=True)
+    contained_folder(final.parent, "--out")
     temporary = final.with_name(f".{final.name}.tmp")
-    temporary.write_bytes(data)
+    with os.fdopen(open_in_folder(temporary, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, "--out"), "wb") as out:
+        out.write(data)
+    check_no_link(final, "--out")
     os.replace(temporary, final)
     return str(final)
 
@@ -150,7 +153,7 @@ def _failure(exc: Exception) -> str:
 
 
 def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | None = None,
-            logs_dir: str | None = None, nodes: set[str] | None = None) -> Iterator[Result]:
+            logs_dir: str | None = None, nodes: set[str] | None = None, log_format: str = "swarmnav") -> Iterator[Result]:
     """Run the cells as Ray tasks (one CPU each) on a local instance or the cluster at ``address``; the ids of
     the nodes that ran them are added to ``nodes``."""
     import ray
@@ -166,7 +169,7 @@ def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | No
                 batch = [solo.popleft()] if solo else list(islice(source, sizer.size()))
                 if not batch:
                     break
-                inflight[task.remote(batch, logs_dir is not None)] = batch
+                inflight[task.remote(batch, log_format if logs_dir is not None else None)] = batch
             if not inflight:
                 break
             done, _ = ray.wait(list(inflight), num_returns=1)

@@ -33,6 +33,8 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
+from swarmnav.models.contained_files import check_no_link, folder as contained_folder
+
 RUNS = "runs.parquet"
 PROGRESS = "progress.parquet"
 
@@ -63,6 +65,9 @@ RUN_SCHEMA = pa.schema([
     ("oracle_cell_m", pa.float64()), ("time_score", pa.float64()), ("static_density", pa.float64()),
     ("dispersion", pa.float64()), ("survivability", pa.float64()), ("dynamic_traversability", pa.float64()),
     ("t_star_ratio", pa.float64()), ("difficulty_error", pa.string()), ("run_cpu_s", pa.float64()),
+    # among agents (orca / social_force obstacles) only: sim/crowd_stepping.crowd_metrics
+    ("discomfort_frequency", pa.float64()), ("min_separation_m", pa.float64()),
+    ("path_irregularity_rad_m", pa.float64()),
 ])
 PROGRESS_SCHEMA = pa.schema([
     ("config_hash", pa.string()), ("iteration", pa.int64()), ("best_cost", pa.float64()),
@@ -126,6 +131,7 @@ def set_aside(path: FilePath, reason: str) -> None:
     folder = path.parent.parent / DAMAGED
     target = folder / f"{path.parent.name}-{path.name}"
     try:
+        check_no_link(folder, "--out")  # a planted link would carry the part out of the study folder
         folder.mkdir(exist_ok=True)
         os.replace(path, target)
         where = f"moved to {target}"
@@ -235,7 +241,7 @@ class RowWriter:
         self.token = uuid.uuid4().hex[:8]
         self.parts = 0
         for name in (RUNS, PROGRESS):
-            (self.out_dir / name).mkdir(parents=True, exist_ok=True)
+            contained_folder(self.out_dir / name, "--out")  # a planted link is refused, never written through
 
     def add(self, row: dict[str, Any], progress: list[dict[str, Any]]) -> None:
         self.runs.append(row)

@@ -6,7 +6,8 @@ For every physics row whose scenario has a moving obstacle, the study's driver a
 * ``oracle_verdict``: ``solvable`` (the oracle, :mod:`controllers.oracle_search`, found a collision-free
   arrival on its lattice within the time limit), ``unsolvable`` (it proved none at its resolution:
   ``oracle_reason`` says why, e.g. ``time_limit``) or ``undecided`` (the search raised: ``oracle_reason`` holds
-  the error; the row is kept, as every failure is);
+  the error; the row is kept, as every failure is) or ``none`` (the scene's agents see the robot and react to
+  it: no clairvoyant yardstick exists, and nothing is counted against a navigator there);
 * ``oracle_t_star_s`` (T*, the earliest arrival) and ``oracle_cell_m`` (the resolution it decided at);
 * ``time_score``: BARN's (Perille et al. 2020), on rows of a solvable scene only: 0 when the run failed, else
   T* / T clipped to [0, 1], T the run's ``time_to_goal_s``; null on unsolvable and undecided scenes, so that a
@@ -30,6 +31,8 @@ import json
 import os
 from pathlib import Path as FilePath
 from typing import Any
+
+from swarmnav.models.contained_files import check_no_link, loads_json, replace_file
 
 FILE = "difficulty.json"
 METRICS = ("static_density", "dispersion", "survivability", "dynamic_traversability", "t_star_ratio")
@@ -58,6 +61,10 @@ def measure(scenario, time_limit_s: float | None) -> dict[str, Any]:
                              "time_limit_s": time_limit_s, "dynamic": any(ob.moving for ob in scenario.obstacles)}
     if not entry["dynamic"]:
         return entry
+    from swarmnav.controllers.oracle_search import reactive_agents
+    if reactive_agents(scenario):
+        entry.update(oracle_verdict="none", oracle_reason="the agents react to the robot: no clairvoyant yardstick")
+        return entry
     try:
         found = oracle_metrics(scenario, None, time_limit_s)
         verdict = found["oracle"]
@@ -84,9 +91,15 @@ class Yardstick:
         self.digests: dict[str, str] = {}
         self.computed = 0  # scenes measured by this instance (not read from the file)
         try:
-            self.scenes = json.loads(self.path.read_text(encoding="utf-8")).get("scenes", {})
-        except (OSError, ValueError, AttributeError):
+            check_no_link(self.path, "--out")  # a link planted in the folder is neither read nor written through
+            self.scenes = loads_json(self.path.read_text(encoding="utf-8"), str(self.path)).get("scenes", {})
+        except (OSError, AttributeError):
             self.scenes = {}
+        except ValueError as exc:  # unreadable JSON: measured again; a planted link: refused
+            if "symbolic link" in str(exc):
+                raise
+            self.scenes = {}
+        self.scenes = self.scenes if isinstance(self.scenes, dict) else {}
 
     def _digest(self, ref: str) -> str:
         if ref not in self.digests:
@@ -116,9 +129,7 @@ class Yardstick:
         return self.scenes[key]
 
     def _save(self) -> None:
-        temporary = self.path.with_name(f".{FILE}.tmp")
-        temporary.write_text(json.dumps({"scenes": self.scenes}, indent=1, sort_keys=True) + "\n", encoding="utf-8")
-        os.replace(temporary, self.path)
+        replace_file(self.path, json.dumps({"scenes": self.scenes}, indent=1, sort_keys=True) + "\n", "--out")
 
     def annotate(self, row: dict[str, Any]) -> dict[str, Any]:
         """``row`` with the columns of the module docstring (left alone for plan-only rows)."""
