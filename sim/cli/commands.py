@@ -16,7 +16,7 @@ from swarmnav.sim import options
 from swarmnav.sim.defaults import (  # noqa: F401  (re-exported: the CLI's own defaults)
     SINGLE_THREAD_ENVIRONMENT, DEFAULT_FPS, LOG_FORMATS, MIN_FPS, MAX_FPS, MIN_DPI, MAX_DPI, BENCH_SIM_QUICK,
     BENCH_ENV_QUICK, BENCH_RENDER_QUICK_FRAMES, BENCH_PLANNERS_SCENARIOS, BENCH_PLANNERS_PLANNERS,
-    BENCH_PLANNERS_SAMPLING, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
+    BENCH_PLANNERS_SAMPLING, BENCH_PLANNERS_SAMPLING_CHOICES, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
 from swarmnav.models.scenario_limits import (MAX_BENCH_DURATION_S, MAX_BENCH_FRAMES, MAX_BENCH_REPEATS, MAX_BENCH_RUNS,
                                              MAX_BENCH_SEEDS, MAX_STUDY_RUNS, MAX_WORKERS)
 from swarmnav.sim.options import add_trust_code_argument  # noqa: F401
@@ -51,9 +51,11 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenarios", nargs="+", default=list(BENCH_PLANNERS_SCENARIOS), metavar="NAME")
     parser.add_argument("--planners", nargs="+", default=list(BENCH_PLANNERS_PLANNERS), choices=BENCH_PLANNERS_PLANNERS,
                         metavar="NAME", help=f"continuous planners among {', '.join(BENCH_PLANNERS_PLANNERS)}")
-    parser.add_argument("--sampling", nargs="*", default=list(BENCH_PLANNERS_SAMPLING), choices=BENCH_PLANNERS_SAMPLING,
-                        metavar="NAME", help=f"OMPL planners among {', '.join(BENCH_PLANNERS_SAMPLING)}, given "
-                        "population x iterations collision checks (default all; none: --sampling alone)")
+    parser.add_argument("--sampling", nargs="*", default=list(BENCH_PLANNERS_SAMPLING),
+                        choices=BENCH_PLANNERS_SAMPLING_CHOICES, metavar="NAME",
+                        help=f"OMPL planners among {', '.join(BENCH_PLANNERS_SAMPLING_CHOICES)}, given population x "
+                        f"iterations collision checks (default {', '.join(BENCH_PLANNERS_SAMPLING)}; "
+                        "none: --sampling alone)")
     parser.add_argument("--seeds", type=RUNS, default=10, help="runs per planner and scenario (default 10)")
     parser.add_argument("--population", type=options.int_in(1, 1_000_000), default=50)
     parser.add_argument("--iterations", type=options.int_in(1, 1_000_000), default=100)
