@@ -27,6 +27,8 @@ def recover_log(source: str | Path, target: str | Path) -> RawLog:
         ConfigError: ``target`` is ``source``.
         OSError: ``target`` cannot be written (with its file name).
     """
+    if not str(target).strip() or Path(target).name in ("", ".", ".."):
+        raise ConfigError("OUT", "must name a file", str(target))
     target = Path(target)
     if target.resolve() == Path(source).resolve():
         raise ConfigError("OUT", "is the source file: write the recovered copy elsewhere", str(target))
