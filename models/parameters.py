@@ -22,6 +22,7 @@ study, a log) only when the user passes ``--trust-code`` for that invocation;
 from __future__ import annotations
 
 import dataclasses
+import functools
 import types
 import typing
 from typing import Any
@@ -44,7 +45,7 @@ def parameter_ranges(cls: type) -> dict[str, Range]:
 
 def parameter_table(cls: type) -> list[dict[str, Any]]:
     """One row per parameter of a component: name, type, default and range (None: not numeric)."""
-    hints = typing.get_type_hints(cls)
+    hints = _type_hints(cls)
     ranges = parameter_ranges(cls)
     rows = []
     for f in dataclasses.fields(cls):
@@ -60,7 +61,7 @@ def parameter_table(cls: type) -> list[dict[str, Any]]:
 
 def numeric_parameters(cls: type) -> tuple[str, ...]:
     """The init fields whose type admits an int or a float (bool excluded)."""
-    hints = typing.get_type_hints(cls)
+    hints = _type_hints(cls)
     out = []
     for f in dataclasses.fields(cls):
         annotation = hints.get(f.name, Any)
@@ -99,6 +100,12 @@ def refuse_code(registry: dict[str, type], kind: str, name: str, params: dict[st
                               f"(or give it on the command line: {option} {key}=...)", source)
 
 
+@functools.lru_cache(maxsize=None)
+def _type_hints(cls: type) -> dict[str, Any]:
+    """``typing.get_type_hints`` of a component class, once per class (it re-evaluates every annotation)."""
+    return typing.get_type_hints(cls)
+
+
 def register_component(registry: dict[str, type], kind: str, cls: type) -> type:
     """Add a component class to a registry under its ``name``; a missing or taken name is an error."""
     name = getattr(cls, "name", None)
@@ -129,7 +136,7 @@ def build_component(registry: dict[str, type], kind: str, name: str, params: dic
         refuse_code(registry, kind, name, params, source)
     cls = registry[name]
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
-    hints = typing.get_type_hints(cls)
+    hints = _type_hints(cls)
     ranges = parameter_ranges(cls)
     table = TomlTable({} if params is None else params, f"{kind}.params", source)
     kwargs = {}

@@ -28,6 +28,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from swarmnav.models.errors import ConfigError
+
 from swarmnav.controllers.navigator import NavigationSetup, Navigator
 from swarmnav.controllers.navigators import NAVIGATORS, make_navigator
 from swarmnav.controllers.point_to_point import PointToPointController
@@ -177,7 +179,12 @@ def plan_episode(spec: EpisodeSpec, scene: CompiledScene | None = None) -> Episo
     planner, budgeted = build_planner(spec)
     navigator = make_navigator(spec.navigator, spec.navigator_params, source)  # fails before planning
     problem = scenario_problem(spec.scenario)
-    path = planner.plan(problem, np.random.default_rng(spec.seed))
+    try:
+        path = planner.plan(problem, np.random.default_rng(spec.seed))
+    except ConfigError as exc:  # a limit the planner met on this scenario: name the file too
+        if exc.source is not None:
+            raise
+        raise ConfigError(exc.field, exc.problem, source) from None
     return Episode(spec, problem, path, planner, navigator, scene, planner_params=resolved_params(planner),
                    budgeted=budgeted)
 

@@ -31,7 +31,9 @@ DEEP = "[" * 5000 + "]" * 5000
 LONG = "x" * 200_000
 NUMBERS = ["nan", "inf", "-inf", "0", "-1", "1e-300", "1e300", str(2**63), str(10**20), "9" * 5000, "1.5"]
 WRONG = ["", "x", "true", DEEP, LONG, "[1, 2]", "{a = 1}"]
-PATHISH = ["", "/dev/zero", "../../escaped", "nonexistent/file.toml", LONG, DEEP]
+# Special files are made by the sweep in its own folder (SPECIAL_PATHS): never a real device as an output.
+SPECIAL_PATHS: list[str] = []
+PATHISH = ["", "../../escaped", "nonexistent/file.toml", LONG, DEEP]
 OK_EXITS = {0, 2, 3, 5}
 
 
@@ -75,23 +77,35 @@ class Sweep:
 
     @contextlib.contextmanager
     def guarded(self, budget_s: float | None = None) -> Iterator[io.StringIO]:
+        """stderr captured; after the budget a watchdog thread signals this one (SIGUSR1: swarmnav's own
+        wall limits use SIGALRM, so the sweep keeps out of its way), whose handler raises :class:`Stopped`."""
+        import threading
         err = io.StringIO()
+        timers: list[threading.Timer] = []
+        pid = os.getpid()
+
+        def arm(seconds: float) -> None:
+            timer = threading.Timer(seconds, lambda: os.kill(pid, signal.SIGUSR1))
+            timer.daemon = True
+            timers.append(timer)
+            timer.start()
 
         def stop(_signal, frame):
             while frame is not None:  # never inside an import: a half-imported module would stay broken
                 if "importlib" in frame.f_code.co_filename:
-                    signal.setitimer(signal.ITIMER_REAL, 0.05)
+                    arm(0.05)
                     return
                 frame = frame.f_back
             raise Stopped("budget")
-        previous = signal.signal(signal.SIGALRM, stop)
-        signal.setitimer(signal.ITIMER_REAL, budget_s or self.budget_s)
+        previous = signal.signal(signal.SIGUSR1, stop)
+        arm(budget_s or self.budget_s)
         try:
             with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
                 yield err
         finally:
-            signal.setitimer(signal.ITIMER_REAL, 0)
-            signal.signal(signal.SIGALRM, previous)
+            for timer in timers:
+                timer.cancel()
+            signal.signal(signal.SIGUSR1, previous)
 
     def cli(self, main: Callable[[list[str]], int], label: str, argv: list[str], budget_s: float | None = None
             ) -> Outcome:
@@ -223,7 +237,7 @@ def values_for(option: CliOption) -> list[str]:
     if option.kind == "number":
         return NUMBERS + WRONG
     if option.flag is None or "out" in option.dest or option.dest in ("video", "waypoints", "junit", "readme"):
-        return PATHISH + ["nan", "-1", "k=" + DEEP]
+        return PATHISH + SPECIAL_PATHS + ["nan", "-1", "k=" + DEEP]
     return ["", "nan", "-1", DEEP, LONG, "k=" + DEEP, "k=nan", "a:b:c=" + DEEP, "../../x"]
 
 
@@ -363,7 +377,7 @@ def document_values(current: Any) -> list[Any]:
     """The worst values for a leaf whose valid value is ``current`` (every type is tried on every leaf)."""
     values = list(PARAMETER_VALUES)
     if isinstance(current, str):
-        values += ["", "../../x", "/dev/zero", "nosuch"]
+        values += ["", "../../x", "nosuch", *SPECIAL_PATHS]
     return [v for v in values if v is not None]
 
 

@@ -6,6 +6,7 @@ nothing is listed by name).  Each must end in exit 0, 2, 3 or 5 with at most one
 from __future__ import annotations
 
 import argparse
+import os
 import time
 import tomllib
 from pathlib import Path
@@ -72,6 +73,8 @@ def files(tmp_path_factory) -> dict[str, str]:
     study = folder / "study.toml"
     study.write_text(f'name = "sweep"\nscenarios = ["{scenario}"]\nmode = "plan"\n[[planners]]\nname = "straight"\n')
     (folder / "empty").mkdir()
+    os.mkfifo(folder / "fifo")
+    sweep_lib.SPECIAL_PATHS[:] = [str(folder / "fifo"), str(folder / "empty")]  # a FIFO, a folder
     return {"scenario": str(scenario), "file": str(study), "log": str(log), "source": str(log),
             "target": str(folder / "recovered.mcap"), "dir": str(folder / "empty"), "kind": "crowd",
             "seed": "1", "out": str(folder / "out.png"), "default": str(scenario), "folder": str(folder)}
@@ -111,14 +114,14 @@ def sweep_cli(parser: argparse.ArgumentParser, files: dict[str, str], sweep: Swe
 def test_every_cli_option_of_every_subcommand(files, cached_parser, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)  # default outputs (logs/, studies/) land here
     sweep = Sweep(BUDGET_S)
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     sweep_cli(cached_parser, files, sweep)
     options = cli_options(cached_parser)
     commands = {o.words for o in options}
     stopped = sum(o.code == "stopped" for o in sweep.outcomes)
     with capsys.disabled():
         print(f"\nCLI sweep: {len(sweep.outcomes):,} invocations over {len(options)} options and positionals of "
-              f"{len(commands)} subcommands in {time.perf_counter() - t0:.1f} s ({stopped} stopped past "
+              f"{len(commands)} subcommands in {time.perf_counter() - t0:.1f} s wall, {time.process_time() - cpu0:.1f} s CPU ({stopped} stopped past "
               f"validation); peak memory {sweep_lib.peak_rss_mb():.0f} MB; slowest: {sweep.slowest()}")
     assert len(sweep.outcomes) > 1_000 and len(commands) >= 20
     assert not sweep.failures(), failure_report(sweep.failures())
@@ -132,7 +135,7 @@ def test_every_planner_and_navigator_parameter(files, capsys):
     from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
     scenario = parse_scenario(FAST_SCENARIO, files["scenario"])
     sweep, exercised = Sweep(BUDGET_S), 0
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     rows = list(component_parameters())
     for kind, name, row in rows:
         make = make_planner if kind == "planner" else make_navigator
@@ -155,7 +158,7 @@ def test_every_planner_and_navigator_parameter(files, capsys):
                            EXERCISE_BUDGET_S)
     with capsys.disabled():
         print(f"\nparameter sweep: {len(sweep.outcomes):,} calls over {len(rows)} parameters ({exercised} accepted "
-              f"values planned or run) in {time.perf_counter() - t0:.1f} s; slowest: {sweep.slowest()}")
+              f"values planned or run) in {time.perf_counter() - t0:.1f} s wall, {time.process_time() - cpu0:.1f} s CPU; slowest: {sweep.slowest()}")
     assert len(rows) > 200 and len(sweep.outcomes) > 3_000
     assert not sweep.failures(), failure_report(sweep.failures())
 
@@ -166,7 +169,7 @@ def test_every_scenario_study_and_suite_field(files, tmp_path, capsys):
     from swarmnav.sim.episode import EpisodeSpec, run_episode
     from swarmnav.sim.study.spec import study_from_tables
     sweep = Sweep(BUDGET_S)
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     scenario_doc = tomllib.loads(FAST_SCENARIO)
     study_doc = {"name": "s", "description": "d", "scenarios": [files["scenario"]], "mode": "plan", "seeds": 1,
                  "world_seeds": [0], "quick_seeds": 1, "wall_limit_s": 10.0, "time_limit_s": 0.1,

@@ -12,12 +12,14 @@ import os
 import sys
 from pathlib import Path as FilePath
 
+from swarmnav.sim import options  # noqa: E402  (light: argparse types only)
+
 WORKERS_PER_CORE = 8  # --workers at most this many per core of the machine
 
 
 def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", help="bundled study name (see `swarmnav studies`) or path to a study .toml")
-    p.add_argument("--out", help="directory of the rows (default: studies/<study name>); run again to resume")
+    p.add_argument("--out", type=options.output_path, help="directory of the rows (default: studies/<study name>); run again to resume")
     p.add_argument("--workers", type=int, help="worker processes, or local Ray CPUs (default: the number of cores)")
     p.add_argument("--engine", choices=("local", "ray"), default="local",
                    help="local processes, or Ray tasks (needs the ray extra: pip install 'swarmnav[ray]')")
@@ -30,7 +32,7 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
     from swarmnav.sim.options import add_trust_code_argument
     add_trust_code_argument(p)
-    p.add_argument("--junit", metavar="FILE", help="write the study's rows as JUnit XML (one test suite per scenario, "
+    p.add_argument("--junit", type=options.output_path, metavar="FILE", help="write the study's rows as JUnit XML (one test suite per scenario, "
                    "a failure per row that is not a success)")
     p.add_argument("--min-success", type=_rate, metavar="RATE",
                    help="exit 5 when a configuration's (scenario, planner, navigator) success rate is below RATE")
@@ -148,14 +150,14 @@ def run_studies(args: argparse.Namespace) -> int:
 
 def add_report_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("dir", nargs="?", help="a study's output directory (holding runs.parquet)")
-    p.add_argument("--out", help="HTML report path (default: DIR/report.html); the Markdown twin and claims.json "
+    p.add_argument("--out", type=options.output_path, help="HTML report path (default: DIR/report.html); the Markdown twin and claims.json "
                                  "go beside it")
     p.add_argument("--json", action="store_true", help="print the claims' verdicts (claims.json) instead")
     p.add_argument("--readme-table", nargs="+", metavar="PATH",
                    help="print the README's table of claims from these claims.json files (or folders holding them, "
                         "e.g. models/studies/results) instead of a report")
     p.add_argument("--readme", help="with --readme-table: replace the table in this README file instead")
-    p.add_argument("--ompl-log", metavar="OUT", help="also write the rows as OMPL benchmark logs, OUT/<scenario>.log "
+    p.add_argument("--ompl-log", type=options.output_path, metavar="OUT", help="also write the rows as OMPL benchmark logs, OUT/<scenario>.log "
                    "(one experiment each), for `ompl_benchmark_statistics OUT/*.log -d bench.db` and Planner Arena")
 
 
