@@ -42,6 +42,7 @@ from swarmnav.controllers.navigators import NAVIGATORS, make_driver
 from swarmnav.controllers.point_to_point import PointToPointController
 from swarmnav.controllers.safety_layer import SafetyLayer
 from swarmnav.controllers.world_map import SensedMap
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario
 from swarmnav.models.parameters import refuse_code
 from swarmnav.models.seeds import Seeds
@@ -223,7 +224,12 @@ def plan_episode(spec: EpisodeSpec | Composition, scene: CompiledScene | None = 
     scenario = parts.spec.scenario
     # With the map unknown the first plan sees no static obstacle (moving ones neither: nothing is sensed yet).
     problem = scenario_problem(scenario) if scenario.map_knowledge == "known" else unknown_map_problem(scenario)
-    path = parts.planner.plan(problem, np.random.default_rng(parts.spec.seed))
+    try:
+        path = parts.planner.plan(problem, np.random.default_rng(parts.spec.seed))
+    except ConfigError as exc:  # a limit the planner met on this scenario: name the file too
+        if exc.source is not None:
+            raise
+        raise ConfigError(exc.field, exc.problem, scenario.source_path) from None
     return parts.episode(problem, path, scene)
 
 

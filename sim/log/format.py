@@ -227,7 +227,7 @@ def metadata_value(text: str) -> Any:
     """The value :func:`metadata_text` wrote: JSON where the text is JSON, else the text itself."""
     try:
         return json.loads(text)
-    except ValueError:
+    except (ValueError, RecursionError):  # not JSON (or nested beyond the parser): the text itself
         return text
 
 
