@@ -50,3 +50,22 @@ def test_an_odometry_run_logs_odom_beside_the_true_pose_and_reports_its_drift(tm
 def test_the_default_run_reports_no_pose_error():
     result = run_episode(EpisodeSpec(load_scenario("gwo-scenario-1")), time_limit_s=1.0).result
     assert "pose_error_m" not in result.summary()
+
+
+def test_a_burger_with_a_270_ray_laser_no_map_and_odometry_reaches_dense_field_30(tmp_path):
+    """The issue's run: laser, map unknown, odometry pose; /map and /odom logged, a small non-zero drift."""
+    from dataclasses import replace
+    from swarmnav.models.robots import ROBOTS
+    burger = ROBOTS["turtlebot3_burger"]
+    base = load_scenario("dense-field-30")
+    scenario = replace(base, robot_model=burger.name, robot_radius_m=burger.planning_radius_m,
+                       max_speed_m_s=burger.max_speed_m_s, sensor_count=270, sensor_fov_deg=270.0,
+                       sensor_range_m=10.0, goal_tolerance_m=0.3).with_knowledge("unknown", "odometry")
+    out = tmp_path / "burger.mcap"
+    episode = run_episode(EpisodeSpec(scenario, navigator="replan"), [McapRecorder(str(out))])
+    summary = episode.result.summary()
+    assert episode.result.success
+    assert 0.0 < summary["pose_error_m"] < 0.03 * episode.result.path_length_m
+    with out.open("rb") as stream:
+        topics = {channel.topic for _, channel, _ in make_reader(stream).iter_messages(topics=["/map", "/odom"])}
+    assert topics == {"/map", "/odom"}
