@@ -9,6 +9,7 @@ import sys
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -112,6 +113,21 @@ def test_a_given_path_that_leaves_the_arena_is_no_success(tmp_path, capsys):
     assert "given='waypoints'" in repr(slightly)
     assert main(["run", "gwo-scenario-1", "--waypoints", str(outside), "--no-log"]) == 0
     assert capsys.readouterr().out.startswith(f"gwo-scenario-1: given path {str(outside)!r} + follow")
+
+
+def test_the_bulk_readers_of_waypoint_files_agree_with_the_row_reader(tmp_path):
+    from swarmnav.sim.given_path import _from_csv, _from_json, read_waypoints
+    points = np.random.default_rng(3).uniform(-5.0, 15.0, (500, 2))
+    csv_file, json_file = tmp_path / "w.csv", tmp_path / "w.json"
+    csv_file.write_text("y, x ,speed\n" + "".join(f"{y!r},{x!r},1\n\n" for x, y in points.tolist()))
+    json_file.write_text(json.dumps({"waypoints": points.tolist(), "collision_free": True}))
+    assert np.array_equal(read_waypoints(csv_file), points) and np.array_equal(read_waypoints(json_file), points)
+    # the row-by-row readers (what a file the bulk readers refuse goes through) give the same numbers
+    quoted = "".join(f'"{y!r}",{x!r},1\n' for x, y in points.tolist())
+    assert np.array_equal(np.asarray(_from_csv("y,x,speed\n" + quoted, "q")), points)
+    assert np.array_equal(np.asarray(_from_json([[1, 2.5], *points.tolist()], "j")), [[1.0, 2.5], *points])
+    with pytest.raises(swarmnav.ConfigError, match=r"\[1\]: expected an \[x, y\] pair"):
+        _from_json([[1.0, 2.0], [True, 3.0]], "j")  # a boolean is no number, in bulk as row by row
 
 
 @pytest.mark.parametrize("text,where", [("x,y\n0,0\nfoo,1\n", "row 3"), ("a,b\n0,0\n", "row 1"),
