@@ -42,6 +42,21 @@ def test_import_swarmnav_is_light_and_public():
     assert out[1] == "True True Problem"
 
 
+def test_a_folder_named_swarmnav_in_the_working_directory(tmp_path):
+    (tmp_path / "swarmnav" / "models").mkdir(parents=True)  # a clone of the repository, say
+    # installed as `make install` does (the package on the path): the installed package wins
+    done = subprocess.run([sys.executable, "-c", "import swarmnav; print(callable(swarmnav.run))"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=60)
+    assert done.stdout.strip() == "True", done.stderr
+    # with the editable install's import hook alone the folder shadows the package: one line naming it, exit 2
+    hook_only = "import sys; sys.path = [p for p in sys.path if not p.endswith('/typing')]; import swarmnav.sim.cli.main"
+    done = subprocess.run([sys.executable, "-c", hook_only], cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    if "shadows" not in done.stderr and done.returncode == 0:
+        pytest.skip("swarmnav is not an editable install here: nothing can shadow it")
+    assert done.returncode == 2 and done.stderr.count("\n") == 1
+    assert f"the folder {tmp_path / 'swarmnav'} shadows the installed swarmnav package" in done.stderr
+
+
 def test_run_to_dict_is_what_run_json_prints(capsys):
     result = swarmnav.run("gwo-scenario-1", planner="astar", seed=0)
     assert result.outcome == result.to_dict()["outcome"] == "goal_reached"
