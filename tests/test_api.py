@@ -57,6 +57,19 @@ def test_a_folder_named_swarmnav_in_the_working_directory(tmp_path):
     assert f"the folder {tmp_path / 'swarmnav'} shadows the installed swarmnav package" in done.stderr
 
 
+def test_the_readme_limits_name_every_max_constant():
+    import re
+    text = (ROOT / "README.md").read_text()
+    limits = text[text.index("### Limits"):]
+    limits = limits[:limits.index("\n## ")]
+    defined = set()
+    for layer in ("models", "planners", "controllers", "sim"):
+        for path in (ROOT / layer).rglob("*.py"):
+            defined |= set(re.findall(r"^(MAX_[A-Z0-9_]+)\s*(?::[^=\n]*)?=", path.read_text(), re.MULTILINE))
+    assert len(defined) > 40
+    assert sorted(name for name in defined if f"`{name}`" not in limits and f"`{name}` (" not in limits) == []
+
+
 def test_run_to_dict_is_what_run_json_prints(capsys):
     result = swarmnav.run("gwo-scenario-1", planner="astar", seed=0)
     assert result.outcome == result.to_dict()["outcome"] == "goal_reached"
