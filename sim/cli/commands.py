@@ -66,7 +66,7 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--modes", nargs="+", default=["paper", "robust"], choices=["paper", "robust"])
     parser.add_argument("--fields", type=options.int_in(0, MAX_BENCH_RUNS), default=10,
                         help="random disc fields of 10-40 discs (default 10; 0: none)")
-    parser.add_argument("--out", metavar="DIR", help="keep the quality studies' rows in DIR/scenarios and DIR/fields "
+    parser.add_argument("--out", type=options.output_path, metavar="DIR", help="keep the quality studies' rows in DIR/scenarios and DIR/fields "
                         "(study folders: `swarmnav report DIR/scenarios`); a folder that holds them already resumes. "
                         "Default: a temporary folder")
     parser.add_argument("--workers", type=WORKERS, default=1,
@@ -90,7 +90,7 @@ def add_bench_grid_arguments(parser: argparse.ArgumentParser) -> None:
                         help="plan every start/goal pair of each map's [map].pairs, not only the scenario's")
     parser.add_argument("--swarm-sample", type=RUNS, default=20,
                         help="Moving AI instances per map on which immas and iaco report their ratio")
-    parser.add_argument("--out", metavar="DIR", help="keep the quality studies' rows in DIR/maps, DIR/restaurant and "
+    parser.add_argument("--out", type=options.output_path, metavar="DIR", help="keep the quality studies' rows in DIR/maps, DIR/restaurant and "
                         "DIR/movingai (study folders: `swarmnav report DIR/maps`); default: a temporary folder")
     parser.add_argument("--quick", action="store_true",
                         help="the two slowest maps, 2 runs, 50 Moving AI instances a map, 1 swarm sample (under a minute)")
@@ -144,7 +144,7 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
                              "e.g. iaco_local+evade:iaco_local:evade=true")
     parser.add_argument("--by-scenario", action="store_true",
                         help="also one row per navigator and scenario, after the overall rows")
-    parser.add_argument("--out", metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
+    parser.add_argument("--out", type=options.output_path, metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
                         "default: a temporary folder")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
     parser.add_argument("--suite", choices=("dyn", "papers", "dyn300", "barn", "barn-like", "crowdnav"),
@@ -270,7 +270,7 @@ def run_log_info(args: argparse.Namespace) -> int:
 
 def add_log_recover_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", metavar="IN", help="a (possibly truncated) .mcap file")
-    parser.add_argument("target", metavar="OUT", help="the complete, indexed .mcap file to write")
+    parser.add_argument("target", metavar="OUT", type=options.output_path, help="the complete, indexed .mcap file to write")
 
 
 def run_log_recover(args: argparse.Namespace) -> int:
@@ -280,7 +280,7 @@ def run_log_recover(args: argparse.Namespace) -> int:
 
 def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", help="an .mcap run log")
-    parser.add_argument("--video", metavar="OUT.mp4", help="render the run to an MP4 (offscreen EGL)")
+    parser.add_argument("--video", type=options.output_path, metavar="OUT.mp4", help="render the run to an MP4 (offscreen EGL)")
     parser.add_argument("--camera", choices=("top", "chase", "follow"), default="top",
                         help="top: the whole arena; chase: behind the robot; follow: straight down on the robot")
     parser.add_argument("--width", type=int, default=640)
@@ -304,7 +304,7 @@ def run_replay(args: argparse.Namespace) -> int:
 
 def add_plot_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", help="an .mcap run log")
-    parser.add_argument("-o", "--out", required=True, help="image to write (.png, .svg, .pdf)")
+    parser.add_argument("-o", "--out", type=options.output_path, required=True, help="image to write (.png, .svg, .pdf)")
     parser.add_argument("--dpi", type=int, default=120, help=f"dots per inch, {MIN_DPI}..{MAX_DPI}")
 
 
@@ -314,7 +314,8 @@ def run_plot(args: argparse.Namespace) -> int:
 
 
 def add_foxglove_layout_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("-o", "--out", metavar="FILE", help="write the layout to FILE (default: print it)")
+    parser.add_argument("-o", "--out", type=options.output_path, metavar="FILE",
+                         help="write the layout to FILE (default: print it)")
     parser.add_argument("--log-format", choices=LOG_FORMATS, default="swarmnav",
                         help="the layout for logs of this format (run --log-format)")
 
