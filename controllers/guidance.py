@@ -16,27 +16,27 @@ import numpy as np
 
 from swarmnav.controllers.navigator import NavigationSetup
 from swarmnav.controllers.prediction import LocalObstacles
-from swarmnav.controllers.safety_filter import SafetyFilter
 from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
 from swarmnav.models.world import Pose2D
 
 
-def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, safety_filter: bool,
-                time_before_collision_s: float, carrot_in_sight: bool = False):
-    """What the local navigators (``dwa``, ``velocity_obstacle``) build alike at reset, from a
+def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, carrot_in_sight: bool = False):
+    """What the local navigators (``dwa``, ``velocity_obstacle``, ``mppi``) build alike at reset, from a
     :class:`~controllers.navigator.NavigationSetup`: (drive geometry, top speed in m/s, the radius kept from
     obstacle centres beyond theirs (robot radius + ``margin_m``), the known static obstacles, the path's
-    carrot, the goal as an (x, y) array, the safety filter or None).  ``carrot_in_sight``: the carrot is kept
+    carrot, the goal as an (x, y) array).  ``carrot_in_sight``: the carrot is kept
     where the robot can drive to it straight past the known map (:class:`PathCarrot`)."""
     known = setup.map_problem
     geometry = setup.controller.geometry
-    carrot = PathCarrot(setup.path.waypoints, lookahead_m)
+    if setup.world_map is None:
+        carrot = PathCarrot(setup.path.waypoints, lookahead_m)
+        local = LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m)
+    else:  # the map unknown: the sensed map's obstacles, and the path replanned on it (controllers.guided)
+        carrot, local = setup.world_map.local_guidance(setup, lookahead_m)
     if carrot_in_sight:
         carrot.keep_in_sight(known.disc_centres_m, known.disc_radii_m, known.box_array_m, known.robot_radius_m)
-    return (geometry, setup.max_speed_m_s, known.robot_radius_m + margin_m,
-            LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m),
-            carrot, np.array([setup.goal.x_m, setup.goal.y_m]),
-            SafetyFilter(geometry, known.robot_radius_m, time_before_collision_s) if safety_filter else None)
+    return (geometry, setup.max_speed_m_s, known.robot_radius_m + margin_m, local,
+            carrot, np.array([setup.goal.x_m, setup.goal.y_m]))
 
 
 class PathCarrot:

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from swarmnav.models.crowd_agents import AgentMotion
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario
 
@@ -49,6 +50,16 @@ HEADINGS = 8
 STEPS = np.array([(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)])  # (dx, dy) cells
 MAX_LATTICE = 100_000_000  # states x ticks recorded (one byte each): a coarser cell beyond (``search``)
 WAIT, MOVE, LEFT, RIGHT = 1, 2, 3, 4
+
+
+class NoClairvoyantYardstick(Exception):
+    """The scenario's agents see the robot (``sees_robot``): their motion depends on what the robot does, so no
+    search over their motion as a function of time can be exact, and the oracle does not pretend to one."""
+
+
+def reactive_agents(scenario: Scenario) -> bool:
+    """Whether any agent of the scenario reacts to the robot."""
+    return any(isinstance(ob.motion, AgentMotion) and ob.motion.crowd.sees_robot for ob in scenario.obstacles)
 
 
 @dataclass(frozen=True)
@@ -167,6 +178,9 @@ def search(scenario: Scenario, settings: OracleSettings | None = None,
     doubling of the cell that fits (large maps); the verdict states the cell used.
     """
     import time as _time
+    if reactive_agents(scenario):
+        raise NoClairvoyantYardstick("no clairvoyant yardstick: the agents see the robot and react to it "
+                                     "(sees_robot), so their motion is not a function of time")
     wall0 = _time.perf_counter()
     settings = settings or OracleSettings()
     settings.check()

@@ -5,12 +5,20 @@ init fields.  A user's table (from a scenario file or ``--set``) is checked
 against the fields' annotations, and every problem is a :class:`ConfigError`
 naming ``<kind>.params.<key>`` (or ``<kind>.name``).
 
-Every numeric parameter declares its range in the component's class:
-``parameter_ranges: ClassVar[dict[str, Range]] = {"iterations": within(0, 100_000), ...}``
-(merged along the class hierarchy, :func:`parameter_ranges`).  A value outside its
-range, NaN or infinite is a :class:`ConfigError` naming the field and the range,
-raised by :func:`build_component` before the component is built, so before anything
-of that size is allocated; :func:`parameter_table` lists them.
+One declaration per parameter: the dataclass field itself, typed, with its range (a number) or its
+choices (a string) beside its default, :func:`param`::
+
+    iterations: int = param(100, within(1, 100_000))
+    strategy: str = param("paper", choices=("paper", "wait"))
+
+Everything takes its checks from there: the TOML reader and ``--set`` (both through
+:func:`build_component`: a value of the wrong type, outside its range, NaN, infinite or not
+among the choices is a :class:`ConfigError` naming the field, raised before the component is
+built, so before anything of that size is allocated), ``planners --json`` / ``navigators --json``
+and the docs (:func:`parameter_table`).  A component's ``__post_init__`` keeps only what one
+field cannot say (a rule between two fields).  The older class-level form,
+``parameter_ranges: ClassVar[dict[str, Range]]``, is still read (merged along the class
+hierarchy, :func:`parameter_ranges`) for plugins written against it.
 
 A parameter that names code (the ``policy`` navigator's ``module:function``) is
 declared with :func:`code_parameter`.  Data is not code: such a value is taken
@@ -29,33 +37,76 @@ from typing import Any
 
 from swarmnav.models.errors import ConfigError
 # Components declare their parameters' ranges with the reader's (Range, above, within), imported from here.
-from swarmnav.models.toml_table import Range, TomlTable, above, within  # noqa: F401
+from swarmnav.models.toml_table import Range, TomlTable, above, check_string, within  # noqa: F401
 
 TRUST_OPTION = "--trust-code"  # the opt-in that lets a data file name code
 _NAMES_CODE = "names_code"
+_RANGE = "range"
+_CHOICES = "choices"
+
+
+def param(default: Any = dataclasses.MISSING, bounds: Range | None = None, *,
+          choices: tuple[str, ...] | None = None) -> Any:
+    """A component parameter: a dataclass field with its default and, beside it, the range a number must lie
+    in (``bounds``) or the strings it may take (``choices``); see the module docstring."""
+    metadata: dict[str, Any] = {}
+    if bounds is not None:
+        metadata[_RANGE] = bounds
+    if choices is not None:
+        metadata[_CHOICES] = tuple(choices)
+    return dataclasses.field(default=default, metadata=metadata)
+
+
+def _init_fields(cls: type) -> list[dataclasses.Field]:
+    return [f for f in dataclasses.fields(cls) if f.init] if dataclasses.is_dataclass(cls) else []
 
 
 def parameter_ranges(cls: type) -> dict[str, Range]:
-    """Every declared range of a component class, its own over its bases'."""
+    """Every declared range of a component class: its fields' (:func:`param`) over the class-level
+    ``parameter_ranges`` of the older form (its own over its bases')."""
     merged: dict[str, Range] = {}
     for klass in reversed(cls.__mro__):
         merged.update(vars(klass).get("parameter_ranges", {}))
+    merged.update({f.name: f.metadata[_RANGE] for f in _init_fields(cls) if _RANGE in f.metadata})
     return merged
 
 
-def parameter_table(cls: type) -> list[dict[str, Any]]:
-    """One row per parameter of a component: name, type, default and range (None: not numeric)."""
-    hints = _type_hints(cls)
-    ranges = parameter_ranges(cls)
+def parameter_choices(cls: type) -> dict[str, tuple[str, ...]]:
+    """The strings each parameter declared with ``choices`` may take."""
+    return {f.name: f.metadata[_CHOICES] for f in _init_fields(cls) if _CHOICES in f.metadata}
+
+
+def _shown_default(f: dataclasses.Field) -> Any:
+    if f.default is not dataclasses.MISSING:
+        return f.default
+    return f.default_factory() if f.default_factory is not dataclasses.MISSING else None
+
+
+def parameter_table(cls: type, extra: tuple[type, tuple[str, ...], dict[str, Any]] | None = None
+                    ) -> list[dict[str, Any]]:
+    """One row per parameter of a component: name, type, default, range and choices (None where it declares
+    none), and whether it names code: what ``planners --json`` and ``navigators --json`` list.
+
+    ``extra``: ``(cls2, names, defaults)``, rows of another declaration that the component takes as its
+    own (a navigator's safety layer switches, :mod:`controllers.safety_layer`), with its defaults.
+    """
     rows = []
-    for f in dataclasses.fields(cls):
-        if not f.init:
-            continue
-        default = f.default if f.default is not dataclasses.MISSING else None
-        annotation = hints.get(f.name, Any)
-        rows.append({"name": f.name, "type": getattr(annotation, "__name__", str(annotation)), "default": default,
-                     "range": str(ranges[f.name]) if f.name in ranges else None,
-                     "names_code": bool(f.metadata.get(_NAMES_CODE))})
+    sources = [(cls, None, {})] + ([extra] if extra is not None else [])
+    for klass, names, defaults in sources:
+        try:
+            hints = typing.get_type_hints(klass)
+        except Exception:  # a plugin's annotation that does not resolve: shown as written
+            hints = {}
+        ranges, choices = parameter_ranges(klass), parameter_choices(klass)
+        for f in _init_fields(klass):
+            if names is not None and f.name not in names:
+                continue
+            annotation = hints.get(f.name, f.type)
+            rows.append({"name": f.name, "type": getattr(annotation, "__name__", str(annotation)),
+                         "default": defaults.get(f.name, _shown_default(f)),
+                         "range": str(ranges[f.name]) if f.name in ranges else None,
+                         "choices": list(choices[f.name]) if f.name in choices else None,
+                         "names_code": bool(f.metadata.get(_NAMES_CODE))})
     return rows
 
 
@@ -118,13 +169,15 @@ def register_component(registry: dict[str, type], kind: str, cls: type) -> type:
 
 
 def build_component(registry: dict[str, type], kind: str, name: str, params: dict[str, Any] | None = None,
-                    source: str | None = None, trust_code: bool = True) -> Any:
+                    source: str | None = None, trust_code: bool = True, also_known: tuple[str, ...] = ()) -> Any:
     """Build ``registry[name]`` from a parameter table, checking every value against its field's type.
 
     Args:
         kind: what the registry holds, for error fields (``"planner"``, ``"navigator"``).
         trust_code: False when ``params`` come from a data file the user did not vouch for: a parameter
             that names code is then refused (:func:`refuse_code`) before the component is built.
+        also_known: parameters the component takes through another declaration (named among the known
+            ones when a key is unknown).
 
     Raises:
         ConfigError: unknown name, unknown parameter, or a value of the wrong type.
@@ -137,13 +190,16 @@ def build_component(registry: dict[str, type], kind: str, name: str, params: dic
     cls = registry[name]
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
     hints = _type_hints(cls)
-    ranges = parameter_ranges(cls)
+    ranges, choices = parameter_ranges(cls), parameter_choices(cls)
     table = TomlTable({} if params is None else params, f"{kind}.params", source)
     kwargs = {}
     for key in table.keys():
         if key not in fields:
-            table.fail(key, f"unknown parameter for {name!r} (known: {', '.join(sorted(fields)) or 'none'})")
+            known = sorted(set(fields) | set(also_known))
+            table.fail(key, f"unknown parameter for {name!r} (known: {', '.join(known) or 'none'})")
         kwargs[key] = table.typed(key, hints.get(key, typing.Any), ranges.get(key))
+        if key in choices and kwargs[key] is not None:
+            check_string(kwargs[key], table.path(key), source, choices[key])
     try:
         return cls(**kwargs)
     except ConfigError as exc:

@@ -15,15 +15,19 @@ from typing import Any
 import numpy as np
 
 from swarmnav.models.contained_files import is_input_path, name_problem  # noqa: F401 (name_problem: re-exported)
+from swarmnav.models.crowd_agents import reseed_agents
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.obstacle_motion import RandomWalkMotion
 from swarmnav.models.scenario_limits import (MAX_CONTROL_STEPS, MAX_GRID_CELLS, MAX_NAME_CHARS,  # noqa: F401
                                              MAX_PHYSICS_STEPS, MAX_SENSORS, MAX_TRACK_SAMPLES, MAX_WALK_STEPS,
                                              MIN_LENGTH_M, MIN_ROBOT_RADIUS_M, MIN_TIMESTEP_S)
+from swarmnav.models.scenario_boxes import read_boxes
 from swarmnav.models.scenario_map import check_grid_size, read_map_section
 from swarmnav.models.scenario_obstacles import MOTION_KINDS, Obstacle, ObstacleWorld, read_obstacles  # noqa: F401
 from swarmnav.models.seeds import Seeds
-from swarmnav.models.toml_table import NON_NEGATIVE, POSITIVE, TomlTable, parse_toml, read_text, within
+from swarmnav.models.occupancy import MAX_MAP_CELLS
+from swarmnav.models.robots import ROBOTS
+from swarmnav.models.toml_table import NON_NEGATIVE, POSITIVE, TomlTable, above, parse_toml, read_text, within
 from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem
 
 SCENARIO_DIR = FilePath(__file__).resolve().parent / "scenarios"
@@ -41,6 +45,8 @@ class SimSettings:
 
 
 SENSOR_MODELS = ("rangefinder", "detector")
+MAP_KNOWLEDGE = ("known", "unknown")
+POSE_SOURCES = ("truth", "odometry")
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,6 +86,32 @@ class Scenario:
     sensor_model: str = "rangefinder"
     # The user vouched for the file's code parameters (--trust-code): see models.parameters.refuse_code.
     trust_code: bool = False
+    # The robot of the catalogue (models.robots): ``robot.model``; its footprint collides in physics, and
+    # robot_radius_m (its circumscribed circle unless the file gives radius_m) is what planners plan for.
+    robot_model: str = "diff_drive"
+    # The rangefinders' field of view (degrees): 360 is a full ring, less a laser's fan centred ahead.
+    sensor_fov_deg: float = 360.0
+    # [knowledge]: what the robot is given.  map "known" (the static obstacles, in advance) or "unknown"
+    # (mapped online from the laser at map_cell_m, controllers.world_map); pose "truth" (the simulator's)
+    # or "odometry" (integrated wheel speeds, with encoder_noise: the relative standard deviation of each
+    # measured wheel speed, drawn from the world seed's streams).
+    map_knowledge: str = "known"
+    pose_source: str = "truth"
+    map_cell_m: float = 0.05
+    encoder_noise: float = 0.0
+
+    def with_knowledge(self, map_knowledge: str | None = None, pose_source: str | None = None) -> "Scenario":
+        """This scenario with the map or the pose source overridden (``--map`` / ``--pose``, a study axis).
+
+        Raises:
+            ConfigError: a value that is not one of :data:`MAP_KNOWLEDGE` / :data:`POSE_SOURCES`.
+        """
+        for name, value, choices in (("map", map_knowledge, MAP_KNOWLEDGE), ("pose", pose_source, POSE_SOURCES)):
+            if value is not None and value not in choices:
+                raise ConfigError(f"knowledge.{name}", f"must be one of {', '.join(choices)}, got {value!r}",
+                                  self.source_path)
+        return replace(self, map_knowledge=map_knowledge or self.map_knowledge,
+                       pose_source=pose_source or self.pose_source)
 
     @property
     def bounds(self) -> Rect:
@@ -100,8 +132,9 @@ class Scenario:
 
     def with_world_seed(self, world_seed: int) -> "Scenario":
         """This scenario with every random obstacle motion drawn from ``world_seed``."""
-        obstacles = tuple(replace(ob, motion=ob.motion.reseeded(world_seed))
-                          if isinstance(ob.motion, RandomWalkMotion) else ob for ob in self.obstacles)
+        obstacles = reseed_agents(tuple(replace(ob, motion=ob.motion.reseeded(world_seed))
+                                        if isinstance(ob.motion, RandomWalkMotion) else ob
+                                        for ob in self.obstacles), world_seed)
         return replace(self, obstacles=obstacles, world_seed=int(world_seed))
 
     def with_clearance(self, clearance_m: float, field_name: str = "clearance_m") -> "Scenario":
@@ -178,13 +211,22 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
     width_m, height_m = arena.number("width_m", bounds=POSITIVE), arena.number("height_m", bounds=POSITIVE)
     walls = arena.boolean("walls", False)
     arena.close()
-    robot_radius_m, max_speed_m_s, clearance_m = _robot(top.table("robot", {}))
+    robot_model, robot_radius_m, max_speed_m_s, clearance_m = _robot(top.table("robot", {}))
     start, goal, tolerance_m = _endpoints(top)
     sensors = top.table("sensors", {})
     sensor_count = sensors.integer("count", 12, bounds=within(1, MAX_SENSORS))
-    sensor_range_m = sensors.number("range_m", 0.4, bounds=within(MIN_LENGTH_M))
+    sensor_fov_deg = sensors.number("fov_deg", 360.0, bounds=above(0, 360))
+    sensor_range_m = sensors.number("range_m", ROBOTS[robot_model].default_range_m, bounds=within(MIN_LENGTH_M))
     sensor_model = sensors.string("model", "rangefinder", choices=SENSOR_MODELS)
     sensors.close()
+    knowledge = top.table("knowledge", {})
+    map_knowledge = knowledge.string("map", "known", choices=MAP_KNOWLEDGE)
+    pose_source = knowledge.string("pose", "truth", choices=POSE_SOURCES)
+    map_cell_m = knowledge.number("map_cell_m", 0.05, bounds=within(MIN_LENGTH_M))
+    encoder_noise = knowledge.number("encoder_noise", 0.0, bounds=within(0.0, 1.0))
+    knowledge.close()
+    if map_knowledge == "unknown":
+        check_grid_size(width_m, height_m, map_cell_m, "knowledge.map_cell_m", source, MAX_MAP_CELLS)
     planner_name, planner_params = _component(top.table("planner", {}), "astar")
     navigator_name, navigator_params = _component(top.table("navigator", {}), "follow")
     sim, cell_m, cell_given = _sim(top.table("sim", {}))
@@ -193,9 +235,9 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
     section = read_map_section(top, SCENARIO_DIR, width_m, height_m)
     if section is None:
         check_grid_size(width_m, height_m, cell_m, "sim.cell_m" if cell_given else "arena", source)
-    boxes = section.boxes if section is not None else ()
+    boxes = (section.boxes if section is not None else ()) + read_boxes(top, width_m, height_m)
     obstacles = read_obstacles(top, ObstacleWorld(width_m, height_m, walls, seed, time_limit_s, sim.control_hz,
-                                                  boxes, section is not None))
+                                                  boxes, section is not None, sim.timestep_s))
     top.close()
     map_grid = None
     if section is not None:
@@ -216,21 +258,25 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
         navigator_name=navigator_name, navigator_params=navigator_params, obstacles=obstacles,
         sim=sim, cell_m=cell_m, source_text=text, source_path=source, boxes=boxes, world_seed=seed,
         map_grid=map_grid, map_pairs=section.pairs if section is not None else (), sensor_model=sensor_model,
-        trust_code=bool(trust_code))
+        trust_code=bool(trust_code), robot_model=robot_model, sensor_fov_deg=sensor_fov_deg,
+        map_knowledge=map_knowledge, pose_source=pose_source, map_cell_m=map_cell_m, encoder_noise=encoder_noise)
     _check_endpoints(scenario, source)
     return scenario
 
 
-def _robot(robot: TomlTable) -> tuple[float, float, float]:
-    """``[robot]``: radius, top speed and planning clearance (metres, metres per second, metres)."""
-    radius_m = robot.number("radius_m", 0.15, bounds=POSITIVE)
+def _robot(robot: TomlTable) -> tuple[str, float, float, float]:
+    """``[robot]``: the catalogue model (:mod:`models.robots`), then its planning radius, top speed and
+    planning clearance (metres, metres per second, metres), the model's defaults where the file gives none."""
+    model_name = robot.string("model", "diff_drive", choices=tuple(ROBOTS))
+    model = ROBOTS[model_name]
+    radius_m = robot.number("radius_m", model.planning_radius_m, bounds=POSITIVE)
     if radius_m < MIN_ROBOT_RADIUS_M:
         robot.fail("radius_m", f"must be at least {MIN_ROBOT_RADIUS_M:g} m (the smallest base modelled), "
                                f"got {radius_m:g}")
-    max_speed_m_s = robot.number("max_speed_m_s", 0.2, bounds=POSITIVE)
+    max_speed_m_s = robot.number("max_speed_m_s", model.max_speed_m_s, bounds=POSITIVE)
     clearance_m = robot.number("clearance_m", 0.05, bounds=NON_NEGATIVE)
     robot.close()
-    return radius_m, max_speed_m_s, clearance_m
+    return model_name, radius_m, max_speed_m_s, clearance_m
 
 
 def _endpoints(top: TomlTable) -> tuple[Pose2D, Pose2D, float]:

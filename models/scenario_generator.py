@@ -21,6 +21,9 @@ where the obstacles are put in the way.  Kinds:
 * ``corridor``: a corridor 1.6 m wide of static discs along the line; the cylinders drive at the robot in
   two lanes (head-on traffic).
 * ``mixed``: about a third crossing, the rest random walkers.
+* ``crowdnav_circle``, ``crowdnav_square``: CrowdNav's test cases (Chen et al. 2019), ``--humans N`` ORCA
+  humans, seen by them with ``--robot-visible``; their own arena, robot and sensing
+  (:mod:`swarmnav.models.crowdnav_scenarios`).
 
 Speeds are ``speed_ratio`` times the robot's top speed, radii are drawn in
 ``[radius_min_m, radius_max_m]``.  A request that cannot be met (more
@@ -34,12 +37,13 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from swarmnav.models.crowdnav_scenarios import CROWDNAV_KINDS, MAX_HUMANS, crowdnav_lines
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario_limits import MAX_MOVING_OBSTACLES, MAX_NAME_CHARS, MAX_SENSORS, MIN_LENGTH_M
 from swarmnav.models.toml_table import above, check_integer, check_number, check_string, within
 
 KINDS = ("crossing", "head_on", "overtake", "crowd", "fast_crossing", "dense_crowd", "door_patrol", "corridor",
-         "mixed")
+         "mixed") + CROWDNAV_KINDS
 ENDPOINT_INSET_M = 1.0
 SOURCE = "scenarios generate"
 
@@ -61,6 +65,8 @@ class GeneratorOptions:
     planner: str = "astar"
     navigator: str = "replan"
     name: str = ""
+    humans: int = 5  # crowdnav_* kinds only
+    robot_visible: bool = False  # crowdnav_* kinds only: the humans see the robot
 
     def check(self, kind: str) -> None:
         def bad(option: str, problem: str) -> None:
@@ -69,7 +75,10 @@ class GeneratorOptions:
             raise ConfigError("KIND", f"unknown kind {kind!r} (expected one of: {', '.join(KINDS)})", SOURCE)
         for f in fields(self):  # every option against its declared range first (NaN, inf, huge counts)
             option, value = f"--{f.name.replace('_', '-')}", getattr(self, f.name)
-            if f.name in OPTION_RANGES and f.type in ("int", int):
+            if f.type in ("bool", bool):
+                if not isinstance(value, bool):
+                    bad(f.name, f"expected true or false, got {value!r}")
+            elif f.name in OPTION_RANGES and f.type in ("int", int):
                 check_integer(value, option, SOURCE, OPTION_RANGES[f.name])
             elif f.name in OPTION_RANGES:
                 check_number(value, option, SOURCE, OPTION_RANGES[f.name])
@@ -110,7 +119,7 @@ OPTION_RANGES = {
     "obstacles": within(1, MAX_MOVING_OBSTACLES), "speed_ratio": above(0, 100),
     "radius_min_m": within(MIN_LENGTH_M, 100), "radius_max_m": within(MIN_LENGTH_M, 100),
     "arena_m": above(0, 200), "range_m": within(MIN_LENGTH_M, 1000), "sensor_count": within(1, MAX_SENSORS),
-    "robot_speed_m_s": above(0, 100), "time_limit_s": within(0, 1e6),
+    "robot_speed_m_s": above(0, 100), "time_limit_s": within(0, 1e6), "humans": within(1, MAX_HUMANS),
 }
 
 
@@ -120,7 +129,10 @@ def command_line(kind: str, seed: int, options: GeneratorOptions) -> str:
     default = GeneratorOptions()
     for f in fields(options):
         value = getattr(options, f.name)
-        if value != getattr(default, f.name):
+        if isinstance(value, bool):
+            if value:
+                parts.append(f"--{f.name.replace('_', '-')}")
+        elif value != getattr(default, f.name):
             parts.append(f"--{f.name.replace('_', '-')} {value:g}" if isinstance(value, float)
                          else f"--{f.name.replace('_', '-')} {value}")
     return " ".join(parts)
@@ -136,6 +148,12 @@ def generate(kind: str, seed: int, options: GeneratorOptions | None = None) -> s
     options.check(kind)
     if seed < 0:
         raise ConfigError("--seed", f"must not be negative, got {seed}", SOURCE)
+    if kind in CROWDNAV_KINDS:
+        head, obstacles = crowdnav_lines(kind, seed, options.humans, options.robot_visible, options.time_limit_s,
+                                         options.planner, options.navigator)
+        name = options.name or f"{kind.replace('_', '-')}-{seed}"
+        return _text([f'name = "{name}"', f'description = "Generated: {command_line(kind, seed, options)}"',
+                      f"seed = {seed}"] + head, obstacles)
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(KINDS.index(kind),)))
     w = options.arena_m
     y_line = w / 2.0
@@ -163,6 +181,10 @@ def generate(kind: str, seed: int, options: GeneratorOptions | None = None) -> s
         f'navigator = {{ name = "{options.navigator}", params = {{}} }}',
         "sim = { cell_m = 0.1 }",
     ]
+    return _text(lines, obstacles)
+
+
+def _text(lines: list[str], obstacles) -> str:
     for x, y, r, motion in obstacles:
         lines += ["", "[[obstacles]]", f"x = {x:.4f}", f"y = {y:.4f}", f"radius_m = {r:.4f}"]
         if motion is not None:  # None: a static disc (the walls of doors and corridors)

@@ -7,7 +7,7 @@ Each is checked before anything of that size is allocated, so an oversized reque
 from __future__ import annotations
 
 MAX_NAME_CHARS = 64            # ``name`` becomes part of the default log file name
-MAX_SENSORS = 360              # rangefinders, evenly spaced (1 degree apart at most)
+MAX_SENSORS = 1080             # rangefinder beams: a 270 degree laser at 0.25 degree (Hokuyo UTM-30LX class)
 MIN_ROBOT_RADIUS_M = 0.05      # smaller robots than the base scaled to 1/3 of its size are not modelled
 MAX_GRID_CELLS = 16_000_000    # the planning grid: 200 x 200 m at 0.05 m per cell
 MAX_CONTROL_STEPS = 1_000_000  # time_limit_s x control_hz (the runner keeps every pose): 5.5 h at 50 Hz

@@ -11,14 +11,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from swarmnav.models.crowd_agents import AGENT_KINDS, MAX_V_PREF_M_S, AgentMotion, AgentSpec, Crowd
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.obstacle_motion import WALK_STEPS, LinearMotion, RandomWalkMotion, Stationary, WaypointMotion
 from swarmnav.models.scenario_limits import (MAX_MOVING_OBSTACLES, MAX_STATIC_OBSTACLES, MAX_TRACK_SAMPLES,
                                              MAX_WALK_STEPS, MIN_LENGTH_M)
-from swarmnav.models.toml_table import NON_NEGATIVE, POSITIVE, TomlTable, within
+from swarmnav.models.toml_table import NON_NEGATIVE, POSITIVE, TomlTable, above, within
 from swarmnav.models.world import Box
 
-MOTION_KINDS = ("linear", "random_walk", "waypoints")
+MOTION_KINDS = ("linear", "random_walk", "waypoints") + AGENT_KINDS
 
 
 @dataclass(frozen=True)
@@ -29,7 +30,7 @@ class Obstacle:
     y_m: float
     radius_m: float
     height_m: float
-    motion: LinearMotion | RandomWalkMotion | WaypointMotion | None = None
+    motion: LinearMotion | RandomWalkMotion | WaypointMotion | AgentMotion | None = None
 
     @property
     def moving(self) -> bool:
@@ -51,6 +52,7 @@ class ObstacleWorld:
     control_hz: float
     boxes: tuple[Box, ...]
     on_map: bool  # the scenario has a [map]: random walks take the map's grid steps by default
+    timestep_s: float = 0.002  # the physics step: agents are stepped once per whole control period of them
 
 
 @dataclass(frozen=True)
@@ -88,16 +90,39 @@ def read_obstacles(top: TomlTable, world: ObstacleWorld) -> tuple[Obstacle, ...]
     _check_motion_size(placed, world, top.source)
     box_array_m = np.array([[b.x_min_m, b.y_min_m, b.x_max_m, b.y_max_m] for b in world.boxes],
                            dtype=float).reshape(-1, 4)
-    obstacles = []
+    motions: list = []
+    agents: list[tuple[int, AgentSpec]] = []
     for i, p in enumerate(placed):
         motion = None
         if p.motion is not None:
             m = p.table.table("motion")
             motion = _motion(m, p, i, world, static_centres, static_radii, box_array_m)
+            if isinstance(motion, AgentSpec):
+                agents.append((i, motion))
             m.close()
         p.table.close()
-        obstacles.append(Obstacle(p.x_m, p.y_m, p.radius_m, p.height_m, motion))
-    return tuple(obstacles)
+        motions.append(motion)
+    if agents:
+        _bind_crowd(motions, agents, world, np.column_stack([static_centres, static_radii]), box_array_m,
+                    top.source)
+    return tuple(Obstacle(p.x_m, p.y_m, p.radius_m, p.height_m, motion) for p, motion in zip(placed, motions))
+
+
+def _bind_crowd(motions: list, agents: list[tuple[int, AgentSpec]], world: ObstacleWorld, discs: np.ndarray,
+                boxes: np.ndarray, source: str | None) -> None:
+    """One :class:`Crowd` for every agent of the scenario; each agent's motion becomes its place in it."""
+    seen = {spec.sees_robot for _, spec in agents}
+    if len(seen) > 1:
+        first = next(i for i, spec in agents if spec.sees_robot != agents[0][1].sees_robot)
+        raise ConfigError(f"obstacles[{first}].motion.sees_robot", "must be the same for every agent of a "
+                          f"scenario (obstacles[{agents[0][0]}] has {str(agents[0][1].sees_robot).lower()})", source)
+    k = max(int(round(1.0 / (world.control_hz * world.timestep_s))), 1)
+    dt_s = k * world.timestep_s
+    steps = int(math.floor(world.time_limit_s / dt_s + 1e-9))
+    crowd = Crowd(tuple(spec for _, spec in agents), discs, boxes, (world.width_m, world.height_m), world.walls,
+                  dt_s, steps, world.seed)
+    for k_agent, (i, _) in enumerate(agents):
+        motions[i] = AgentMotion(crowd, k_agent)
 
 
 def _place(t: TomlTable, world: ObstacleWorld) -> _Placed:
@@ -131,23 +156,40 @@ def _motion(m: TomlTable, p: _Placed, index: int, world: ObstacleWorld, static_c
             world.time_limit_s, lower, upper, static_centres, static_radii, stream=index, world_seed=world.seed,
             static_boxes_m=box_array_m,
             steps=m.string("steps", "grid" if world.on_map else "compass", choices=WALK_STEPS), start_s=start_s)
+    if kind in AGENT_KINDS:
+        return _agent(m, p, kind, world, start_s)
     points = _points(m, world)
     return WaypointMotion(np.vstack([[p.x_m, p.y_m], points]), m.number("speed_m_s", bounds=POSITIVE), start_s)
 
 
-def _points(m: TomlTable, world: ObstacleWorld) -> np.ndarray:
-    """A waypoint motion's ``points``: [x, y] pairs inside the arena."""
-    points = m.raw("points")
+def _agent(m: TomlTable, p: _Placed, kind: str, world: ObstacleWorld, start_s: float) -> AgentSpec:
+    """An agent's ``goal = [x, y]`` (walks there and stays) or ``goals`` (a loop of two or more points)."""
+    if m.has("goal") == m.has("goals"):
+        m.fail("goal", "an agent needs exactly one of goal = [x, y] and goals = [[x, y], ...] (a loop)")
+    if m.has("goal"):
+        goals = _points(m, world, "goal", [m.raw("goal")])
+    else:
+        goals = _points(m, world, "goals")
+        if len(goals) < 2:
+            m.fail("goals", "a loop needs at least two points (one goal: goal = [x, y])")
+    v_pref = m.number("v_pref_m_s", 1.0, bounds=above(0.0, MAX_V_PREF_M_S))
+    return AgentSpec(kind, (p.x_m, p.y_m), p.radius_m, tuple((float(x), float(y)) for x, y in goals), v_pref,
+                     m.boolean("sees_robot", False), start_s)
+
+
+def _points(m: TomlTable, world: ObstacleWorld, key: str = "points", points=None) -> np.ndarray:
+    """A motion's ``points`` (or ``key``): [x, y] pairs inside the arena."""
+    points = m.raw(key) if points is None else points
     if (not isinstance(points, list) or not points
             or not all(isinstance(p, list) and len(p) == 2 and all(
                 isinstance(v, (int, float)) and not isinstance(v, bool) for v in p) for p in points)):
-        m.fail("points", "expected a non-empty array of [x, y] number pairs")
+        m.fail(key, "expected [x, y]" if key == "goal" else "expected a non-empty array of [x, y] number pairs")
     arr = np.array(points, dtype=float)
     if not np.all(np.isfinite(arr)):
-        m.fail("points", "must be finite")
+        m.fail(key, "must be finite")
     outside = np.flatnonzero((arr < 0.0).any(axis=1) | (arr[:, 0] > world.width_m) | (arr[:, 1] > world.height_m))
     if len(outside):
-        m.fail(f"points[{outside[0]}]", f"({arr[outside[0], 0]:g}, {arr[outside[0], 1]:g}) must lie "
+        m.fail(key if key == "goal" else f"{key}[{outside[0]}]", f"({arr[outside[0], 0]:g}, {arr[outside[0], 1]:g}) must lie "
                                         f"in the arena [0, {world.width_m:g}] x [0, {world.height_m:g}]")
     return arr
 

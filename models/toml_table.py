@@ -31,11 +31,13 @@ REQUIRED: Any = ...
 
 @dataclass(frozen=True)
 class Range:
-    """The values a number may take: ``low``..``high``, ``low`` itself excluded when ``low_open``."""
+    """The values a number may take: ``low``..``high``, ``low`` (``high``) itself excluded when ``low_open``
+    (``high_open``)."""
 
     low: float
     high: float
     low_open: bool = False
+    high_open: bool = False
 
     def holds(self, value: float) -> bool:
         try:
@@ -43,21 +45,23 @@ class Range:
                 return False
         except OverflowError:  # an integer beyond any float
             return False
-        return (self.low < value if self.low_open else self.low <= value) and value <= self.high
+        return (self.low < value if self.low_open else self.low <= value) and \
+            (value < self.high if self.high_open else value <= self.high)
 
     def requirement(self) -> str:
         """What a value outside the range must be, in words (``must be positive``, ``must be in [0, 1]``)."""
-        if self.high == math.inf:
+        if self.high == math.inf and not self.high_open:
             if self.low == 0.0:
                 return "must be positive" if self.low_open else "must not be negative"
             if not self.low_open:
                 return f"must be at least {_shown_number(self.low)}"
-        if self.low == -math.inf and not self.low_open:
+        if self.low == -math.inf and not self.low_open and not self.high_open:
             return f"must be at most {_shown_number(self.high)}"
         return f"must be in {self}"
 
     def __str__(self) -> str:
-        return f"{'(' if self.low_open else '['}{_shown_number(self.low)}, {_shown_number(self.high)}]"
+        return (f"{'(' if self.low_open else '['}{_shown_number(self.low)}, {_shown_number(self.high)}"
+                f"{')' if self.high_open else ']'}")
 
 
 def _shown_number(value: float) -> str:

@@ -20,9 +20,11 @@ with ``a`` near 0 as the paper's 100 iterations do.
 Deviations from Abdulla & Hadi (2025), each our reading:
 
 * Sect. 3, Eqs. (6)-(8): the paper's objective is ``w1 F1 + w2 F2`` with no obstacle term
-  and no values of ``w1``, ``w2``; we add Kamil et al.'s (2020) penalty Eqs. (3)-(5) with
-  weight 1 (the same group's ABC paper; without an obstacle term nothing keeps a path out
-  of a disc) and default to ``w1 = 1``, ``w2 = 0`` (the length its Sect. 6 compares);
+  and no values of ``w1``, ``w2``; we add Kamil et al.'s (2020) penalty Eqs. (3)-(5) (the
+  same group's ABC paper; without an obstacle term nothing keeps a path out of a disc) with
+  paper mode's weight 1000 and 2 cm margin (:mod:`planners.run_settings`: with weight 1 the
+  best wolf cuts a disc on gwo-scenario-1 and -3 for every seed tried) and default to
+  ``w1 = 1``, ``w2 = 0`` (the length its Sect. 6 compares);
 * Sect. 6: "a population size of 0.5" is read as 50 wolves;
 * Eq. (25) divides by 3, not by the extraction's 2 (see above).
 

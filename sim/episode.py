@@ -1,8 +1,16 @@
 """The one run composition: an episode spec in, a plan and a simulated run out.
 
 Everything that plans and simulates a scenario (the CLI's ``plan`` and ``run``,
-``replay --verify``, the benchmarks, studies, the tests) goes through
-:func:`plan_episode` and :func:`run_episode`; nothing else assembles a run.
+the API, ``replay --verify``, the benchmarks, studies, given paths, the environment's
+path, the tests) goes through :func:`compose` and :func:`plan_episode` (or
+:func:`given_episode`) and :func:`run_episode`; nothing else resolves a spec, builds a
+run's components or an :class:`Episode`.
+
+The flow of one run: an :class:`EpisodeSpec` (what the user named) is resolved once
+(:meth:`EpisodeSpec.resolved`), its components are built once (:func:`compose`: the
+planner under its budget, the navigator and the safety layer after it), the path is
+planned (or given), and :func:`run_episode` hands the same components to the stepper's
+closed loop (:meth:`sim.runner.Simulation.run`).
 
 Parameters resolve in one place (:meth:`EpisodeSpec.resolved`): a scenario's own
 planner (navigator) parameters apply when the spec names the same planner
@@ -15,9 +23,10 @@ or the world seed :meth:`Scenario.with_world_seed` set).  The planner draws from
 ``default_rng(seed)``; the navigator from its own stream,
 ``SeedSequence(seed, spawn_key=(1,))``, so a navigator's draws never shift the plan.
 
-:func:`plan_episode` builds the planner and the navigator once (a bad parameter of
-either fails before planning) and plans; :func:`run_episode` runs that planned
-episode with them, on a :class:`~sim.runner.Simulation` compiled once per episode.
+:func:`compose` builds the planner, the navigator and its safety layer once (a bad
+parameter of any fails before planning); :func:`plan_episode` plans with them;
+:func:`run_episode` runs that planned episode with them, on a
+:class:`~sim.runner.Simulation` compiled once per episode.
 """
 
 from __future__ import annotations
@@ -28,11 +37,12 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from swarmnav.models.errors import ConfigError
-
 from swarmnav.controllers.navigator import NavigationSetup, Navigator
-from swarmnav.controllers.navigators import NAVIGATORS, make_navigator
+from swarmnav.controllers.navigators import NAVIGATORS, make_driver
 from swarmnav.controllers.point_to_point import PointToPointController
+from swarmnav.controllers.safety_layer import SafetyLayer
+from swarmnav.controllers.world_map import SensedMap
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario
 from swarmnav.models.parameters import refuse_code
 from swarmnav.models.seeds import Seeds
@@ -100,9 +110,8 @@ class EpisodeSpec:
                         scenario.source_path)
         planner_params = {**from_file[0], **(self.planner_params or {})}
         navigator_params = {**from_file[1], **(self.navigator_params or {})}
-        fallback = scenario.seeds
-        seed = fallback.planner if self.seed is None else int(self.seed)
-        world_seed = fallback.world if self.world_seed is None else int(self.world_seed)
+        seeds = self.seeds
+        seed, world_seed = seeds.planner, seeds.world
         if world_seed != scenario.world_seed:
             scenario = scenario.with_world_seed(world_seed)
         if self.clearance_m is not None:
@@ -112,26 +121,28 @@ class EpisodeSpec:
 
     @property
     def seeds(self) -> Seeds:
-        """The run's seeds, the scenario's where this spec names none."""
-        spec = self if self.seed is not None and self.world_seed is not None else self.resolved()
-        return Seeds(spec.seed, spec.world_seed)
+        """The run's seeds, the scenario's where this spec names none (the one place of that fallback)."""
+        fallback = self.scenario.seeds
+        return Seeds(fallback.planner if self.seed is None else int(self.seed),
+                     fallback.world if self.world_seed is None else int(self.world_seed))
 
 
 @dataclass(eq=False)
 class Episode:
     """A planned (and, once run, simulated) episode: the resolved spec, its problem and path, and the
-    planner and navigator built for it (once: :func:`run_episode` uses these)."""
+    planner, navigator and safety layer built for it (once: :func:`run_episode` uses these)."""
 
     spec: EpisodeSpec  # resolved
     problem: Problem
     path: Path
     planner: Planner
-    navigator: Navigator
+    navigator: Navigator | None  # None: planned only (plan_episode(drive=False)), never run
     scene: CompiledScene | None = field(default=None, repr=False)  # the scene to run; None: the scenario's
     result: RunResult | None = None
     _simulation: Simulation | None = field(default=None, repr=False)
     planner_params: dict[str, Any] = field(default_factory=dict)  # every parameter of the planner, resolved
     budgeted: bool = False  # the planner runs under ``spec.budget``
+    safety: SafetyLayer | None = None  # the layer after the navigator (controllers.safety_layer); None: none
 
     @property
     def simulation(self) -> Simulation:
@@ -163,30 +174,81 @@ class Episode:
         return out
 
 
-def plan_episode(spec: EpisodeSpec, scene: CompiledScene | None = None) -> Episode:
-    """Resolve the spec, build its planner and navigator, and plan on the scenario's obstacles at t = 0.
+@dataclass(frozen=True, eq=False)
+class Composition:
+    """A resolved spec and the components built from it, each once: what :func:`plan_episode` plans with
+    and :func:`run_episode` runs."""
+
+    spec: EpisodeSpec  # resolved
+    planner: Planner
+    budgeted: bool  # the planner runs under ``spec.budget``
+    navigator: Navigator | None  # None: composed to plan only (the environment's path)
+    safety: SafetyLayer | None
+
+    def episode(self, problem: Problem, path: Path, scene: CompiledScene | None = None) -> Episode:
+        """The :class:`Episode` of this composition with its first path."""
+        return Episode(self.spec, problem, path, self.planner, self.navigator, scene,
+                       planner_params=resolved_params(self.planner), budgeted=self.budgeted, safety=self.safety)
+
+
+def compose(spec: EpisodeSpec | Composition, drive: bool = True) -> Composition:
+    """Resolve the spec and build its components once: the planner (under the spec's budget) and, with
+    ``drive``, the navigator and its safety layer (a composition given is returned as it is).
+
+    Raises:
+        ConfigError: unknown planner or navigator, or a bad parameter (naming the field).
+    """
+    if isinstance(spec, Composition):
+        return spec
+    spec = spec.resolved()
+    planner, budgeted = build_planner(spec)
+    navigator, safety = make_driver(spec.navigator, spec.navigator_params, spec.scenario.source_path) \
+        if drive else (None, None)
+    return Composition(spec, planner, budgeted, navigator, safety)
+
+
+def plan_episode(spec: EpisodeSpec | Composition, scene: CompiledScene | None = None,
+                 drive: bool = True) -> Episode:
+    """Compose the spec (:func:`compose`) and plan on the scenario's obstacles at t = 0.
 
     Args:
         scene: a compiled scene to run instead of compiling the scenario (replay runs the MJCF
             its log carries).
+        drive: build the navigator and its layer too (False: a path only, e.g. the environment's).
 
     Raises:
         ConfigError: unknown planner or navigator, or a bad parameter (naming the field).
         PlanningError: the planner found no path.
     """
-    spec = spec.resolved()
-    source = spec.scenario.source_path
-    planner, budgeted = build_planner(spec)
-    navigator = make_navigator(spec.navigator, spec.navigator_params, source)  # fails before planning
-    problem = scenario_problem(spec.scenario)
+    parts = compose(spec, drive)  # a bad parameter fails before planning
+    scenario = parts.spec.scenario
+    # With the map unknown the first plan sees no static obstacle (moving ones neither: nothing is sensed yet).
+    problem = scenario_problem(scenario) if scenario.map_knowledge == "known" else unknown_map_problem(scenario)
     try:
-        path = planner.plan(problem, np.random.default_rng(spec.seed))
+        path = parts.planner.plan(problem, np.random.default_rng(parts.spec.seed))
     except ConfigError as exc:  # a limit the planner met on this scenario: name the file too
         if exc.source is not None:
             raise
-        raise ConfigError(exc.field, exc.problem, source) from None
-    return Episode(spec, problem, path, planner, navigator, scene, planner_params=resolved_params(planner),
-                   budgeted=budgeted)
+        raise ConfigError(exc.field, exc.problem, scenario.source_path) from None
+    return parts.episode(problem, path, scene)
+
+
+def given_episode(spec: EpisodeSpec | Composition, waypoints: np.ndarray, source: str) -> Episode:
+    """An episode whose path is the given waypoints instead of a plan (``run --waypoints``), composed as
+    every run is (the spec's planner still serves a navigator that replans).
+
+    Raises:
+        ConfigError: a bad component or parameter, or waypoints that leave the arena (naming ``source``).
+    """
+    from swarmnav.sim.given_path import given_path
+    parts = compose(spec)
+    problem, path = given_path(parts.spec.scenario, waypoints, source)
+    return parts.episode(problem, path)
+
+
+def unknown_map_problem(scenario: Scenario) -> Problem:
+    """What the robot knows at t = 0 with the map unknown: the arena, its start and goal, no obstacle."""
+    return scenario_problem(replace(scenario, obstacles=(), boxes=(), map_grid=None))
 
 
 def build_planner(spec: EpisodeSpec) -> tuple[Any, bool]:
@@ -217,21 +279,29 @@ def run_episode(episode: Episode | EpisodeSpec, recorders: Sequence[Recorder] = 
     spec, simulation = planned.spec, planned.simulation
     scenario = spec.scenario
     navigator = planned.navigator
+    if navigator is None:
+        raise ValueError("this episode was planned without a navigator (plan_episode(drive=False)): nothing to run")
+    unknown = scenario.map_knowledge == "unknown"
+    known_problem = static_problem(scenario) if not unknown else planned.problem
+    world_map = SensedMap(planned.problem, scenario.bounds, scenario.map_cell_m) if unknown else None
     setup = NavigationSetup(
-        path=planned.path, problem=planned.problem, planner=planned.planner if navigator.uses_planner else None,
+        path=planned.path, problem=planned.problem,
+        # With the map unknown every navigator that plans replans its (guidance) path on the sensed map.
+        planner=planned.planner if navigator.uses_planner or unknown else None,
         rng=np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(NAVIGATOR_STREAM,))),
         controller=PointToPointController(simulation.scene.drive, max_speed_m_s=scenario.max_speed_m_s),
         goal=simulation.goal_checker(), control_dt_s=simulation.control_dt_s,
-        max_speed_m_s=scenario.max_speed_m_s, known_problem=static_problem(scenario),
-        scenario=scenario)
+        max_speed_m_s=scenario.max_speed_m_s, known_problem=known_problem,
+        scenario=scenario, world_map=world_map)
     recorder = RecorderGroup(list(recorders)) if recorders else None
     # The log records every resolved parameter (replaying them builds the same planner).
     context = simulation.context(spec.planner, planned.planner_params or spec.planner_params, spec.seed,
                                  spec.navigator, spec.navigator_params) if recorder is not None else None
     result = simulation.run(navigator, setup, recorder=recorder, context=context,
-                            time_limit_s=time_limit_s, stop_on_collision=stop_on_collision)
+                            time_limit_s=time_limit_s, stop_on_collision=stop_on_collision,
+                            safety=planned.safety)
     return replace(planned, result=result)
 
 
-__all__ = ["Episode", "EpisodeSpec", "NAVIGATOR_STREAM", "build_planner", "json_safe", "plan_episode",
-           "reference_length_m", "resolved_params", "run_episode", "static_problem"]
+__all__ = ["Composition", "Episode", "EpisodeSpec", "NAVIGATOR_STREAM", "build_planner", "compose", "given_episode",
+           "json_safe", "plan_episode", "reference_length_m", "resolved_params", "run_episode", "static_problem"]

@@ -18,6 +18,12 @@ file's choosing.
 
 A plugin that fails to import, is not a class, or takes a name already registered (a bundled one or another
 plugin's) is one warning line on stderr naming the distribution, and is skipped; the rest works.
+
+Every place that looks a component up by name loads the plugins first (:func:`load_plugins`): the command line,
+the API's calls, a study's validation, each study cell in a local worker or a Ray task
+(:func:`swarmnav.sim.study.cell.run_cell`) and the environment.  A process scans the entry points again when
+its ``sys.path`` changed since the last scan (a script that put a plugin's folder on it), loading only the
+entries it has not seen.
 """
 
 from __future__ import annotations
@@ -32,7 +38,10 @@ GROUPS = ("swarmnav.planners", "swarmnav.navigators", "swarmnav.scenarios")
 
 #: ``(kind, name) -> "distribution version"`` of every component a plugin registered.
 ORIGINS: dict[tuple[str, str], str] = {}
-_loaded = False
+#: ``distribution name -> version`` of every plugin whose components (or scenario folder) were registered.
+DISTRIBUTIONS: dict[str, str] = {}
+_scanned_path: tuple[str, ...] | None = None  # sys.path at the last scan
+_seen: set[tuple[str, str, str]] = set()  # (group, name, value) of every entry point already handled
 
 
 def _distribution(entry: importlib.metadata.EntryPoint) -> str:
@@ -67,6 +76,13 @@ def _register(entry: importlib.metadata.EntryPoint, kind: str, registry: dict[st
             _warn(entry, str(exc))
             return
         ORIGINS[(kind, cls.name)] = _distribution(entry)
+        _record_distribution(entry)
+
+
+def _record_distribution(entry: importlib.metadata.EntryPoint) -> None:
+    dist = getattr(entry, "dist", None)
+    if dist is not None:
+        DISTRIBUTIONS[dist.name] = dist.version
 
 
 def _scenario_folder(entry: importlib.metadata.EntryPoint) -> FilePath | None:
@@ -82,24 +98,44 @@ def _scenario_folder(entry: importlib.metadata.EntryPoint) -> FilePath | None:
     return path
 
 
+def _new_entries(group: str) -> list[importlib.metadata.EntryPoint]:
+    """The entry points of ``group`` not handled by an earlier scan (each distribution's first of a name)."""
+    out = []
+    for entry in importlib.metadata.entry_points(group=group):
+        key = (group, entry.name, entry.value)
+        if key not in _seen:
+            _seen.add(key)
+            out.append(entry)
+    return out
+
+
 def load_plugins() -> None:
-    """Register every installed plugin once per process (later calls do nothing)."""
-    global _loaded
-    if _loaded:
+    """Register every installed plugin; again only when ``sys.path`` changed since the last call (then only
+    the entry points not seen before), so it costs nothing where it is called on every lookup."""
+    global _scanned_path
+    path = tuple(sys.path)
+    if path == _scanned_path:
         return
-    _loaded = True
+    _scanned_path = path
     from swarmnav.controllers import navigators
     from swarmnav.models import scenario
     from swarmnav.planners import registry
 
-    for entry in importlib.metadata.entry_points(group="swarmnav.planners"):
+    for entry in _new_entries("swarmnav.planners"):
         _register(entry, "planner", registry.PLANNERS, registry.register)
-    for entry in importlib.metadata.entry_points(group="swarmnav.navigators"):
+    for entry in _new_entries("swarmnav.navigators"):
         _register(entry, "navigator", navigators.NAVIGATORS, navigators.register)
-    for entry in importlib.metadata.entry_points(group="swarmnav.scenarios"):
+    for entry in _new_entries("swarmnav.scenarios"):
         folder = _scenario_folder(entry)
         if folder is not None and folder not in scenario.EXTRA_SCENARIO_DIRS:
             scenario.EXTRA_SCENARIO_DIRS.append(folder)
+            _record_distribution(entry)
+
+
+def distributions() -> dict[str, str]:
+    """``name -> version`` of the plugin distributions this process loaded (for a Ray node's check)."""
+    load_plugins()
+    return dict(sorted(DISTRIBUTIONS.items()))
 
 
 def origin(kind: str, name: str) -> str:
@@ -108,38 +144,24 @@ def origin(kind: str, name: str) -> str:
 
 
 def describe_components(kind: str) -> list[dict[str, Any]]:
-    """Every registered planner or navigator with its parameters (name, type, default, documented range if the
-    component declares one), its one-line description and its package: what ``swarmnav planners`` lists."""
-    import dataclasses
-    import typing
-
-    from swarmnav.models.parameters import parameter_ranges
+    """Every registered planner or navigator with its parameters (name, type, default, and its range or choices
+    where it declares them: :func:`models.parameters.parameter_table`, a navigator's safety layer switches
+    included), its one-line description and its package: what ``swarmnav planners`` lists."""
+    from swarmnav.models.parameters import parameter_table
     load_plugins()
     if kind == "planner":
         from swarmnav.planners.registry import PLANNERS as registry_map
+        table = lambda name: parameter_table(registry_map[name])  # noqa: E731
     else:
         from swarmnav.controllers.navigators import NAVIGATORS as registry_map
+        from swarmnav.controllers.navigators import navigator_table as table
     out = []
     for name in sorted(registry_map):
         cls = registry_map[name]
         doc = (cls.__doc__ or "").strip().splitlines()
-        try:
-            hints = typing.get_type_hints(cls)
-        except Exception:
-            hints = {}
-        ranges = {k: str(v) for k, v in parameter_ranges(cls).items()}  # merged along the class hierarchy
-        params = []
-        for f in (dataclasses.fields(cls) if dataclasses.is_dataclass(cls) else ()):
-            if not f.init:
-                continue
-            default = f.default if f.default is not dataclasses.MISSING else (
-                f.default_factory() if f.default_factory is not dataclasses.MISSING else None)
-            annotation = hints.get(f.name, f.type)
-            entry = {"name": f.name, "type": getattr(annotation, "__name__", str(annotation)),
-                     "default": _json_value(default)}
-            if f.name in ranges:
-                entry["range"] = _json_value(ranges[f.name])
-            params.append(entry)
+        params = [{"name": row["name"], "type": row["type"], "default": _json_value(row["default"]),
+                   **{key: _json_value(row[key]) for key in ("range", "choices") if row[key] is not None}}
+                  for row in table(name)]
         out.append({"name": name, "description": doc[0] if doc else "", "package": origin(kind, name),
                     "parameters": params})
     return out

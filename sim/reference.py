@@ -3,7 +3,9 @@
 What the robot knows in advance is the map: the scenario's problem with its
 moving obstacles left out (:func:`static_problem`).  L* is the exact shortest
 length on it (``optimal``'s ``optimum_length_m``, not its polygon's slightly
-longer length), or Theta*'s path length on a map of boxes.
+longer length), or Theta*'s path length on a map of boxes or among more than
+:data:`planners.path_guess.MAX_TANGENT_DISCS` static discs (BARN's worlds: the tangent graph of 200-300
+cylinders costs seconds a run).
 """
 
 from __future__ import annotations
@@ -13,10 +15,10 @@ from dataclasses import replace
 import numpy as np
 
 from swarmnav.models.scenario import Scenario
-from swarmnav.models.scenario_limits import MAX_TANGENT_GRAPH_DISCS
 from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.theta_star import ThetaStarPlanner
 from swarmnav.planners.optimal import OptimalPlanner
+from swarmnav.planners.path_guess import MAX_TANGENT_DISCS
 from swarmnav.planners.problem import Problem, scenario_problem
 
 
@@ -37,18 +39,16 @@ def _static_key(scenario: Scenario) -> tuple:
 
 
 def reference_length_m(scenario: Scenario) -> float | None:
-    """L* for SPL (see the module docstring); None when there is no path among the static obstacles, or when
-    they are more discs than an exact tangent graph takes (:data:`MAX_TANGENT_GRAPH_DISCS`).
+    """L* for SPL (see the module docstring); None when there is no path among the static obstacles.
 
     Cached by the static geometry (:func:`_static_key`).
     """
     key = _static_key(scenario)
     if key not in _REFERENCE_LENGTHS:
         problem = static_problem(scenario)
-        planner = ThetaStarPlanner() if problem.boxes or problem.grid_override is not None else OptimalPlanner()
-        if isinstance(planner, OptimalPlanner) and len(problem.obstacles) > MAX_TANGENT_GRAPH_DISCS:
-            _REFERENCE_LENGTHS[key] = None  # not computed: beyond the stated maximum of an exact graph
-            return None
+        # the exact tangent graph costs seconds beyond MAX_TANGENT_DISCS static discs (a BARN world has 200-300)
+        planner = (ThetaStarPlanner() if problem.boxes or problem.grid_override is not None
+                   or len(problem.obstacles) > MAX_TANGENT_DISCS else OptimalPlanner())
         try:
             stats = planner.plan(problem, np.random.default_rng(0)).stats
             _REFERENCE_LENGTHS[key] = float(stats.extra.get("optimum_length_m", stats.length_m))

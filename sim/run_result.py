@@ -9,12 +9,18 @@ from typing import Any
 import numpy as np
 
 
+#: Every way a run ends: the goal reached; the time limit; a collision that stopped the run
+#: (``stop_on_collision``); the robot's centre beyond an arena edge by more than its radius, or a given path
+#: (``run --waypoints``) with a waypoint outside the arena (``left_arena``).
+OUTCOMES = ("goal_reached", "timeout", "collision", "left_arena")
+
+
 @dataclass
 class RunResult:
     """What happened in one closed-loop run (arrays have one row per control step)."""
 
     reached: bool
-    outcome: str  # "goal_reached" | "timeout" | "collision"
+    outcome: str  # "goal_reached" | "timeout" | "collision" | "left_arena" (see OUTCOMES)
     collisions: int
     first_collision_s: float | None
     sim_time_s: float
@@ -36,11 +42,15 @@ class RunResult:
     navigator_wall_s: float = 0.0  # wall time spent in navigator.step (not in summary(): benchmarks read it)
     # Where the first collision began (time_s, x_m, y_m of the base, the obstacle geom's name, the robot geom's).
     first_contact: dict[str, Any] | None = None
+    # Among agents (orca / social_force obstacles) only: discomfort_frequency, min_separation_m,
+    # path_irregularity_rad_m (sim.crowd_stepping.crowd_metrics); None without agents (and not in the summary).
+    crowd: dict[str, float] | None = None
 
     @property
     def success(self) -> bool:
-        """Reached the goal before the time limit with no collision."""
-        return self.reached and self.collisions == 0
+        """Reached the goal before the time limit with no collision, never having left the arena (nor driven
+        a given path that leaves it: outcome ``left_arena``)."""
+        return self.reached and self.collisions == 0 and self.outcome == "goal_reached"
 
     @property
     def spl(self) -> float | None:
@@ -65,7 +75,7 @@ class RunResult:
                 "success": self.success, "time_to_goal_s": round(self.sim_time_s, 6) if self.reached else None,
                 "spl": self.spl, "time_in_danger_s": round(self.time_in_danger_s, 6), "replans": self.replans,
                 "replan_wall_s": round(self.replan_wall_s, 4), "stopped_s": round(self.stopped_s, 6),
-                "safety_triggers": self.safety_triggers}
+                "safety_triggers": self.safety_triggers, **(self.crowd or {})}
 
     def log_summary(self) -> dict[str, Any]:
         """:meth:`summary` without wall-clock figures other than ``wall_*`` (which the log writer drops)."""

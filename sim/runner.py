@@ -3,7 +3,9 @@
 :class:`Simulation` is a scenario's compiled scene; :meth:`Simulation.run` hands
 the navigator each observation of an :class:`~sim.stepper.EpisodeStepper` and the
 stepper each of the navigator's commands (with its new paths, events and belief),
-until the stepper reports an outcome.  The steps of a control period, and their
+passed first through the run's safety layer (:mod:`controllers.safety_layer`: the
+evasion and the safety filter, after the navigator as Nav2's Collision Monitor is after
+its controller), until the stepper reports an outcome.  The steps of a control period, and their
 order, are the stepper's (:mod:`sim.stepper`); the Gymnasium / dm_env environment
 drives the same stepper with a policy's actions, so the two cannot drift.
 """
@@ -18,6 +20,7 @@ import numpy as np
 
 from swarmnav.controllers.goal import GoalChecker
 from swarmnav.controllers.navigator import NavigationSetup, Navigator
+from swarmnav.controllers.safety_layer import SafetyLayer
 from swarmnav.models.scenario import Scenario
 from swarmnav.sim.recording import ObstacleInfo, Recorder, RunContext
 from swarmnav.sim.scene import CompiledScene, compile_scene
@@ -25,6 +28,9 @@ from swarmnav.sim.run_result import RunResult
 from swarmnav.sim.stepper import (EpisodeStepper, goal_checker, obstacle_positions, reset_data,
                                   steps_per_control)
 from swarmnav.sim.versions import software_versions
+
+
+MAP_LOG_PERIOD_S = 1.0  # the sensed map on /map: once a simulated second (Nav2 publishes its global costmap at 1 Hz)
 
 
 class Simulation:
@@ -77,8 +83,11 @@ class Simulation:
 
     def run(self, navigator: Navigator, setup: NavigationSetup, recorder: Recorder | None = None,
             context: RunContext | None = None, time_limit_s: float | None = None,
-            stop_on_collision: bool | None = None) -> RunResult:
+            stop_on_collision: bool | None = None, safety: SafetyLayer | None = None) -> RunResult:
         """Drive the robot with ``navigator`` until goal, timeout or (optionally) first collision.
+
+        ``safety``: the run's safety layer, applied to every answer of the navigator (None: none).
+        The navigator's wall time (``navigator_wall_s``) includes the layer's.
 
         The recorder, when given, is finished even if the loop raises, so what it
         wrote stays readable.  The result's SPL uses the stepper's L*.
@@ -87,14 +96,26 @@ class Simulation:
         navigator_wall_s = 0.0
         try:
             navigator.reset(setup)
+            layer = safety if safety is not None and safety.on else None
+            if layer is not None:
+                layer.reset(setup)
             stepper = self.stepper(time_limit_s=time_limit_s, stop_on_collision=stop_on_collision,
                                    recorder=recorder, context=context, path_m=setup.path.waypoints,
-                                   sense_obstacles=navigator.uses_detections)
+                                   sense_obstacles=navigator.uses_detections or layer is not None)
             observation = stepper.reset()
             clock = time.perf_counter
+            world_map = setup.world_map  # with the map unknown: fed every scan, before the navigator reads it
+            next_map_log_s = 0.0
             while not stepper.outcome:
+                if world_map is not None:
+                    world_map.observe(observation)
+                    if recorder is not None and observation.time_s >= next_map_log_s - 1e-9:
+                        next_map_log_s = observation.time_s + MAP_LOG_PERIOD_S
+                        recorder.occupancy(observation.time_s, world_map.grid)
                 nav0 = clock()
                 decision = navigator.step(observation)
+                if layer is not None:
+                    decision = layer.after(observation, decision)
                 navigator_wall_s += clock() - nav0
                 observation = stepper.step(decision.command, decision.belief, decision.new_path, decision.events)
         except BaseException as exc:

@@ -1,7 +1,8 @@
 """Compose the MuJoCo scene for a scenario with ``MjSpec``.
 
-``models/diff_drive/scene.xml`` (which includes ``robot.xml``) is the base.  We
-resize the robot to the scenario's radius and rangefinder setup, then add the
+The scenario's robot of the catalogue (:mod:`models.robots`: ``models/<robot>/scene.xml``, which includes
+its ``robot.xml``) is the base.  We resize the disc robot to the scenario's radius, lay out the
+rangefinders (the disc's ring on its rim, or a laser's fan from one site), then add the
 arena: walls, static cylinders (plain geoms), moving cylinders (mocap bodies,
 moved kinematically by the runner) and box obstacles from grid maps.  Every
 element gets a name.
@@ -17,11 +18,13 @@ import mujoco
 import numpy as np
 
 from swarmnav.controllers.kinematics import DriveGeometry
+from swarmnav.models.robots import ROBOTS
 from swarmnav.models.scenario import Scenario
 
 MODEL_DIR = FilePath(__file__).resolve().parent.parent / "models" / "diff_drive"
 SCENE_XML = MODEL_DIR / "scene.xml"
-ROBOT_BODIES = ("base_link", "left_wheel", "right_wheel")
+ROBOT_ROOT = "base_link"  # every body under it is the robot's
+LASER_SITE = "laser"  # the origin of a scanning laser's beams (see _set_laser)
 STATIC_RGBA = (0.55, 0.45, 0.38, 1.0)
 MOVING_RGBA = (0.95, 0.55, 0.1, 1.0)
 WALL_RGBA = (0.4, 0.4, 0.45, 1.0)
@@ -49,7 +52,7 @@ class CompiledScene:
     free_qpos_adr: int
     free_qvel_adr: int
     wheel_qvel_adr: tuple[int, int]
-    range_sensor_adr: np.ndarray   # (K,) sensordata indices of the rangefinders
+    range_sensor_adr: np.ndarray   # (K,) sensordata indices of the rangefinders (empty with a laser)
     range_angles_rad: np.ndarray   # (K,) beam directions in base_link, in [0, 2 pi), CCW from +x
     range_cutoff_m: float
     range_offset_m: float          # distance of the rangefinder sites from the base origin
@@ -59,17 +62,25 @@ class CompiledScene:
     obstacles: tuple[ObstacleGeom, ...]
     is_robot_geom: np.ndarray      # (ngeom,) bool
     is_obstacle_geom: np.ndarray   # (ngeom,) bool
+    laser_site_id: int = -1        # a scanning laser's origin site (sim.laser casts its beams), -1 with rangefinders
 
 
 def build_spec(scenario: Scenario) -> mujoco.MjSpec:
     """The scene for a scenario as an editable spec (not yet compiled)."""
-    spec = mujoco.MjSpec.from_file(str(SCENE_XML))
+    robot = ROBOTS[scenario.robot_model]
+    spec = mujoco.MjSpec.from_file(str(robot.scene_xml))
     spec.modelname = f"swarmnav_{scenario.name}"
     spec.option.timestep = scenario.sim.timestep_s
 
     radius = scenario.robot_radius_m
-    _fit_base(spec, radius)
-    _set_rangefinders(spec, scenario.sensor_count, radius, scenario.sensor_range_m)
+    if robot.round_chassis:
+        _fit_base(spec, radius)
+        _fit_top_speed(spec, scenario.max_speed_m_s)
+    if robot.ring_sensors and scenario.sensor_fov_deg == 360.0:
+        _set_rangefinders(spec, scenario.sensor_count, radius, scenario.sensor_range_m)
+    else:
+        _set_laser(spec, scenario.sensor_count, scenario.sensor_fov_deg, scenario.sensor_range_m,
+                   robot.ring_sensors)
 
     width, height = scenario.arena_width_m, scenario.arena_height_m
     floor = spec.geom("floor")
@@ -123,7 +134,7 @@ def _fit_base(spec: mujoco.MjSpec, radius_m: float) -> None:
     base_radius_m = float(chassis.size[0])
     if radius_m < base_radius_m:
         scale = radius_m / base_radius_m
-        for body in (spec.body(name) for name in ROBOT_BODIES):
+        for body in (spec.body(name) for name in ("base_link", "left_wheel", "right_wheel")):
             if body.name != "base_link":
                 body.pos = np.asarray(body.pos) * scale
             for geom in body.geoms:
@@ -136,25 +147,26 @@ def _fit_base(spec: mujoco.MjSpec, radius_m: float) -> None:
     chassis.size = [radius_m, chassis.size[1], 0.0]
 
 
+def _fit_top_speed(spec: mujoco.MjSpec, max_speed_m_s: float) -> None:
+    """Let the wheels turn fast enough for the scenario's top speed when the base's own limit is below it.
+
+    The base's wheel speed limit (10 rad/s on 0.04 m tyres: 0.4 m/s) stays as it is for every robot at or
+    below it; a faster robot (CrowdNav's, 1 m/s) gets the wheel speed ``max_speed_m_s / wheel radius``.
+    """
+    wheel_radius_m = float(spec.geom("left_wheel_tyre").size[0])
+    need_rad_s = max_speed_m_s / wheel_radius_m
+    for actuator in spec.actuators:
+        limit = float(np.abs(np.asarray(actuator.ctrlrange)).min())
+        if need_rad_s > limit:
+            actuator.ctrlrange = np.array([-need_rad_s, need_rad_s])
+
+
 def _set_rangefinders(spec: mujoco.MjSpec, count: int, body_radius_m: float, cutoff_m: float) -> None:
     """Place ``count`` rangefinders evenly on the rim, pointing outward, above the wheels."""
     template = spec.site("range_site_00")
     z = float(template.pos[2])
-    base = spec.body("base_link")
-    existing = [s for s in spec.sites if s.name.startswith("range_site_")]
-    if len(existing) != count:
-        # The XML's own sensor is the template (what it measures lives in intprm).
-        data_spec = np.array(spec.sensor("range_00").intprm)
-        for sensor in [s for s in spec.sensors if s.name.startswith("range_")]:
-            spec.delete(sensor)
-        for site in existing:
-            spec.delete(site)
-        site_class = spec.find_default("range")
-        for k in range(count):
-            base.add_site(name=f"range_site_{k:02d}", default=site_class)
-            sensor = spec.add_sensor(name=f"range_{k:02d}", type=mujoco.mjtSensor.mjSENS_RANGEFINDER,
-                                     objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"range_site_{k:02d}")
-            sensor.intprm = data_spec
+    # The XML's own sensor is the template (what it measures lives in intprm).
+    _replace_rangefinders(spec, count)
     rim = body_radius_m + 0.005
     for k in range(count):
         angle = 2.0 * math.pi * k / count
@@ -165,6 +177,56 @@ def _set_rangefinders(spec: mujoco.MjSpec, count: int, body_radius_m: float, cut
         mujoco.mju_quatZ2Vec(quat, np.array([math.cos(angle), math.sin(angle), 0.0]))
         site.quat = quat
         spec.sensor(f"range_{k:02d}").cutoff = cutoff_m
+
+
+def laser_angles_rad(count: int, fov_deg: float) -> np.ndarray:
+    """Beam directions of a laser: a full circle from straight ahead counter-clockwise (fov 360: no beam twice),
+    else ``count`` beams evenly from -fov/2 to +fov/2 (a LaserScan's angle_min to angle_max)."""
+    if fov_deg >= 360.0:
+        return 2.0 * math.pi * np.arange(count) / count
+    fov = math.radians(fov_deg)
+    return -fov / 2 + fov * np.arange(count) / max(count - 1, 1) if count > 1 else np.zeros(1)
+
+
+def _replace_rangefinders(spec: mujoco.MjSpec, count: int) -> None:
+    """``count`` rangefinder sites and sensors in place of the file's (the first is the template)."""
+    existing = [s for s in spec.sites if s.name.startswith("range_site_")]
+    if len(existing) == count:
+        return
+    data_spec = np.array(spec.sensor("range_00").intprm)
+    for sensor in [s for s in spec.sensors if s.name.startswith("range_")]:
+        spec.delete(sensor)
+    for site in existing:
+        spec.delete(site)
+    site_class = spec.find_default("range")
+    base = spec.body("base_link")
+    for k in range(count):
+        base.add_site(name=f"range_site_{k:02d}", default=site_class)
+        sensor = spec.add_sensor(name=f"range_{k:02d}", type=mujoco.mjtSensor.mjSENS_RANGEFINDER,
+                                 objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"range_site_{k:02d}")
+        sensor.intprm = data_spec
+
+
+def _set_laser(spec: mujoco.MjSpec, count: int, fov_deg: float, cutoff_m: float, centred: bool) -> None:
+    """A scanning laser: ``count`` beams over ``fov_deg`` (:func:`laser_angles_rad`) from one origin, the site
+    ``laser`` (the robot file's ``range_site_00``; put on the base's axis when ``centred``, as for the disc
+    robot's fan), declared by the numerics ``laser_count``, ``laser_fov_deg`` and ``laser_range_m``.
+
+    No rangefinder sensor remains: MuJoCo computes sensors at every physics step, and ``sim.laser`` casts
+    the beams once per control step with ``mj_multiRay`` instead (``bench sim`` measures both).
+    """
+    template = spec.site("range_site_00")
+    x, y, z = (float(v) for v in template.pos)
+    for sensor in [s for s in spec.sensors if s.name.startswith("range_")]:
+        spec.delete(sensor)
+    for site in [s for s in spec.sites if s.name.startswith("range_site_") and s.name != "range_site_00"]:
+        spec.delete(site)
+    template.name = LASER_SITE
+    template.pos = [0.0, 0.0, z] if centred else [x, y, z]
+    template.quat = [1.0, 0.0, 0.0, 0.0]
+    for name, value in (("laser_count", float(count)), ("laser_fov_deg", float(fov_deg)),
+                        ("laser_range_m", float(cutoff_m))):
+        spec.add_numeric(name=name, data=[value])
 
 
 def compile_scene(scenario: Scenario) -> CompiledScene:
@@ -203,9 +265,21 @@ def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
         offsets.append(math.hypot(p[0], p[1]))
         heights.append(float(p[2]))
     cutoff = float(model.sensor_cutoff[range_ids[0]]) if range_ids else 0.0
+    laser_site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, LASER_SITE)
+    if laser_site >= 0:
+        numeric = {name: float(model.numeric(name).data[0]) for name in ("laser_count", "laser_fov_deg",
+                                                                          "laser_range_m")}
+        angles = laser_angles_rad(int(round(numeric["laser_count"])), numeric["laser_fov_deg"]).tolist()
+        offsets = [0.0]
+        heights = [float(model.site_pos[laser_site][2])]
+        cutoff = numeric["laser_range_m"]
 
-    robot_bodies = {model.body(n).id for n in ROBOT_BODIES}
-    is_robot = np.array([model.geom_bodyid[g] in robot_bodies and model.geom_contype[g] + model.geom_conaffinity[g] > 0
+    root = model.body(ROBOT_ROOT).id
+    robot_bodies = {b for b in range(model.nbody) if model.body_rootid[b] == root}
+    # A robot geom that can touch an obstacle (contype / conaffinity 1, the obstacles' bit): wheels that
+    # touch only the floor (bit 2, the catalogue's box robots) are not.
+    is_robot = np.array([model.geom_bodyid[g] in robot_bodies and bool((model.geom_contype[g]
+                                                                        | model.geom_conaffinity[g]) & 1)
                          for g in range(model.ngeom)])
     obstacles = []
     is_obstacle = np.zeros(model.ngeom, dtype=bool)
@@ -225,4 +299,4 @@ def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
         range_offset_m=float(np.mean(offsets)) if offsets else 0.0,
         range_height_m=float(np.mean(heights)) if heights else 0.0,
         robot_geom_ids=np.flatnonzero(is_robot), chassis_geom_id=gid("chassis"),
-        obstacles=tuple(obstacles), is_robot_geom=is_robot, is_obstacle_geom=is_obstacle)
+        obstacles=tuple(obstacles), is_robot_geom=is_robot, is_obstacle_geom=is_obstacle, laser_site_id=laser_site)

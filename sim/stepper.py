@@ -47,7 +47,9 @@ from swarmnav.planners.problem import Path
 from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
 from swarmnav.sim.contact import ContactMonitor
 from swarmnav.sim.control_period import control_periods, steps_per_control
+from swarmnav.sim.crowd_stepping import ReactiveCrowd, crowd_metrics, human_columns
 from swarmnav.sim.detector import ObstacleSensing
+from swarmnav.sim.laser import LaserCaster
 from swarmnav.sim.recording import Recorder, RunContext, StepFrame
 from swarmnav.sim.reference import reference_length_m as shortest_static_length_m
 from swarmnav.sim.run_result import RunResult
@@ -122,7 +124,11 @@ class EpisodeStepper:
         self.recorder = recorder
         self.context = context
         self.path_m = path_m
-        self.sense_obstacles = bool(sense_obstacles)
+        # With the map unknown and the rays as the sensing (Nav2's obstacle layer), every hit goes to the
+        # sensed map (controllers.world_map), moving obstacles' too: the ray tracker, which tells unknown
+        # hits from the known map's, has no map to tell them from, and makes no detections.
+        self.sense_obstacles = bool(sense_obstacles) and not (scenario.map_knowledge == "unknown"
+                                                              and scenario.sensor_model == "rangefinder")
         # L* of the SPL: the shortest path among the static obstacles (sim.reference).
         self.reference_length_m = shortest_static_length_m(scenario)
         self.stop_on_collision = scenario.sim.stop_on_collision if stop_on_collision is None else stop_on_collision
@@ -134,16 +140,29 @@ class EpisodeStepper:
             if time_limit_s is None else control_periods(time_limit_s, self.dt_s, "time limit (override)")
         self.times_s = np.arange(self.n_max + 1) * self.dt_s
         self.goal = goal_checker(scenario)
+        # The robot has left the arena when its centre is beyond an edge by more than its radius (its body
+        # wholly past that edge): the run ends there, outcome "left_arena" (never a success).
+        arena, margin_m = scenario.bounds, scenario.robot_radius_m
+        self.arena_limits_m = (arena.x_min_m - margin_m, arena.y_min_m - margin_m,
+                               arena.x_max_m + margin_m, arena.y_max_m + margin_m)
+        # A path (a given one: planners keep inside the arena) with a waypoint outside the arena: reaching the
+        # goal along it is "left_arena" too.
+        self.path_leaves_arena = path_m is not None and not bool(np.all(
+            (path_m[:, 0] >= arena.x_min_m - 1e-6) & (path_m[:, 0] <= arena.x_max_m + 1e-6)
+            & (path_m[:, 1] >= arena.y_min_m - 1e-6) & (path_m[:, 1] <= arena.y_max_m + 1e-6)))
         moving = moving_obstacles(scene)
         self.mocap_index = np.array([ob.mocap_index for ob in moving], dtype=np.int64)
         self._moves = bool(moving)
         self.obstacle_track_m = obstacle_positions(scenario, scene, self.times_s)  # (T, M, 2)
         self._radii_m = np.array([scenario.obstacles[ob.scenario_index].radius_m for ob in moving])
+        self._humans = human_columns(scenario, moving)  # agents: the crowd metrics of the result
         # How far the moving obstacles can have moved: obstacle_shift_m[j] - obstacle_shift_m[i]
         # bounds every obstacle's displacement between control steps i and j (for clearance skips).
         track = self.obstacle_track_m
         hops = np.hypot(*np.moveaxis(np.diff(track, axis=0), 2, 0)).max(axis=1) if track.shape[1] else \
             np.zeros(max(len(track) - 1, 0))
+        self._crowd = ReactiveCrowd.of(scenario, moving, self.dt_s) if moving else None  # agents that see the robot
+        hops = hops if self._crowd is None else np.maximum(hops, self._crowd.max_hop_m())  # bounded by top speed
         self.obstacle_shift_m = np.concatenate([[0.0], np.cumsum(hops)]).tolist()
         # Farther than this from every obstacle, no contact can begin within one control period:
         # twice the distance the base covers at full wheel speed, plus a centimetre.
@@ -267,8 +286,11 @@ class EpisodeStepper:
         adr = np.asarray(scene.range_sensor_adr)
         contiguous = len(adr) > 0 and np.array_equal(adr, np.arange(adr[0], adr[0] + len(adr)))
         self._range_raw = data.sensordata[adr[0]:adr[0] + len(adr)] if contiguous else None
+        self._laser = LaserCaster(scene, data) if scene.laser_site_id >= 0 else None
         self.sensing = ObstacleSensing(self.scenario, self.obstacle_track_m, self._radii_m, self.dt_s,
                                        scene.range_angles_rad, scene.range_offset_m)
+        if self._crowd is not None:
+            self._crowd.reset(self.obstacle_track_m, self.sensing.velocity_m_s)
         self._shift_at_measure_m = 0.0
         self._observed_step = -1
         self.poses = np.zeros((self.n_max + 1, 3))
@@ -282,6 +304,7 @@ class EpisodeStepper:
         self.step_index = 0
         self.danger_steps = self.stopped_steps = self.replans = self.safety_triggers = 0
         self.outcome = ""
+        self._reached = False
         self.result = None
 
     def _advance(self) -> None:
@@ -303,13 +326,19 @@ class EpisodeStepper:
         """Obstacles to the new time, the observation, the outcome; the end of the episode when there is one."""
         step = self.step_index
         if self._moves:
+            if self._crowd is not None:  # agents that see the robot: their step s -> s + 1 from its state now
+                self._crowd.advance(step, self._base_qpos, self._base_qvel)
             self._mocap_pos[self.mocap_index, :2] = self.obstacle_track_m[step]
         self.observation = observation = self._observe()
         pose = observation.pose
         if self.goal.reached(pose):
-            outcome = "goal_reached"
+            outcome = "left_arena" if self.path_leaves_arena else "goal_reached"
+            self._reached = True
         elif self.stop_on_collision and self.monitor.collisions:
             outcome = "collision"
+        elif not (self.arena_limits_m[0] <= pose.x_m <= self.arena_limits_m[2]
+                  and self.arena_limits_m[1] <= pose.y_m <= self.arena_limits_m[3]):
+            outcome = "left_arena"
         elif step >= self.n_max:
             outcome = "timeout"
         else:
@@ -356,8 +385,11 @@ class EpisodeStepper:
         vx, vy, _, _, _, omega = self._base_qvel.tolist()
         pose = Pose2D(x, y, heading)
         scene = self.scene
-        raw = self._range_raw if self._range_raw is not None else self.data.sensordata[scene.range_sensor_adr]
-        ranges = ranges_from_sensors(raw, scene.range_cutoff_m)
+        if self._laser is not None:
+            ranges = self._laser.scan(heading)
+        else:
+            raw = self._range_raw if self._range_raw is not None else self.data.sensordata[scene.range_sensor_adr]
+            ranges = ranges_from_sensors(raw, scene.range_cutoff_m)
         time_s = step * self.dt_s
         linear_m_s, angular_rad_s = base_twist(vx, vy, omega, heading)
         return Observation(time_s, pose, Twist(linear_m_s, angular_rad_s), ranges, scene.range_angles_rad,
@@ -377,7 +409,7 @@ class EpisodeStepper:
                            {"x_m": pose.x_m, "y_m": pose.y_m})
         step, monitor = self.step_index, self.monitor
         self.result = RunResult(
-            reached=outcome == "goal_reached", outcome=outcome, collisions=monitor.collisions,
+            reached=self._reached, outcome=outcome, collisions=monitor.collisions,
             first_collision_s=monitor.first_collision_s, first_contact=monitor.first_contact,
             sim_time_s=step * self.dt_s,
             wall_time_s=time.perf_counter() - self._wall0,
@@ -386,7 +418,10 @@ class EpisodeStepper:
             wheel_command_rad_s=self.wheel_cmd[:step + 1].copy(),
             collision_points_m=np.array(monitor.points, dtype=float).reshape(-1, 2),
             time_in_danger_s=self.danger_steps * self.dt_s, stopped_s=self.stopped_steps * self.dt_s,
-            replans=self.replans, safety_triggers=self.safety_triggers, reference_length_m=self.reference_length_m)
+            replans=self.replans, safety_triggers=self.safety_triggers, reference_length_m=self.reference_length_m,
+            crowd=crowd_metrics(self.poses[:step + 1], self.obstacle_track_m[:step + 1, self._humans],
+                                self._radii_m[self._humans], self.scenario.robot_radius_m, self.length_m)
+            if len(self._humans) else None)
         if self._unfinished:
             self._unfinished = False
             recorder.finish(self.result.log_summary())

@@ -6,17 +6,18 @@ import json
 import os
 import subprocess
 import sys
-import tomllib
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 import swarmnav
 from swarmnav.sim.cli.main import EXIT_EXPECTATION, main
 
+from plugin_dist import PLUGIN_STUDY, dist_info, example_plugin, python_path
+
 ROOT = Path(__file__).resolve().parent.parent
-EXAMPLE = ROOT / "examples" / "swarmnav_plugin_example"
 WALL_CLOCK = {"wall_time_s", "replan_wall_s", "plan_time_s"}
 
 
@@ -93,6 +94,26 @@ def test_a_path_through_an_obstacle_reports_the_collision_and_fails_expect(tmp_p
     assert main(["run", "gwo-scenario-2", "--planner", "astar", "--no-log", "--expect", "success"]) == EXIT_EXPECTATION
 
 
+def test_a_given_path_that_leaves_the_arena_is_no_success(tmp_path, capsys):
+    # gwo-scenario-1's arena is [0, 10] x [0, 10]: (0, -3) is 3 m outside; the robot follows and leaves it
+    outside = tmp_path / "outside.json"
+    outside.write_text("[[0, 0], [0, -3], [10, 10]]")
+    code = main(["run", "gwo-scenario-1", "--waypoints", str(outside), "--no-log", "--json", "--expect", "success"])
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert code == EXIT_EXPECTATION
+    assert out["outcome"] == "left_arena" and out["success"] is False and out["reached"] is False
+    assert out["plan"]["collision_free"] is False
+    assert "left_arena" in captured.err and captured.err.count("\n") == 1
+    # 0.1 m outside, less than the robot's radius: the robot stays within a radius of the arena and reaches the
+    # goal, but along a path that leaves the arena: no success either
+    slightly = swarmnav.run("gwo-scenario-1", waypoints=[[0, 0], [5, -0.1], [10, 10]])
+    assert slightly.reached and slightly.outcome == "left_arena" and not slightly.success
+    assert "given='waypoints'" in repr(slightly)
+    assert main(["run", "gwo-scenario-1", "--waypoints", str(outside), "--no-log"]) == 0
+    assert capsys.readouterr().out.startswith(f"gwo-scenario-1: given path {str(outside)!r} + follow")
+
+
 @pytest.mark.parametrize("text,where", [("x,y\n0,0\nfoo,1\n", "row 3"), ("a,b\n0,0\n", "row 1"),
                                         ("[[0, 0], [1]]", "[1]"), ('{"path": []}', "--waypoints"),
                                         ("[[0, 0]]", "at least two"), ("[[0, 0], [NaN, 1]]", "must be finite")])
@@ -105,25 +126,16 @@ def test_bad_waypoint_files_are_one_line(tmp_path, capsys, text, where):
 
 
 def _plugin_path(tmp_path: Path, broken: bool = False) -> dict[str, str]:
-    """The example package importable and its distribution metadata (entry points) on the path, as an
-    installed distribution would have them, without a build."""
-    info = tmp_path / "swarmnav_plugin_example-0.1.0.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: swarmnav-plugin-example\nVersion: 0.1.0\n")
-    groups = tomllib.loads((EXAMPLE / "pyproject.toml").read_text())["project"]["entry-points"]
-    (info / "entry_points.txt").write_text("".join(
-        f"[{group}]\n" + "".join(f"{name} = {value}\n" for name, value in entries.items())
-        for group, entries in groups.items()))
+    """The example plugin installed as far as the path goes (``plugin_dist``), with a broken and a clashing
+    plugin beside it if ``broken``."""
+    entries = example_plugin(tmp_path)
     if broken:
-        broken_info = tmp_path / "broken_plugin-1.0.dist-info"
-        broken_info.mkdir()
-        (broken_info / "METADATA").write_text("Metadata-Version: 2.1\nName: broken-plugin\nVersion: 1.0\n")
-        (broken_info / "entry_points.txt").write_text("[swarmnav.planners]\nbroken = no_such_module_here:Planner\n"
-                                                      "[swarmnav.navigators]\nfollow = clashing_plugin:Follow\n")
+        dist_info(tmp_path, "broken-plugin", "1.0", {"swarmnav.planners": {"broken": "no_such_module_here:Planner"},
+                                                     "swarmnav.navigators": {"follow": "clashing_plugin:Follow"}})
         (tmp_path / "clashing_plugin.py").write_text(
             "from swarmnav.controllers.navigators.follow import FollowNavigator\n\n"
             "class Follow(FollowNavigator):\n    pass\n")
-    return {"PYTHONPATH": os.pathsep.join([str(tmp_path), str(EXAMPLE / "src"), os.environ.get("PYTHONPATH", "")])}
+    return python_path(*entries)
 
 
 def test_an_installed_plugin_is_listed_and_runs(tmp_path):
@@ -141,12 +153,16 @@ def test_an_installed_plugin_is_listed_and_runs(tmp_path):
     out = json.loads(run.stdout)
     assert out["planner"] == "random_detour" and out["success"] is True and out["plan"]["collision_free"]
     study = tmp_path / "plugin-study.toml"
-    study.write_text('name = "plugin-study"\nscenarios = ["gwo-scenario-3", "plugin-corridor"]\nmode = "plan"\n'
-                     'seeds = 2\n[[planners]]\nname = "random_detour"\n[[planners]]\nname = "astar"\n')
-    done = _swarmnav("study", str(study), "--out", str(tmp_path / "rows"), "--workers", "1", "--json",
+    study.write_text(PLUGIN_STUDY)
+    # spawned workers (two: the batches split) know the plugin's planner and scenario: no error row
+    done = _swarmnav("study", str(study), "--out", str(tmp_path / "rows"), "--workers", "2", "--json",
                      "--junit", str(tmp_path / "junit.xml"), env=env)
     assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout)["ran"] == 8
+    assert json.loads(done.stdout)["outcomes"] == {"ok": 8}
+    rows = pd.read_parquet(tmp_path / "rows" / "runs.parquet")
+    assert rows.groupby(["planner", "scenario", "outcome"]).size().to_dict() == {
+        (planner, scenario, "ok"): 2 for planner in ("astar", "random_detour")
+        for scenario in ("gwo-scenario-3", "plugin-corridor")}
     cases = ElementTree.parse(tmp_path / "junit.xml").getroot().iter("testcase")
     assert sum("random_detour" in case.get("name") for case in cases) == 4
 
@@ -179,6 +195,38 @@ def test_study_junit_and_min_success(tmp_path):
     # astar succeeds on scenario 1: the same study passes a lower bar
     again = _swarmnav("study", str(study), "--out", str(tmp_path / "rows"), "--min-success", "0")
     assert again.returncode == 0
+
+
+def test_junit_tells_errors_from_failures_and_its_counts_add_up(tmp_path):
+    junitparser = pytest.importorskip("junitparser")
+    # plan-only: gwo raises on iaco-simple's grid map (an error row), straight cuts an obstacle on both (a failure)
+    study = tmp_path / "mixed.toml"
+    study.write_text('name = "mixed"\nscenarios = ["gwo-scenario-1", "iaco-simple"]\nmode = "plan"\n'
+                     '[[planners]]\nname = "astar"\n[[planners]]\nname = "straight"\n'
+                     '[[planners]]\nname = "gwo"\nparams = { population = 10, iterations = 5 }\n')
+    junit = tmp_path / "junit.xml"
+    assert main(["study", str(study), "--out", str(tmp_path / "rows"), "--workers", "1", "--junit", str(junit)]) == 0
+    rows = pd.read_parquet(tmp_path / "rows" / "runs.parquet")
+    expected = {(r.scenario, r.planner): "error" if r.outcome == "error" else "ok" if r.success else "failure"
+                for r in rows.itertuples()}
+    assert expected[("iaco-simple", "gwo")] == "error" and expected[("gwo-scenario-1", "straight")] == "failure"
+    document = junitparser.JUnitXml.fromfile(str(junit))
+    found, totals = {}, {"tests": 0, "failures": 0, "errors": 0}
+    for suite in document:
+        kinds = []
+        for case in suite:
+            results = [type(r).__name__ for r in case.result]
+            assert len(results) <= 1
+            kinds.append({"Error": "error", "Failure": "failure"}.get(results[0], "?") if results else "ok")
+            found[(suite.name.split(".", 1)[1], case.name.split(" +")[0])] = kinds[-1]
+        assert (suite.tests, suite.failures, suite.errors) == (len(kinds), kinds.count("failure"), kinds.count("error"))
+        assert suite.time == pytest.approx(sum(case.time for case in suite), abs=1e-6)
+        for key in totals:
+            totals[key] += getattr(suite, key)
+    assert found == expected
+    root = ElementTree.parse(junit).getroot()
+    assert {key: int(root.get(key)) for key in totals} == totals
+    assert totals["errors"] == sum(v == "error" for v in expected.values()) >= 1
 
 
 @pytest.mark.parametrize("argv", [["run", "gwo-scenario-1", "--planner", "straight", "--no-log", "--json-out", "{dir}"],

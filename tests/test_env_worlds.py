@@ -68,11 +68,18 @@ def test_gymnasiums_checker_passes_on_drawn_worlds():
     ({"kinds": ["crossing"], "sensor_count": [8, 16]}, "env.scenarios.sensor_count"),
     ({"kinds": ["crossing"], "speed_ratio": [0.9, 0.2]}, "env.scenarios.speed_ratio"),
     ({"kinds": ["overtake"], "speed_ratio": [0.5, 1.5]}, "--speed-ratio"),
-    ("gwo-scenario-1", "env.scenarios"),
+    (42, "env.scenarios"),
+    ([], "env.scenarios"),
 ])
 def test_bad_specifications_name_the_option(spec, field):
     with pytest.raises(ConfigError, match=field.replace(".", r"\.")):
         NavigateEnv(scenarios=spec)
+
+
+def test_one_scenario_name_is_a_list_of_one():
+    env = NavigateEnv(scenarios="gwo-scenario-1")
+    env.reset(seed=3)
+    assert env.task.scenario.name == load_scenario("gwo-scenario-1").name
 
 
 def test_recordings_of_drawn_worlds_are_numbered_on(tmp_path):

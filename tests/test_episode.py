@@ -249,3 +249,30 @@ def test_a_navigator_that_does_not_declare_what_it_uses_is_refused_at_registrati
     with pytest.raises(TypeError, match="no step method"):
         register(Stepless)
     assert "stepless" not in NAVIGATORS
+
+
+def test_only_the_composition_resolves_a_spec_or_builds_an_episode():
+    """sim/episode.py is the one place (compose, plan_episode, given_episode): the CLI, the API, studies,
+    given paths and the environment all go through it."""
+    import pathlib
+    import re
+    root = pathlib.Path(__file__).resolve().parents[1]
+    sources = [p for folder in ("models", "planners", "controllers", "sim") for p in (root / folder).rglob("*.py")]
+    assert len(sources) > 100
+    offenders = [str(p.relative_to(root)) for p in sources if p.name != "episode.py"
+                 and re.search(r"(?<![\w.])Episode\(|\.resolved\(\)", p.read_text())]
+    assert not offenders
+
+
+def test_a_given_path_is_composed_as_a_planned_run_and_a_path_alone_builds_no_navigator():
+    from swarmnav.sim.episode import compose, given_episode
+    from swarmnav.models.scenario import load_scenario
+    spec = EpisodeSpec(load_scenario("gwo-scenario-1"), "astar", navigator="replan")
+    planned = plan_episode(spec)
+    given = given_episode(spec, planned.path.waypoints, "test")
+    assert given.planner_params == planned.planner_params and "cell_m" in given.planner_params
+    assert type(given.navigator) is type(planned.navigator) and given.safety == planned.safety
+    assert given.safety.evade and np.array_equal(given.path.waypoints, planned.path.waypoints)
+    parts = compose(spec, drive=False)
+    assert parts.navigator is None and parts.safety is None
+    assert plan_episode(parts).path.same_as(planned.path)

@@ -1,4 +1,4 @@
-"""The evasion layer of ``replan`` and ``dstar_replan``: when it takes over, what it chooses, and a run."""
+"""The evasion stage of the safety layer (``replan`` and ``dstar_replan`` take it by default): when it takes over, what it chooses, and a run."""
 
 import math
 
@@ -9,7 +9,7 @@ from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.evasion import Evasion
 from swarmnav.controllers.kinematics import DriveGeometry, WheelSpeeds
 from swarmnav.controllers.navigator import DetectedObstacle
-from swarmnav.controllers.navigators import make_navigator
+from swarmnav.controllers.navigators import make_driver, make_navigator
 from swarmnav.controllers.prediction import LocalObstacles, time_to_collision_s
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import parse_scenario
@@ -59,11 +59,30 @@ def test_the_escape_keeps_off_the_known_map():
 
 
 @pytest.mark.parametrize("navigator", ["replan", "dstar_replan"])
-def test_evade_is_a_named_option_with_a_bounded_trigger(navigator):
-    assert make_navigator(navigator).evade
-    assert not make_navigator(navigator, {"evade": False}).evade
+def test_evade_is_a_named_option_of_the_layer_with_a_bounded_trigger(navigator):
+    assert make_driver(navigator)[1].evade
+    layer_off = make_driver(navigator, {"evade": False})[1]
+    assert not layer_off.evade and not layer_off.on
+    assert not hasattr(make_navigator(navigator), "evade")         # the layer's, not the navigator's
     with pytest.raises(ConfigError, match="evade_trigger_s"):
         make_navigator(navigator, {"evade_trigger_s": -1.0})
+
+
+@pytest.mark.parametrize("navigator", ["follow", "velocity_obstacle", "oracle"])
+def test_a_navigator_takes_only_the_layer_switches_it_offers(navigator):
+    """``evade`` is offered by the path followers (replan, dstar_replan, iaco_local, immas_stepwise) only."""
+    with pytest.raises(ConfigError, match="navigator.params.evade"):
+        make_driver(navigator, {"evade": True})
+
+
+def test_no_navigator_imports_the_safety_filter_or_the_evasion():
+    """The layer after the navigator (controllers.safety_layer) is the only user of both."""
+    import pathlib
+    folder = pathlib.Path(__file__).resolve().parents[1] / "controllers" / "navigators"
+    sources = {p.name: p.read_text() for p in folder.glob("*.py")}
+    assert len(sources) >= 10
+    for name, text in sources.items():
+        assert "safety_filter import" not in text and "evasion import" not in text, name
 
 
 CHASED = """

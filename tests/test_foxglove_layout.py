@@ -45,8 +45,9 @@ def test_layout_panels_read_topics_a_log_has(tmp_path):
     run_episode(EpisodeSpec(load_scenario("gwo-scenario-2")), [McapRecorder(path)])
     log = read_log(path)
     used = set().union(*(_topics(p) for p in panels))
-    # /navigator appears only in logs of navigators that sense; every other topic is in every log.
-    assert used - {"/navigator"} <= set(log.counts), used - set(log.counts)
+    # /navigator appears only in logs of navigators that sense, /map with the map unknown, /odom with the
+    # odometry pose; every other topic is in every log.
+    assert used - {"/navigator", "/map", "/odom"} <= set(log.counts), used - set(log.counts)
     assert {"/scene", "/obstacles", "/wheels", "/events", "/range/scan"} <= used
     wheels = next(p for p in panels if any(s["value"].startswith("/wheels.") for s in p["config"].get("paths", [])))
     fields = {s["value"].split(".", 1)[1] for s in wheels["config"]["paths"]}
@@ -61,3 +62,21 @@ def test_foxglove_layout_command_writes_the_file(tmp_path, capsys):
     assert json.loads(out.read_text()) == json.loads(shipped_layout())
     assert main(["foxglove-layout", "-o", str(tmp_path)]) == 2
     assert "-o" in capsys.readouterr().err
+
+
+def test_ros2_layout_is_the_sdk_build_on_topics_a_ros2_log_has(tmp_path, capsys):
+    assert shipped_layout("ros2") == build_layout("ros2")
+    panels = list(_panels(json.loads(shipped_layout("ros2"))["content"]))
+    path = tmp_path / "run.mcap"
+    run_episode(EpisodeSpec(load_scenario("gwo-scenario-2")), [McapRecorder(path, log_format="ros2")],
+                time_limit_s=2.0)
+    log = read_log(path)
+    used = set().union(*(_topics(p) for p in panels))
+    assert used - {"/navigator"} <= set(log.counts), used - set(log.counts)
+    assert {"/scene", "/obstacles", "/plan", "/scan", "/joint_states", "/wheels/command", "/rosout"} <= used
+    scene = next(p for p in panels if p["panelType"] == "ThreeDee")
+    with path.open("rb") as stream:
+        _, _, static = next(make_reader(stream).iter_messages(topics=["/tf_static"]))
+    assert scene["config"]["fixedFrame"].encode() in static.data  # the layout's frame is in the log's tree
+    assert main(["foxglove-layout", "--log-format", "ros2"]) == 0
+    assert json.loads(capsys.readouterr().out) == json.loads(shipped_layout("ros2"))

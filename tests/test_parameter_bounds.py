@@ -172,6 +172,32 @@ def test_every_numeric_parameter_declares_its_range(registry):
     assert not {name: keys for name, keys in missing.items() if keys}
 
 
+def test_one_declaration_per_parameter_gives_the_reader_its_checks_and_the_listing_its_rows():
+    """A navigator's field (``param``) carries its range or choices; the reader (TOML, ``--set``) and
+    ``navigators --json`` both take them from there, the safety layer's switches included."""
+    import pathlib
+
+    from swarmnav.controllers.navigators import make_driver, navigator_table
+    from swarmnav.controllers.safety_layer import SafetyLayer
+    with pytest.raises(ConfigError, match=r"navigator\.params\.strategy: unknown value 'fast' "
+                                          r"\(expected one of: paper, wait_only\)"):
+        make_navigator("iaco_local", {"strategy": "fast"})
+    with pytest.raises(ConfigError, match=r"navigator\.params\.same_line_deg: must be in \[0, 90\), got 90"):
+        make_navigator("iaco_local", {"same_line_deg": 90})
+    with pytest.raises(ConfigError, match=r"navigator\.params\.time_before_collision_s: must be in \(0, 600\]"):
+        make_driver("dwa", {"time_before_collision_s": 0.0})
+    rows = {row["name"]: row for row in navigator_table("iaco_local")}
+    assert rows["strategy"]["choices"] == ["paper", "wait_only"] and rows["same_line_deg"]["range"] == "[0, 90)"
+    assert rows["evade"]["default"] is False and rows["evade_trigger_s"]["range"] == "[0, 600]"
+    assert {row["name"]: row["default"] for row in navigator_table("replan")}["evade"] is True
+    assert set(numeric_parameters(SafetyLayer)) <= set(parameter_ranges(SafetyLayer))
+    # No navigator keeps a second declaration or a checking helper of its own.
+    folder = pathlib.Path(__file__).resolve().parents[1] / "controllers" / "navigators"
+    for path in folder.glob("*.py"):
+        text = path.read_text()
+        assert "parameter_ranges" not in text and "def check_" not in text, path.name
+
+
 def test_a_value_out_of_range_names_the_field_and_the_range():
     with pytest.raises(ConfigError, match=r"navigator\.params\.horizon_s: must be in \(0, 10\], got 1e\+12"):
         make_navigator("dwa", {"horizon_s": 1e12})

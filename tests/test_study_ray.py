@@ -3,6 +3,7 @@ enforced inside a task; no token-authentication warning at start-up; a task whos
 hand or killed from outside) is an error row and the study goes on."""
 
 import dataclasses
+import json
 import logging
 import os
 import signal
@@ -17,6 +18,8 @@ from swarmnav.sim.study.ray_engine import RAY_AUTH_LOGGER, start_ray
 from swarmnav.sim.study.execute import run_study
 from swarmnav.sim.study.rows import PROGRESS_TIMING_COLUMNS, TIMING_COLUMNS
 from swarmnav.sim.study.spec import parse_study
+
+from plugin_dist import PLUGIN_STUDY, dist_info, example_plugin, python_path
 
 ray = pytest.importorskip("ray", reason="the ray extra is not installed (pip install 'swarmnav[ray]')")
 
@@ -44,7 +47,13 @@ class _Records(logging.Handler):
 
 
 @pytest.fixture(scope="module")
-def ray_start_log():
+def plugin_site(tmp_path_factory) -> list[str]:
+    """The path entries of the example plugin (``plugin_dist``), installed on the instance's workers."""
+    return example_plugin(tmp_path_factory.mktemp("plugin-site"))
+
+
+@pytest.fixture(scope="module")
+def ray_start_log(plugin_site):
     """Start one local instance for the module; yield what Ray's authentication set-up logged meanwhile."""
     if ray.is_initialized():
         pytest.skip("a Ray instance is already running in this process")
@@ -52,8 +61,9 @@ def ray_start_log():
     logger = logging.getLogger(RAY_AUTH_LOGGER)
     logger.addHandler(records)
     saved = os.environ.get("PYTHONPATH")
-    # the instance's workers inherit this environment: they can import the tests' dying policy
-    os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(Path(__file__).parent), saved) if p)
+    # the instance's workers inherit this environment: they can import the tests' dying policy, and they have
+    # the example plugin installed (this process does not load it: its registries stay the bundled ones)
+    os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(Path(__file__).parent), *plugin_site, saved) if p)
     try:
         start_ray(None, 2)
     finally:
@@ -150,6 +160,39 @@ def test_a_ray_worker_killed_from_outside_is_one_error_row(ray_start_log, tmp_pa
     error = rows[rows.outcome == "error"].error.iloc[0]
     assert error.startswith("the worker running this cell died (WorkerCrashedError")
     assert error.endswith("1 try, Ray's own retries are off)")
+
+
+def _study_on_the_instance(tmp_path: Path, env: dict[str, str]):
+    """``swarmnav study`` of the plugin study, a driver of its own joining this module's instance."""
+    import subprocess
+    import sys
+    (tmp_path / "plugin-study.toml").write_text(PLUGIN_STUDY)
+    address = ray.get_runtime_context().gcs_address
+    return subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "study", "plugin-study.toml", "--out", "rows",
+                           "--engine", "ray", "--address", address, "--json"], capture_output=True, text=True,
+                          cwd=tmp_path, env={**os.environ, **env}, timeout=300)
+
+
+def test_a_plugin_planner_and_scenario_run_on_ray_workers(ray_start_log, plugin_site, tmp_path):
+    done = _study_on_the_instance(tmp_path, python_path(*plugin_site))
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["outcomes"] == {"ok": 8}
+    rows = pd.read_parquet(tmp_path / "rows" / "runs.parquet")
+    assert rows.groupby(["planner", "scenario", "outcome"]).size().to_dict() == {
+        (planner, scenario, "ok"): 2 for planner in ("astar", "random_detour")
+        for scenario in ("gwo-scenario-3", "plugin-corridor")}
+
+
+def test_a_plugin_missing_on_the_ray_workers_fails_the_study_naming_it(ray_start_log, plugin_site, tmp_path):
+    # the driver has one more plugin distribution than the instance's workers
+    dist_info(tmp_path / "extra", "lab-extra-plugin", "2.1", {"swarmnav.planners": {"astar2": "lab_extra:Astar2"}})
+    (tmp_path / "extra" / "lab_extra.py").write_text(
+        "from swarmnav.planners.grid_search import AStarPlanner\n\nclass Astar2(AStarPlanner):\n    name = 'astar2'\n")
+    done = _study_on_the_instance(tmp_path, python_path(str(tmp_path / "extra"), *plugin_site))
+    said = [line for line in done.stderr.splitlines() if line.startswith("swarmnav:")]  # Ray logs its connection
+    assert done.returncode == 2 and len(said) == 1, done.stderr
+    assert "plugins: lab-extra-plugin not installed (driver 2.1)" in said[0] and "--address: node " in said[0]
+    assert len(pd.read_parquet(tmp_path / "rows" / "runs.parquet")) == 0  # no error rows
 
 
 def test_sigterm_ends_a_ray_study_with_one_line_and_keeps_its_rows(tmp_path):

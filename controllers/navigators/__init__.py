@@ -18,7 +18,8 @@ from swarmnav.controllers.navigators.mppi import MppiNavigator
 from swarmnav.controllers.navigators.oracle import ClairvoyantOracleNavigator
 from swarmnav.controllers.navigators.replan import ReplanNavigator
 from swarmnav.controllers.navigators.velocity_obstacle import VelocityObstacleNavigator
-from swarmnav.models.parameters import build_component, register_component
+from swarmnav.controllers.safety_layer import SafetyLayer, layer_settings, offered
+from swarmnav.models.parameters import build_component, parameter_table, register_component
 
 NAVIGATORS: dict[str, type[Navigator]] = {}
 NavigatorClass = TypeVar("NavigatorClass", bound=type)
@@ -43,11 +44,34 @@ register(MppiNavigator)  # Williams et al. (2017) as Nav2 adapts it (controllers
 register(ClairvoyantOracleNavigator)  # the clairvoyant yardstick (controllers/navigators/oracle.py)
 
 
+def make_driver(name: str, params: dict[str, Any] | None = None, source: str | None = None,
+                trust_code: bool = True) -> tuple[Navigator, SafetyLayer]:
+    """Build a registered navigator and the run's safety layer after it (:mod:`controllers.safety_layer`)
+    from the navigator's name and one parameter table: the layer takes the switches the navigator offers
+    (``safety_layer``) and their thresholds, the navigator the rest (ConfigError naming the field;
+    ``trust_code``: see :func:`models.parameters.build_component`)."""
+    cls = NAVIGATORS.get(name)
+    own, layer = layer_settings(cls, params) if cls is not None else (params, {})
+    navigator = build_component(NAVIGATORS, "navigator", name, own, source, trust_code, offered(cls))
+    return navigator, build_component({name: SafetyLayer}, "navigator", name, layer, source)
+
+
 def make_navigator(name: str, params: dict[str, Any] | None = None, source: str | None = None,
                    trust_code: bool = True) -> Navigator:
-    """Build a registered navigator from its name and a parameter table (ConfigError naming the field;
-    ``trust_code``: see :func:`models.parameters.build_component`)."""
-    return build_component(NAVIGATORS, "navigator", name, params, source, trust_code)
+    """The navigator of :func:`make_driver` alone (its layer parameters checked and set aside)."""
+    return make_driver(name, params, source, trust_code)[0]
 
 
-__all__ = ["NAVIGATORS", "register", "make_navigator"]
+def navigator_table(name: str) -> list[dict[str, Any]]:
+    """The parameters a registered navigator takes (:func:`models.parameters.parameter_table`): its own, then
+    the safety layer's switches it offers, with its defaults."""
+    cls = NAVIGATORS[name]
+    return parameter_table(cls, (SafetyLayer, offered(cls), layer_settings(cls, {})[1]))
+
+
+def navigator_parameters(name: str) -> tuple[str, ...]:
+    """The names of every parameter a registered navigator takes (:func:`navigator_table`)."""
+    return tuple(row["name"] for row in navigator_table(name))
+
+
+__all__ = ["NAVIGATORS", "make_driver", "make_navigator", "navigator_parameters", "navigator_table", "register"]

@@ -48,7 +48,8 @@ field, which no swarm planner keeps), so a row of "gwo + dstar_replan" says in i
 navigator parameters that the robot drove D* Lite's paths; the ``replan`` navigator is the
 one that replans with the run's own planner and parameters.
 
-**Evasion** (``evade``, on by default; ours): the velocity-obstacle evasion of :mod:`controllers.evasion`
+**Evasion** (``evade``, on by default; ours): the safety layer's (:mod:`controllers.safety_layer`, applied
+by the stepper after this navigator's step) velocity-obstacle evasion of :mod:`controllers.evasion`
 overrides the command while a sensed obstacle's predicted time to collision with the robot is below
 ``evade_trigger_s``.  Why its collisions with the 2 m detector on dyn300 (e.g. ``d300-fast-13``): the sweeps are kept off the robot's cell (step 1), so an obstacle that comes at the robot (a crosser
 faster than it, one that chases it along its detour) is marked everywhere but where the robot is, and D* Lite's
@@ -57,7 +58,7 @@ path (the controller turns on the spot), the obstacle runs into it.  A grid of s
 say "step aside now"; the evasion does.  ``evade = false`` gives the earlier behaviour.
 
 ``cell_m`` = 0 uses the scenario's ``sim.cell_m`` (a map scenario's own cells
-always).  The optional safety filter is the one every navigator shares.
+always).  The optional safety filter (``safety_filter``) is the same layer's.
 Planning wall time (``replan_wall_s``) counts the D* Lite repairs only.
 """
 
@@ -70,14 +71,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.navigators.replan import check_positive, keep_outside
+from swarmnav.controllers.navigators.replan import keep_outside
 from swarmnav.controllers.prediction import swept_discs
-from swarmnav.controllers.evasion import evasion_for
-from swarmnav.controllers.safety_filter import SafetyFilter
-from swarmnav.models.errors import ConfigError
 from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
 from swarmnav.models.scenario_limits import MAX_GRID_CELLS
 from swarmnav.models.world import rasterise
@@ -99,41 +97,27 @@ class DStarReplanNavigator:
         cell_m: the grid's cell size; 0 = the scenario's.
         improvement_m: a new path replaces a still-free one only when shorter by more than this.
         update_period_s: the sweeps are marked (and D* Lite repaired) at most this often.
-        safety_filter, time_before_collision_s: the optional Nav2-style filter.
-        evade, evade_trigger_s: the evasion layer (see the module docstring) and its trigger.
         planner: the planner of every path followed: ``"dstar_lite"`` (the only one; see the module docstring).
     """
 
     name: ClassVar[str] = "dstar_replan"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "horizon_s": within(0, 600), "margin_m": within(0, 100), "cell_m": within(0, 100),
-        "improvement_m": within(0, 1e6), "update_period_s": within(0, 1e6), "time_before_collision_s": within(0, 600),
-        "evade_trigger_s": within(0, 600)}  # models.parameters: checked on build
+    safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False, "evade": True}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: float = field(default=0.0, init=False, repr=False)
 
-    horizon_s: float = 3.0
-    margin_m: float = 0.1
-    cell_m: float = 0.0
-    improvement_m: float = 0.5
-    update_period_s: float = 0.2
-    safety_filter: bool = False
-    time_before_collision_s: float = 1.0
-    evade: bool = True
-    evade_trigger_s: float = 2.0
-    planner: str = "dstar_lite"
-
-    def __post_init__(self) -> None:
-        check_positive(self, ("horizon_s", "time_before_collision_s"),
-                       ("margin_m", "cell_m", "improvement_m", "update_period_s"))
-        if self.planner != "dstar_lite":
-            raise ConfigError("navigator.params.planner",
-                              f"must be 'dstar_lite' (this navigator repairs D* Lite's own paths), got {self.planner!r}")
+    horizon_s: float = param(3.0, above(0, 600))
+    margin_m: float = param(0.1, within(0, 100))
+    cell_m: float = param(0.0, within(0, 100))
+    improvement_m: float = param(0.5, within(0, 1e6))
+    update_period_s: float = param(0.2, within(0, 1e6))
+    planner: str = param("dstar_lite", choices=("dstar_lite",))  # it repairs D* Lite's own paths
 
     def reset(self, setup: NavigationSetup) -> None:
         known = setup.map_problem
         self.known = known
+        self.setup = setup
+        self.map_revision = setup.map_revision
         self.controller = setup.controller
         if known.grid_override is not None:
             self.grid = known.grid_override
@@ -161,9 +145,6 @@ class DStarReplanNavigator:
         self.next_update_s = 0.0
         self.sweeps: list = []
         self.replan_wall_s = 0.0
-        self.filter = SafetyFilter(setup.controller.geometry, known.robot_radius_m,
-                                   self.time_before_collision_s) if self.safety_filter else None
-        self.evasion = evasion_for(setup, self.evade_trigger_s) if self.evade else None
 
     # -- the step ------------------------------------------------------------
     def step(self, observation: Observation) -> NavigationStep:
@@ -204,7 +185,7 @@ class DStarReplanNavigator:
     def _mark(self, observation: Observation) -> bool:
         """Mark this step's sweeps; True when any cell changed (and D* Lite was told)."""
         pose = observation.pose
-        occupied = self.static
+        occupied = self._map_cells()
         self.sweeps = []
         if observation.detections:
             self.sweeps = keep_outside(swept_discs(observation.detections, self.horizon_s),
@@ -218,6 +199,17 @@ class DStarReplanNavigator:
         self.current = occupied
         self.dstar.update_cells({(int(r), int(c)): bool(occupied[r, c]) for r, c in flips})
         return True
+
+    def _map_cells(self) -> np.ndarray:
+        """The map's blocked cells: fixed with a known map; with the map unknown, the sensed map's latest
+        publication rasterised on this grid (its changes reach D* Lite with the sweeps', as cell updates)."""
+        if self.setup.map_revision != self.map_revision:
+            self.map_revision = self.setup.map_revision
+            known = self.known = self.setup.map_problem
+            cells = rasterise(known.bounds, known.obstacles, known.boxes, known.inflation_m, self.grid.cell_m).occupied
+            if cells.shape == self.static.shape:
+                self.static = cells
+        return self.static
 
     def _rasterise(self, inflation_m: float) -> np.ndarray | None:
         """This step's sweeps on the grid's cells, grown by ``inflation_m`` (None with none)."""
@@ -264,6 +256,8 @@ class DStarReplanNavigator:
         if not on_path:
             return "left the path"
         rest = self.cells[self.at:]
+        if self.setup.world_map is not None and any(self.static[r, c] for r, c in rest):
+            return "blocked on the sensed map"
         # Blocked: a sweep grown by the bare inflation (without margin_m) covers a cell still to come.
         marks = self._rasterise(self.known.inflation_m)
         if marks is not None and any(marks[r, c] for r, c in rest):
@@ -316,15 +310,6 @@ class DStarReplanNavigator:
 
     def _finish(self, observation: Observation, command: ControlCommand, events: list,
                 new_path: Path | None) -> NavigationStep:
-        if self.evasion is not None:
-            command, evading = self.evasion.apply(observation.pose, command, observation.detections)
-            if evading:
-                events.append(("evade", {"linear_m_s": round(command.linear_m_s, 6),
-                                         "angular_rad_s": round(command.angular_rad_s, 6)}))
-        if self.filter is not None:
-            command, triggered = self.filter.apply(observation.pose, command, observation.detections)
-            if triggered:
-                events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
         return NavigationStep(command, new_path, tuple(events), Belief(observation.detections, self.horizon_s))
 
 

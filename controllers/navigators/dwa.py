@@ -53,12 +53,11 @@ from typing import ClassVar
 import numpy as np
 
 from swarmnav.models.errors import ConfigError
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.navigators.replan import check_positive
 from swarmnav.models.world import wrap_angle_rad
 
 
@@ -76,7 +75,6 @@ class DynamicWindowNavigator:
         dist_cap_m: ``dist`` beyond this counts as free.
         margin_m: extra distance kept beyond the robot radius.
         lookahead_m: the carrot's distance along the path.
-        safety_filter, time_before_collision_s: the optional Nav2-style filter.
         carrot_in_sight: the carrot is the farthest point of the lookahead the robot can reach straight past
             the known map (:meth:`controllers.guidance.PathCarrot.keep_in_sight`; ours, on by default: on
             dyn300's door scenes the carrot behind a wall held the robot still against it; false: the plain
@@ -84,48 +82,36 @@ class DynamicWindowNavigator:
     """
 
     name: ClassVar[str] = "dwa"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        # v_samples x omega_samples x horizon_s / sim_step_s rollout points: at most 50 x 100 x 500
-        "alpha": within(0, 1e6), "beta": within(0, 1e6), "gamma": within(0, 1e6), "accel_m_s2": above(0, 1000),
-        "angular_accel_rad_s2": above(0, 1000), "window_s": above(0, 10), "max_angular_rad_s": above(0, 100),
-        "v_samples": within(1, 50), "omega_samples": within(1, 100), "horizon_s": above(0, 10),
-        "sim_step_s": within(0.02, 1), "dist_cap_m": above(0, 1000), "margin_m": within(0, 100),
-        "lookahead_m": above(0, 1000), "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
+    safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
 
-    alpha: float = 1.0
-    beta: float = 1.2
-    gamma: float = 0.3
-    accel_m_s2: float = 0.5
-    angular_accel_rad_s2: float = 3.0
-    window_s: float = 0.25
-    max_angular_rad_s: float = 1.2
-    v_samples: int = 7
-    omega_samples: int = 25
-    horizon_s: float = 3.0
-    sim_step_s: float = 0.15
-    dist_cap_m: float = 1.0
-    margin_m: float = 0.05
-    lookahead_m: float = 1.0
-    safety_filter: bool = False
-    time_before_collision_s: float = 1.0
+    # v_samples x omega_samples x horizon_s / sim_step_s rollout points: at most 50 x 100 x 500
+    alpha: float = param(1.0, within(0, 1e6))
+    beta: float = param(1.2, within(0, 1e6))
+    gamma: float = param(0.3, within(0, 1e6))
+    accel_m_s2: float = param(0.5, above(0, 1000))
+    angular_accel_rad_s2: float = param(3.0, above(0, 1000))
+    window_s: float = param(0.25, above(0, 10))
+    max_angular_rad_s: float = param(1.2, above(0, 100))
+    v_samples: int = param(7, within(1, 50))
+    omega_samples: int = param(25, within(1, 100))
+    horizon_s: float = param(3.0, above(0, 10))
+    sim_step_s: float = param(0.15, within(0.02, 1))
+    dist_cap_m: float = param(1.0, above(0, 1000))
+    margin_m: float = param(0.05, within(0, 100))
+    lookahead_m: float = param(1.0, above(0, 1000))
     carrot_in_sight: bool = True
 
     def __post_init__(self) -> None:
-        check_positive(self, ("accel_m_s2", "angular_accel_rad_s2", "window_s", "max_angular_rad_s", "horizon_s",
-                              "sim_step_s", "dist_cap_m", "lookahead_m", "time_before_collision_s"),
-                       ("alpha", "beta", "gamma", "margin_m"))
-        check_positive(self, ("v_samples", "omega_samples"))
         if self.horizon_s < self.sim_step_s:  # no rollout step at all
             raise ConfigError("navigator.params.horizon_s", f"must be at least sim_step_s ({self.sim_step_s:g} s), "
                                                             f"got {self.horizon_s!r}")
 
     def reset(self, setup: NavigationSetup) -> None:
-        (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal,
-         self.filter) = local_setup(setup, self.margin_m, self.lookahead_m, self.safety_filter,
-                                    self.time_before_collision_s, self.carrot_in_sight)
+        (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(
+            setup, self.margin_m, self.lookahead_m, self.carrot_in_sight)
         self.goal_tolerance_m = setup.goal.tolerance_m
         self.times = np.arange(1, int(round(self.horizon_s / self.sim_step_s)) + 1) * self.sim_step_s  # (T,)
         self.reach = self.max_speed * self.horizon_s + 1.0
@@ -195,12 +181,7 @@ class DynamicWindowNavigator:
             err = wrap_angle_rad(math.atan2(ry, rx) - pose.heading_rad)
             w_cmd = float(np.clip(2.0 * err, -self.max_angular_rad_s, self.max_angular_rad_s))
         command = ControlCommand(wheel_speeds(v_cmd, w_cmd, self.geometry), v_cmd, w_cmd, 0)
-        events = []
-        if self.filter is not None:
-            command, triggered = self.filter.apply(pose, command, observation.detections)
-            if triggered:
-                events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
-        return NavigationStep(command, None, tuple(events), Belief(observation.detections, self.horizon_s))
+        return NavigationStep(command, None, (), Belief(observation.detections, self.horizon_s))
 
     def _gaps(self, x0: float, y0: float, c: float, s: float, x: np.ndarray, y: np.ndarray,
               observation: Observation) -> np.ndarray | None:

@@ -48,8 +48,7 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
-from swarmnav.models.parameters import Range, above, within
-from swarmnav.controllers.evasion import evaded, evasion_for
+from swarmnav.models.parameters import Range, above, param, within
 from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import (Cell, CellWalker, cells_of_path, grid_problem, heading_of,
                                                        static_grid, step_line)
@@ -57,7 +56,6 @@ from swarmnav.controllers.navigators.collision_types import (CATCHING_UP, CROSSI
                                                              escape_moves, escape_offsets, first_band_index,
                                                              precondition_x_of_moves,
                                                              predicted_meeting_s, timing)
-from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
 from swarmnav.planners.problem import Path
@@ -78,41 +76,23 @@ class IacoLocalNavigator:
         lead_steps: robot steps added to the escape's in Eq. (12) (ours; 0 = the paper), for the
             time our differential-drive robot needs to turn in place towards the escape cell,
             which the paper's grid robot does not spend.
-        evade, evade_trigger_s: the evasion layer of :mod:`controllers.evasion` (off by default: not the
-            paper's; a named option beyond it) and its trigger.
     """
 
     name: ClassVar[str] = "iaco_local"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "same_line_deg": within(0, 180), "margin_m": within(0, 100), "horizon_cells": within(1, 1000),
-        "reach_m": above(0, 100), "lead_steps": within(0, 1000),
-        "evade_trigger_s": within(0, 600)}  # models.parameters: checked on build
+    # The safety layer's evasion (controllers.safety_layer, after the step): off by default, not the paper's.
+    safety_layer: ClassVar[dict[str, bool]] = {"evade": False}
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured
-    strategy: str = "paper"
-    same_line_deg: float = 15.0
-    margin_m: float = 0.05
-    horizon_cells: int = 12
-    reach_m: float = 0.1
-    lead_steps: int = 0
-    evade: bool = False
-    evade_trigger_s: float = 2.0
+    strategy: str = param("paper", choices=STRATEGIES)
+    same_line_deg: float = param(15.0, Range(0, 90, high_open=True))
+    margin_m: float = param(0.05, within(0, 100))
+    horizon_cells: int = param(12, within(1, 1000))
+    reach_m: float = param(0.1, above(0, 100))
+    lead_steps: int = param(0, within(0, 1000))
     counts: dict[str, int] = field(default_factory=dict, init=False, repr=False)
 
-    def __post_init__(self) -> None:
-        for key, ok, problem in (
-                ("strategy", self.strategy in STRATEGIES, f"must be one of: {', '.join(STRATEGIES)}"),
-                ("same_line_deg", 0.0 <= self.same_line_deg < 90.0, "must lie in [0, 90)"),
-                ("margin_m", self.margin_m >= 0.0, "must not be negative"),
-                ("horizon_cells", self.horizon_cells >= 1, "must be at least 1"),
-                ("reach_m", self.reach_m > 0.0, "must be positive"),
-                ("lead_steps", self.lead_steps >= 0, "must not be negative")):
-            if not ok:
-                raise ConfigError(f"navigator.params.{key}", f"{problem}, got {getattr(self, key)!r}")
-
     def reset(self, setup: NavigationSetup) -> None:
-        self.evasion = evasion_for(setup, self.evade_trigger_s) if self.evade else None
         self.setup = setup
         problem = setup.map_problem  # static obstacles only: the moving ones are sensed
         self.problem = problem
@@ -144,11 +124,7 @@ class IacoLocalNavigator:
 
     # -- one control step -------------------------------------------------------------------------
     def step(self, observation: Observation) -> NavigationStep:
-        """The paper's step; with ``evade`` (off by default: not the paper's) the evasion layer of
-        :mod:`controllers.evasion` on its command."""
-        return evaded(self.evasion, observation, self._paper_step(observation))
-
-    def _paper_step(self, observation: Observation) -> NavigationStep:
+        """The paper's step (the safety layer's ``evade``, off by default, acts after it)."""
         events: list[tuple[str, dict[str, Any]]] = []
         new_path, self._pending_path = self._pending_path, None
         if self.waiting:

@@ -43,7 +43,7 @@ random walkers do not see the robot and may step onto its cell, or cross its
 move, while it turns or waits, and the robot has no rule for that (no replanning).
 
 Beyond the paper, each a named option off by default (the defaults are the paper's robot): ``evade``
-(:mod:`controllers.evasion`), ``lookahead_cells`` and ``carrot_m`` (drive through the walk instead of stopping
+(the safety layer's evasion, :mod:`controllers.safety_layer`), ``lookahead_cells`` and ``carrot_m`` (drive through the walk instead of stopping
 at each cell, :mod:`controllers.navigators.immas_drive`) and ``predict_s`` (a longer Dobstacle for that walk);
 the next cell stays Eq. (3)'s choice at every cell reached.  The class docstring says why, with figures.
 """
@@ -57,8 +57,7 @@ from typing import Any, Callable, ClassVar, Iterable
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
-from swarmnav.controllers.evasion import evaded, evasion_for
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, static_grid
 from swarmnav.controllers.navigators.immas_drive import DriveThrough, WalkTally
@@ -215,8 +214,6 @@ class ImmasStepwiseNavigator:
     Args:
         alpha, beta: Eq. (3)'s weights; None takes the scenario's ``immas`` planner's, else 3 and 1 (line 4).
         reach_m: distance to a cell's centre at which the robot has reached it.
-        evade, evade_trigger_s: the evasion layer of :mod:`controllers.evasion` (off by default: not the
-            paper's; a named option beyond it) and its trigger.
         lookahead_cells, carrot_m: beyond the paper, off by default (0: the paper's robot, which stops at
             each cell): drive through the walk, the next cell still Eq. (3)'s choice at each cell reached,
             the controller steering at a carrot ``carrot_m`` along the walk carried on ``lookahead_cells``
@@ -233,33 +230,24 @@ class ImmasStepwiseNavigator:
     """
 
     name: ClassVar[str] = "immas_stepwise"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "alpha": within(0, 100), "beta": within(0, 100), "reach_m": above(0, 100),
-        "evade_trigger_s": within(0, 600), "lookahead_cells": within(0, 1000),
-        "carrot_m": above(0, 100), "predict_s": within(0, 600)}  # models.parameters: checked on build
+    # The safety layer's evasion (controllers.safety_layer, after the step): off by default, not the paper's.
+    safety_layer: ClassVar[dict[str, bool]] = {"evade": False}
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured
-    alpha: float | None = None
-    beta: float | None = None
-    reach_m: float = 0.1
-    evade: bool = False
-    evade_trigger_s: float = 2.0
-    lookahead_cells: int = 0
-    carrot_m: float = 0.4
-    predict_s: float = 0.0
+    alpha: float | None = param(None, within(0, 100))
+    beta: float | None = param(None, within(0, 100))
+    reach_m: float = param(0.1, above(0, 100))
+    lookahead_cells: int = param(0, within(0, 1000))
+    carrot_m: float = param(0.4, above(0, 100))
+    predict_s: float = param(0.0, within(0, 600))
 
     def __post_init__(self) -> None:
-        for key, ok, problem in (("alpha", self.alpha is None or self.alpha >= 0, "must not be negative"),
-                                 ("beta", self.beta is None or self.beta >= 0, "must not be negative"),
-                                 ("reach_m", self.reach_m > 0, "must be positive"),
-                                 ("predict_s", not self.predict_s or self.lookahead_cells > 0,
-                                  "needs lookahead_cells > 0 (it changes the walk driven through)")):
-            if not ok:
-                raise ConfigError(f"navigator.params.{key}", f"{problem}, got {getattr(self, key)!r}")
+        if self.predict_s and not self.lookahead_cells > 0:  # a rule between two fields (each one's range: param)
+            raise ConfigError("navigator.params.predict_s", "needs lookahead_cells > 0 (it changes the walk driven "
+                                                            f"through), got {self.predict_s!r}")
 
     def reset(self, setup: NavigationSetup) -> None:
-        self.evasion = evasion_for(setup, self.evade_trigger_s) if self.evade else None
         problem = setup.map_problem  # static obstacles only: the moving ones are sensed
         self.grid = grid = static_grid(problem)
         given = isinstance(setup.planner, ImprovedMaxMinAntSystemPlanner)
@@ -327,10 +315,9 @@ class ImmasStepwiseNavigator:
         return self.walker.start([here, target])
 
     def step(self, observation: Observation) -> NavigationStep:
-        """The paper's step; with ``evade`` (off by default: not the paper's) the evasion layer of
-        :mod:`controllers.evasion` on its command."""
-        return evaded(self.evasion, observation, self._paper_step(observation) if self.drive is None
-                      else self._drive_step(observation))
+        """The paper's step, or driving through the walk (the safety layer's ``evade``, off by default,
+        acts after it)."""
+        return self._paper_step(observation) if self.drive is None else self._drive_step(observation)
 
     def _drive_step(self, observation: Observation) -> NavigationStep:
         """``lookahead_cells`` > 0: driving through the walk (:class:`~controllers.navigators.immas_drive.DriveThrough`)."""

@@ -40,12 +40,11 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.navigators.replan import check_positive
 from swarmnav.models.errors import ConfigError
 
 
@@ -73,7 +72,6 @@ class MppiNavigator:
         noise_bank: draw the noise from a bank of ``noise_bank`` x K sequences made at reset, K consecutive
             ones (circular) from a random start each step; 0: fresh draws every step, as the paper.  Drawing
             60,000 normals was most of a step's time (named option, ours).
-        safety_filter, time_before_collision_s: the optional Nav2-style filter.
         carrot_in_sight: the carrot is the farthest point of the lookahead the robot can reach straight past
             the known map (:meth:`controllers.guidance.PathCarrot.keep_in_sight`; ours, on by default: on
             dyn300's door scenes the carrot behind a wall held the robot still against it; false: the plain
@@ -81,57 +79,42 @@ class MppiNavigator:
     """
 
     name: ClassVar[str] = "mppi"
+    safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
     # noise_bank x samples x horizon_steps x 2 float32 are drawn at reset: at most 16 x 20,000 x 100 x 2 (256 MB)
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "samples": within(1, 20_000), "horizon_steps": within(1, 100), "model_dt_s": above(0, 10),
-        "linear_std_m_s": within(0, 100), "angular_std_rad_s": within(0, 100), "temperature": above(0, 1e6),
-        "control_cost": within(0, 1e6), "margin_m": within(0, 100), "repulsion_m": within(0, 100),
-        "repulsion_weight": within(0, 1e6), "collision_cost": within(0, 1e9), "lookahead_m": above(0, 1000),
-        "follow_weight": within(0, 1e6), "path_weight": within(0, 1e6), "goal_radius_m": within(0, 1000),
-        "goal_weight": within(0, 1e6), "max_angular_rad_s": above(0, 100), "noise_bank": within(1, 16),
-        "optimise_period_s": within(0, 10), "time_before_collision_s": within(0, 600)}
 
-    samples: int = 1000
-    horizon_steps: int = 30
-    model_dt_s: float = 0.1
-    linear_std_m_s: float = 0.1
-    angular_std_rad_s: float = 0.6
-    temperature: float = 0.3
-    control_cost: float = 0.015
-    margin_m: float = 0.05
-    repulsion_m: float = 0.2
-    repulsion_weight: float = 20.0
-    collision_cost: float = 1000.0
-    lookahead_m: float = 1.0
-    follow_weight: float = 5.0
-    path_weight: float = 1.0
-    goal_radius_m: float = 0.6
-    goal_weight: float = 5.0
-    max_angular_rad_s: float = 1.2
-    noise_bank: int = 8
-    optimise_period_s: float = 0.1
-    safety_filter: bool = False
-    time_before_collision_s: float = 1.0
+    samples: int = param(1000, within(1, 20_000))
+    horizon_steps: int = param(30, within(1, 100))
+    model_dt_s: float = param(0.1, above(0, 10))
+    linear_std_m_s: float = param(0.1, above(0, 100))
+    angular_std_rad_s: float = param(0.6, above(0, 100))
+    temperature: float = param(0.3, above(0, 1e6))
+    control_cost: float = param(0.015, within(0, 1e6))
+    margin_m: float = param(0.05, within(0, 100))
+    repulsion_m: float = param(0.2, within(0, 100))
+    repulsion_weight: float = param(20.0, within(0, 1e6))
+    collision_cost: float = param(1000.0, above(0, 1e9))
+    lookahead_m: float = param(1.0, above(0, 1000))
+    follow_weight: float = param(5.0, within(0, 1e6))
+    path_weight: float = param(1.0, within(0, 1e6))
+    goal_radius_m: float = param(0.6, above(0, 1000))
+    goal_weight: float = param(5.0, within(0, 1e6))
+    max_angular_rad_s: float = param(1.2, above(0, 100))
+    noise_bank: int = param(8, within(1, 16))
+    optimise_period_s: float = param(0.1, within(0, 10))
     carrot_in_sight: bool = True
 
     def __post_init__(self) -> None:
-        check_positive(self, ("samples", "horizon_steps", "model_dt_s", "linear_std_m_s", "angular_std_rad_s",
-                              "temperature", "lookahead_m", "max_angular_rad_s", "time_before_collision_s",
-                              "collision_cost", "goal_radius_m"),
-                       ("control_cost", "noise_bank", "optimise_period_s", "margin_m", "repulsion_m", "repulsion_weight",
-                        "follow_weight",
-                        "path_weight", "goal_weight"))
+        # Each field's own range is declared with it (param); what no single field can say:
         if self.samples * self.horizon_steps > 1_000_000:
             raise ConfigError("navigator.params.samples", f"samples x horizon_steps must be at most 1,000,000, "
                                                           f"got {self.samples * self.horizon_steps:,}")
 
     def reset(self, setup: NavigationSetup) -> None:
-        (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal,
-         self.filter) = local_setup(setup, self.margin_m, self.lookahead_m, self.safety_filter,
-                                    self.time_before_collision_s, self.carrot_in_sight)
+        (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(
+            setup, self.margin_m, self.lookahead_m, self.carrot_in_sight)
         self.rng = setup.rng
         self.optimised_at_s = -1.0
         self.nominal = np.zeros((self.horizon_steps, 2), dtype=np.float32)
@@ -246,13 +229,8 @@ class MppiNavigator:
 
     def _answer(self, pose, v: float, omega: float, observation: Observation) -> NavigationStep:
         command = ControlCommand(wheel_speeds(v, omega, self.geometry), v, omega, 0)
-        events = []
-        if self.filter is not None:
-            command, triggered = self.filter.apply(pose, command, observation.detections)
-            if triggered:
-                events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
         horizon = self.model_dt_s * self.horizon_steps
-        return NavigationStep(command, None, tuple(events), Belief(observation.detections, horizon))
+        return NavigationStep(command, None, (), Belief(observation.detections, horizon))
 
 
 def _resample(points: np.ndarray, spacing_m: float) -> np.ndarray:

@@ -28,11 +28,10 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.navigators.replan import check_positive
 from swarmnav.controllers.oracle_search import OraclePlan, OracleSettings, search
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import wrap_angle_rad
@@ -54,22 +53,17 @@ class ClairvoyantOracleNavigator:
     replan_wall_s: ClassVar[float] = 0.0     # its search runs in reset(), not in step()
     clairvoyant: ClassVar[bool] = True       # benchmarks report it as the yardstick, never as a contender
     # the lattice coarsens itself past 10^8 state-ticks, so a fine cell costs time, not memory (models.parameters)
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "cell_m": within(0.01, 10), "speed_fraction": above(0, 1), "turn_rate_rad_s": above(0, 100),
-        "margin_m": within(0, 10), "gain_x": within(0, 1e4), "gain_y": within(0, 1e6), "gain_theta": within(0, 1e4),
-        "max_angular_rad_s": above(0, 100)}
 
-    cell_m: float = 0.1
-    speed_fraction: float = 0.9
-    turn_rate_rad_s: float = 1.0
-    margin_m: float = 0.04
-    gain_x: float = 2.0
-    gain_y: float = 40.0
-    gain_theta: float = 8.0
-    max_angular_rad_s: float = 1.5
+    cell_m: float = param(0.1, within(0.01, 10))
+    speed_fraction: float = param(0.9, above(0, 1))
+    turn_rate_rad_s: float = param(1.0, above(0, 100))
+    margin_m: float = param(0.04, within(0, 10))
+    gain_x: float = param(2.0, above(0, 1e4))
+    gain_y: float = param(40.0, above(0, 1e6))
+    gain_theta: float = param(8.0, above(0, 1e4))
+    max_angular_rad_s: float = param(1.5, above(0, 100))
 
     def __post_init__(self) -> None:
-        check_positive(self, ("gain_x", "gain_y", "gain_theta", "max_angular_rad_s"), ())
         self.settings = OracleSettings(self.cell_m, self.speed_fraction, self.turn_rate_rad_s, self.margin_m)
         self.settings.check("navigator.params")
         self.plan: OraclePlan | None = None

@@ -28,7 +28,7 @@ from swarmnav.controllers.policy_interface import (ACTION_MODES, ActionError, Po
                                                    checked_action, flatten_observation, observation_layout)
 from swarmnav.controllers.observation_normaliser import ObservationNormaliser
 from swarmnav.models.errors import ConfigError
-from swarmnav.models.parameters import Range, above, code_parameter, within
+from swarmnav.models.parameters import code_parameter, param, within
 
 FIELD = "navigator.params.policy"
 
@@ -69,28 +69,18 @@ class PolicyNavigator:
     """
 
     name: ClassVar[str] = "policy"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "path_waypoints": within(0, 1000), "obstacle_slots": within(1, 1000)}  # models.parameters: checked on build
     uses_detections: bool = field(default=True, init=False, repr=False)  # per run: set by reset
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
     policy: str = code_parameter()  # names code: never taken from a data file without --trust-code
-    action: str = "twist"
-    path_waypoints: int = 0
-    obstacle_slots: int | None = None
+    action: str = param("twist", choices=ACTION_MODES)
+    path_waypoints: int = param(0, within(0, 1000))
+    obstacle_slots: int | None = param(None, within(1, 1000))
     tracked_obstacles: bool = False
     flatten: bool = False
     normalise: str = ""
 
     def __post_init__(self) -> None:
-        if self.action not in ACTION_MODES:
-            raise ConfigError("navigator.params.action", f"expected one of {list(ACTION_MODES)}, got {self.action!r}")
-        if self.path_waypoints < 0:
-            raise ConfigError("navigator.params.path_waypoints", f"must be >= 0, got {self.path_waypoints}")
-        if self.obstacle_slots is not None and self.obstacle_slots < 1:
-            raise ConfigError("navigator.params.obstacle_slots", f"must be >= 1, got {self.obstacle_slots}")
-        if not isinstance(self.flatten, bool):
-            raise ConfigError("navigator.params.flatten", f"expected true or false, got {self.flatten!r}")
         self._normaliser = (ObservationNormaliser.load(self.normalise, "navigator.params.normalise")
                             if self.normalise else None)
         self._policy = load_policy(self.policy)

@@ -31,18 +31,18 @@ are used; our choices:
   may still run into the robot: that counts as a collision, as in BARN).
 * **Latency**: a new path takes effect ``planning_latency_s`` of simulated time
   after the replan (default 0); meanwhile the robot drives on the old path.
-* **Safety filter** (off by default, ``safety_filter = true``): the Nav2
-  "approach" filter of :mod:`controllers.safety_filter` on every command.
-* **Evasion** (``evade``, on by default; ours, beyond the paper, which has no moving obstacle that comes at
-  the robot): the velocity-obstacle evasion of :mod:`controllers.evasion` overrides the command while a
-  sensed obstacle's predicted time to collision with the robot is below ``evade_trigger_s``.  The sweeps
+* **Safety layer** (:mod:`controllers.safety_layer`, applied by the stepper after this navigator's step;
+  ``safety_layer`` below offers its two switches): the Nav2 "approach" filter (``safety_filter``, off by
+  default) and the evasion (``evade``, on by default; ours, beyond the paper, which has no moving obstacle
+  that comes at the robot): the velocity-obstacle evasion of :mod:`controllers.evasion` overrides the command
+  while a sensed obstacle's predicted time to collision with the robot is below ``evade_trigger_s``.  The sweeps
   this navigator plans around are kept off the robot's own position, so an obstacle coming at it was
   invisible exactly where it mattered: on the dyn300 suite most failures were collisions with crossers faster
   than the robot and walkers, after which the robot reached its goal (``evade = false``: the earlier
   behaviour; the before and after figures are in the README).
 
 Events: ``replan`` (reason, the obstacles' track ids, planning wall time is
-not logged: it is not deterministic), ``replan_failed``, ``safety_trigger``.
+not logged: it is not deterministic), ``replan_failed``; the layer's ``evade`` and ``safety_trigger``.
 """
 
 from __future__ import annotations
@@ -52,26 +52,14 @@ import time
 from dataclasses import dataclass, replace, field
 from typing import Any, ClassVar
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_discs
-from swarmnav.controllers.evasion import evasion_for
-from swarmnav.controllers.safety_filter import SafetyFilter
-from swarmnav.models.errors import ConfigError
+from swarmnav.controllers.guided import free_start
 from swarmnav.models.world import Disc, Pose2D, rasterise
 from swarmnav.planners.errors import PlanningError, StartBlocked
 from swarmnav.planners.problem import Path, Problem
-
-
-def check_positive(owner: Any, names: tuple[str, ...], non_negative: tuple[str, ...] = ()) -> None:
-    """ConfigError naming ``navigator.params.NAME`` for a parameter that must be positive (or >= 0)."""
-    for name in names:
-        if not getattr(owner, name) > 0:
-            raise ConfigError(f"navigator.params.{name}", f"must be positive, got {getattr(owner, name)!r}")
-    for name in non_negative:
-        if not getattr(owner, name) >= 0:
-            raise ConfigError(f"navigator.params.{name}", f"must not be negative, got {getattr(owner, name)!r}")
 
 
 def keep_outside(discs: list[Disc], points: list[tuple[float, float]], inflation_m: float) -> list[Disc]:
@@ -118,40 +106,29 @@ class ReplanNavigator:
         cooldown_s: least simulated time between two replans.
         retry_s: wait after a failed replan before trying again (stopped meanwhile).
         planning_latency_s: simulated time before a new path takes effect.
-        safety_filter: apply the Nav2-style safety filter to every command.
-        time_before_collision_s: the safety filter's threshold.
-        evade: the evasion layer (:mod:`controllers.evasion`) on every command.
-        evade_trigger_s: the predicted time to collision below which the evasion takes over.
     """
 
     name: ClassVar[str] = "replan"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "lookahead_m": within(0, 1000), "horizon_s": within(0, 600), "margin_m": within(0, 100),
-        "cooldown_s": within(0, 1e6), "retry_s": within(0, 1e6), "planning_latency_s": within(0, 1e6),
-        "time_before_collision_s": within(0, 600),
-        "evade_trigger_s": within(0, 600)}  # models.parameters: checked on build
+    safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False, "evade": True}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: float = field(default=0.0, init=False, repr=False)
 
-    lookahead_m: float = 2.5
-    horizon_s: float = 6.0
-    margin_m: float = 0.05
-    cooldown_s: float = 0.5
-    retry_s: float = 0.5
-    planning_latency_s: float = 0.0
-    safety_filter: bool = False
-    time_before_collision_s: float = 1.0
-    evade: bool = True
-    evade_trigger_s: float = 2.0
+    lookahead_m: float = param(2.5, above(0, 1000))
+    horizon_s: float = param(6.0, above(0, 600))
+    margin_m: float = param(0.05, within(0, 100))
+    cooldown_s: float = param(0.5, within(0, 1e6))
+    retry_s: float = param(0.5, above(0, 1e6))
+    planning_latency_s: float = param(0.0, within(0, 1e6))
 
-    def __post_init__(self) -> None:
-        check_positive(self, ("lookahead_m", "horizon_s", "retry_s", "time_before_collision_s"),
-                       ("margin_m", "cooldown_s", "planning_latency_s"))
+    @property
+    def known(self) -> Problem:
+        """The map it plans on (``NavigationSetup.map_problem``: the known map, or the sensed map's latest)."""
+        return self.setup.map_problem
 
     def reset(self, setup: NavigationSetup) -> None:
         self.setup = setup
-        self.known = setup.map_problem
+        self.checked_revision = setup.map_revision
         self.controller = setup.controller
         self.path = setup.path
         self.controller.reset(setup.path)
@@ -159,9 +136,6 @@ class ReplanNavigator:
         self.pending: tuple[float, Path] | None = None
         self.waiting_until_s: float | None = None
         self.replan_wall_s = 0.0
-        self.filter = SafetyFilter(setup.controller.geometry, setup.problem.robot_radius_m,
-                                   self.time_before_collision_s) if self.safety_filter else None
-        self.evasion = evasion_for(setup, self.evade_trigger_s) if self.evade else None
 
     # -- the step ------------------------------------------------------------
     def step(self, observation: Observation) -> NavigationStep:
@@ -194,10 +168,15 @@ class ReplanNavigator:
         return self._finish(observation, command, events, new_path)
 
     def blocked(self, observation: Observation) -> str:
-        """A reason to replan ("blocked by sensed obstacle") or ""."""
+        """A reason to replan ("blocked by sensed obstacle", "blocked on the sensed map") or ""."""
+        pose = observation.pose
+        if self.setup.map_revision != self.checked_revision:  # the sensed map changed (never with a known map)
+            self.checked_revision = self.setup.map_revision
+            rest = path_ahead(pose, self.path.waypoints, self.controller.waypoint_index, math.inf)
+            if self.setup.world_map.blocks(rest):
+                return "blocked on the sensed map"
         if not observation.detections:
             return ""
-        pose = observation.pose
         ahead = path_ahead(pose, self.path.waypoints, self.controller.waypoint_index, self.lookahead_m)
         # The same discs a replan would plan around (kept off the robot), so a fresh path is not blocked at once.
         sweeps = keep_outside(swept_discs(observation.detections, self.horizon_s), [(pose.x_m, pose.y_m)],
@@ -220,8 +199,9 @@ class ReplanNavigator:
             try:
                 path = self.setup.planner.plan(problem, self.setup.rng)
             except StartBlocked:
-                # The robot has cut within the clearance of a known obstacle: plan with no clearance.
-                problem = replace(problem, clearance_m=0.0)
+                # The robot has cut within the clearance of a known obstacle: plan with no clearance
+                # (and, on a sensed map, whose cells are coarser than the obstacles, from the nearest free point).
+                problem = replace(problem, clearance_m=0.0) if self.setup.world_map is None else free_start(problem)
                 path = self.setup.planner.plan(problem, self.setup.rng)
             ok = problem.is_collision_free(path.waypoints, tolerance_m=1e-6)
             why = "" if ok else "the planner's path is not collision-free"
@@ -243,13 +223,4 @@ class ReplanNavigator:
 
     def _finish(self, observation: Observation, command: ControlCommand, events: list,
                 new_path: Path | None) -> NavigationStep:
-        if self.evasion is not None:
-            command, evading = self.evasion.apply(observation.pose, command, observation.detections)
-            if evading:
-                events.append(("evade", {"linear_m_s": round(command.linear_m_s, 6),
-                                         "angular_rad_s": round(command.angular_rad_s, 6)}))
-        if self.filter is not None:
-            command, triggered = self.filter.apply(observation.pose, command, observation.detections)
-            if triggered:
-                events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
         return NavigationStep(command, new_path, tuple(events), Belief(observation.detections, self.horizon_s))

@@ -38,12 +38,11 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.navigators.replan import check_positive
 from swarmnav.controllers.velocity_candidates import candidate_times_s, chosen_candidate, unicycle_command
 
 
@@ -61,7 +60,6 @@ class VelocityObstacleNavigator:
             skirted obstacles it could not escape (bench navigation: 0.87 -> 0.97 success on the suite).
         lookahead_m: the carrot's distance along the global path.
         heading_gain, max_angular_rad_s, turn_in_place_rad: the (v, omega) conversion.
-        safety_filter, time_before_collision_s: the optional Nav2-style filter.
         carrot_in_sight: the carrot is the farthest point of the lookahead the robot can reach straight past
             the known map (:meth:`controllers.guidance.PathCarrot.keep_in_sight`; ours, on by default: on
             dyn300's door scenes the carrot behind a wall held the robot still against it; false: the plain
@@ -69,37 +67,25 @@ class VelocityObstacleNavigator:
     """
 
     name: ClassVar[str] = "velocity_obstacle"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "time_horizon_s": above(0, 60), "speed_samples": within(1, 100), "heading_samples": within(1, 360),
-        "max_turn_rad": within(0, math.pi), "margin_m": within(0, 100), "lookahead_m": above(0, 1000),
-        "heading_gain": within(0, 1000), "max_angular_rad_s": above(0, 100), "turn_in_place_rad": within(0, math.pi),
-        "time_before_collision_s": within(0, 600)}  # models.parameters: checked on build
+    safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
 
-    time_horizon_s: float = 4.0
-    speed_samples: int = 5
-    heading_samples: int = 25
-    max_turn_rad: float = math.pi
-    margin_m: float = 0.15
-    lookahead_m: float = 1.0
-    heading_gain: float = 2.5
-    max_angular_rad_s: float = 1.2
-    turn_in_place_rad: float = math.radians(60.0)
-    safety_filter: bool = False
-    time_before_collision_s: float = 1.0
+    time_horizon_s: float = param(4.0, above(0, 60))
+    speed_samples: int = param(5, within(1, 100))
+    heading_samples: int = param(25, within(1, 360))
+    max_turn_rad: float = param(math.pi, above(0, math.pi))
+    margin_m: float = param(0.15, within(0, 100))
+    lookahead_m: float = param(1.0, above(0, 1000))
+    heading_gain: float = param(2.5, above(0, 1000))
+    max_angular_rad_s: float = param(1.2, above(0, 100))
+    turn_in_place_rad: float = param(math.radians(60.0), above(0, math.pi))
     carrot_in_sight: bool = True
 
-    def __post_init__(self) -> None:
-        check_positive(self, ("time_horizon_s", "max_turn_rad", "lookahead_m", "heading_gain", "max_angular_rad_s",
-                              "turn_in_place_rad", "time_before_collision_s", "speed_samples", "heading_samples"),
-                       ("margin_m",))
-
     def reset(self, setup: NavigationSetup) -> None:
-        (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal,
-         self.filter) = local_setup(setup, self.margin_m, self.lookahead_m, self.safety_filter,
-                                    self.time_before_collision_s, self.carrot_in_sight)
+        (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(
+            setup, self.margin_m, self.lookahead_m, self.carrot_in_sight)
         speeds = np.linspace(self.max_speed / self.speed_samples, self.max_speed, self.speed_samples)
         offsets = np.linspace(-self.max_turn_rad, self.max_turn_rad, self.heading_samples)
         speed, offset = (a.ravel() for a in np.meshgrid(speeds, offsets, indexing="ij"))
@@ -130,9 +116,4 @@ class VelocityObstacleNavigator:
         v, omega = unicycle_command(float(self.speeds[k]), float(self.offsets[k]), self.heading_gain,
                                     self.max_angular_rad_s, self.turn_in_place_rad)
         command = ControlCommand(wheel_speeds(v, omega, self.geometry), v, omega, 0)
-        events = []
-        if self.filter is not None:
-            command, triggered = self.filter.apply(pose, command, observation.detections)
-            if triggered:
-                events.append(("safety_trigger", {"linear_m_s": command.linear_m_s}))
-        return NavigationStep(command, None, tuple(events), Belief(observation.detections, self.time_horizon_s))
+        return NavigationStep(command, None, (), Belief(observation.detections, self.time_horizon_s))

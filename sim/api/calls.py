@@ -9,7 +9,8 @@ from __future__ import annotations
 import os
 import time
 from pathlib import Path as FilePath
-from typing import TYPE_CHECKING, Any, Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from swarmnav.results import PlanResult, RunOutcome
 
@@ -17,11 +18,13 @@ if TYPE_CHECKING:
     import numpy as np
 
     from swarmnav.models.scenario import Scenario
+    from swarmnav.sim.episode import EpisodeSpec
+    from swarmnav.sim.study.spec import Study
 
-ScenarioLike = "str | os.PathLike | Scenario"
+ComponentClass = TypeVar("ComponentClass", bound=type)
 
 
-def load_scenario(name_or_path: str | os.PathLike, trust_code: bool = False) -> "Scenario":
+def load_scenario(name_or_path: str | os.PathLike[str], trust_code: bool = False) -> Scenario:
     """A bundled scenario by name (``swarmnav scenarios``), an installed package's, or a ``.toml`` path
     (``trust_code``: the file may name code to run, e.g. a ``policy``; see ``--trust-code``).
 
@@ -49,15 +52,24 @@ def check_components(scenario: "Scenario", trust_code: bool = False) -> None:
     make_navigator(scenario.navigator_name, scenario.navigator_params, scenario.source_path, trust_code=trust_code)
 
 
-def _scenario(scenario: Any) -> "Scenario":
+def _scenario(scenario: str | os.PathLike[str] | Scenario) -> Scenario:
+    """A scenario as given, or loaded by name or path and its components checked (the caller has loaded the
+    plugins)."""
     from swarmnav.models.scenario import Scenario
-    return scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    from swarmnav.models.scenario import load_scenario as load
+    if isinstance(scenario, Scenario):
+        return scenario
+    loaded = load(str(scenario))
+    check_components(loaded)
+    return loaded
 
 
-def episode_spec(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
-                 navigator: str | None = None, navigator_params: dict[str, Any] | None = None,
-                 seed: int | None = None, world_seed: int | None = None, clearance_m: float | None = None):
-    """The :class:`swarmnav.sim.episode.EpisodeSpec` of these arguments (``None``: the scenario's)."""
+def episode_spec(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
+                 params: Mapping[str, Any] | None = None, navigator: str | None = None,
+                 navigator_params: Mapping[str, Any] | None = None, seed: int | None = None,
+                 world_seed: int | None = None, clearance_m: float | None = None) -> EpisodeSpec:
+    """The :class:`swarmnav.sim.episode.EpisodeSpec` of these arguments (``None``: the scenario's); the
+    plugins are loaded here, once per call."""
     from swarmnav.sim.episode import EpisodeSpec
     from swarmnav.sim.plugins import load_plugins
     load_plugins()
@@ -66,8 +78,9 @@ def episode_spec(scenario: Any, planner: str | None = None, params: dict[str, An
                        seed=seed, world_seed=world_seed, clearance_m=clearance_m)
 
 
-def plan(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
-         seed: int | None = None, clearance_m: float | None = None) -> PlanResult:
+def plan(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
+         params: Mapping[str, Any] | None = None, seed: int | None = None,
+         clearance_m: float | None = None) -> PlanResult:
     """Plan the scenario (its obstacles at t = 0) with a registered planner.
 
     Raises:
@@ -78,29 +91,23 @@ def plan(scenario: Any, planner: str | None = None, params: dict[str, Any] | Non
     return PlanResult(plan_episode(episode_spec(scenario, planner, params, seed=seed, clearance_m=clearance_m)))
 
 
-def given_episode(spec, waypoints: "np.ndarray", source: str):
-    """An episode whose path is the given waypoints instead of a plan (``run --waypoints``): the spec's planner
-    still serves a navigator that replans."""
-    from swarmnav.controllers.navigators import make_navigator
-    from swarmnav.planners.registry import make_planner
-    from swarmnav.sim.episode import Episode
-    from swarmnav.sim.given_path import given_path
-    spec = spec.resolved()
-    planner = make_planner(spec.planner, spec.planner_params, spec.scenario.source_path)  # bad names fail early
-    navigator = make_navigator(spec.navigator, spec.navigator_params, spec.scenario.source_path)
-    problem, path = given_path(spec.scenario, waypoints, source)
-    return Episode(spec, problem, path, planner, navigator)
+def given_episode(spec: EpisodeSpec, waypoints: np.ndarray, source: str) -> Any:
+    """An episode whose path is the given waypoints instead of a plan (``run --waypoints``), composed as every
+    run is (:func:`swarmnav.sim.episode.given_episode`)."""
+    from swarmnav.sim.episode import given_episode as composed
+    return composed(spec, waypoints, source)
 
 
-def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
-        navigator: str | None = None, navigator_params: dict[str, Any] | None = None,
-        seed: int | None = None, world_seed: int | None = None, clearance_m: float | None = None, *,
-        waypoints: "Sequence[Sequence[float]] | np.ndarray | str | os.PathLike | None" = None,
-        log: "str | os.PathLike | bool | None" = None, overwrite: bool = False,
-        video: "str | os.PathLike | None" = None, camera: str = "top", width: int = 640, height: int = 480,
+def run(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
+        params: Mapping[str, Any] | None = None, navigator: str | None = None,
+        navigator_params: Mapping[str, Any] | None = None, seed: int | None = None, world_seed: int | None = None,
+        clearance_m: float | None = None, *,
+        waypoints: Sequence[Sequence[float]] | np.ndarray | str | os.PathLike[str] | None = None,
+        log: str | os.PathLike[str] | bool | None = None, overwrite: bool = False,
+        video: str | os.PathLike[str] | None = None, camera: str = "top", width: int = 640, height: int = 480,
         fps: float | None = None, stop_on_collision: bool | None = None, live: bool = False,
-        on_live: Callable[[str], None] | None = None) -> RunOutcome:
-    """Plan (or take ``waypoints``) and drive the scenario in MuJoCo.
+        on_live: Callable[[str], None] | None = None, log_format: str = "swarmnav") -> RunOutcome:
+    """Plan (or take ``waypoints``) and drive the scenario in MuJoCo (:func:`run_spec` of :func:`episode_spec`).
 
     Args:
         waypoints: a path to drive instead of planning: ``(N, 2)`` metres, or a CSV/JSON file
@@ -108,14 +115,27 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
         log: an MCAP path, ``True`` for ``logs/<scenario>_<planner>_seed<N>_<stamp>.mcap``, or ``None``/``False``
             for no log.
         video: an MP4 path rendered offscreen while running.
+        log_format: ``swarmnav`` (Foxglove's schemas) or ``ros2`` (CDR messages of the standard ROS 2 types).
 
     Raises:
         ConfigError: bad input (naming the field); the log or video file exists without ``overwrite``.
         PlanningError: no path.
     """
-    from swarmnav.models.errors import ConfigError
-    from swarmnav.sim.episode import plan_episode, run_episode
     spec = episode_spec(scenario, planner, params, navigator, navigator_params, seed, world_seed, clearance_m)
+    return run_spec(spec, waypoints=waypoints, log=log, overwrite=overwrite, video=video, camera=camera, width=width,
+                    height=height, fps=fps, stop_on_collision=stop_on_collision, live=live, on_live=on_live,
+                    log_format=log_format)
+
+
+def run_spec(spec: Any, *, waypoints: "Sequence[Sequence[float]] | np.ndarray | str | os.PathLike | None" = None,
+             log: "str | os.PathLike | bool | None" = None, overwrite: bool = False,
+             video: "str | os.PathLike | None" = None, camera: str = "top", width: int = 640, height: int = 480,
+             fps: float | None = None, stop_on_collision: bool | None = None, live: bool = False,
+             on_live: Callable[[str], None] | None = None, log_format: str = "swarmnav") -> RunOutcome:
+    """Plan (or take ``waypoints``) and drive an :class:`~swarmnav.sim.episode.EpisodeSpec` (the command line's
+    ``run`` builds its spec as ``plan`` does, then comes here); the outputs as :func:`run` takes them."""
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.sim.episode import given_episode, plan_episode, run_episode
     if waypoints is not None:
         from swarmnav.sim.given_path import as_waypoints, read_waypoints
         if isinstance(waypoints, (str, os.PathLike)):
@@ -134,7 +154,7 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
             raise ConfigError("--out", "Is a directory (give a file path)", str(log_path))
         if log_path.exists() and not overwrite:
             raise ConfigError("--out", "file exists (use --overwrite)", str(log_path))
-        recorders.append(McapRecorder(log_path, live=live, overwrite=True, on_live=on_live))
+        recorders.append(McapRecorder(log_path, live=live, overwrite=True, on_live=on_live, log_format=log_format))
     elif live:
         raise ConfigError("--live", "needs the log (drop --no-log)")
     if video:
@@ -146,7 +166,8 @@ def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None
     return RunOutcome(episode, str(log_path) if log_path else None, str(video) if video else None)
 
 
-def run_study(file_or_spec: Any, out: str | os.PathLike | None = None, *, workers: int | None = None,
+def run_study(file_or_spec: str | os.PathLike[str] | Mapping[str, Any] | Study,
+              out: str | os.PathLike[str] | None = None, *, workers: int | None = None,
               engine: str = "local", address: str | None = None, logs: bool = False,
               quick: bool = False) -> dict[str, Any]:
     """Run a study (a bundled name, a ``.toml`` path, or the tables of a study file as a dict) into ``out``
@@ -158,8 +179,8 @@ def run_study(file_or_spec: Any, out: str | os.PathLike | None = None, *, worker
     load_plugins()
     if isinstance(file_or_spec, Study):
         study = file_or_spec
-    elif isinstance(file_or_spec, dict):
-        study = study_from_tables(file_or_spec, "<tables>", str(file_or_spec.get("name", "study")))
+    elif isinstance(file_or_spec, Mapping):
+        study = study_from_tables(dict(file_or_spec), "<tables>", str(file_or_spec.get("name", "study")))
     else:
         study = load_study(str(file_or_spec))
     if quick:
@@ -168,7 +189,7 @@ def run_study(file_or_spec: Any, out: str | os.PathLike | None = None, *, worker
     return execute(study, target, engine=engine, workers=workers, address=address, logs=logs)
 
 
-def register_planner(cls: type) -> type:
+def register_planner(cls: ComponentClass) -> ComponentClass:
     """Register a planner class in this process (a decorator, too); every command run from this process, and
     this API, then knows it by ``cls.name``.  To make it known to the ``swarmnav`` command and to study
     workers, declare it as an entry point (``swarmnav.planners``) of an installed package instead."""
@@ -176,7 +197,7 @@ def register_planner(cls: type) -> type:
     return register(cls)
 
 
-def register_navigator(cls: type) -> type:
+def register_navigator(cls: ComponentClass) -> ComponentClass:
     """Register a navigator class in this process (see :func:`register_planner`; group ``swarmnav.navigators``)."""
     from swarmnav.controllers.navigators import register
     return register(cls)

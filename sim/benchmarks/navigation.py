@@ -75,11 +75,11 @@ def default_navigators(settings: dict[str, dict[str, Any]] | None = None) -> lis
 
 def navigator_settings(pairs: dict[str, Any], navigators: list[str]) -> dict[str, dict[str, Any]]:
     """``--navigator-set KEY=VALUE``: each navigator gets the keys it has as parameters; a key none has is an error."""
-    import dataclasses
+    from swarmnav.controllers.navigators import navigator_parameters
     from swarmnav.models.errors import ConfigError
     out: dict[str, dict[str, Any]] = {}
     for key, value in pairs.items():
-        takers = [n for n in navigators if key in {f.name for f in dataclasses.fields(NAVIGATORS[n]) if f.init}]
+        takers = [n for n in navigators if key in navigator_parameters(n)]
         if not takers:
             raise ConfigError("--navigator-set", f"no navigator of this benchmark has a parameter {key!r}")
         for name in takers:
@@ -191,48 +191,71 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                          quick: bool = False, sensor_model: str | None = None,
                          workers: int = 1, speed: bool = True, per_group: int | None = None,
                          arms: list[Arm] = (), engine: str = "local", address: str | None = None,
-                         seed_offset: int = 0) -> list[dict[str, Any]]:
+                         seed_offset: int = 0, barn: dict[str, Any] | None = None) -> list[dict[str, Any]]:
     """One row per navigator and the oracle's (see the module docstring); ``navigator_params``: per navigator
     name.  With ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key;
     the overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given;
     ``suite`` (e.g. ``dyn300``) runs a generated suite instead of ``scenarios``; ``arms``: more rows, each a
     navigator under its own label with its own parameters (the rows are keyed by label); ``engine="ray"``:
-    the runs on Ray (a local instance of ``workers`` CPUs, or the cluster at ``address``)."""
+    the runs on Ray (a local instance of ``workers`` CPUs, or the cluster at ``address``); ``suite="barn"``: the
+    BARN worlds (:mod:`sim.benchmarks.barn`; ``barn``: its ``worlds``, ``runs`` and ``dir``), with its score."""
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
             return benchmark_navigation(seeds, navigators, scenarios, progress, navigator_params, by_scenario,
                                         folder, suite, quick, sensor_model, workers, speed, per_group, arms,
-                                        engine, address, seed_offset)
+                                        engine, address, seed_offset, barn)
     from swarmnav.sim.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
     contenders = [n for n in (navigators or default_navigators(navigator_params)) if not is_clairvoyant(n)]
     check_arms(contenders, list(arms))
     shipped: dict[str, dict[str, Any]] = {}
-    if suite is not None:
+    barn_meta = None
+    if suite in ("barn", "barn-like"):
+        from swarmnav.sim.benchmarks import barn as barn_suite
+        names, barn_meta, barn_setup = barn_suite.write_barn_suite(out_dir, quick, (barn or {}).get("worlds"),
+                                                                   (barn or {}).get("runs"), (barn or {}).get("dir"),
+                                                                   generated=suite == "barn-like",
+                                                                   planner=(barn or {}).get("planner"),
+                                                                   setup_name=(barn or {}).get("setup") or "auto")
+        run_seeds, speed = None, False  # the speed figures re-run every scene's oracle search: not here
+    elif suite is not None:
         names, loaded = write_suite(suite, quick, sensor_model, out_dir, per_group, seed_offset)
         shipped = loaded.verdicts
         run_seeds = None
     else:
         names, run_seeds = scenarios or suite_names(), seeds
-    tables = navigation_study(run_seeds, contenders + [ORACLE], names, navigator_params, list(arms))
+    # the BARN suites run no oracle unless asked: on BARN's worlds it collided in every one of 26 stand-in runs
+    # (barn-test50), so it is no yardstick there (sim/benchmarks/barn.py)
+    yardstick = [ORACLE] if barn_meta is None or (barn or {}).get("oracle") else []
+    tables = navigation_study(run_seeds, contenders + yardstick, names, navigator_params, list(arms))
     rows = run_study_tables(tables, out_dir, show_progress=progress, workers=workers, engine=engine,
                             address=address)
     verdicts = oracle_verdicts(rows)
-    labels = contenders + [a.label for a in arms] + [ORACLE]
+    labels = contenders + [a.label for a in arms] + yardstick
     runs = {label: [r for r in rows if r["navigator_label"] == label] for label in labels}
     settings = {a.label: {"arm_of": a.navigator, "arm_params": a.params} for a in arms}
     sensing = "+".join(sorted({load_scenario(name).sensor_model for name in names}))
-    table = [{"scenario": None, **_row(nav, arm, verdicts, shipped), "sensor_model": sensing,
-              **settings.get(nav, {})} for nav, arm in runs.items()]
+    from swarmnav.sim.benchmarks.crowd_rows import crowd_rows, robot_visible
+    visible = robot_visible(names)
+    if visible:  # scenes among agents: one table per setting (CrowdNav's invisible and visible robot)
+        table = crowd_rows(runs, visible, verdicts, shipped, sensing, settings, _row, ORACLE)
+    else:
+        table = [{"scenario": None, **_row(nav, arm, verdicts, shipped), "sensor_model": sensing,
+                  **settings.get(nav, {})} for nav, arm in runs.items()]
     if speed:
         _add_speed(table, rows)
+        if visible:  # the agents' own cost (navigation_speed.crowd_step_cost), on the oracle's row
+            from swarmnav.sim.benchmarks.navigation_speed import crowd_step_cost
+            next(r for r in table if r["navigator"] == ORACLE)["crowd_step"] = crowd_step_cost()
     if by_scenario:
         for name in dict.fromkeys(r["scenario"] for r in rows):
             extra = {"difficulty": {k: shipped[name][k] for k in DIFFICULTY_KEYS}} if name in shipped else {}
             for nav, arm in runs.items():
                 table.append({"scenario": name, **_row(nav, [r for r in arm if r["scenario"] == name], verdicts,
                                                        shipped), **extra})
+    if barn_meta is not None:
+        barn_suite.add_scores(table, rows, barn_meta, barn_setup, by_scenario, (barn or {}).get("dir"))
     return table
 
 
@@ -286,6 +309,7 @@ def _plain_row(navigator: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
         "success_rate": sum(bool(r["success"]) for r in rows) / n,
         "collision_rate": sum(bool(r["collisions"]) for r in drove) / n,
         "timeout_rate": sum(r["run_outcome"] == "timeout" for r in drove) / n,
+        "left_arena_rate": sum(r["run_outcome"] == "left_arena" for r in drove) / n,
         "mean_time_to_goal_s": _mean(reached),
         "mean_spl": _mean([r["spl"] or 0.0 for r in drove]),
         "mean_time_in_danger_s": _mean([r["time_in_danger_s"] for r in drove]),
@@ -316,6 +340,7 @@ def run(args: argparse.Namespace) -> int:
     settings = navigator_settings(parse_settings(args.navigator_set, "--navigator-set"),
                                   args.navigator or list(NAVIGATORS))
     suite = None if args.suite == "dyn" else args.suite
+    barn = _barn_options(args, suite)
     if suite is None and getattr(args, "sensor_model", None):
         raise ConfigError("--sensor-model", "applies to a generated suite (--suite dyn300) only")
     if getattr(args, "address", None) and getattr(args, "engine", "local") != "ray":
@@ -333,12 +358,25 @@ def run(args: argparse.Namespace) -> int:
                                 workers=getattr(args, "workers", 1) or 1, per_group=getattr(args, "per_group", None),
                                 arms=arms, engine=getattr(args, "engine", "local"),
                                 address=getattr(args, "address", None),
-                                seed_offset=getattr(args, "seed_offset", 0) or 0)
+                                seed_offset=getattr(args, "seed_offset", 0) or 0, barn=barn)
     if args.json:
         print(json.dumps(rows))
         return 0
     overall = [r for r in rows if r["scenario"] is None]
-    _print_table(overall, "")
+    if any("robot_visible" in r for r in overall):  # among agents: CrowdNav's two settings apart
+        from swarmnav.sim.benchmarks.crowd_rows import print_crowd_lines
+        for seen in (False, True):
+            part = [r for r in overall if r.get("robot_visible") is seen]
+            if part:
+                _print_table(part, f"robot {'visible' if seen else 'invisible'} to the humans"
+                             + (" (no clairvoyant yardstick)" if seen else ""))
+                print_crowd_lines(part)
+                print()
+    else:
+        _print_table(overall, "")
+    if suite in ("barn", "barn-like"):
+        from swarmnav.sim.benchmarks.barn import print_scores
+        print_scores(overall)
     if args.by_scenario:
         for name in dict.fromkeys(r["scenario"] for r in rows if r["scenario"] is not None):
             print()
@@ -349,7 +387,31 @@ def run(args: argparse.Namespace) -> int:
     mppi = next((r.get("mppi_every_step") for r in overall if r["navigator"] == "mppi"), None)
     for line in speed_lines(overall, oracle or {}, mppi):
         print(line)
+    crowd = next((r["crowd_step"] for r in overall if r.get("crowd_step")), None)
+    if crowd:
+        from swarmnav.sim.benchmarks.navigation_speed import crowd_line
+        print(crowd_line(crowd))
     return 0
+
+
+def _barn_options(args: argparse.Namespace, suite: str | None) -> dict[str, Any] | None:
+    """``--barn-dir``, ``--barn-runs``, ``--barn-worlds`` (``--suite barn`` and ``barn-like`` only; the dyn300
+    options refused there)."""
+    from swarmnav.models.errors import ConfigError
+    given = {k: getattr(args, f"barn_{k}", None) for k in ("dir", "runs", "worlds", "planner", "setup", "oracle")}
+    if suite not in ("barn", "barn-like"):
+        for key, value in given.items():
+            if value is not None:
+                raise ConfigError(f"--barn-{key}", "applies to --suite barn only")
+        return None
+    for option in ("sensor_model", "per_group", "seed_offset"):
+        if getattr(args, option, None):
+            raise ConfigError(f"--{option.replace('_', '-')}", "applies to --suite dyn300 only")
+    from swarmnav.sim.benchmarks.barn import barn_dir, parse_planner, parse_worlds
+    if suite == "barn":
+        barn_dir(given["dir"])  # no data: one line before anything runs
+    return {"dir": given["dir"], "runs": given["runs"], "worlds": parse_worlds(given["worlds"], suite == "barn-like"),
+            "planner": parse_planner(given["planner"]), "setup": given["setup"], "oracle": given["oracle"]}
 
 
 def _print_table(rows: list[dict[str, Any]], title: str) -> None:

@@ -14,9 +14,9 @@ from typing import Callable
 
 from swarmnav.sim import options
 from swarmnav.sim.defaults import (  # noqa: F401  (re-exported: the CLI's own defaults)
-    SINGLE_THREAD_ENVIRONMENT, DEFAULT_FPS, MIN_FPS, MAX_FPS, MIN_DPI, MAX_DPI, BENCH_SIM_QUICK,
+    SINGLE_THREAD_ENVIRONMENT, DEFAULT_FPS, LOG_FORMATS, MIN_FPS, MAX_FPS, MIN_DPI, MAX_DPI, BENCH_SIM_QUICK,
     BENCH_ENV_QUICK, BENCH_RENDER_QUICK_FRAMES, BENCH_PLANNERS_SCENARIOS, BENCH_PLANNERS_PLANNERS,
-    BENCH_PLANNERS_SAMPLING, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
+    BENCH_PLANNERS_SAMPLING, BENCH_PLANNERS_SAMPLING_CHOICES, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
 from swarmnav.models.scenario_limits import (MAX_BENCH_DURATION_S, MAX_BENCH_FRAMES, MAX_BENCH_REPEATS, MAX_BENCH_RUNS,
                                              MAX_BENCH_SEEDS, MAX_STUDY_RUNS, MAX_WORKERS)
 from swarmnav.sim.options import add_trust_code_argument  # noqa: F401
@@ -51,9 +51,11 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenarios", nargs="+", default=list(BENCH_PLANNERS_SCENARIOS), metavar="NAME")
     parser.add_argument("--planners", nargs="+", default=list(BENCH_PLANNERS_PLANNERS), choices=BENCH_PLANNERS_PLANNERS,
                         metavar="NAME", help=f"continuous planners among {', '.join(BENCH_PLANNERS_PLANNERS)}")
-    parser.add_argument("--sampling", nargs="*", default=list(BENCH_PLANNERS_SAMPLING), choices=BENCH_PLANNERS_SAMPLING,
-                        metavar="NAME", help=f"OMPL planners among {', '.join(BENCH_PLANNERS_SAMPLING)}, given "
-                        "population x iterations collision checks (default all; none: --sampling alone)")
+    parser.add_argument("--sampling", nargs="*", default=list(BENCH_PLANNERS_SAMPLING),
+                        choices=BENCH_PLANNERS_SAMPLING_CHOICES, metavar="NAME",
+                        help=f"OMPL planners among {', '.join(BENCH_PLANNERS_SAMPLING_CHOICES)}, given population x "
+                        f"iterations collision checks (default {', '.join(BENCH_PLANNERS_SAMPLING)}; "
+                        "none: --sampling alone)")
     parser.add_argument("--seeds", type=RUNS, default=10, help="runs per planner and scenario (default 10)")
     parser.add_argument("--population", type=options.int_in(1, 1_000_000), default=50)
     parser.add_argument("--iterations", type=options.int_in(1, 1_000_000), default=100)
@@ -145,10 +147,31 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=options.output_path, metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
                         "default: a temporary folder")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
-    parser.add_argument("--suite", choices=("dyn", "papers", "dyn300"), default="dyn",
+    parser.add_argument("--suite", choices=("dyn", "papers", "dyn300", "barn", "barn-like", "crowdnav"),
+                        default="dyn",
                         help="dyn: the dyn-* suite (default); papers: the papers' strategies beside replan + iaco "
                              "and dstar_replan, one row per run (sim/benchmarks/paper_navigation.py); dyn300: the "
-                             "300 generated scenes of models/suites/dyn300.toml, by difficulty")
+                             "300 generated scenes of models/suites/dyn300.toml, by difficulty; barn: the 300 BARN "
+                             "worlds under the challenge's protocol and score (sim/benchmarks/barn.py; --quick: its "
+                             "50 test worlds x 10 runs); barn-like: BARN-like worlds at fresh seeds "
+                             "(sim/benchmarks/barn_like.py; --barn-worlds A:B seeds, default 0:50); crowdnav: CrowdNav's "
+                             "circle-crossing test cases, robot invisible and visible to the humans")
+    parser.add_argument("--barn-dir", metavar="DIR", help="--suite barn: the BARN data (default: $SWARMNAV_BARN_DIR, "
+                        "else ../shared/benchmarks/barn)")
+    parser.add_argument("--barn-runs", type=options.positive_int, metavar="N",
+                        help="--suite barn: runs per world (default 1; --quick: 10), run j >= 1 from a seeded start "
+                             "jitter")
+    parser.add_argument("--barn-worlds", metavar="test|all|A:B[:STEP]|I,J,...",
+                        help="--suite barn: these worlds (default all 300; --quick: test, the 50 worlds 0, 6, ..., 294)")
+    parser.add_argument("--barn-setup", choices=("auto", "stand-in"),
+                        help="--suite barn / barn-like: auto (default): the protocol's Jackal, laser and unknown map "
+                             "as far as installed; stand-in: a disc of the Jackal's inscribed radius, map known")
+    parser.add_argument("--barn-oracle", action="store_true", default=None,
+                        help="--suite barn / barn-like: also run the clairvoyant oracle (off by default there: it "
+                             "collided in every stand-in run on BARN's worlds)")
+    parser.add_argument("--barn-planner", metavar="NAME[:KEY=VALUE,...]",
+                        help="--suite barn / barn-like: the known-map track, every run planned by this planner on the "
+                             "map given (e.g. gwo:mode=robust, mmas:cell_m=0.15)")
     parser.add_argument("--quick", action="store_true",
                         help=f"1 world seed on {', '.join(BENCH_NAVIGATION_QUICK_SCENARIOS)} (under a minute); "
                              "with --suite dyn300: a stratified sample, 2 scenes per group")
@@ -169,7 +192,7 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_bench_navigation(args: argparse.Namespace) -> int:
     from swarmnav.sim.benchmarks import navigation
-    if args.quick and args.suite != "dyn300":
+    if args.quick and args.suite not in ("dyn300", "barn", "barn-like"):
         args.seeds, args.scenario = 1, args.scenario or list(BENCH_NAVIGATION_QUICK_SCENARIOS)
     return navigation.run(args)
 
@@ -221,6 +244,18 @@ def add_bench_log_arguments(parser: argparse.ArgumentParser) -> None:
 def run_bench_log(args: argparse.Namespace) -> int:
     from swarmnav.sim.benchmarks import log
     return log.run(args)
+
+
+def add_bench_defaults_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--seeds", type=options.positive_int, default=10, help="seeds 0..N-1 per case (default 10)")
+    parser.add_argument("--planners", nargs="+", metavar="NAME", help="only these planners (default: every paper's)")
+    parser.add_argument("--quick", action="store_true", help="3 seeds per case")
+    parser.add_argument("--json", action="store_true")
+
+
+def run_bench_defaults(args: argparse.Namespace) -> int:
+    from swarmnav.sim.benchmarks import paper_defaults
+    return paper_defaults.run(args)
 
 
 def add_log_info_arguments(parser: argparse.ArgumentParser) -> None:
@@ -279,7 +314,10 @@ def run_plot(args: argparse.Namespace) -> int:
 
 
 def add_foxglove_layout_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("-o", "--out", type=options.output_path, metavar="FILE", help="write the layout to FILE (default: print it)")
+    parser.add_argument("-o", "--out", type=options.output_path, metavar="FILE",
+                         help="write the layout to FILE (default: print it)")
+    parser.add_argument("--log-format", choices=LOG_FORMATS, default="swarmnav",
+                        help="the layout for logs of this format (run --log-format)")
 
 
 def run_foxglove_layout(args: argparse.Namespace) -> int:
@@ -304,6 +342,8 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
      "start-up of `swarmnav scenarios` against a bare `python -c pass`"),
     (("bench", "log"), add_bench_log_arguments, run_bench_log,
      "write a long run log, then time and peak memory of each reader beside the mcap library's"),
+    (("bench", "defaults"), add_bench_defaults_arguments, run_bench_defaults,
+     "each paper's planners at their defaults on its scenarios: collision-free plans over N seeds"),
     (("log", "info"), add_log_info_arguments, run_log_info, "what a log holds"),
     (("log", "recover"), add_log_recover_arguments, run_log_recover, "rewrite a truncated log as a complete one"),
     (("replay",), add_replay_arguments, run_replay, "re-render or re-simulate a log"),

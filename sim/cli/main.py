@@ -27,6 +27,7 @@ from swarmnav.planners.errors import PlanningError
 from swarmnav.sim import options
 from swarmnav.sim.cli import stop_signal
 from swarmnav.sim.options import parse_settings
+from swarmnav.sim.defaults import LOG_FORMATS
 from swarmnav.sim.cli.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
 
 # As sim.video.render does, before any subcommand imports mujoco (which reads it once, on import).
@@ -55,14 +56,21 @@ class OneLineParser(argparse.ArgumentParser):
 
 
 def _load(args: argparse.Namespace):
-    """The scenario, as the API loads it (plugins' too); ``--trust-code``: its code parameters may run."""
-    from swarmnav.calls import load_scenario
-    return load_scenario(args.scenario, trust_code=args.trust_code)
+    """The scenario (a bundled one, a plugin's: :func:`main` has loaded the plugins once for the command);
+    ``--trust-code``: its code parameters may run; its own planner and navigator tables are checked on load,
+    whatever ``--planner`` overrides.  ``run``'s ``--map`` / ``--pose`` override its ``[knowledge]``."""
+    from swarmnav.calls import check_components
+    from swarmnav.models.scenario import load_scenario
+    scenario = load_scenario(args.scenario, args.trust_code)
+    check_components(scenario, args.trust_code)
+    if getattr(args, "map", None) or getattr(args, "pose", None):
+        scenario = scenario.with_knowledge(getattr(args, "map", None), getattr(args, "pose", None))
+    return scenario
 
 
 def _episode_spec(args: argparse.Namespace, scenario):
-    """The episode the command line asks for: the scenario, then ``--planner``/``--set``, ``--navigator``/
-    ``--navigator-set`` and the two seeds on top."""
+    """The episode the command line asks for (``plan`` and ``run`` alike): the scenario, then ``--planner``/
+    ``--set``, ``--navigator``/``--navigator-set`` and the two seeds on top."""
     from swarmnav.sim.episode import EpisodeSpec
     return EpisodeSpec(scenario, planner=args.planner, planner_params=parse_settings(args.set, "--set"),
                        navigator=args.navigator,
@@ -87,6 +95,8 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
         return cmd_generate(args)
     if getattr(args, "scenarios_command", None) == "info":
         return cmd_scenario_info(args)
+    if getattr(args, "scenarios_command", None) == "import":
+        return args.scenario_run(args)
     rows = []
     for name in list_scenarios():
         s = load_scenario(name)
@@ -130,7 +140,8 @@ def cmd_components(args: argparse.Namespace) -> int:
         origin = "" if row["package"] == "swarmnav" else f"  [{row['package']}]"
         print(f"{row['name']:<20} {row['description']}{origin}")
         for param in row["parameters"]:
-            bounds = f" in {param['range']}" if "range" in param else ""
+            bounds = f" in {param['range']}" if "range" in param else \
+                f" one of {', '.join(param['choices'])}" if "choices" in param else ""
             print(f"    {param['name']} = {param['default']!r} ({param['type']}{bounds})")
     return EXIT_OK
 
@@ -168,9 +179,11 @@ def _add_generate_options(p: argparse.ArgumentParser) -> None:
     for name, kind in (("obstacles", int), ("speed_ratio", float), ("radius_min_m", float),
                        ("radius_max_m", float), ("arena_m", float), ("sensor_model", str), ("range_m", float),
                        ("sensor_count", int), ("robot_speed_m_s", float), ("time_limit_s", float),
-                       ("planner", str), ("navigator", str), ("name", str)):
+                       ("planner", str), ("navigator", str), ("name", str), ("humans", int)):
         p.add_argument(f"--{name.replace('_', '-')}", dest=name, type=kind,
                        help=f"default: {getattr(GeneratorOptions(), name)!r}")
+    p.add_argument("--robot-visible", dest="robot_visible", action="store_true", default=None,
+                   help="crowdnav_* kinds: the humans see the robot and avoid it (default: they do not)")
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
@@ -194,21 +207,20 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from swarmnav.calls import run
+    from swarmnav.calls import run_spec
     options.check_output_file(args.json_out, "--json-out")
     if args.video:
         from swarmnav.sim.video.render import check_video_size
         check_video_size(args.width, args.height, args.fps)  # before the plan: bad options fail at once
     scenario = _load(args)  # the file's own errors name the file, never an option
     try:
-        outcome = run(scenario, args.planner, parse_settings(args.set, "--set"), args.navigator,
-                      parse_settings(args.navigator_set, "--navigator-set"), args.seed, args.world_seed,
-                      waypoints=args.waypoints, log=False if args.no_log else (args.out or True),
-                      overwrite=args.overwrite, video=args.video, camera=args.camera, width=args.width,
-                      height=args.height, fps=args.fps, stop_on_collision=True if args.stop_on_collision else None,
-                      live=args.live,
-                      on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove WebSocket)",
-                                                file=sys.stderr))
+        outcome = run_spec(_episode_spec(args, scenario), waypoints=args.waypoints,
+                           log=False if args.no_log else (args.out or True), overwrite=args.overwrite,
+                           video=args.video, camera=args.camera, width=args.width, height=args.height, fps=args.fps,
+                           stop_on_collision=True if args.stop_on_collision else None, live=args.live,
+                           log_format=args.log_format,
+                           on_live=lambda url: print(f"live view: {url} (Foxglove: Open connection > Foxglove "
+                                                     "WebSocket)", file=sys.stderr))
     except ConfigError as exc:
         raise _blame_options(args, exc) from None
     out = outcome.to_dict()
@@ -219,10 +231,14 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(json.dumps(out))
     else:
         status = "reached the goal" if result.reached else f"did not reach the goal ({result.outcome})"
-        print(f"{out['scenario']}: {out['planner']} + {out['navigator']} (seed {out['seed']}, world seed "
+        if result.reached and result.outcome != "goal_reached":
+            status += f", but {result.outcome}"
+        given = out["plan"]["details"].get("given")  # a given path: nothing was planned
+        print(f"{out['scenario']}: {'given path ' + repr(given) if given else out['planner']} + {out['navigator']} "
+              f"(seed {out['seed']}, world seed "
               f"{out['world_seed']}) {status} in {result.sim_time_s:.2f} s sim "
               f"({result.wall_time_s:.2f} s wall); driven {result.path_length_m:.3f} m "
-              f"(planned {path.stats.length_m:.3f} m); collisions {result.collisions}"
+              f"({'given' if given else 'planned'} {path.stats.length_m:.3f} m); collisions {result.collisions}"
               + (f", first at {result.first_collision_s:.2f} s with {result.first_contact['obstacle']} at "
                  f"({result.first_contact['x_m']:.2f}, {result.first_contact['y_m']:.2f})"
                  if result.first_contact is not None else "")
@@ -273,13 +289,17 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("scenarios", help="list the bundled scenarios, or generate one")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_scenarios)
-    scenario_commands = p.add_subparsers(dest="scenarios_command", metavar="generate|info")
+    scenario_commands = p.add_subparsers(dest="scenarios_command", metavar="generate|info|import")
     gen = scenario_commands.add_parser("generate", help="write a dynamic scenario (crossing, head_on, ...) from a seed")
     _add_generate_options(gen)
     info = scenario_commands.add_parser("info", help="difficulty metrics and the clairvoyant oracle's verdict")
     info.add_argument("scenario", metavar="SCENARIO", help="a bundled name or a .toml path")
     info.add_argument("--world-seed", type=options.seed, help="seed of the random obstacle motions (default: the scenario's)")
     info.add_argument("--json", action="store_true", help="print one JSON object")
+    from swarmnav.sim.cli import world_import
+    imp = scenario_commands.add_parser("import", help="a Gazebo world's static cylinders and boxes as a scenario file")
+    world_import.add_arguments(imp)
+    imp.set_defaults(scenario_run=world_import.run)
 
     p = sub.add_parser("plan", help="plan a path for a scenario")
     _add_run_options(p)
@@ -290,6 +310,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=options.output_path, help="MCAP log path (default: logs/<scenario>_<planner>_seed<N>_<stamp>.mcap)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
     p.add_argument("--no-log", action="store_true", help="write no MCAP log")
+    p.add_argument("--log-format", choices=LOG_FORMATS, default="swarmnav",
+                   help="swarmnav (Foxglove's schemas, the default) or ros2 (CDR, the standard ROS 2 types)")
     p.add_argument("--live", action="store_true", help="also serve the channels to Foxglove on 127.0.0.1")
     p.add_argument("--video", type=options.output_path, help="render an MP4 while running (offscreen EGL)")
     p.add_argument("--camera", default="top", choices=("top", "chase", "follow"),
@@ -298,6 +320,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--height", type=int, default=480)
     p.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 0.1..240")
     p.add_argument("--stop-on-collision", action="store_true", help="stop at the first collision")
+    p.add_argument("--map", choices=("known", "unknown"),
+                   help="the static map given in advance (known) or built from the laser as the robot drives "
+                   "(unknown); default: the scenario's knowledge.map")
+    p.add_argument("--pose", choices=("truth", "odometry"),
+                   help="the pose the navigator sees: the simulator's (truth) or integrated wheel speeds "
+                   "(odometry); default: the scenario's knowledge.pose")
     p.add_argument("--waypoints", metavar="FILE", help="drive this path instead of planning: CSV with x,y columns, "
                    "a JSON list of [x, y] pairs, or the output of `plan --json`")
     p.add_argument("--json-out", type=options.output_path, metavar="FILE", help="also write the `--json` object to FILE")

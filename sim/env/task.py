@@ -50,9 +50,11 @@ from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.policy_interface import (ACTION_MODES, PolicyObserver, action_command, checked_action,
                                                    ObservationLayout, normalised_action, observation_layout)
 from swarmnav.models.errors import ConfigError
+from swarmnav.sim.defaults import LOG_FORMATS
 from swarmnav.models.scenario import Scenario, load_scenario
 from swarmnav.models.seeds import Seeds
 from swarmnav.sim.episode import EpisodeSpec, plan_episode
+from swarmnav.sim.plugins import load_plugins
 from swarmnav.sim.control_period import control_periods
 from swarmnav.sim.env.observations import action_spec, observation_specs
 from swarmnav.sim.env.reward import RewardWeights
@@ -86,6 +88,7 @@ class EnvOptions:
         world_seed: the obstacles' random walks (None: the scenario's).
         record_to: an ``.mcap`` path to record each episode to with the recorder of
             ``swarmnav run``; ``{episode}`` in it is replaced by the episode number.
+        record_format: the recording's log format, ``swarmnav`` or ``ros2`` (``--log-format`` of ``run``).
     """
 
     action: str = "twist"
@@ -101,8 +104,11 @@ class EnvOptions:
     seed: int | None = None
     world_seed: int | None = None
     record_to: str | None = None
+    record_format: str = "swarmnav"
 
     def __post_init__(self) -> None:
+        if self.record_format not in LOG_FORMATS:
+            raise ConfigError("env.record_format", f"expected one of {list(LOG_FORMATS)}, got {self.record_format!r}")
         if self.action not in ACTION_MODES:
             raise ConfigError("env.action", f"expected one of {list(ACTION_MODES)}, got {self.action!r}")
         if self.path_waypoints < 1:
@@ -176,9 +182,7 @@ class NavigationTask(control.Task):
         self.scene = index_scene(physics.model.ptr, xml)  # the indices, on the physics' own model
         self.simulation = Simulation(scenario, self.scene)
         check_time_limit(options.time_limit_s, self.simulation.control_dt_s)
-        fallback = scenario.seeds
-        self.set_seeds(Seeds(fallback.planner if options.seed is None else int(options.seed),
-                             fallback.world if options.world_seed is None else int(options.world_seed)))
+        self.set_seeds(EpisodeSpec(scenario, seed=options.seed, world_seed=options.world_seed).seeds)
         self.layout = layout or task_layout(scenario, options, self.scene.drive)
         self.episode = -1
         self.stepper: EpisodeStepper | None = None
@@ -204,7 +208,7 @@ class NavigationTask(control.Task):
         if self._planned is None or self._planned[0] != self.seeds:
             spec = EpisodeSpec(self.scenario, planner=self.options.path_planner, seed=self.seeds.planner,
                                world_seed=self.seeds.world)
-            self._planned = (self.seeds, plan_episode(spec))
+            self._planned = (self.seeds, plan_episode(spec, drive=False))  # a path: no navigator to build
         return self._planned[1]
 
     # --- dm_control.rl.control.Task ---------------------------------------------------------------
@@ -263,7 +267,7 @@ class NavigationTask(control.Task):
         return self.reward_value
 
     def get_termination(self, physics: SwarmnavPhysics) -> float | None:
-        if self.outcome in ("goal_reached", "collision"):
+        if self.outcome in ("goal_reached", "collision", "left_arena"):
             return 0.0
         if self.outcome == "timeout":
             return 1.0
@@ -310,7 +314,8 @@ class NavigationTask(control.Task):
         if self.options.record_to is None:
             return None
         from swarmnav.sim.log.writer import McapRecorder
-        return McapRecorder(FilePath(self.options.record_to.replace("{episode}", str(self.episode))), overwrite=True)
+        return McapRecorder(FilePath(self.options.record_to.replace("{episode}", str(self.episode))), overwrite=True,
+                            log_format=self.options.record_format)
 
 
 def task_layout(scenario: Scenario, options: EnvOptions, drive) -> ObservationLayout:
@@ -325,8 +330,9 @@ def make_environment(scenario: Scenario | str, options: EnvOptions | None = None
 
     ``kwargs`` are :class:`EnvOptions` fields when ``options`` is not given; ``layout`` fixes the
     observation's entries and bounds (:mod:`sim.env.worlds`: the same spaces across scenarios), else the
-    scenario's own.
+    scenario's own.  Installed plugins' scenarios and planners are known here (:mod:`swarmnav.sim.plugins`).
     """
+    load_plugins()
     if isinstance(scenario, (str, FilePath)):
         scenario = load_scenario(str(scenario))
     options = options or EnvOptions(**kwargs)

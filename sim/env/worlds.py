@@ -2,7 +2,7 @@
 
 ``NavigateEnv(scenarios=...)`` takes either
 
-* a list of scenarios (bundled names, paths or :class:`Scenario` objects): each
+* a list of scenarios (bundled names, paths or :class:`Scenario` objects), or one of them: each
   episode takes one, uniformly; or
 * a generator specification, a dict with ``kinds`` (a list of the kinds of
   ``swarmnav scenarios generate``: crossing, head_on, overtake, crowd) and any
@@ -35,6 +35,7 @@ ConfigError names ``env.scenarios`` otherwise), and the robot too (the action sp
 from __future__ import annotations
 
 import dataclasses
+import os
 from dataclasses import dataclass
 from pathlib import Path as FilePath
 from typing import Any, Protocol, Sequence
@@ -45,6 +46,7 @@ from swarmnav.controllers.policy_interface import ObservationLayout
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario, load_scenario, parse_scenario
 from swarmnav.models.scenario_generator import KINDS, GeneratorOptions, generate
+from swarmnav.sim.plugins import load_plugins
 
 FIELD = "env.scenarios"
 DRAW_CHILD = 2  # SeedSequence(seed).spawn(3)[2]: children 0 and 1 are Seeds.derived's
@@ -150,11 +152,16 @@ class GeneratorSpec:
 
 
 def scenario_source(value: Any) -> ScenarioSource:
-    """The ``scenarios=`` option -> a source (ConfigError naming ``env.scenarios`` for anything else)."""
+    """The ``scenarios=`` option -> a source: a generator dict, a list of scenarios, or one scenario (a name, a
+    path or a :class:`Scenario`, a list of one); ConfigError naming ``env.scenarios`` for anything else."""
+    load_plugins()
     if isinstance(value, dict):
         return GeneratorSpec.parse(value)
-    if isinstance(value, (str, FilePath, Scenario)) or not isinstance(value, Sequence) or not value:
-        raise ConfigError(FIELD, f"expected a non-empty list of scenarios or a generator dict, got {value!r}")
+    if isinstance(value, (str, os.PathLike, Scenario)):
+        value = [value]
+    if not isinstance(value, Sequence) or not value:
+        raise ConfigError(FIELD, f"expected a non-empty list of scenarios, one scenario or a generator dict, "
+                                 f"got {value!r}")
     return ScenarioList(tuple(v if isinstance(v, Scenario) else load_scenario(str(v)) for v in value))
 
 

@@ -34,7 +34,45 @@ Channels (Foxglove well-known protobuf schemas unless said otherwise):
                         that use the sensing, from the first step they sensed something,
                         then every step until they sense nothing (one update that only
                         deletes).  Not in :data:`CHANNELS`: readers leave it alone.
+``/map``                Grid in ``world``: the occupancy grid the laser built, once a
+                        simulated second; only with the map unknown (``knowledge.map``).
+                        One int8 field ``occupancy``: percent, -1 never seen.  Optional.
+``/odom``               PoseInFrame in ``world``: the pose the navigator saw, integrated
+                        from the wheels' speeds, every control step; only with
+                        ``knowledge.pose = "odometry"`` (``/robot/pose`` stays the truth).
+                        Optional.
 ======================  ===============================================================
+
+Profile ``ros2`` (``--log-format ros2``): CDR messages with ``ros2msg`` schemas of the standard
+ROS 2 types (:mod:`sim.log.ros2_types`), frames after REP 105 (``map`` -> ``odom`` ->
+``base_link``; ``base_scan`` the rangefinders' plane) and units after REP 103:
+
+======================  ===============================================================
+``/tf_static``          tf2_msgs/TFMessage, once at t = 0: ``world`` -> ``map`` (identity,
+                        for views set up on ``world``), ``base_link`` -> ``base_scan``
+                        and, when the run has no odometry estimate, ``map`` -> ``odom``
+                        (identity: odometry is the simulator's pose)
+``/tf``                 tf2_msgs/TFMessage, every control step: ``odom`` -> ``base_link``
+                        (and ``map`` -> ``odom`` when the run estimates odometry)
+``/odom``               nav_msgs/Odometry in ``odom``, child ``base_link``; the twist is
+                        the base's velocity over the last control period, in ``base_link``
+``/scan``               sensor_msgs/LaserScan in ``base_scan``; +inf where a beam saw
+                        nothing (REP 117); ranges from base_link's axis, as above
+``/joint_states``       sensor_msgs/JointState: the wheels' measured rad/s (``velocity``)
+``/wheels/command``     sensor_msgs/JointState: the wheels' commanded rad/s
+``/cmd_vel``            geometry_msgs/Twist: the controller's v and omega
+``/plan``               nav_msgs/Path in ``map``; at the start and after any replan
+``/obstacles``          visualization_msgs/MarkerArray, one marker per obstacle (``ns`` its
+                        entity id); sent as ``/obstacles`` above
+``/scene``              visualization_msgs/MarkerArray at t = 0: arena outline, footprint
+``/navigator``          visualization_msgs/MarkerArray: what the navigator acted on (as above)
+``/map``                nav_msgs/OccupancyGrid: the map the robot builds, when the run's map
+                        is unknown (written only when the run carries one)
+``/rosout``             rcl_interfaces/Log: one per event, ``msg`` as ``/events`` above
+``/clock``              rosgraph_msgs/Clock: simulation time, every control step
+======================  ===============================================================
+
+The active waypoint of ``/controller`` has no standard message and is not in ``ros2`` logs.
 
 Time: ``log_time`` = ``publish_time`` = every message's own timestamp = simulation
 time in ns from 0.  No wall-clock time is written, so two runs with the same seed
@@ -52,10 +90,16 @@ from typing import Any
 
 import numpy as np
 
+from swarmnav.sim.defaults import LOG_FORMATS as _DEFAULT_FORMATS
+
 WORLD_FRAME = "world"
 BASE_FRAME = "base_link"
 MJCF_ATTACHMENT = "scene.xml"
 LOG_PROFILE = "swarmnav"
+ROS2_PROFILE = "ros2"
+LOG_FORMATS = _DEFAULT_FORMATS  # (LOG_PROFILE, ROS2_PROFILE): --log-format; the MCAP profile of each is its name
+assert LOG_FORMATS == (LOG_PROFILE, ROS2_PROFILE)
+MAP_FRAME, ODOM_FRAME, SCAN_FRAME = "map", "odom", "base_scan"
 
 WHEELS_SCHEMA = {
     "title": "swarmnav.WheelSpeeds",
@@ -101,6 +145,16 @@ CHANNELS: dict[str, tuple[str, str]] = {
     "/events": ("protobuf", "foxglove.Log"),
     "/scene": ("protobuf", "foxglove.SceneUpdate"),
 }
+# The ros2 profile's channels: topic -> (message encoding, schema name).
+ROS2_CHANNELS: dict[str, tuple[str, str]] = {
+    topic: ("cdr", f"{short.split('/')[0]}/msg/{short.split('/')[1]}") for topic, short in (
+        ("/tf_static", "tf2_msgs/TFMessage"), ("/tf", "tf2_msgs/TFMessage"), ("/odom", "nav_msgs/Odometry"),
+        ("/scan", "sensor_msgs/LaserScan"), ("/joint_states", "sensor_msgs/JointState"),
+        ("/wheels/command", "sensor_msgs/JointState"), ("/cmd_vel", "geometry_msgs/Twist"),
+        ("/plan", "nav_msgs/Path"), ("/obstacles", "visualization_msgs/MarkerArray"),
+        ("/scene", "visualization_msgs/MarkerArray"), ("/navigator", "visualization_msgs/MarkerArray"),
+        ("/map", "nav_msgs/OccupancyGrid"), ("/rosout", "rcl_interfaces/Log"), ("/clock", "rosgraph_msgs/Clock"))}
+ROS2_EVENTS_TOPIC = "/rosout"
 # Older logs may carry these instead: topic -> (message encoding, schema name).
 LEGACY_CHANNELS: dict[str, tuple[str, str]] = {"/events": ("json", LEGACY_EVENT_SCHEMA["title"])}
 EVENTS_TOPIC = "/events"
@@ -109,6 +163,13 @@ ARENA_ENTITY = "arena"
 FOOTPRINT_ENTITY = "robot_footprint"
 TOPICS = tuple(CHANNELS)
 NAVIGATOR_TOPIC = "/navigator"  # a foxglove.SceneUpdate; optional (see the table above)
+MAP_TOPIC = "/map"  # a foxglove.Grid; optional (see the table above)
+ODOM_TOPIC = "/odom"  # a foxglove.PoseInFrame; optional (see the table above)
+
+
+def events_topic(profile: str) -> str:
+    """The topic a log of ``profile`` carries its events on."""
+    return ROS2_EVENTS_TOPIC if profile == ROS2_PROFILE else EVENTS_TOPIC
 
 
 def time_ns(time_s: float) -> int:

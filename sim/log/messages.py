@@ -141,17 +141,21 @@ def belief_update(obstacles, horizon_s: float, t_ns: int) -> SceneUpdate:
                        entities=entities)
 
 
-_WARNING_EVENTS = {"collision_begin", "stopped_on_collision", "timeout"}
+_WARNING_EVENTS = {"collision_begin", "stopped_on_collision", "timeout", "left_arena"}
 _ERROR_EVENTS = {"error", "interrupted"}
 _ARENA_Z_M = 0.002
 _FOOTPRINT_HEIGHT_M = 0.01
 _FOOTPRINT_Z_M = 0.005  # just above the floor, under the chassis
 
 
+def event_severity(kind: str) -> str:
+    """An event's level: ``warning`` for collisions and timeouts, ``error`` for errors, else ``info``."""
+    return "warning" if kind in _WARNING_EVENTS else "error" if kind in _ERROR_EVENTS else "info"
+
+
 def event_log(time_s_ns: int, kind: str, details: dict[str, Any]) -> Log:
     """``/events``: one ``foxglove.Log`` (Foxglove's Log panel lists it, filterable by level)."""
-    level = (LogLevel.Warning if kind in _WARNING_EVENTS else LogLevel.Error if kind in _ERROR_EVENTS
-             else LogLevel.Info)
+    level = {"warning": LogLevel.Warning, "error": LogLevel.Error, "info": LogLevel.Info}[event_severity(kind)]
     return Log(timestamp=stamp(time_s_ns), level=level, message=event_text(kind, details), name="swarmnav")
 
 

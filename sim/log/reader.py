@@ -20,6 +20,7 @@ import numpy as np
 from mcap.records import Channel, Message
 from google.protobuf.message import DecodeError
 from mcap_protobuf.decoder import DecoderFactory
+from mcap_ros2.decoder import DecoderFactory as Ros2DecoderFactory
 
 from swarmnav.sim.log.format import (
     CHANNELS,
@@ -27,12 +28,16 @@ from swarmnav.sim.log.format import (
     LEGACY_CHANNELS,
     LOG_PROFILE,
     MJCF_ATTACHMENT,
+    ROS2_CHANNELS,
+    ROS2_PROFILE,
     TOPICS,
     event_from_text,
+    events_topic,
     metadata_value,
 )
 from swarmnav.sim.log.columns import Rows
 from swarmnav.sim.log.records import LogError, RawLog, RawLogView, read_records
+from swarmnav.sim.log.ros2_reader import Ros2Rows
 from swarmnav.sim.log.run_metadata import checked_run_metadata
 
 
@@ -90,7 +95,11 @@ class RunLog(RawLogView):
 def _decoder_for(raw: RawLog, channel: Channel, protobuf: DecoderFactory) -> Callable[[bytes], Any]:
     if channel.message_encoding == "json":
         return json.loads
-    decoder = protobuf.decoder_for(channel.message_encoding, raw.schemas.get(channel.schema_id))
+    factory = Ros2DecoderFactory() if channel.message_encoding == "cdr" else protobuf
+    try:
+        decoder = factory.decoder_for(channel.message_encoding, raw.schemas.get(channel.schema_id))
+    except Exception as error:  # a schema text mcap_ros2 cannot parse
+        raise LogError(raw.path, f"cannot decode channel {channel.topic} ({type(error).__name__}: {error})") from None
     if decoder is None:
         raise LogError(raw.path, f"cannot decode channel {channel.topic} ({channel.message_encoding})")
     return decoder
@@ -106,11 +115,18 @@ def event_decoder(raw: RawLog, channel: Channel,
             event = decode(data)
             return str(event.get("kind", "?")), event.get("details", {})
         return legacy
+    if channel.message_encoding == "cdr":
+        return lambda data: event_from_text(decode(data).msg)
     return lambda data: event_from_text(decode(data).message)
 
 
+def channel_table(raw: RawLog) -> dict[str, tuple[str, str]]:
+    """topic -> (message encoding, schema name) of the log's profile (``ros2`` or ``swarmnav``)."""
+    return ROS2_CHANNELS if raw.profile == ROS2_PROFILE else CHANNELS
+
+
 def _check_channel(raw: RawLog, channel: Channel) -> None:
-    expected = CHANNELS.get(channel.topic)
+    expected = channel_table(raw).get(channel.topic)
     if expected is None:
         return  # channels of other topics are left alone
     schema = raw.schemas.get(channel.schema_id)
@@ -153,24 +169,26 @@ class _Decoder:
         self.paths: list[tuple[float, np.ndarray]] = []
         self.tracks: dict[str, tuple[Rows, list]] = {}  # id -> ((t, x, y) rows, [last time])
         self.events: list[tuple[float, str, dict[str, Any]]] = []
+        self._ros2 = Ros2Rows(self)
 
     def __call__(self, raw: RawLog, message: Message) -> None:
         channel_id = message.channel_id
         if channel_id not in self._decoders:
             channel = raw.channels.get(channel_id)
-            if channel is None or channel.topic not in CHANNELS:
+            if channel is None or channel.topic not in channel_table(raw):
                 self._decoders[channel_id] = None
             else:
                 _check_channel(raw, channel)
-                decode = (event_decoder(raw, channel, self._protobuf) if channel.topic == EVENTS_TOPIC
+                decode = (event_decoder(raw, channel, self._protobuf) if channel.topic == events_topic(raw.profile)
                           else _decoder_for(raw, channel, self._protobuf))
-                self._decoders[channel_id] = (channel.topic, decode)
+                ros2 = channel.message_encoding == "cdr"
+                self._decoders[channel_id] = (channel.topic, decode, self._ros2.add if ros2 else self._add)
         entry = self._decoders[channel_id]
         if entry is None:
             return
-        topic, decoder = entry
+        topic, decoder, add = entry
         try:
-            self._add(topic, message.log_time * 1e-9, decoder(message.data))
+            add(topic, message.log_time * 1e-9, decoder(message.data))
         except (DecodeError, ValueError, KeyError, TypeError, AttributeError, IndexError) as error:
             raise LogError(raw.path, f"a message cannot be decoded ({type(error).__name__}: {error})") from None
 
@@ -208,6 +226,7 @@ class _Decoder:
             self.events.append((t, kind, details))
 
     def run_log(self, raw: RawLog) -> RunLog:
+        self._ros2.finish()
         tf = self.tf.array()
         quaternion_wxyz = tf[:, 4:8]
         w, x, y, z = quaternion_wxyz.T
@@ -298,7 +317,7 @@ def outcome_text(log: RunLog) -> str:
             if key in log.outcome:
                 return str(log.outcome[key])
     kinds = [kind for _, kind, _ in log.events]
-    for kind in ("goal_reached", "timeout"):
+    for kind in ("goal_reached", "timeout", "left_arena"):
         if kind in kinds:
             return kind
     return "none: the run did not finish (no outcome recorded)"

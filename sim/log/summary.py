@@ -24,7 +24,7 @@ from typing import Any
 from mcap.reader import SeekingReader
 from mcap.records import Message
 
-from swarmnav.sim.log.format import EVENTS_TOPIC, metadata_value
+from swarmnav.sim.log.format import events_topic, metadata_value
 from swarmnav.sim.log.reader import check_channels, check_has_steps, event_decoder
 from swarmnav.sim.log.records import LogError, RawLog, RawLogView, open_regular, read_records
 from swarmnav.sim.log.run_metadata import checked_run_metadata
@@ -102,10 +102,11 @@ def _from_summary(path: Path) -> LogSummary | None:
                      last_time_ns=statistics.message_end_time if statistics.message_count else 0)
         check_channels(raw)
         events = []
-        if any(c.topic == EVENTS_TOPIC for c in raw.channels.values()):
+        topic = events_topic(raw.profile)
+        if any(c.topic == topic for c in raw.channels.values()):
             decode = _Events(raw)
             try:
-                for _, _, message in reader.iter_messages(topics=[EVENTS_TOPIC], log_time_order=True):
+                for _, _, message in reader.iter_messages(topics=[topic], log_time_order=True):
                     events.append(decode(message))
             except LogError:
                 raise
@@ -137,7 +138,7 @@ def from_records(path: str | Path) -> LogSummary:
     def keep_events(raw: RawLog, message: Message) -> None:
         if message.channel_id not in topics:
             channel = raw.channels.get(message.channel_id)
-            topics[message.channel_id] = channel is not None and channel.topic == EVENTS_TOPIC
+            topics[message.channel_id] = channel is not None and channel.topic == events_topic(raw.profile)
         if topics[message.channel_id]:
             if not decoders:
                 decoders.append(_Events(raw))

@@ -18,12 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from swarmnav.sim.log.columns import Rows
-from swarmnav.sim.log.format import scan_from_ranges
+from swarmnav.sim.log.format import ROS2_PROFILE, scan_from_ranges
 from swarmnav.sim.log.reader import RunLog, outcome_text
 from swarmnav.sim.recording import RunContext, StepFrame
 
 # Outcomes of a run that reached its natural end; any other log stops early.
-FINISHED_OUTCOMES = ("goal_reached", "timeout", "collision", "stopped_on_collision")
+FINISHED_OUTCOMES = ("goal_reached", "timeout", "collision", "stopped_on_collision", "left_arena")
 
 
 @dataclass
@@ -170,7 +170,10 @@ def compare_with_log(log: RunLog, capture: TrajectoryCapture, planned_waypoints_
     offset_m = float(log.run_value("sensor_offset_m", 0.0))
     sim_ranges = capture.ranges().reshape(len(sim_t), -1)
     m = min(len(sim_ranges), len(log.range_m))
-    ranges_equal, range_error = _range_deviation_m(scan_from_ranges(sim_ranges[:m], offset_m), log.range_m[:m])
+    simulated_scan = scan_from_ranges(sim_ranges[:m], offset_m)
+    if log.raw.profile == ROS2_PROFILE:  # a LaserScan holds float32 ranges: compare what it can hold
+        simulated_scan = simulated_scan.astype(np.float32).astype(float)
+    ranges_equal, range_error = _range_deviation_m(simulated_scan, log.range_m[:m])
 
     worst = int(np.argmax(dp)) if n and dp.max() > 0 else None
     return VerifyReport(

@@ -5,6 +5,12 @@ file and, with ``live=True``, a loopback WebSocket server for Foxglove
 (:mod:`sim.log.live_view`) are both sinks of that context, so they see exactly the
 same messages.  The channels, time stamps and names are in :mod:`sim.log.format`.
 
+``log_format`` picks the channels, the file's one seam between formats: ``swarmnav``
+(:class:`sim.log.swarmnav_channels.SwarmnavChannels`, Foxglove's protobuf schemas, the
+default) or ``ros2`` (:class:`sim.log.ros2_channels.Ros2Channels`, CDR messages of the
+standard ROS 2 types, MCAP profile ``ros2``).  Everything else here (the file, the
+metadata, the attachment, flushing, the live view, pacing) is the same for both.
+
 Metadata records: ``scenario`` (name, TOML text), ``planner`` and ``navigator`` (name, JSON params),
 ``run`` (seed, world seed, time steps, sensor layout, obstacles), ``versions`` and, from
 ``finish``, ``outcome`` (the runner's summary).  Values are plain text where they are
@@ -29,55 +35,27 @@ from typing import Any, Callable
 
 import foxglove
 import numpy as np
-from foxglove.channels import LogChannel, PosesInFrameChannel, SceneUpdateChannel
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
-from foxglove.messages import (
-    FrameTransform,
-    LaserScan,
-    Pose,
-    PoseInFrame,
-    PosesInFrame,
-    SceneUpdate,
-    Vector3,
-)
 
+from swarmnav.sim.log.map_channel import MapChannel
 from swarmnav.sim.log.live_view import DEFAULT_LIVE_HOST, DEFAULT_LIVE_PORT, LiveServer
-from swarmnav.sim.log.encoding import SceneEncoder, StepEncoder, timestamp_field
 from swarmnav.sim.log.file import LogFile
 from swarmnav.sim.log.format import (
-    BASE_FRAME,
-    CONTROLLER_SCHEMA,
-    EVENTS_TOPIC,
-    LOG_PROFILE,
+    LOG_FORMATS,
     MJCF_ATTACHMENT,
-    NAVIGATOR_TOPIC,
-    SCENE_TOPIC,
+    ROS2_PROFILE,
     TOPICS,
-    WHEELS_SCHEMA,
-    WORLD_FRAME,
     default_log_path,
     dumps,
     metadata_text,
-    scan_list_from_ranges,
     time_ns,
     writer_versions,
 )
-from swarmnav.sim.log.messages import (
-    belief_update,
-    chassis_radius_m,
-    controller_json,
-    event_log,
-    json_schema,
-    obstacle_entity,
-    obstacle_template,
-    run_metadata,
-    scene_update,
-    stamp,
-    wheels_json,
-    yaw_quaternion,
-)
+from swarmnav.sim.log.messages import run_metadata
 from swarmnav.sim.log.pacing import RealTimePacer
-from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
+from swarmnav.sim.log.ros2_channels import Ros2Channels
+from swarmnav.sim.log.swarmnav_channels import SwarmnavChannels
+from swarmnav.sim.recording import RunContext, StepFrame
 
 # TOPICS and default_log_path live in sim.log.format; re-exported for existing callers.
 __all__ = ["McapRecorder", "TOPICS", "default_log_path"]
@@ -118,6 +96,7 @@ class McapRecorder:
         on_live: called with the server's URL once it listens (the caller prints it;
             the recorder never prints).
         overwrite: replace an existing file instead of refusing.
+        log_format: ``swarmnav`` or ``ros2`` (:data:`sim.log.format.LOG_FORMATS`).
 
     Errors: ``start`` raises ``ConfigError`` for a live port it cannot serve
     (before the file exists) and ``OSError`` (with the file name) when the file
@@ -137,9 +116,14 @@ class McapRecorder:
         live_speed: float | None = 1.0,
         on_live: Callable[[str], None] | None = None,
         overwrite: bool = False,
+        log_format: str = "swarmnav",
     ):
         if not flush_interval_s > 0:
             raise ValueError("flush_interval_s must be positive")
+        if log_format not in LOG_FORMATS:
+            raise ValueError(f"log_format must be one of {', '.join(LOG_FORMATS)}, not {log_format!r}")
+        self.log_format = log_format
+        self._channels = Ros2Channels() if log_format == "ros2" else SwarmnavChannels()
         self.file_path = Path(path)
         self.flush_interval_s = float(flush_interval_s)
         self.live = live
@@ -153,13 +137,9 @@ class McapRecorder:
         self._server: LiveServer | None = None
         self._file: LogFile | None = None
         self._writer = None
-        self._last_path: PosesInFrame | None = None
         self._next_flush_ns = 0
         self._last_ns = 0
-        self._moving_infos: tuple[ObstacleInfo, ...] = ()
-        self._json_channels: list[foxglove.Channel] = []
-        self._navigator: SceneUpdateChannel | None = None  # made at the first belief with obstacles
-        self._belief_drawn = False
+        self._map: MapChannel | None = None  # /map, made at the first sensed map (only with the map unknown)
 
     # -- Recorder protocol -------------------------------------------------
 
@@ -183,44 +163,14 @@ class McapRecorder:
             # zstd level 1: in the closed loop it compresses a second of log in half the time of the
             # default level (3), to about the same size (dense-field-30: 289 vs 292 kB for 20 s).
             compression_level=ZSTD_LEVEL,
-            profile=LOG_PROFILE,
+            profile=self._channels.profile,
             disable_seeking=True,
             compression_threads=0,  # the 2 cores belong to the simulation
         )
         self._writer = foxglove.open_mcap(self._file, context=self._fox, writer_options=options)
-        # The per-step protobuf channels take bytes from a StepEncoder (sim.log.encoding): the SDK's
-        # schemas and encoding, without building its message objects every step.
-        self._tf, self._pose = (
-            foxglove.Channel(topic, schema=message.get_schema(), message_encoding="protobuf", context=self._fox)
-            for topic, message in (("/tf", FrameTransform), ("/robot/pose", PoseInFrame)))
-        self._path = PosesInFrameChannel("/planner/path", context=self._fox)
-        self._obstacles = foxglove.Channel("/obstacles", schema=SceneUpdate.get_schema(), message_encoding="protobuf",
-                                           context=self._fox)
-        self._scan = foxglove.Channel("/range/scan", schema=LaserScan.get_schema(), message_encoding="protobuf",
-                                      context=self._fox)
-        self._wheels, self._controller = self._json_channels = [
-            foxglove.Channel(topic, schema=json_schema(schema), message_encoding="json", context=self._fox)
-            for topic, schema in (("/wheels", WHEELS_SCHEMA), ("/controller", CONTROLLER_SCHEMA))
-        ]
-        self._events = LogChannel(EVENTS_TOPIC, context=self._fox)
-        self._scene_channel = SceneUpdateChannel(SCENE_TOPIC, context=self._fox)
+        self._channels.open(self._fox, context)
         self._guard(self._write_run_records, context)
-
-        self._scan_start_rad = float(angles[0]) if angles.size else 0.0
-        self._scan_end_rad = float(angles[-1]) if angles.size else 0.0
-        self._beam_offset_m = float(context.sensor_offset_m)
-        self._encoder = StepEncoder(WORLD_FRAME, BASE_FRAME,
-                                    ((0.0, 0.0, float(context.sensor_height_m)), (0.0, 0.0, 0.0, 1.0)),
-                                    self._scan_start_rad, self._scan_end_rad)  # end: inclusive
-        self._moving_infos = tuple(o for o in context.obstacles if o.moving)
-        static_entities = [obstacle_entity(o, o.position_m[0], o.position_m[1], 0).encode()
-                           for o in context.obstacles if not o.moving]
-        self._scene = SceneEncoder(static_entities, WORLD_FRAME,
-                                   [(o.entity_id, obstacle_template(o)) for o in self._moving_infos])
-        self._obstacles.base.log(self._scene_update(0, None), 0, None)
-        self._scene_message = scene_update(context.arena_size_m, chassis_radius_m(context.mjcf_xml))
-        self._scene_channel.log(self._scene_message, log_time=0)
-        self.messages_written += 2
+        self.messages_written += self._channels.begin(context)
         self._next_flush_ns = time_ns(self.flush_interval_s)
         if self._pacer is not None:
             self._pacer.start(context)
@@ -234,55 +184,30 @@ class McapRecorder:
         points = np.asarray(waypoints_m, dtype=float)
         if points.ndim != 2 or points.shape[0] == 0:
             return
-        deltas = np.diff(points[:, :2], axis=0)
-        headings = np.arctan2(deltas[:, 1], deltas[:, 0]) if len(deltas) else np.zeros(0)
-        headings = np.append(headings, headings[-1] if len(headings) else 0.0)
-        poses = [
-            Pose(position=Vector3(x=float(x), y=float(y), z=0.01), orientation=yaw_quaternion(float(h)))
-            for (x, y), h in zip(points[:, :2], headings)
-        ]
-        message = PosesInFrame(timestamp=stamp(t_ns), frame_id=WORLD_FRAME, poses=poses)
-        self._path.log(message, log_time=t_ns)
-        self._last_path = message
-        self._after_write(t_ns, 1)
+        self._after_write(t_ns, self._channels.path(t_ns, points))
 
     def step(self, frame: StepFrame) -> None:
         """Log one control step on every per-step channel."""
         t_ns = time_ns(frame.time_s)
-        time_stamp = timestamp_field(t_ns)
-        px, py, pz = np.asarray(frame.position_m, dtype=float).tolist()
-        qw, qx, qy, qz = np.asarray(frame.quaternion_wxyz, dtype=float).tolist()
-        encoder = self._encoder
-        tf, pose = encoder.transform(time_stamp, (px, py, pz), (qx, qy, qz, qw))
-        self._tf.base.log(tf, t_ns, None)
-        self._pose.base.log(pose, t_ns, None)
-        self._scan.base.log(encoder.scan(time_stamp, scan_list_from_ranges(frame.range_m, self._beam_offset_m)),
-                            t_ns, None)
-        # The JSON channels' own ``log`` only encodes text and calls its ``base``: called directly.
-        self._wheels.base.log(wheels_json(frame.wheel_command_rad_s, frame.wheel_measured_rad_s).encode(), t_ns, None)
-        self._controller.base.log(
-            controller_json(frame.linear_m_s, frame.angular_rad_s, frame.waypoint_index).encode(), t_ns, None)
-        written = 5
         late = self._server.late_topics() if self._server is not None else ()
-        if self._moving_infos or "/obstacles" in late:
-            self._obstacles.base.log(self._scene_update(t_ns, frame.moving_obstacles_m), t_ns, None)
-            written += 1
-        if SCENE_TOPIC in late:
-            self._scene_channel.log(self._scene_message, log_time=t_ns)
-            written += 1
-        if "/planner/path" in late and self._last_path is not None:
-            self._path.log(self._last_path, log_time=t_ns)
-            written += 1
-        written += self._log_belief(frame.belief, t_ns)
-        self._after_write(t_ns, written)
+        self._after_write(t_ns, self._channels.step(frame, t_ns, late))
         if self._pacer is not None:
             self._pacer.step(frame)
+
+    def occupancy(self, time_s: float, grid: Any) -> None:
+        """Log the sensed map on ``/map`` (:mod:`sim.log.map_channel`; the channel made at the first)."""
+        if self._channels.profile == ROS2_PROFILE:  # a ROS 2 log's /map would be a nav_msgs one: not written
+            return
+        t_ns = time_ns(time_s)
+        if self._map is None:
+            self._map = MapChannel(self._fox)
+        self._map.log(t_ns, grid)
+        self._after_write(t_ns, 1)
 
     def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
         """Log a discrete event and flush, so it survives a crash right after."""
         t_ns = time_ns(time_s)
-        self._events.log(event_log(t_ns, kind, details), log_time=t_ns)
-        self._after_write(t_ns, 1)
+        self._after_write(t_ns, self._channels.event(t_ns, kind, details))
         self._flush()
 
     def finish(self, summary: dict[str, Any]) -> None:
@@ -309,9 +234,7 @@ class McapRecorder:
                     pass  # the write error was reported when it happened
         finally:
             log_file.close()
-            for channel in self._json_channels:
-                # foxglove keeps JSON channels in a registry of its own; closing is its public API.
-                channel.close()
+            self._channels.close()
             self._stop_server()
 
     # -- helpers -----------------------------------------------------------
@@ -350,7 +273,7 @@ class McapRecorder:
             "navigator", {"name": context.navigator_name, "params": dumps(context.navigator_params)}
         )
         writer.write_metadata("run", run_metadata(context))
-        writer.write_metadata("versions", writer_versions(context.versions))
+        writer.write_metadata("versions", {**writer_versions(context.versions), **self._channels.versions()})
         writer.attach(
             log_time=0,
             create_time=0,
@@ -358,24 +281,6 @@ class McapRecorder:
             media_type="application/xml",
             data=context.mjcf_xml.encode(),
         )
-
-    def _scene_update(self, t_ns: int, moving_xy_m: np.ndarray | None) -> bytes:
-        """``/obstacles``: every entity, the moving ones at ``moving_xy_m`` (None: where they start)."""
-        if moving_xy_m is None:
-            moving_xy_m = np.array([o.position_m[:2] for o in self._moving_infos]).reshape(-1, 2)
-        return self._scene.update(timestamp_field(t_ns), np.asarray(moving_xy_m, dtype=float).tolist())
-
-    def _log_belief(self, belief: Any, t_ns: int) -> int:
-        """``/navigator`` while the navigator acts on sensed obstacles, and once more when it stops."""
-        obstacles = belief.obstacles if belief is not None else ()
-        if not obstacles and not self._belief_drawn:
-            return 0
-        if self._navigator is None:
-            self._navigator = SceneUpdateChannel(NAVIGATOR_TOPIC, context=self._fox)
-        self._navigator.log(belief_update(obstacles, belief.horizon_s if belief is not None else 0.0, t_ns),
-                            log_time=t_ns)
-        self._belief_drawn = bool(obstacles)
-        return 1
 
     def _after_write(self, t_ns: int, count: int) -> None:
         self.messages_written += count

@@ -5,6 +5,10 @@ failure never escapes: a planner that finds no path is an outcome ``no_path``
 row, one that raises anything else an ``error`` row with the message, and a run
 past the study's wall limit a ``timeout`` row.
 
+A cell naming a planner, navigator or scenario this process does not know (a plugin installed where the
+driver runs but not where the worker does) is no row: :class:`ComponentMissing` ends the whole study, as
+the driver's own validation would have.
+
 Outcome (``outcome``) is the harness's: ``ok``, ``no_path``, ``error`` or
 ``timeout``.  The simulation's own end (``goal_reached``, ``timeout`` in simulated
 time, ``collision``) is ``run_outcome``.  ``success`` is: plan-only, a
@@ -22,10 +26,12 @@ import time
 from pathlib import Path as FilePath
 from typing import Any
 
-from swarmnav.models.scenario import load_scenario
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import load_scenario, resolve_scenario_path
 from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.swarm import Budget
-from swarmnav.sim.episode import EpisodeSpec, build_planner, json_safe, plan_episode, resolved_params, run_episode
+from swarmnav.sim.plugins import load_plugins
+from swarmnav.sim.episode import EpisodeSpec, compose, json_safe, plan_episode, resolved_params, run_episode
 from swarmnav.sim.study.grid import Cell
 from swarmnav.sim.trajectory_metrics import bends, count_turns
 from swarmnav.sim.versions import software_versions
@@ -71,7 +77,7 @@ class WallLimitExceeded(BaseException):
 
 # The navigation metrics of ``run --json`` kept as columns of their own.
 NAVIGATION_METRICS = ("time_to_goal_s", "spl", "time_in_danger_s", "replans", "replan_wall_s", "stopped_s",
-                      "safety_triggers")
+                      "safety_triggers", "discomfort_frequency", "min_separation_m", "path_irregularity_rad_m")
 
 
 class _WallLimit:
@@ -120,8 +126,42 @@ def base_row(cell: Cell) -> dict[str, Any]:
             "budget_time_s": (cell.budget or {}).get("time_s")}
 
 
-def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """Run one cell; return its run row and its best-cost history rows (``progress``)."""
+class ComponentMissing(ConfigError):
+    """A cell names a component the worker's process does not know (its plugin is not installed there)."""
+
+    def __reduce__(self):  # crosses the worker's pipe and Ray as itself
+        return (ComponentMissing, (self.field, self.problem, self.source))
+
+
+def check_components(cell: Cell) -> None:
+    """Raise :class:`ComponentMissing` unless this process knows the cell's planner, navigator and scenario
+    (plugins loaded first)."""
+    from swarmnav.controllers.navigators import NAVIGATORS
+    from swarmnav.planners.registry import PLANNERS
+    load_plugins()
+    missing = []
+    if cell.planner not in PLANNERS:
+        missing.append(f"planner {cell.planner!r}")
+    if cell.navigator not in NAVIGATORS:
+        missing.append(f"navigator {cell.navigator!r}")
+    try:
+        resolve_scenario_path(cell.scenario)
+    except ConfigError:
+        missing.append(f"scenario {cell.scenario!r}")
+    if missing:
+        raise ComponentMissing("study", f"a worker does not know the {' and the '.join(missing)} that the study "
+                               "names (install the plugin that provides it where the workers run)")
+
+
+def run_cell(cell: Cell, logs_dir: str | None = None,
+             log_format: str = "swarmnav") -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """Run one cell; return its run row and its best-cost history rows (``progress``); its log (in
+    ``logs_dir``) of format ``log_format``.
+
+    Raises:
+        ComponentMissing: the cell names a component unknown in this process (no row: the study ends).
+    """
+    check_components(cell)
     row = base_row(cell)
     row["versions"] = _versions_json()
     progress: list[dict[str, Any]] = []
@@ -135,17 +175,17 @@ def run_cell(cell: Cell, logs_dir: str | None = None) -> tuple[dict[str, Any], l
                                seed=cell.seed, world_seed=cell.world_seed, clearance_m=cell.clearance_m,
                                budget=None if cell.budget is None else Budget(**cell.budget))
             row["clearance_m"] = scenario.clearance_m if cell.clearance_m is None else cell.clearance_m
-            planner, budgeted = build_planner(spec.resolved())   # recorded for every row, failed ones too
-            row.update(planner_resolved=json.dumps(resolved_params(planner), sort_keys=True), budgeted=budgeted,
-                       plan_mode=getattr(planner, "mode", None))
-            episode = plan_episode(spec)
+            parts = compose(spec)   # its planner recorded for every row, failed ones too; built once
+            row.update(planner_resolved=json.dumps(resolved_params(parts.planner), sort_keys=True),
+                       budgeted=parts.budgeted, plan_mode=getattr(parts.planner, "mode", None))
+            episode = plan_episode(parts)
             if cell.physics:
                 tally = EventTally()
                 recorders = [tally]
                 if logs_dir is not None:
                     from swarmnav.sim.log.writer import McapRecorder
                     log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
-                    recorders.append(McapRecorder(log_path, overwrite=True))
+                    recorders.append(McapRecorder(log_path, overwrite=True, log_format=log_format))
                     row["log"] = str(log_path)
                 cpu0 = time.thread_time()
                 episode = run_episode(episode, recorders, time_limit_s=cell.time_limit_s)

@@ -13,7 +13,9 @@ one pipe and one process sentinel per worker (``multiprocessing.connection.wait`
 so each completion costs the same whatever the size of the study.  Short cells
 travel in batches sized from the measured cell time (:class:`BatchSizer`); every
 cell's result comes back on its own, so the driver always knows which cell a
-worker is running.  A worker that dies (killed, a segfault, ``os._exit``) turns
+worker is running.  A worker that does not know a component a cell names (a plugin
+the driver has and the worker cannot find) answers :class:`ComponentMissing`
+instead of a row, and the driver ends the study with it (exit 2), no error rows.  A worker that dies (killed, a segfault, ``os._exit``) turns
 that cell into an ``error`` row naming the signal or exit code; the rest of its
 queue goes to a fresh worker.
 """
@@ -32,7 +34,7 @@ from multiprocessing.connection import wait as wait_any
 from typing import Any, Iterable, Iterator
 
 from swarmnav.sim.defaults import SINGLE_THREAD_ENVIRONMENT
-from swarmnav.sim.study.cell import _versions_json, base_row, run_cell
+from swarmnav.sim.study.cell import ComponentMissing, _versions_json, base_row, run_cell
 from swarmnav.sim.study.grid import Cell
 
 PARENT_POLL_S = 0.5
@@ -107,7 +109,7 @@ def _exit_with_parent(parent_pid: int) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
-def _worker_main(conn, parent_pid: int, logs_dir: str | None) -> None:
+def _worker_main(conn, parent_pid: int, logs_dir: str | None, log_format: str = "swarmnav") -> None:
     """A local worker: batches arrive on ``conn`` (read by a thread, so the driver's sends never wait on a
     running cell), each cell runs on this process's main thread (where the wall limit's timer works) and its
     result goes back at once.  Ctrl-C is the driver's to handle: it terminates its workers."""
@@ -124,13 +126,18 @@ def _worker_main(conn, parent_pid: int, logs_dir: str | None) -> None:
     threading.Thread(target=receive, daemon=True).start()
     while (batch := inbox.get()) is not None:
         for cell in batch:
-            conn.send(run_cell(cell, logs_dir))
+            try:
+                result: Result | ComponentMissing = run_cell(cell, logs_dir, log_format)
+            except ComponentMissing as exc:
+                result = exc
+            conn.send(result)
 
 
 class _LocalWorker:
-    def __init__(self, context, logs_dir: str | None):
+    def __init__(self, context, logs_dir: str | None, log_format: str = "swarmnav"):
         self.conn, child = context.Pipe()
-        self.process = context.Process(target=_worker_main, args=(child, os.getpid(), logs_dir), daemon=True)
+        self.process = context.Process(target=_worker_main, args=(child, os.getpid(), logs_dir, log_format),
+                                       daemon=True)
         self.process.start()
         child.close()
         self.queued: deque[Cell] = deque()  # sent, not yet returned, in the order the worker runs them
@@ -168,7 +175,8 @@ class _LocalWorker:
         self.conn.close()
 
 
-def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None) -> Iterator[Result]:
+def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None,
+              log_format: str = "swarmnav") -> Iterator[Result]:
     """Run the cells on ``workers`` spawned processes; on an early exit (Ctrl-C, SIGTERM) the workers
     this engine started are terminated."""
     source = iter(cells)
@@ -199,7 +207,7 @@ def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None) 
                         break
                     if worker is None:
                         with _environment(worker_environment()):
-                            worker = pool[slot] = _LocalWorker(context, logs_dir)
+                            worker = pool[slot] = _LocalWorker(context, logs_dir, log_format)
                     worker.send(batch)
             busy = [w for w in pool if w is not None and w.queued]
             if not busy:
@@ -209,15 +217,20 @@ def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None) 
                 if worker.conn not in ready and worker.process.sentinel not in ready:
                     continue
                 results, gone = worker.receive()
-                for row, progress in results:
+                for result in results:
+                    if isinstance(result, ComponentMissing):
+                        raise result
+                    row, progress = result
                     worker.queued.popleft()
                     sizer.observe(row)
                     yield row, progress
                 if gone or not worker.process.is_alive():
                     worker.process.join()
-                    for row, progress in worker.receive()[0]:  # what it sent before it died
+                    for result in worker.receive()[0]:  # what it sent before it died
+                        if isinstance(result, ComponentMissing):
+                            raise result
                         worker.queued.popleft()
-                        yield row, progress
+                        yield result
                     if worker.queued:
                         yield died_row(worker.queued.popleft(), exit_description(worker.process.exitcode))
                         retry.extendleft(reversed(worker.queued))
@@ -231,8 +244,8 @@ def run_local(cells: Iterable[Cell], workers: int, logs_dir: str | None = None) 
                 worker.stop(terminate=not finished)
 
 
-def run_inline(cells: Iterable[Cell], logs_dir: str | None = None) -> Iterator[Result]:
+def run_inline(cells: Iterable[Cell], logs_dir: str | None = None, log_format: str = "swarmnav") -> Iterator[Result]:
     """Run the cells one after another in this process (the benchmarks' engine: plan times are measured
     alone and warm, as their own timing loops measure them; no worker start-up)."""
     for cell in cells:
-        yield run_cell(cell, logs_dir)
+        yield run_cell(cell, logs_dir, log_format)

@@ -25,6 +25,7 @@ from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.study.engines import run_inline, run_local
 from swarmnav.sim.study.grid import Cell, count_cells, iter_cells
 from swarmnav.sim.study.lock import FolderLock
+from swarmnav.sim.study.main_guard import check_main_guard
 from swarmnav.sim.study.rows import RowWriter, compact, done_hashes, read_table
 from swarmnav.sim.study.spec import Study, study_from_tables
 from swarmnav.sim.study.yardstick import Yardstick
@@ -55,8 +56,9 @@ def _scenario_entry(ref: str, world_seed: int | None, study: Study) -> dict[str,
 
 
 def study_metadata(study: Study) -> dict[str, Any]:
+    from swarmnav.sim.study.provenance import study_inputs
     world_seed = study.world_seeds[0]
-    return {"claims": [c.as_dict() for c in study.claims],"name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
+    return {"inputs": study_inputs(study), "claims": [c.as_dict() for c in study.claims], "name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
             "reference": study.reference, "planners": [p.label for p in study.planners],
             "navigators": [n.label for n in study.navigators],
             "paper": [dataclasses.asdict(p) for p in study.paper],
@@ -76,11 +78,32 @@ def _write_metadata(study: Study, out_dir: FilePath) -> None:
         previous = old.get("name")
         # rows of an earlier version of the study stay in the folder: keep the geometry of their scenarios
         metadata["scenarios"] = {**old.get("scenarios", {}), **metadata["scenarios"]}
+        metadata["inputs"] = resumed_inputs(old.get("inputs"), metadata["inputs"], out_dir)
         if previous != study.name:
             raise ConfigError("--out", f"holds the rows of study {previous!r}, not {study.name!r} "
                                        "(choose another directory)", str(out_dir))
     out_dir.mkdir(parents=True, exist_ok=True)
     replace_file(path, json.dumps(metadata, indent=2) + "\n", "--out")
+
+
+def resumed_inputs(old: dict[str, Any] | None, new: dict[str, Any], out_dir: FilePath) -> dict[str, Any]:
+    """The inputs a resumed folder records: today's, unless rows already there were made by sources,
+    scenarios or a swarmnav version that have changed since; then the old record stays (with today's study
+    file, whose claims and comments decide no row, and the files of newly used components added), so that
+    ``report --check-fresh`` calls the mixed rows stale, and a warning says to start the folder afresh."""
+    from swarmnav.sim.study.provenance import stale_inputs
+    if not old or not (out_dir / "runs.parquet").exists():
+        return new
+    changes = [c for c in stale_inputs(old, new)[0] if not c.startswith("study file")
+               and not c.endswith("newly used") and not c.endswith("no longer used")]
+    if not changes:
+        return {**new, "sources": {**old.get("sources", {}), **new["sources"]},
+                "scenarios": {**old.get("scenarios", {}), **new["scenarios"]}}
+    print(f"swarmnav: warning: {out_dir} holds rows made before {'; '.join(changes)}: its verdicts will be stale "
+          "(delete the folder to rerun the study afresh)", file=sys.stderr)
+    return {**old, "study_file": new["study_file"],
+            "sources": {**new["sources"], **old.get("sources", {})},
+            "scenarios": {**new["scenarios"], **old.get("scenarios", {})}}
 
 
 class ProgressBar:
@@ -114,13 +137,16 @@ def pending_cells(study: Study, out_dir: FilePath, retry_errors: bool = False) -
 
 
 def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local", workers: int | None = None,
-              address: str | None = None, logs: bool = False, show_progress: bool = False,
+              address: str | None = None, logs: bool | str = False, show_progress: bool = False,
               retry_errors: bool = False) -> dict[str, Any]:
     """Run every cell of ``study`` that ``out_dir`` does not hold yet; return a summary of this invocation.
 
     The folder is locked while the study runs (a second study into it is refused, naming this one's PID);
-    when every cell has a row, the parts are compacted."""
+    when every cell has a row, the parts are compacted.  ``logs``: keep each physics run's MCAP log in
+    ``out_dir/logs``, of format ``swarmnav`` (``True``) or the format named (``"ros2"``)."""
     out_dir = FilePath(out_dir)
+    if engine == "local":
+        check_main_guard()  # a script's unguarded top level: each spawned worker would run it again
     if engine == "ray" and address:
         from swarmnav.sim.study.ray_engine import check_reachable
         check_reachable(address)  # before anything is written
@@ -129,19 +155,20 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
 
 
 def _run_locked(study: Study, out_dir: FilePath, engine: str, workers: int | None, address: str | None,
-                logs: bool, show_progress: bool, retry_errors: bool) -> dict[str, Any]:
+                logs: bool | str, show_progress: bool, retry_errors: bool) -> dict[str, Any]:
     _write_metadata(study, out_dir)
     todo, pending, total = pending_cells(study, out_dir, retry_errors)
     workers = workers or os.cpu_count() or 1
     logs_dir = str(contained_folder(out_dir / "logs", "--out").resolve()) if logs else None
+    log_format = logs if isinstance(logs, str) else "swarmnav"
     nodes: set[str] = set()
     if engine == "ray":
         from swarmnav.sim.study.ray_engine import run_ray
-        results: Iterator = run_ray(todo, address, None if address else workers, logs_dir, nodes)
+        results: Iterator = run_ray(todo, address, None if address else workers, logs_dir, nodes, log_format)
     elif engine == "inline":
-        results = run_inline(todo, logs_dir)
+        results = run_inline(todo, logs_dir, log_format)
     else:
-        results = run_local(todo, workers, logs_dir)
+        results = run_local(todo, workers, logs_dir, log_format)
     writer = RowWriter(out_dir)
     yardstick = Yardstick(out_dir, study.time_limit_s, study.trust_code)
     bar = ProgressBar(pending, sys.stderr) if show_progress and pending else None

@@ -5,9 +5,11 @@ CPU of the cluster), ``ray.wait`` over those references only, cells taken from a
 lazy iterator, batches sized from the measured cell time.
 
 On a cluster (``--address``) every node must have the driver's swarmnav (and its
-MuJoCo, NumPy, SciPy and Python) installed: each task answers with the node's
-address and versions, and a node whose versions differ fails the study at once,
-naming the node (its rows are not kept).  Logs (``--logs``) are written by the
+MuJoCo, NumPy, SciPy and Python) installed, and the driver's plugins (entry-point
+distributions, :mod:`swarmnav.sim.plugins`) at the driver's versions: each task
+answers with the node's address, versions and plugin distributions, and a node
+whose versions differ, or that lacks a plugin or a component a cell names, fails
+the study at once, naming the node and the distribution (its rows are not kept).  Logs (``--logs``) are written by the
 task to a temporary folder on its node and travel back with the row; the driver
 writes them under its own ``--out``, so no log depends on a worker's disk.
 
@@ -31,7 +33,8 @@ from typing import Any, Iterable, Iterator
 
 from swarmnav.models.contained_files import check_no_link, folder as contained_folder, open_in_folder
 from swarmnav.models.errors import ConfigError
-from swarmnav.sim.study.cell import _versions_json, run_cell
+from swarmnav.sim.plugins import distributions
+from swarmnav.sim.study.cell import ComponentMissing, _versions_json, run_cell
 from swarmnav.sim.study.engines import BATCHES_IN_FLIGHT, BatchSizer, Result, died_row, worker_environment
 from swarmnav.sim.study.grid import Cell
 
@@ -78,23 +81,48 @@ def start_ray(address: str | None, workers: int | None) -> None:
         signal.signal(signal.SIGTERM, previous)
 
 
-def run_batch(cells: list[Cell], keep_logs: bool) -> dict[str, Any]:
+def run_batch(cells: list[Cell], keep_logs: str | None) -> dict[str, Any]:
     """A task: run the cells in order; return the node, its versions, and each cell's row, progress and log
-    bytes (``None`` without ``--logs`` or in plan-only mode)."""
+    bytes (``None`` without ``--logs`` or in plan-only mode); ``keep_logs``: the logs' format, None for none."""
     import ray
+    context = ray.get_runtime_context()
+    answer: dict[str, Any] = {"node": ray.util.get_node_ip_address(), "node_id": context.get_node_id(),
+                              "versions": _versions_json(), "plugins": distributions(), "missing": None}
     results = []
     for cell in cells:
-        if keep_logs and cell.physics:
-            with tempfile.TemporaryDirectory(prefix="swarmnav-log-") as folder:
-                row, progress = run_cell(cell, folder)
-                log = FilePath(folder) / f"{cell.config_hash}.mcap"
-                data = log.read_bytes() if log.exists() else None
-        else:
-            (row, progress), data = run_cell(cell), None
-        results.append((row, progress, data))
-    context = ray.get_runtime_context()
-    return {"node": ray.util.get_node_ip_address(), "node_id": context.get_node_id(), "versions": _versions_json(),
-            "results": results}
+        try:
+            results.append(_run_one(cell, keep_logs))
+        except ComponentMissing as exc:
+            answer["missing"] = exc.problem
+            break
+    return {**answer, "results": results}
+
+
+def _run_one(cell: Cell, keep_logs: str | None) -> tuple[dict[str, Any], list[dict[str, Any]], bytes | None]:
+    """One cell's row, progress and log bytes (see :func:`run_batch`)."""
+    if not (keep_logs and cell.physics):
+        row, progress = run_cell(cell)
+        return row, progress, None
+    with tempfile.TemporaryDirectory(prefix="swarmnav-log-") as folder:
+        row, progress = run_cell(cell, folder, keep_logs)
+        log = FilePath(folder) / f"{cell.config_hash}.mcap"
+        return row, progress, log.read_bytes() if log.exists() else None
+
+
+def _node(answer: dict[str, Any]) -> str:
+    return f"node {answer['node']} (id {answer.get('node_id', '?')[:12]})"
+
+
+def _check_plugins(answer: dict[str, Any], driver: dict[str, str]) -> None:
+    """Every plugin distribution the driver loaded is on the node at the driver's version."""
+    theirs = answer.get("plugins", {})
+    differ = [f"{name} {theirs[name] if name in theirs else 'not installed'} (driver {version})"
+              for name, version in driver.items() if theirs.get(name) != version]
+    if differ:
+        raise ConfigError("--address", f"{_node(answer)} differs from the driver in its plugins: {', '.join(differ)}; "
+                                       "install the driver's plugins on every node of the cluster")
+    if answer.get("missing"):
+        raise ConfigError("--address", f"{_node(answer)}: {answer['missing']}")
 
 
 def _check_versions(answer: dict[str, Any], driver: str) -> None:
@@ -103,7 +131,7 @@ def _check_versions(answer: dict[str, Any], driver: str) -> None:
     theirs, ours = json.loads(answer["versions"]), json.loads(driver)
     differ = ", ".join(f"{k} {theirs.get(k)} (driver {ours.get(k)})" for k in sorted(set(theirs) | set(ours))
                        if theirs.get(k) != ours.get(k))
-    raise ConfigError("--address", f"node {answer['node']} (id {answer.get('node_id', '?')[:12]}) runs {differ}; install the driver's versions on "
+    raise ConfigError("--address", f"{_node(answer)} runs {differ}; install the driver's versions on "
                                    "every node of the cluster")
 
 
@@ -125,14 +153,14 @@ def _failure(exc: Exception) -> str:
 
 
 def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | None = None,
-            logs_dir: str | None = None, nodes: set[str] | None = None) -> Iterator[Result]:
+            logs_dir: str | None = None, nodes: set[str] | None = None, log_format: str = "swarmnav") -> Iterator[Result]:
     """Run the cells as Ray tasks (one CPU each) on a local instance or the cluster at ``address``; the ids of
     the nodes that ran them are added to ``nodes``."""
     import ray
     start_ray(address, workers)
     task = ray.remote(num_cpus=1, max_retries=0)(run_batch)
     slots = BATCHES_IN_FLIGHT * max(1, int(ray.cluster_resources().get("CPU", 1)))
-    driver_versions = _versions_json()
+    driver_versions, driver_plugins = _versions_json(), distributions()
     source, solo, sizer = iter(cells), deque(), BatchSizer()
     inflight: dict[Any, list[Cell]] = {}
     try:
@@ -141,7 +169,7 @@ def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | No
                 batch = [solo.popleft()] if solo else list(islice(source, sizer.size()))
                 if not batch:
                     break
-                inflight[task.remote(batch, logs_dir is not None)] = batch
+                inflight[task.remote(batch, log_format if logs_dir is not None else None)] = batch
             if not inflight:
                 break
             done, _ = ray.wait(list(inflight), num_returns=1)
@@ -156,6 +184,7 @@ def run_ray(cells: Iterable[Cell], address: str | None = None, workers: int | No
                         solo.extend(batch)  # again one cell per task: only the cell that fails is an error row
                     continue
                 _check_versions(answer, driver_versions)
+                _check_plugins(answer, driver_plugins)
                 if nodes is not None:
                     nodes.add(answer["node_id"])
                 for row, progress, log in answer["results"]:

@@ -65,6 +65,9 @@ RUN_SCHEMA = pa.schema([
     ("oracle_cell_m", pa.float64()), ("time_score", pa.float64()), ("static_density", pa.float64()),
     ("dispersion", pa.float64()), ("survivability", pa.float64()), ("dynamic_traversability", pa.float64()),
     ("t_star_ratio", pa.float64()), ("difficulty_error", pa.string()), ("run_cpu_s", pa.float64()),
+    # among agents (orca / social_force obstacles) only: sim/crowd_stepping.crowd_metrics
+    ("discomfort_frequency", pa.float64()), ("min_separation_m", pa.float64()),
+    ("path_irregularity_rad_m", pa.float64()),
 ])
 PROGRESS_SCHEMA = pa.schema([
     ("config_hash", pa.string()), ("iteration", pa.int64()), ("best_cost", pa.float64()),

@@ -66,6 +66,7 @@ from swarmnav.models.scenario_limits import MAX_STUDY_RUNS
 from swarmnav.models.toml_table import POSITIVE, TomlTable, above, parse_toml, read_text, within
 from swarmnav.planners.registry import make_planner
 from swarmnav.planners.swarm import Budget
+from swarmnav.sim.plugins import load_plugins
 from swarmnav.sim.study.claim_spec import Claim, read_claims
 from swarmnav.sim.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, PaperValue, check_time_limit,  # noqa: F401
                                               read_budget, read_clearance, read_components, read_paper,
@@ -101,6 +102,9 @@ class Study:
     claims: tuple[Claim, ...] = ()  # the paper's claims the rows test (the report's verdicts)
     trust_code: bool = False  # --trust-code: its files (study, scenarios) may name code to run
     budget: Budget | None = None  # every planner's budget, unless its entry names its own
+    # --claims-only: the (scenario stem, planner arm label, navigator arm label or None) the claims compare;
+    # None: every arm runs
+    claim_arms: frozenset[tuple[str, str, str | None]] | None = None
 
     def budget_of(self, planner: Component) -> Budget | None:
         """The budget a planner entry runs under: its own, else the study's."""
@@ -111,6 +115,20 @@ class Study:
         if self.paired_seeds:
             return list(zip(self.world_seeds, self.seeds))
         return [(w, s) for w in self.world_seeds for s in self.seeds]
+
+    def claims_only(self) -> "Study":
+        """The study restricted to the arms its claims compare (each claim's planner and ``than`` labels on its
+        scenario, with its navigator when it names one): the rows the verdicts need and no more.  Its cells
+        are the full study's cells (the same hashes), so a later full run into the same folder resumes."""
+        arms = frozenset((c.scenario, label, c.navigator) for c in self.claims for label in (c.planner, *c.than))
+        return replace(self, claim_arms=arms)
+
+    def wants(self, scenario: str, planner_label: str, navigator_label: str) -> bool:
+        """Whether the run grid includes this arm (always, unless :meth:`claims_only`)."""
+        if self.claim_arms is None:
+            return True
+        stem = FilePath(scenario).stem
+        return (stem, planner_label, navigator_label) in self.claim_arms or (stem, planner_label, None) in self.claim_arms
 
     def quick(self) -> "Study":
         """The study on its first ``quick_seeds`` seeds (its rows are the full study's rows for those seeds,
@@ -164,6 +182,7 @@ def study_from_tables(data: dict[str, Any], source: str = "<tables>", default_na
 
 
 def _read_study(top: TomlTable, default_name: str, trust_code: bool) -> Study:
+    load_plugins()  # the names of installed plugins' planners, navigators and scenarios are valid here too
     top.only(TOP_KEYS)
     name = top.string("name", default_name, non_empty=True)
     problem = name_problem(name)  # the default --out is studies/<name>: a name is never a path

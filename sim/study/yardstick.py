@@ -6,7 +6,8 @@ For every physics row whose scenario has a moving obstacle, the study's driver a
 * ``oracle_verdict``: ``solvable`` (the oracle, :mod:`controllers.oracle_search`, found a collision-free
   arrival on its lattice within the time limit), ``unsolvable`` (it proved none at its resolution:
   ``oracle_reason`` says why, e.g. ``time_limit``) or ``undecided`` (the search raised: ``oracle_reason`` holds
-  the error; the row is kept, as every failure is);
+  the error; the row is kept, as every failure is) or ``none`` (the scene's agents see the robot and react to
+  it: no clairvoyant yardstick exists, and nothing is counted against a navigator there);
 * ``oracle_t_star_s`` (T*, the earliest arrival) and ``oracle_cell_m`` (the resolution it decided at);
 * ``time_score``: BARN's (Perille et al. 2020), on rows of a solvable scene only: 0 when the run failed, else
   T* / T clipped to [0, 1], T the run's ``time_to_goal_s``; null on unsolvable and undecided scenes, so that a
@@ -59,6 +60,10 @@ def measure(scenario, time_limit_s: float | None) -> dict[str, Any]:
     entry: dict[str, Any] = {"scenario": scenario.name, "world_seed": scenario.world_seed,
                              "time_limit_s": time_limit_s, "dynamic": any(ob.moving for ob in scenario.obstacles)}
     if not entry["dynamic"]:
+        return entry
+    from swarmnav.controllers.oracle_search import reactive_agents
+    if reactive_agents(scenario):
+        entry.update(oracle_verdict="none", oracle_reason="the agents react to the robot: no clairvoyant yardstick")
         return entry
     try:
         found = oracle_metrics(scenario, None, time_limit_s)

@@ -1,0 +1,169 @@
+"""The README's BARN tables, generated from the committed ``bench navigation --suite barn --by-scenario --json``
+results (``models/suites/results/barn-test50.json``, ``barn.json``) beside the published figures.
+
+``python -m swarmnav.sim.benchmarks.barn_table [--readme FILE]`` prints the block (or replaces it between its
+markers in FILE); ``make readme-table`` runs it; ``tests/test_barn_table.py`` fails when the README drifts from
+the JSON.  Every figure in the block is read from a result file or is a published one cited beside it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path as FilePath
+from typing import Any
+
+from swarmnav.models.errors import ConfigError
+
+RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results"
+RESULTS = (RESULTS_DIR / "barn-test50.json", RESULTS_DIR / "barn-test10-dwa-vo.json", RESULTS_DIR / "barn.json",
+           RESULTS_DIR / "barn-like.json", RESULTS_DIR / "barn-jackal-test10.json")
+TEST_50, ALL_300, FRESH = RESULTS[0], RESULTS[2], RESULTS[3]  # compared: BARN-like worlds against BARN's
+BEGIN = "<!-- barn-table: generated from models/suites/results/barn*.json by `make readme-table`; do not edit by hand -->"
+END = "<!-- end of barn-table -->"
+ORACLE = "oracle"
+# Published, on the same 50 test worlds x 10 runs (the challenge's report_test.py): the challenge repository's
+# README (Daffan/the-barn-challenge at bf5a226f), as quoted in ../shared/benchmarks/barn/README.md.
+PUBLISHED = [{"entry": "move_base + DWA, Gazebo, Jackal, map unknown (the challenge's baseline)",
+              "source": "Daffan/the-barn-challenge README (commit bf5a226f), via ../shared/benchmarks/barn/README.md",
+              "runs": 500, "success_rate": 0.88, "collision_rate": 0.048, "timeout_rate": 0.072,
+              "barn_score": 0.1693, "mean_time_s": 33.47}]
+
+
+def read_result(path: FilePath) -> list[dict[str, Any]]:
+    try:
+        rows = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ConfigError("barn table", f"cannot read a bench navigation result ({exc})", str(path)) from None
+    if not isinstance(rows, list) or not all(isinstance(r, dict) and "barn_score" in r for r in rows):
+        raise ConfigError("barn table", "is not a `bench navigation --suite barn --json` result", str(path))
+    return rows
+
+
+def _f(value: Any, spec: str) -> str:
+    return "–" if value is None else format(value, spec)
+
+
+def _worlds_runs(rows: list[dict[str, Any]]) -> tuple[int, int]:
+    per_run = [r for r in rows if r.get("scenario") is not None]
+    worlds = {r["world"] for r in per_run}
+    runs = {(r["world"], r["run"]) for r in per_run}
+    return len(worlds), (len(runs) // len(worlds) if worlds else 0)
+
+
+def result_lines(path: FilePath, rows: list[dict[str, Any]]) -> list[str]:
+    overall = [r for r in rows if r.get("scenario") is None]
+    worlds, runs = _worlds_runs(rows)
+    setup = overall[0]["barn_setup"] if overall else ""
+    lines = [f"**`{path.name}`**: {worlds} worlds x {runs} run(s) each; {setup}.", "",
+             "| navigator | runs | success | collisions | timeouts | BARN score | mean time to goal s |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for r in overall:
+        name = f"{r['navigator']} (clairvoyant yardstick)" if r["navigator"] == ORACLE else r["navigator"]
+        lines.append(f"| {name} | {r['runs']} | {r['success_rate']:.3f} | {r['collision_rate']:.3f} | "
+                     f"{r['timeout_rate']:.3f} | {_f(r['barn_score'], '.4f')} | {_f(r['mean_time_to_goal_s'], '.2f')} |")
+    contenders = [r for r in overall if r["navigator"] != ORACLE]
+    if contenders:
+        best = max(contenders, key=lambda r: (r["barn_score"] or 0.0, r["success_rate"]))
+        lines += ["", f"Best by score: `{best['navigator']}`, {best['barn_score']:.4f} (success "
+                      f"{best['success_rate']:.3f})."]
+    return lines
+
+
+def published_lines() -> list[str]:
+    lines = ["Published on the same 50 test worlds x 10 runs:", "",
+             "| entry | runs | success | collisions | timeouts | BARN score | mean time s | source |",
+             "|---|---:|---:|---:|---:|---:|---:|---|"]
+    for p in PUBLISHED:
+        lines.append(f"| {p['entry']} | {p['runs']} | {p['success_rate']:.3f} | {p['collision_rate']:.3f} | "
+                     f"{p['timeout_rate']:.3f} | {p['barn_score']:.4f} | {p['mean_time_s']:.2f} | {p['source']} |")
+    return lines
+
+
+def difficulty_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """Success against BARN's difficulty metrics, per navigator, from the per-run rows."""
+    from swarmnav.sim.benchmarks.barn_difficulty import METRICS, success_against_difficulty
+    per_run = [r for r in rows if r.get("scenario") is not None and r.get("difficulty")]
+    names = [n for n in dict.fromkeys(r["navigator"] for r in per_run)]
+    if not per_run:
+        return []
+    lines = ["Success against difficulty (Spearman's rho of a world's success with the metric over the worlds; "
+             "success in the lower / upper half of the worlds by the metric):", "",
+             "| navigator | " + " | ".join(METRICS) + " |", "|---|" + "---:|" * len(METRICS)]
+    for name in names:
+        table = success_against_difficulty(per_run, name)
+        cells = [f"{_f(table[k]['spearman'], '+.2f')} ({_f(table[k]['success_low_half'], '.2f')} / "
+                 f"{_f(table[k]['success_high_half'], '.2f')})" for k in METRICS]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
+    """The BARN-like worlds' figures against BARN's (the 300 when committed, else the 50 test worlds), navigator
+    by navigator, same setup only (issue 34's check: within 0.05)."""
+    against = next((p for p in (ALL_300, TEST_50) if p in results and p.is_file()), None)
+    if against is None or FRESH not in results or not FRESH.is_file():
+        return []
+    base_rows, fresh_rows = read_result(against), read_result(FRESH)
+    base = {r["navigator"]: r for r in base_rows if r.get("scenario") is None}
+    fresh = {r["navigator"]: r for r in fresh_rows if r.get("scenario") is None}
+    lines = []
+    for name in [n for n in fresh if n in base]:
+        b, f = base[name], fresh[name]
+        ds, dsc = f["success_rate"] - b["success_rate"], (f["barn_score"] or 0.0) - (b["barn_score"] or 0.0)
+        if f["barn_setup"] != b["barn_setup"]:
+            continue
+        lines.append(f"BARN-like worlds (`{FRESH.name}`) against BARN's (`{against.name}`), `{name}`: success "
+                     f"{f['success_rate']:.3f} vs "
+                     f"{b['success_rate']:.3f} ({ds:+.3f}), score {f['barn_score']:.4f} vs {b['barn_score']:.4f} "
+                     f"({dsc:+.4f}): {'within' if abs(ds) <= 0.05 and abs(dsc) <= 0.05 else 'NOT within'} 0.05.")
+    return lines + [""] if lines else []
+
+
+def block(results: tuple[FilePath, ...] = RESULTS) -> str:
+    lines = [BEGIN, ""]
+    for path in results:
+        if path.is_file():
+            rows = read_result(path)
+            lines += result_lines(path, rows) + [""]
+            diff = difficulty_lines(rows)
+            lines += (diff + [""]) if diff else []
+    lines += fresh_lines(results) + published_lines() + ["", END]
+    return "\n".join(lines)
+
+
+def replace_block(text: str, new_block: str, source: str) -> str:
+    start = text.find(BEGIN)
+    end = text.find(END, start) if start >= 0 else -1
+    if start < 0 or end < start:
+        raise ConfigError("--readme", "has no barn-table markers", source)
+    return text[:start] + new_block + text[end + len(END):]
+
+
+def current_block(text: str) -> str | None:
+    start = text.find(BEGIN)
+    end = text.find(END, start) if start >= 0 else -1
+    return None if start < 0 or end < start else text[start:end + len(END)]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m swarmnav.sim.benchmarks.barn_table",
+                                     description=__doc__.splitlines()[0])
+    parser.add_argument("--readme", help="replace the block between the markers in this file")
+    args = parser.parse_args(argv)
+    try:
+        generated = block()
+        if args.readme:
+            path = FilePath(args.readme)
+            path.write_text(replace_block(path.read_text(encoding="utf-8"), generated, args.readme), encoding="utf-8")
+        else:
+            print(generated)
+    except ConfigError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

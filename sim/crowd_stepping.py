@@ -1,0 +1,88 @@
+"""Agents that see the robot (``sees_robot = true``), advanced by the stepper one control period at a time.
+
+A crowd that cannot see the robot is a pure function of time (:mod:`swarmnav.models.crowd_agents`) and moves
+like every scripted obstacle.  One that sees it depends on where the robot is: at control step ``s``, once the
+robot's pose and velocity are known, :meth:`ReactiveCrowd.advance` moves the agents to their positions at step
+``s + 1`` (written into the stepper's track) and sets their velocity at ``s`` (what the ``detector`` reports:
+the velocity they chose, never a later one).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from swarmnav.models.crowd_agents import AgentMotion, Crowd, CrowdSession
+
+
+class ReactiveCrowd:
+    """The agents among a stepper's moving obstacles (``columns`` of its track) and their episode."""
+
+    def __init__(self, crowd: Crowd, columns: np.ndarray, robot_radius_m: float, dt_s: float):
+        self.crowd = crowd
+        self.columns = columns
+        self.robot_radius_m = float(robot_radius_m)
+        self.dt_s = dt_s
+        self.session: CrowdSession | None = None
+
+    @classmethod
+    def of(cls, scenario, moving: list, dt_s: float) -> "ReactiveCrowd | None":
+        """The scenario's crowd when it sees the robot (None otherwise); ``moving``: the scene's moving obstacles."""
+        motions = [scenario.obstacles[ob.scenario_index].motion for ob in moving]
+        agents = [(col, m) for col, m in enumerate(motions) if isinstance(m, AgentMotion)]
+        if not agents or not agents[0][1].crowd.sees_robot:
+            return None
+        columns = np.array([col for col, m in sorted(agents, key=lambda a: a[1].index)], dtype=np.int64)
+        return cls(agents[0][1].crowd, columns, scenario.robot_radius_m, dt_s)
+
+    def max_hop_m(self) -> float:
+        """How far an agent can move in one control period."""
+        return self.crowd.max_speed_m_s * self.dt_s
+
+    def reset(self, track_m: np.ndarray, velocity_m_s: np.ndarray) -> None:
+        """A new episode writing into the stepper's ``track_m`` (T, M, 2) and the sensing's ``velocity_m_s``."""
+        self.session = CrowdSession(self.crowd)
+        self.track_m = track_m
+        self.velocity_m_s = velocity_m_s
+        track_m[0, self.columns] = self.session.positions_m
+
+    def advance(self, step: int, base_qpos: np.ndarray, base_qvel: np.ndarray) -> None:
+        """The agents from step ``step`` to ``step + 1``, seeing the robot where the physics has it now."""
+        if step + 1 >= len(self.track_m):
+            return
+        robot = (float(base_qpos[0]), float(base_qpos[1]), float(base_qvel[0]), float(base_qvel[1]),
+                 self.robot_radius_m)
+        now = self.session.positions_m.copy()
+        self.track_m[step + 1, self.columns] = self.session.advance(step, robot)
+        self.velocity_m_s[step, self.columns] = (self.track_m[step + 1, self.columns] - now) / self.dt_s
+
+
+def human_columns(scenario, moving: list) -> np.ndarray:
+    """The columns of the stepper's track that are agents (CrowdNav's humans), in track order."""
+    return np.array([col for col, ob in enumerate(moving)
+                     if isinstance(scenario.obstacles[ob.scenario_index].motion, AgentMotion)], dtype=np.int64)
+
+
+DISCOMFORT_M = 0.2  # Chen et al. (2019)'s discomfort distance, rim to rim
+
+
+def crowd_metrics(poses: np.ndarray, track_m: np.ndarray, radii_m: np.ndarray, robot_radius_m: float,
+                  path_length_m: float) -> dict[str, float]:
+    """The crowd-navigation metrics of a run among agents (``poses``, ``track_m``: its control steps, start first;
+    ``track_m`` and ``radii_m`` of the agents only).
+
+    * ``discomfort_frequency``: the share of control steps after the start whose observation has a human within
+      ``DISCOMFORT_M`` of the robot's rim (CrowdNav's "frequency of being in danger": steps with the closest
+      rim-to-rim distance below the discomfort distance, over all steps).
+    * ``min_separation_m``: the smallest rim-to-rim distance to a human over the run's observations (negative:
+      overlap).
+    * ``path_irregularity_rad_m``: all turning of the robot's heading along the run (rad) per metre driven; our
+      reading of Guzzi et al. (2013)'s "unnecessary turning per unit path length" (the robot starts facing its
+      goal, so a straight run needs none); 0 for a run that did not move.
+    """
+    gap = np.hypot(*np.moveaxis(track_m - poses[:, None, :2], 2, 0)) - radii_m[None, :] - robot_radius_m
+    closest = gap.min(axis=1)
+    after = closest[1:]
+    turning = float(np.abs((np.diff(poses[:, 2]) + np.pi) % (2.0 * np.pi) - np.pi).sum())
+    return {"discomfort_frequency": float(np.mean(after < DISCOMFORT_M)) if len(after) else 0.0,
+            "min_separation_m": float(closest.min()),
+            "path_irregularity_rad_m": turning / path_length_m if path_length_m > 0 else 0.0}
