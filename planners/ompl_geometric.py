@@ -153,7 +153,7 @@ class LBKPIECE1Planner(_FirstSolutionPlanner):
     ompl_class: ClassVar[str] = "LBKPIECE1"
     range_m: float = 0.0
     border_fraction: float = 0.9
-    parameter_ranges: ClassVar[dict[str, Range]] = {"range_m": RANGE_M, "border_fraction": above(0, 1)}
+    parameter_ranges: ClassVar[dict[str, Range]] = {"range_m": RANGE_M, "border_fraction": within(1e-6, 1)}  # OMPL refuses a fraction below its epsilon
 
     def check_own_parameters(self) -> None:
         _check_range(self, self.range_m)
