@@ -14,14 +14,26 @@ export MUJOCO_GL ?= egl
 
 STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin)))")
 
-.PHONY: demo test bench install clean studies readme-table
+.PHONY: demo test bench install clean studies readme-table rerun-stale typing-path docs
 
 $(STAMP): pyproject.toml Makefile planners/_colony_walk.c planners/_grid_search.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	@echo "installing swarmnav into $(VENV) (pip's output: $(VENV)/install.log)"
 	@$(BIN)/python -m pip install --quiet --upgrade pip > $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
 	@$(BIN)/python -m pip install --quiet -e '.[test,bench,rl]' >> $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
+	@$(MAKE) --no-print-directory typing-path
 	@touch $(STAMP)
+
+# The editable install maps swarmnav, swarmnav.sim, ... to their folders with an import hook, which type checkers
+# do not run: mypy would not find swarmnav at all. A folder of symbolic links, $(VENV)/typing/swarmnav (the files
+# of sim/api/ and the folders models, planners, controllers and sim, so a module added later is there too), put on
+# the path by a static .pth file, is the package as a wheel lays it out, py.typed included.
+TYPING_TREE := $(CURDIR)/$(VENV)/typing
+typing-path:
+	@rm -rf $(TYPING_TREE) && mkdir -p $(TYPING_TREE)/swarmnav
+	@for f in sim/api/*.py sim/api/py.typed; do ln -s $(CURDIR)/$$f $(TYPING_TREE)/swarmnav/; done
+	@for d in models planners controllers sim; do ln -s $(CURDIR)/$$d $(TYPING_TREE)/swarmnav/$$d; done
+	@$(BIN)/python -c "import sys, sysconfig; open(sysconfig.get_paths()['purelib'] + '/swarmnav_typing.pth', 'w').write(sys.argv[1] + '\n')" $(TYPING_TREE)
 
 install: $(STAMP)
 
@@ -34,6 +46,13 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
+
+# The documentation site (mkdocs.yml, docs/): built with --strict into site/, then served on
+# http://127.0.0.1:$(DOCS_PORT) (rebuilt as pages change; Ctrl-C stops it).
+DOCS_PORT ?= 8000
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict -d site
+	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs serve --strict -a 127.0.0.1:$(DOCS_PORT)
 
 # Every benchmark; `make bench BENCH_FLAGS=--quick` runs each in under a minute.
 BENCH_FLAGS ?=
@@ -56,22 +75,29 @@ studies: $(STAMP)
 		$(BIN)/swarmnav study $$s $(STUDY_RUN) --out studies/$$s && $(BIN)/swarmnav report studies/$$s || exit 1; \
 	done
 
-# The README's claims table: each bundled study with [[claims]] run on its quick seeds (`make readme-table
-# CLAIMS_RUN=` in full) into a fresh
+# The README's claims table: each bundled study with [[claims]] run in full into a fresh
 # studies/readme-table/<name>/, its verdicts copied to models/studies/results/<name>/claims.json (committed),
 # and the table between the README's claims-table markers regenerated from them; then the README's navigation
 # table from the committed `bench navigation --suite dyn300 --json` result (models/suites/results/dyn300.json).
 CLAIM_STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin) if s['claims']))")
-CLAIMS_RUN ?= --quick
+# Each study runs only the arms its claims compare (--claims-only), on every seed of the study file (the seed
+# rule's count); CLAIMS_RUN=--quick runs the quick seeds instead (not for committing: their verdicts are
+# underpowered).  `make rerun-stale` reruns exactly the studies whose committed claims.json is stale.
+CLAIMS_RUN ?=
 readme-table: $(STAMP)
 	for s in $(CLAIM_STUDIES); do \
 		rm -rf studies/readme-table/$$s; \
-		$(BIN)/swarmnav study $$s $(CLAIMS_RUN) --out studies/readme-table/$$s && \
+		$(BIN)/swarmnav study $$s --claims-only $(CLAIMS_RUN) --out studies/readme-table/$$s && \
 		$(BIN)/swarmnav report studies/readme-table/$$s && mkdir -p models/studies/results/$$s && \
 		cp studies/readme-table/$$s/claims.json models/studies/results/$$s/claims.json || exit 1; \
 	done
 	$(BIN)/swarmnav report --readme-table models/studies/results --readme README.md
 	for r in dyn300 dyn300-rangefinder dyn; do $(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/$$r.json --readme README.md || exit 1; done
+	$(BIN)/python -m swarmnav.sim.benchmarks.barn_table --readme README.md
+	$(BIN)/python -m swarmnav.sim.benchmarks.crowd_table models/suites/results/crowdnav.json --readme README.md
+
+rerun-stale: $(STAMP)
+	$(MAKE) readme-table CLAIM_STUDIES="$$($(BIN)/swarmnav report --check-fresh models/studies/results --names)"
 
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) build site *.egg-info

@@ -139,6 +139,8 @@ class CrowdSession:
         self.start_s = np.array([s.start_s for s in specs], dtype=float)
         self.goal_index = np.zeros(len(specs), dtype=int)
         self._goals = [np.asarray(s.goals_m, dtype=float) for s in specs]
+        self._goal_m = np.array([g[0] for g in self._goals], dtype=float).reshape(-1, 2)  # each one's current goal
+        self._loops = [i for i, g in enumerate(self._goals) if len(g) > 1]
         self.orca = np.array([s.kind == "orca" for s in specs])
         self.social = ~self.orca
         self._boxes = np.asarray(crowd.static_boxes, dtype=float).reshape(-1, 4)
@@ -180,18 +182,17 @@ class CrowdSession:
 
     def preferred_velocities(self, time_s: float) -> np.ndarray:
         """Toward each agent's goal at ``min(v_pref, distance)``; zero before its ``start_s``."""
-        out = np.zeros_like(self.positions_m)
-        for i, goals in enumerate(self._goals):
-            if time_s < self.start_s[i]:
-                continue
-            if len(goals) > 1:  # a loop: the next point once this one is reached
-                d = goals[self.goal_index[i]] - self.positions_m[i]
-                if math.hypot(d[0], d[1]) <= self.radii_m[i]:
-                    self.goal_index[i] = (self.goal_index[i] + 1) % len(goals)
+        for i in self._loops:  # a loop: the next point once this one is reached
+            goals = self._goals[i]
             d = goals[self.goal_index[i]] - self.positions_m[i]
-            dist = math.hypot(d[0], d[1])
-            out[i] = d * (min(self.v_pref[i], dist) / dist) if dist > 0 else 0.0
-        return out
+            if math.hypot(d[0], d[1]) <= self.radii_m[i]:
+                self.goal_index[i] = (self.goal_index[i] + 1) % len(goals)
+                self._goal_m[i] = goals[self.goal_index[i]]
+        d = self._goal_m - self.positions_m
+        dist = np.hypot(d[:, 0], d[:, 1])
+        scale = np.divide(np.minimum(self.v_pref, dist), dist, out=np.zeros_like(dist), where=dist > 0)
+        scale[time_s < self.start_s] = 0.0
+        return d * scale[:, None]
 
     def advance(self, step: int, robot: tuple[float, float, float, float, float] | None) -> np.ndarray:
         """Every agent one control period on from ``step``; the new positions (A, 2)."""

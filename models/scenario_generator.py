@@ -37,8 +37,10 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from swarmnav.models.crowdnav_scenarios import CROWDNAV_KINDS, crowdnav_lines
+from swarmnav.models.crowdnav_scenarios import CROWDNAV_KINDS, MAX_HUMANS, crowdnav_lines
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario_limits import MAX_MOVING_OBSTACLES, MAX_NAME_CHARS, MAX_SENSORS, MIN_LENGTH_M
+from swarmnav.models.toml_table import above, check_integer, check_number, check_string, within
 
 KINDS = ("crossing", "head_on", "overtake", "crowd", "fast_crossing", "dense_crowd", "door_patrol", "corridor",
          "mixed") + CROWDNAV_KINDS
@@ -71,6 +73,19 @@ class GeneratorOptions:
             raise ConfigError(f"--{option.replace('_', '-')}", problem, SOURCE)
         if kind not in KINDS:
             raise ConfigError("KIND", f"unknown kind {kind!r} (expected one of: {', '.join(KINDS)})", SOURCE)
+        for f in fields(self):  # every option against its declared range first (NaN, inf, huge counts)
+            option, value = f"--{f.name.replace('_', '-')}", getattr(self, f.name)
+            if f.type in ("bool", bool):
+                if not isinstance(value, bool):
+                    bad(f.name, f"expected true or false, got {value!r}")
+            elif f.name in OPTION_RANGES and f.type in ("int", int):
+                check_integer(value, option, SOURCE, OPTION_RANGES[f.name])
+            elif f.name in OPTION_RANGES:
+                check_number(value, option, SOURCE, OPTION_RANGES[f.name])
+            else:
+                check_string(value, option, SOURCE)
+                if len(value) > MAX_NAME_CHARS:
+                    bad(f.name, f"at most {MAX_NAME_CHARS} characters, got {len(value):,}")
         if self.obstacles < 1:
             bad("obstacles", f"must be at least 1, got {self.obstacles}")
         for key in ("speed_ratio", "radius_min_m", "arena_m", "range_m", "robot_speed_m_s"):
@@ -97,6 +112,15 @@ class GeneratorOptions:
         if self.arena_m <= 2 * ENDPOINT_INSET_M + 1.0:
             bad("arena_m", f"must exceed {2 * ENDPOINT_INSET_M + 1.0:g} m (start and goal sit "
                            f"{ENDPOINT_INSET_M:g} m in from the edges), got {self.arena_m:g}")
+
+
+# The declared range of every numeric option (checked before anything is drawn).
+OPTION_RANGES = {
+    "obstacles": within(1, MAX_MOVING_OBSTACLES), "speed_ratio": above(0, 100),
+    "radius_min_m": within(MIN_LENGTH_M, 100), "radius_max_m": within(MIN_LENGTH_M, 100),
+    "arena_m": above(0, 200), "range_m": within(MIN_LENGTH_M, 1000), "sensor_count": within(1, MAX_SENSORS),
+    "robot_speed_m_s": above(0, 100), "time_limit_s": within(0, 1e6), "humans": within(1, MAX_HUMANS),
+}
 
 
 def command_line(kind: str, seed: int, options: GeneratorOptions) -> str:

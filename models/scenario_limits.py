@@ -16,15 +16,22 @@ MAX_TRACK_SAMPLES = 20_000_000   # control steps x moving obstacles (positions c
 MIN_LENGTH_M = 0.001           # obstacle radii and heights, map cells, sensor range: MuJoCo's XML keeps ~6 digits
 MIN_TIMESTEP_S = 1e-6
 MAX_WALK_STEPS = 100_000       # random-walk periods over all walks, drawn up front (about 3 s of work)
-MAX_STATIC_OBSTACLES = 2_000   # [[obstacles]] entries: the exact reference path's tangent graph grows with n^2
+MAX_STATIC_OBSTACLES = 10_000  # static [[obstacles]] (10,000 discs plan with astar and compile, tests/test_hostile_input.py)
+MAX_TANGENT_GRAPH_DISCS = 300  # discs of an exact tangent graph (optimal, the SPL reference, robust guesses):
+                               # its time grows ~n^3 (200 discs: 7 s, 500: 70 s, measured); the SPL of a run
+                               # with more static discs is null
+MAX_MOVING_OBSTACLES = 1_000   # moving [[obstacles]] (each a MuJoCo mocap body, tracked every control step)
 MAX_INPUT_FILE_BYTES = 64_000_000  # any input file (scenario, study, suite, waypoints, map): checked before reading
 MAX_NESTING_DEPTH = 32         # arrays or tables inside one another, in a file or a KEY=VALUE setting
 MAX_SETTING_CHARS = 100_000    # one KEY=VALUE of --set, --navigator-set, --arm
-MAX_SWEEP_VALUES = 100_000     # values of one swept parameter (a list in a study), counted before expanding
+MAX_SWEEP_VALUES = 100_000     # values of one swept parameter (a list in a study)
+MAX_STUDY_RUNS = 2_000_000     # runs of one study (scenarios x settings x seeds), each a row; a sweep's settings
+                               # (the product of its lists' lengths) are counted before any is expanded
 MAX_COLONY_WALK_CELLS = 50_000_000  # ant colonies: ants x max_steps cells of one iteration's walks, drawn up front
 # Benchmarks (bench ...): counts and durations a user can give on the command line
 MAX_BENCH_REPEATS = 1_000      # bench sim/env --repeats, bench study --rounds
-MAX_BENCH_RUNS = 10_000        # bench cli --runs, bench grid --runs, bench planners --seeds/--peer-runs/--fields
+MAX_BENCH_RUNS = 1_000         # bench cli --runs, bench grid --runs/--swarm-sample, bench planners --seeds/--peer-runs/--fields
 MAX_BENCH_FRAMES = 100_000     # bench render --frames
 MAX_BENCH_SEEDS = 100_000      # bench navigation --seeds, --per-group, bench study --seeds
-MAX_BENCH_DURATION_S = 100_000.0  # bench sim/env/log --duration (simulated seconds)
+MAX_BENCH_DURATION_S = 20_000.0  # bench sim/env/log --duration (simulated seconds): MAX_CONTROL_STEPS at 50 Hz
+MAX_WORKERS = 1_024            # --workers of a benchmark (a study's: 8 per core)

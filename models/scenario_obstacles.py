@@ -14,7 +14,8 @@ import numpy as np
 from swarmnav.models.crowd_agents import AGENT_KINDS, MAX_V_PREF_M_S, AgentMotion, AgentSpec, Crowd
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.obstacle_motion import WALK_STEPS, LinearMotion, RandomWalkMotion, Stationary, WaypointMotion
-from swarmnav.models.scenario_limits import MAX_TRACK_SAMPLES, MAX_WALK_STEPS, MIN_LENGTH_M
+from swarmnav.models.scenario_limits import (MAX_MOVING_OBSTACLES, MAX_STATIC_OBSTACLES, MAX_TRACK_SAMPLES,
+                                             MAX_WALK_STEPS, MIN_LENGTH_M)
 from swarmnav.models.toml_table import NON_NEGATIVE, POSITIVE, TomlTable, above, within
 from swarmnav.models.world import Box
 
@@ -73,8 +74,17 @@ def read_obstacles(top: TomlTable, world: ObstacleWorld) -> tuple[Obstacle, ...]
         ConfigError: a field of the wrong type or range, a centre outside the arena, or more precomputed
             motion than the stated maxima allow (checked before any of it is drawn).
     """
-    placed = [_place(t, world) for t in top.tables("obstacles", [])]
+    tables = top.tables("obstacles", [])
+    if len(tables) > MAX_STATIC_OBSTACLES + MAX_MOVING_OBSTACLES:
+        top.fail("obstacles", f"{len(tables):,} entries, at most {MAX_STATIC_OBSTACLES + MAX_MOVING_OBSTACLES:,}")
+    placed = [_place(t, world) for t in tables]
     static = [p for p in placed if p.motion is None]
+    if len(placed) - len(static) > MAX_MOVING_OBSTACLES:
+        top.fail("obstacles", f"{len(placed) - len(static):,} moving obstacles, at most {MAX_MOVING_OBSTACLES:,} "
+                              "(MAX_MOVING_OBSTACLES)")
+    if len(static) > MAX_STATIC_OBSTACLES:
+        top.fail("obstacles", f"{len(static):,} static obstacles, at most {MAX_STATIC_OBSTACLES:,} "
+                              "(MAX_STATIC_OBSTACLES: a run's exact reference path grows about as n^3)")
     static_centres = np.array([(p.x_m, p.y_m) for p in static], dtype=float).reshape(-1, 2)
     static_radii = np.array([p.radius_m for p in static], dtype=float)
     _check_motion_size(placed, world, top.source)

@@ -31,7 +31,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import Range, within
+from swarmnav.models.scenario_limits import MAX_COLONY_WALK_CELLS
 from swarmnav.planners.colony_walk import STEP_LENGTHS, ColonyWalk, GridGraph, walk_colony
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.grid_graph import cell_clearance_m, cells_to_waypoints, count_bends, grid_endpoints, grid_problem
@@ -157,6 +159,9 @@ class GridColonyPlanner(AntColonyPlanner):
         return super().parameter_checks() + (
             ("beta", self.beta >= 0, "must not be negative"),
             ("max_steps", self.max_steps >= 0, "must not be negative"),
+            ("max_steps", self.ants * self.max_steps <= MAX_COLONY_WALK_CELLS,
+             f"ants x max_steps is {self.ants * self.max_steps:,} tour cells, at most {MAX_COLONY_WALK_CELLS:,} "
+             "(MAX_COLONY_WALK_CELLS: an iteration's tours are drawn up front)"),
             ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
         )
 
@@ -222,6 +227,10 @@ class GridColonyPlanner(AntColonyPlanner):
         data = state.data
         cell_weights, turn_weights, max_steps, max_length = self.move_weights(state, problem, iteration)
         ants = self.colony_size(state)
+        if ants * max_steps > MAX_COLONY_WALK_CELLS:  # a default max_steps on a large grid: before allocating
+            raise ConfigError("planner.params.max_steps", f"{ants:,} ants x {max_steps:,} steps is "
+                              f"{ants * max_steps:,} tour cells, at most {MAX_COLONY_WALK_CELLS:,} "
+                              "(MAX_COLONY_WALK_CELLS): give fewer ants or a smaller max_steps")
         walk = walk_colony(data["graph"], data["start"], data["goal"], ants, cell_weights, turn_weights, rng,
                            max_steps, max_length=max_length)
         state.evaluations += ants

@@ -78,7 +78,7 @@ class OptimalPlanner:
     """
 
     name: ClassVar[str] = "optimal"
-    parameter_ranges: ClassVar[dict[str, Range]] = {"arc_bulge_m": above(0, 1)}  # models.parameters: checked on build
+    parameter_ranges: ClassVar[dict[str, Range]] = {"arc_bulge_m": within(1e-6, 1)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs"})
 
     arc_bulge_m: float = 1e-5

@@ -32,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario_limits import MAX_TANGENT_GRAPH_DISCS
 from swarmnav.models.world import Rect
 from swarmnav.planners.segment_gaps import row_blocks, segments_clear
 
@@ -141,7 +143,15 @@ def _candidate_segments(start: np.ndarray, goal: np.ndarray, centres: np.ndarray
 def build_tangent_graph(start: np.ndarray, goal: np.ndarray, centres: np.ndarray, radii: np.ndarray,
                         bounds: Rect) -> TangentGraph:
     """The tangent graph from ``start`` to ``goal`` around the discs ``(centres, radii)``
-    within ``bounds`` (see the module docstring)."""
+    within ``bounds`` (see the module docstring).
+
+    Raises:
+        ConfigError: more than :data:`MAX_TANGENT_GRAPH_DISCS` discs (checked before anything is built).
+    """
+    if len(radii) > MAX_TANGENT_GRAPH_DISCS:
+        raise ConfigError("obstacles", f"an exact tangent graph among {len(radii):,} discs (at most "
+                                       f"{MAX_TANGENT_GRAPH_DISCS:,}, MAX_TANGENT_GRAPH_DISCS: its time grows ~n^3); "
+                                       "use a grid planner (astar, theta_star)")
     start = np.asarray(start, dtype=float).reshape(2)
     goal = np.asarray(goal, dtype=float).reshape(2)
     centres = np.asarray(centres, dtype=float).reshape(-1, 2)

@@ -58,18 +58,41 @@ def non_negative_float(text: str) -> float:
     return value
 
 
+def int_in(low: int, high: int):
+    """An argument type: an integer from ``low`` to ``high`` (a count with its stated maximum)."""
+    def count(text: str) -> int:
+        value = _integer(text)
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"must be an integer from {low:,} to {high:,}, got {text[:40]}")
+        return value
+    count.__name__ = "integer"
+    return count
+
+
+def float_in(low: float, high: float, low_open: bool = True):
+    """An argument type: a finite number above ``low`` (or from it, without ``low_open``) up to ``high``."""
+    def number(text: str) -> float:
+        value = _number(text)
+        if not ((value > low if low_open else value >= low) and value <= high):
+            raise argparse.ArgumentTypeError(f"must be {'above' if low_open else 'at least'} {low:g} and at most "
+                                             f"{high:g}, got {text[:40]}")
+        return value
+    number.__name__ = "number"
+    return number
+
+
 def _integer(text: str) -> int:
     try:
         return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+    except ValueError:  # also a string of more than 4,300 digits
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text[:40]!r}") from None
 
 
 def _number(text: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"expected a number, got {text[:40]!r}") from None
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"must be finite, got {text}")
     return value

@@ -3,7 +3,9 @@
 What the robot knows in advance is the map: the scenario's problem with its
 moving obstacles left out (:func:`static_problem`).  L* is the exact shortest
 length on it (``optimal``'s ``optimum_length_m``, not its polygon's slightly
-longer length), or Theta*'s path length on a map of boxes.
+longer length), or Theta*'s path length on a map of boxes or among more than
+:data:`planners.path_guess.MAX_TANGENT_DISCS` static discs (BARN's worlds: the tangent graph of 200-300
+cylinders costs seconds a run).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from swarmnav.models.scenario import Scenario
 from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.theta_star import ThetaStarPlanner
 from swarmnav.planners.optimal import OptimalPlanner
+from swarmnav.planners.path_guess import MAX_TANGENT_DISCS
 from swarmnav.planners.problem import Problem, scenario_problem
 
 
@@ -43,7 +46,9 @@ def reference_length_m(scenario: Scenario) -> float | None:
     key = _static_key(scenario)
     if key not in _REFERENCE_LENGTHS:
         problem = static_problem(scenario)
-        planner = ThetaStarPlanner() if problem.boxes or problem.grid_override is not None else OptimalPlanner()
+        # the exact tangent graph costs seconds beyond MAX_TANGENT_DISCS static discs (a BARN world has 200-300)
+        planner = (ThetaStarPlanner() if problem.boxes or problem.grid_override is not None
+                   or len(problem.obstacles) > MAX_TANGENT_DISCS else OptimalPlanner())
         try:
             stats = planner.plan(problem, np.random.default_rng(0)).stats
             _REFERENCE_LENGTHS[key] = float(stats.extra.get("optimum_length_m", stats.length_m))

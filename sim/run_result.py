@@ -9,12 +9,18 @@ from typing import Any
 import numpy as np
 
 
+#: Every way a run ends: the goal reached; the time limit; a collision that stopped the run
+#: (``stop_on_collision``); the robot's centre beyond an arena edge by more than its radius, or a given path
+#: (``run --waypoints``) with a waypoint outside the arena (``left_arena``).
+OUTCOMES = ("goal_reached", "timeout", "collision", "left_arena")
+
+
 @dataclass
 class RunResult:
     """What happened in one closed-loop run (arrays have one row per control step)."""
 
     reached: bool
-    outcome: str  # "goal_reached" | "timeout" | "collision"
+    outcome: str  # "goal_reached" | "timeout" | "collision" | "left_arena" (see OUTCOMES)
     collisions: int
     first_collision_s: float | None
     sim_time_s: float
@@ -42,8 +48,9 @@ class RunResult:
 
     @property
     def success(self) -> bool:
-        """Reached the goal before the time limit with no collision."""
-        return self.reached and self.collisions == 0
+        """Reached the goal before the time limit with no collision, never having left the arena (nor driven
+        a given path that leaves it: outcome ``left_arena``)."""
+        return self.reached and self.collisions == 0 and self.outcome == "goal_reached"
 
     @property
     def spl(self) -> float | None:

@@ -136,6 +136,16 @@ class EpisodeStepper:
             if time_limit_s is None else control_periods(time_limit_s, self.dt_s, "time limit (override)")
         self.times_s = np.arange(self.n_max + 1) * self.dt_s
         self.goal = goal_checker(scenario)
+        # The robot has left the arena when its centre is beyond an edge by more than its radius (its body
+        # wholly past that edge): the run ends there, outcome "left_arena" (never a success).
+        arena, margin_m = scenario.bounds, scenario.robot_radius_m
+        self.arena_limits_m = (arena.x_min_m - margin_m, arena.y_min_m - margin_m,
+                               arena.x_max_m + margin_m, arena.y_max_m + margin_m)
+        # A path (a given one: planners keep inside the arena) with a waypoint outside the arena: reaching the
+        # goal along it is "left_arena" too.
+        self.path_leaves_arena = path_m is not None and not bool(np.all(
+            (path_m[:, 0] >= arena.x_min_m - 1e-6) & (path_m[:, 0] <= arena.x_max_m + 1e-6)
+            & (path_m[:, 1] >= arena.y_min_m - 1e-6) & (path_m[:, 1] <= arena.y_max_m + 1e-6)))
         moving = moving_obstacles(scene)
         self.mocap_index = np.array([ob.mocap_index for ob in moving], dtype=np.int64)
         self._moves = bool(moving)
@@ -290,6 +300,7 @@ class EpisodeStepper:
         self.step_index = 0
         self.danger_steps = self.stopped_steps = self.replans = self.safety_triggers = 0
         self.outcome = ""
+        self._reached = False
         self.result = None
 
     def _advance(self) -> None:
@@ -317,9 +328,13 @@ class EpisodeStepper:
         self.observation = observation = self._observe()
         pose = observation.pose
         if self.goal.reached(pose):
-            outcome = "goal_reached"
+            outcome = "left_arena" if self.path_leaves_arena else "goal_reached"
+            self._reached = True
         elif self.stop_on_collision and self.monitor.collisions:
             outcome = "collision"
+        elif not (self.arena_limits_m[0] <= pose.x_m <= self.arena_limits_m[2]
+                  and self.arena_limits_m[1] <= pose.y_m <= self.arena_limits_m[3]):
+            outcome = "left_arena"
         elif step >= self.n_max:
             outcome = "timeout"
         else:
@@ -390,7 +405,7 @@ class EpisodeStepper:
                            {"x_m": pose.x_m, "y_m": pose.y_m})
         step, monitor = self.step_index, self.monitor
         self.result = RunResult(
-            reached=outcome == "goal_reached", outcome=outcome, collisions=monitor.collisions,
+            reached=self._reached, outcome=outcome, collisions=monitor.collisions,
             first_collision_s=monitor.first_collision_s, first_contact=monitor.first_contact,
             sim_time_s=step * self.dt_s,
             wall_time_s=time.perf_counter() - self._wall0,

@@ -94,6 +94,26 @@ def test_a_path_through_an_obstacle_reports_the_collision_and_fails_expect(tmp_p
     assert main(["run", "gwo-scenario-2", "--planner", "astar", "--no-log", "--expect", "success"]) == EXIT_EXPECTATION
 
 
+def test_a_given_path_that_leaves_the_arena_is_no_success(tmp_path, capsys):
+    # gwo-scenario-1's arena is [0, 10] x [0, 10]: (0, -3) is 3 m outside; the robot follows and leaves it
+    outside = tmp_path / "outside.json"
+    outside.write_text("[[0, 0], [0, -3], [10, 10]]")
+    code = main(["run", "gwo-scenario-1", "--waypoints", str(outside), "--no-log", "--json", "--expect", "success"])
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert code == EXIT_EXPECTATION
+    assert out["outcome"] == "left_arena" and out["success"] is False and out["reached"] is False
+    assert out["plan"]["collision_free"] is False
+    assert "left_arena" in captured.err and captured.err.count("\n") == 1
+    # 0.1 m outside, less than the robot's radius: the robot stays within a radius of the arena and reaches the
+    # goal, but along a path that leaves the arena: no success either
+    slightly = swarmnav.run("gwo-scenario-1", waypoints=[[0, 0], [5, -0.1], [10, 10]])
+    assert slightly.reached and slightly.outcome == "left_arena" and not slightly.success
+    assert "given='waypoints'" in repr(slightly)
+    assert main(["run", "gwo-scenario-1", "--waypoints", str(outside), "--no-log"]) == 0
+    assert capsys.readouterr().out.startswith(f"gwo-scenario-1: given path {str(outside)!r} + follow")
+
+
 @pytest.mark.parametrize("text,where", [("x,y\n0,0\nfoo,1\n", "row 3"), ("a,b\n0,0\n", "row 1"),
                                         ("[[0, 0], [1]]", "[1]"), ('{"path": []}', "--waypoints"),
                                         ("[[0, 0]]", "at least two"), ("[[0, 0], [NaN, 1]]", "must be finite")])
@@ -175,6 +195,38 @@ def test_study_junit_and_min_success(tmp_path):
     # astar succeeds on scenario 1: the same study passes a lower bar
     again = _swarmnav("study", str(study), "--out", str(tmp_path / "rows"), "--min-success", "0")
     assert again.returncode == 0
+
+
+def test_junit_tells_errors_from_failures_and_its_counts_add_up(tmp_path):
+    junitparser = pytest.importorskip("junitparser")
+    # plan-only: gwo raises on iaco-simple's grid map (an error row), straight cuts an obstacle on both (a failure)
+    study = tmp_path / "mixed.toml"
+    study.write_text('name = "mixed"\nscenarios = ["gwo-scenario-1", "iaco-simple"]\nmode = "plan"\n'
+                     '[[planners]]\nname = "astar"\n[[planners]]\nname = "straight"\n'
+                     '[[planners]]\nname = "gwo"\nparams = { population = 10, iterations = 5 }\n')
+    junit = tmp_path / "junit.xml"
+    assert main(["study", str(study), "--out", str(tmp_path / "rows"), "--workers", "1", "--junit", str(junit)]) == 0
+    rows = pd.read_parquet(tmp_path / "rows" / "runs.parquet")
+    expected = {(r.scenario, r.planner): "error" if r.outcome == "error" else "ok" if r.success else "failure"
+                for r in rows.itertuples()}
+    assert expected[("iaco-simple", "gwo")] == "error" and expected[("gwo-scenario-1", "straight")] == "failure"
+    document = junitparser.JUnitXml.fromfile(str(junit))
+    found, totals = {}, {"tests": 0, "failures": 0, "errors": 0}
+    for suite in document:
+        kinds = []
+        for case in suite:
+            results = [type(r).__name__ for r in case.result]
+            assert len(results) <= 1
+            kinds.append({"Error": "error", "Failure": "failure"}.get(results[0], "?") if results else "ok")
+            found[(suite.name.split(".", 1)[1], case.name.split(" +")[0])] = kinds[-1]
+        assert (suite.tests, suite.failures, suite.errors) == (len(kinds), kinds.count("failure"), kinds.count("error"))
+        assert suite.time == pytest.approx(sum(case.time for case in suite), abs=1e-6)
+        for key in totals:
+            totals[key] += getattr(suite, key)
+    assert found == expected
+    root = ElementTree.parse(junit).getroot()
+    assert {key: int(root.get(key)) for key in totals} == totals
+    assert totals["errors"] == sum(v == "error" for v in expected.values()) >= 1
 
 
 @pytest.mark.parametrize("argv", [["run", "gwo-scenario-1", "--planner", "straight", "--no-log", "--json-out", "{dir}"],

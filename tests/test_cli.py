@@ -166,14 +166,14 @@ def test_out_naming_a_directory_is_one_line_and_leaves_it_alone(tmp_path, capsys
 
 
 def test_plan_json_says_which_mode_a_continuous_planner_used(capsys):
-    # The default is the paper's algorithm on every scene: here its weight-1 penalty ends inside a disc.
-    assert main(["plan", "gwo-scenario-1", "--planner", "gwo", "--json"]) == 3
+    # The default is the paper's algorithm (with the penalty its results need): a weight-1 penalty ends inside a disc.
+    assert main(["plan", "gwo-scenario-1", "--planner", "gwo", "--set", "penalty_weight=1.0",
+                 "--set", "penalty_margin_m=0.0", "--json"]) == 3
     assert "gwo (paper mode)" in capsys.readouterr().err
-    assert main(["plan", "gwo-scenario-1", "--planner", "gwo", "--set", "penalty_weight=1000.0",
-                 "--set", "penalty_margin_m=0.02", "--json"]) == 0
+    assert main(["plan", "gwo-scenario-1", "--planner", "gwo", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["details"]["mode"] == "paper" and out["details"]["settings"]["penalty_weight"] == 1000.0
-    assert out["planner_params"]["penalty_weight"] == 1000.0 and out["planner_params"]["population"] == 50
+    assert out["planner_params"]["population"] == 50
     assert main(["plan", "dense-field-30", "--planner", "gwo", "--set", "iterations=20", "--set", "mode='robust'",
                  "--json"]) == 0
     details = json.loads(capsys.readouterr().out)["details"]

@@ -137,3 +137,82 @@ def test_a_log_is_never_written_through_a_link(capsys, tmp_path, probe):
     err = one_line(capsys, ["run", str(probe), "--planner", "straight", "--out", str(tmp_path / "run.mcap"),
                             "--overwrite"])
     assert "symbolic link" in err and target.read_text() == "precious\n"
+
+
+# --- a log from elsewhere ------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def probe_log(tmp_path_factory) -> Path:
+    from swarmnav.models.scenario import parse_scenario
+    from swarmnav.sim.episode import EpisodeSpec, run_episode
+    from swarmnav.sim.log.writer import McapRecorder
+    path = tmp_path_factory.mktemp("log") / "probe.mcap"
+    run_episode(EpisodeSpec(parse_scenario(PROBE_SCENARIO, "probe.toml")), [McapRecorder(path)], time_limit_s=0.2)
+    return path
+
+
+def tampered(source: Path, target: Path, scene=None, run: dict | None = None, drop: str | None = None) -> Path:
+    """A copy of ``source`` with its scene.xml rewritten by ``scene`` and ``run`` metadata changed."""
+    import json
+    from mcap.writer import CompressionType, Writer
+    from swarmnav.sim.log.records import read_records
+    from swarmnav.sim.log.recover import _Copier
+    with target.open("wb") as stream:
+        writer = Writer(stream, compression=CompressionType.ZSTD)
+        copier = _Copier(writer)
+        raw = read_records(source, on_message=copier.message)
+        copier.start(raw)
+        for name, values in raw.metadata.items():
+            values = dict(values)
+            if name == "run":
+                values.update(run or {})
+                if drop:
+                    obstacles = json.loads(values["obstacles"])
+                    for entry in obstacles:
+                        entry.pop(drop)
+                    values["obstacles"] = json.dumps(obstacles)
+            writer.add_metadata(name, values)
+        for a in raw.attachments.values():
+            data = a.data if scene is None else scene(a.data.decode()).encode()
+            writer.add_attachment(create_time=a.create_time, log_time=a.log_time, name=a.name,
+                                  media_type=a.media_type, data=data)
+        writer.finish()
+    return target
+
+
+SCENES = {
+    "garbage": (lambda xml: "<<<not xml", "not XML"),
+    "size memory": (lambda xml: xml.replace(">", "><size memory='900G'/>", 1), "<size>"),
+    "include": (lambda xml: xml.replace(">", "><include file='/etc/passwd'/>", 1), "<include>"),
+    "mesh file": (lambda xml: xml.replace("<asset>", "<asset><mesh name='m' file='/etc/passwd'/>", 1), "file"),
+    "asset folder": (lambda xml: xml.replace("<compiler", "<compiler meshdir='/etc'", 1), "folder"),
+    "huge texture": (lambda xml: xml.replace("<asset>", "<asset><texture name='t' type='2d' builtin='flat' "
+                                                         "width='100000' height='100000'/>", 1), "width"),
+    "not compilable": (lambda xml: xml.replace("<worldbody>", "<worldbody><geom type='nosuch'/>", 1), "compile"),
+}
+
+
+@pytest.mark.parametrize("kind", sorted(SCENES))
+def test_a_log_scene_reaching_beyond_itself_is_refused_by_replay(capsys, tmp_path, probe_log, kind):
+    rewrite, word = SCENES[kind]
+    log = tampered(probe_log, tmp_path / "t.mcap", scene=rewrite)
+    for argv in (["replay", str(log), "--verify"],
+                 ["replay", str(log), "--video", str(tmp_path / "v.mp4"), "--width", "32", "--height", "32"]):
+        err = one_line(capsys, argv)
+        assert str(log) in err and word in err, err
+
+
+@pytest.mark.parametrize("run, drop, field", [({"seed": '"nan"'}, None, "run.seed"),
+                                              ({"world_seed": "-1"}, None, "run.world_seed"),
+                                              ({"arena_size_m": '"wide"'}, None, "run.arena_size_m"),
+                                              ({"obstacles": "[" * 5000}, None, "run.obstacles"),
+                                              (None, "size_m", "run.obstacles"),
+                                              (None, "entity_id", "run.obstacles")])
+def test_bad_run_metadata_is_one_line_for_every_reader(capsys, tmp_path, probe_log, run, drop, field):
+    log = tampered(probe_log, tmp_path / "t.mcap", run=run, drop=drop)
+    for argv in (["replay", str(log), "--verify"], ["plot", str(log), "-o", str(tmp_path / "p.png")],
+                 ["log", "info", str(log)],
+                 ["replay", str(log), "--video", str(tmp_path / "v.mp4"), "--width", "32", "--height", "32"]):
+        err = one_line(capsys, argv)
+        assert f"metadata {field}" in err, (argv, err)

@@ -110,7 +110,8 @@ def test_agents_that_see_the_robot_go_round_it_and_others_walk_into_it(tmp_path,
     ('{ kind = "orca", goal = [2, 2], tau_s = 1 }', "obstacles[0].motion.tau_s"),
 ])
 def test_bad_agent_fields_name_the_field(tmp_path, motion, field):
-    text = HEAD.format(name="bad", limit=4, rx=5, ry=5) + f"\n[[obstacles]]\nx = 1\ny = 1\nradius_m = 0.3\nmotion = {motion}\n"
+    text = (HEAD.format(name="bad", limit=4, rx=5, ry=5)
+            + f"\n[[obstacles]]\nx = 1\ny = 1\nradius_m = 0.3\nmotion = {motion}\n")
     with pytest.raises(ConfigError) as info:
         load_scenario(str(write(tmp_path, text)))
     assert info.value.field == field
@@ -122,3 +123,13 @@ def test_sees_robot_must_agree_over_the_agents(tmp_path):
     with pytest.raises(ConfigError) as info:
         load_scenario(str(write(tmp_path, text)))
     assert info.value.field == "obstacles[1].motion.sees_robot"
+
+
+def test_a_run_among_agents_that_see_the_robot_gives_the_same_log_bytes_twice(tmp_path):
+    from swarmnav.models.scenario import parse_scenario
+    from swarmnav.models.scenario_generator import GeneratorOptions, generate
+    scenario = parse_scenario(generate("crowdnav_circle", 2, GeneratorOptions(robot_visible=True)), "<t>")
+    paths = [tmp_path / f"run{k}.mcap" for k in range(2)]
+    for path in paths:
+        run_episode(EpisodeSpec(scenario, navigator="velocity_obstacle"), [McapRecorder(path)], time_limit_s=3.0)
+    assert paths[0].read_bytes() == paths[1].read_bytes()

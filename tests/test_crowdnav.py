@@ -91,8 +91,8 @@ def test_crowd_metrics_count_steps_within_the_discomfort_distance():
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--humans", "0"], "--humans: must be from 1 to 20"),
-    (["--humans", "21"], "--humans: must be from 1 to 20"),
+    (["--humans", "0"], "--humans: must be in [1, 20]"),
+    (["--humans", "21"], "--humans: must be in [1, 20]"),
 ])
 def test_bad_generator_options_are_one_line_and_exit_2(argv, message, capsys):
     assert main(["scenarios", "generate", "crowdnav_circle", "--seed", "1"] + argv) == 2

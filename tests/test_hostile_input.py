@@ -32,7 +32,10 @@ def write(tmp_path: Path, text: str, name: str = "scenario.toml") -> str:
 
 
 def run_cli(capsys, *argv):
-    code = main(list(argv))
+    try:
+        code = main(list(argv))
+    except SystemExit as exc:  # argparse refuses an option's value itself
+        code = exc.code
     out, err = capsys.readouterr()
     return code, out, err
 

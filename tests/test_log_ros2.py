@@ -43,6 +43,10 @@ def _decoded(path: Path) -> dict[str, list]:
     out: dict[str, list] = {}
     with AnyReader([path], default_typestore=HUMBLE) as reader:
         assert all(c.msgtype == ROS2_CHANNELS[c.topic][1] for c in reader.connections)
+        for c in reader.connections:  # each channel's offered QoS, as rosbags reads it: latched topics transient-local
+            (qos,) = c.ext.offered_qos_profiles
+            assert qos.durability.name == ("TRANSIENT_LOCAL" if c.topic in ("/tf_static", "/map") else "VOLATILE")
+            assert qos.reliability.name == "RELIABLE"
         for connection, _, raw in reader.messages():
             out.setdefault(connection.topic, []).append(HUMBLE.deserialize_cdr(raw, connection.msgtype))
     return out
@@ -153,7 +157,7 @@ def test_bad_log_format_is_refused_by_run_study_and_env(capsys):
         EnvOptions(record_format="ros1")
 
 
-def test_study_logs_and_the_env_recorder_write_the_ros2_profile(tmp_path):
+def test_study_logs_and_the_env_recorder_write_the_ros2_profile_and_replay_renders_it(tmp_path):
     from swarmnav.sim.cli.main import main
     from swarmnav.sim.env.gym_adapter import NavigateEnv
     from swarmnav.sim.log.summary import read_summary
@@ -166,6 +170,11 @@ def test_study_logs_and_the_env_recorder_write_the_ros2_profile(tmp_path):
     (log,) = (out / "logs").glob("*.mcap")
     assert read_summary(log).raw.profile == "ros2"
     assert set(_decoded(log)) >= {"/tf", "/odom", "/scan", "/plan", "/rosout"}
+    import imageio.v3 as iio
+    video = tmp_path / "study-run.mp4"  # replay --video reads a ros2 log (one simulated second, 4 frames)
+    assert main(["replay", str(log), "--video", str(video), "--width", "160", "--height", "120", "--fps", "4"]) == 0
+    frames = iio.imread(video)
+    assert frames.shape[0] >= 4 and frames.shape[1:3] == (120, 160) and frames.std() > 0
     env = NavigateEnv("restaurant-table-5", time_limit_s=0.3, record_to=str(tmp_path / "ep{episode}.mcap"),
                       record_format="ros2")
     env.reset(seed=0)
@@ -174,3 +183,17 @@ def test_study_logs_and_the_env_recorder_write_the_ros2_profile(tmp_path):
     env.close()
     messages = _decoded(tmp_path / "ep0.mcap")
     assert len(messages["/odom"]) >= 3 and read_summary(tmp_path / "ep0.mcap").raw.profile == "ros2"
+
+
+def test_a_cut_ros2_log_is_read_and_recovered_as_ros2(ros2_run, tmp_path):
+    from swarmnav.sim.cli.main import main
+    from swarmnav.sim.log.reader import read_log
+    path, outcome = ros2_run
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+    assert main(["log", "recover", str(cut), str(tmp_path / "recovered.mcap")]) == 0
+    recovered = read_log(tmp_path / "recovered.mcap")
+    assert recovered.raw.profile == "ros2" and recovered.complete
+    kept = len(recovered.time_s)
+    assert 0 < kept < len(outcome.result.poses)
+    np.testing.assert_array_equal(recovered.position_m[:, :2], outcome.result.poses[:kept, :2])

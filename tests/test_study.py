@@ -123,8 +123,8 @@ def test_a_raising_planner_and_a_run_past_the_wall_limit_are_rows(tmp_path, caps
     assert not rows.success.any()
     assert main(["report", str(tmp_path / "out")]) == 0  # a report of failures only still counts them
     report = (tmp_path / "out" / "report.md").read_text()
-    # runs, success, collision, timeout, no path, error, success %
-    assert "| gwo | 1 | 0 | 0 | 0 | 0 | 1 | 0 |" in report and "| gwo | 1 | 0 | 0 | 1 | 0 | 0 | 0 |" in report
+    # runs, success, collision, left arena, timeout, no path, error, success %
+    assert "| gwo | 1 | 0 | 0 | 0 | 0 | 0 | 1 | 0 |" in report and "| gwo | 1 | 0 | 0 | 0 | 1 | 0 | 0 | 0 |" in report
 
 
 def _markdown_table(text: str, first_header: str) -> list[list[str]]:

@@ -77,6 +77,7 @@ from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationSt
 from swarmnav.controllers.navigators.replan import keep_outside
 from swarmnav.controllers.prediction import swept_discs
 from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
+from swarmnav.models.scenario_limits import MAX_GRID_CELLS
 from swarmnav.models.world import rasterise
 from swarmnav.planners.dstar_lite import DStarLite
 from swarmnav.planners.errors import NoPathFound
@@ -119,8 +120,13 @@ class DStarReplanNavigator:
         if known.grid_override is not None:
             self.grid = known.grid_override
         else:
-            self.grid = rasterise(known.bounds, known.obstacles, known.boxes, known.inflation_m,
-                                  self.cell_m or known.cell_m)
+            cell_m = self.cell_m or known.cell_m
+            cells = (known.bounds.width_m / cell_m) * (known.bounds.height_m / cell_m)  # a float: never overflows
+            if not cells <= MAX_GRID_CELLS:  # before the grid is allocated
+                raise ConfigError("navigator.params.cell_m" if self.cell_m else "sim.cell_m",
+                                  f"{cell_m:g} m cells over the {known.bounds.width_m:g} x {known.bounds.height_m:g} m "
+                                  f"arena are {cells:.3g} grid cells, at most {MAX_GRID_CELLS:,} (MAX_GRID_CELLS)")
+            self.grid = rasterise(known.bounds, known.obstacles, known.boxes, known.inflation_m, cell_m)
         self.static = np.asarray(self.grid.occupied, dtype=bool)
         self.current = self.static.copy()
         self.inflation_m = known.inflation_m + self.margin_m

@@ -52,6 +52,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
@@ -102,6 +103,11 @@ class DynamicWindowNavigator:
     margin_m: float = param(0.05, within(0, 100))
     lookahead_m: float = param(1.0, above(0, 1000))
     carrot_in_sight: bool = True
+
+    def __post_init__(self) -> None:
+        if self.horizon_s < self.sim_step_s:  # no rollout step at all
+            raise ConfigError("navigator.params.horizon_s", f"must be at least sim_step_s ({self.sim_step_s:g} s), "
+                                                            f"got {self.horizon_s!r}")
 
     def reset(self, setup: NavigationSetup) -> None:
         (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(

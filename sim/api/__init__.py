@@ -1,6 +1,6 @@
 """swarmnav's Python API: plan and run scenarios, run studies, bring your own planner and navigator.
 
-::
+For example:
 
     import swarmnav
     result = swarmnav.run("gwo-scenario-1", planner="astar", seed=0)
@@ -16,23 +16,39 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from swarmnav.calls import load_scenario, plan, register_navigator, register_planner, run, run_study
-from swarmnav.models.world_scenario import ImportSettings, import_world
-from swarmnav.results import PlanResult, RunOutcome
+from swarmnav.calls import load_scenario as load_scenario
+from swarmnav.calls import plan as plan
+from swarmnav.calls import register_navigator as register_navigator
+from swarmnav.calls import register_planner as register_planner
+from swarmnav.calls import run as run
+from swarmnav.calls import run_study as run_study
+from swarmnav.models.world_scenario import ImportSettings as ImportSettings
+from swarmnav.models.world_scenario import import_world as import_world
+from swarmnav.results import PlanResult as PlanResult
+from swarmnav.results import RunOutcome as RunOutcome
 
-if TYPE_CHECKING:
-    from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Navigator, Observation
-    from swarmnav.models.errors import ConfigError
-    from swarmnav.models.scenario import Scenario
-    from swarmnav.planners.errors import NoPathFound, PlanningError
-    from swarmnav.planners.problem import Path, Planner, PlanStats, Problem
+if TYPE_CHECKING:  # for type checkers the seams are plain re-exports; at run time they load on first use
+    from swarmnav.controllers.navigator import NavigationSetup as NavigationSetup
+    from swarmnav.controllers.navigator import NavigationStep as NavigationStep
+    from swarmnav.controllers.navigator import Navigator as Navigator
+    from swarmnav.controllers.navigator import Observation as Observation
+    from swarmnav.models.errors import ConfigError as ConfigError
+    from swarmnav.models.scenario import Scenario as Scenario
+    from swarmnav.planners.errors import NoPathFound as NoPathFound
+    from swarmnav.planners.errors import PlanningError as PlanningError
+    from swarmnav.planners.problem import Path as Path
+    from swarmnav.planners.problem import Planner as Planner
+    from swarmnav.planners.problem import PlanStats as PlanStats
+    from swarmnav.planners.problem import Problem as Problem
 
 _SEAMS = ("Scenario", "ConfigError", "Problem", "Path", "Planner", "PlanStats", "PlanningError", "NoPathFound",
           "Navigator", "Observation", "NavigationSetup", "NavigationStep")
 
-__all__ = ["load_scenario", "plan", "run", "run_study", "register_planner", "register_navigator", "import_world",
-           "ImportSettings",
-           "PlanResult", "RunOutcome", *_SEAMS]
+# A literal list (type checkers read it as it is written): the calls, their results, then _SEAMS.
+__all__ = ["load_scenario", "plan", "run", "run_study", "register_planner", "register_navigator",
+           "import_world", "ImportSettings", "PlanResult", "RunOutcome",
+           "Scenario", "ConfigError", "Problem", "Path", "Planner", "PlanStats", "PlanningError", "NoPathFound",
+           "Navigator", "Observation", "NavigationSetup", "NavigationStep"]
 
 
 def __getattr__(name: str) -> Any:

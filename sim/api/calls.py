@@ -9,7 +9,8 @@ from __future__ import annotations
 import os
 import time
 from pathlib import Path as FilePath
-from typing import TYPE_CHECKING, Any, Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from swarmnav.results import PlanResult, RunOutcome
 
@@ -17,11 +18,13 @@ if TYPE_CHECKING:
     import numpy as np
 
     from swarmnav.models.scenario import Scenario
+    from swarmnav.sim.episode import EpisodeSpec
+    from swarmnav.sim.study.spec import Study
 
-ScenarioLike = "str | os.PathLike | Scenario"
+ComponentClass = TypeVar("ComponentClass", bound=type)
 
 
-def load_scenario(name_or_path: str | os.PathLike, trust_code: bool = False) -> "Scenario":
+def load_scenario(name_or_path: str | os.PathLike[str], trust_code: bool = False) -> Scenario:
     """A bundled scenario by name (``swarmnav scenarios``), an installed package's, or a ``.toml`` path
     (``trust_code``: the file may name code to run, e.g. a ``policy``; see ``--trust-code``).
 
@@ -31,19 +34,40 @@ def load_scenario(name_or_path: str | os.PathLike, trust_code: bool = False) -> 
     from swarmnav.models.scenario import load_scenario as load
     from swarmnav.sim.plugins import load_plugins
     load_plugins()
-    return load(str(name_or_path), trust_code)
+    scenario = load(str(name_or_path), trust_code)
+    check_components(scenario, trust_code)
+    return scenario
 
 
-def _scenario(scenario: Any) -> "Scenario":
-    """A scenario as given, or loaded by name or path (the caller has loaded the plugins)."""
+def check_components(scenario: "Scenario", trust_code: bool = False) -> None:
+    """The scenario's ``planner`` and ``navigator`` tables built once, so a file naming an unknown component or
+    parameter is refused on load (naming the field), whatever ``--planner`` later overrides.
+
+    Raises:
+        ConfigError: ``planner.name``, ``planner.params.KEY`` (or the navigator's) and the file.
+    """
+    from swarmnav.controllers.navigators import make_navigator
+    from swarmnav.planners.registry import make_planner
+    make_planner(scenario.planner_name, scenario.planner_params, scenario.source_path, trust_code=trust_code)
+    make_navigator(scenario.navigator_name, scenario.navigator_params, scenario.source_path, trust_code=trust_code)
+
+
+def _scenario(scenario: str | os.PathLike[str] | Scenario) -> Scenario:
+    """A scenario as given, or loaded by name or path and its components checked (the caller has loaded the
+    plugins)."""
     from swarmnav.models.scenario import Scenario
     from swarmnav.models.scenario import load_scenario as load
-    return scenario if isinstance(scenario, Scenario) else load(str(scenario))
+    if isinstance(scenario, Scenario):
+        return scenario
+    loaded = load(str(scenario))
+    check_components(loaded)
+    return loaded
 
 
-def episode_spec(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
-                 navigator: str | None = None, navigator_params: dict[str, Any] | None = None,
-                 seed: int | None = None, world_seed: int | None = None, clearance_m: float | None = None):
+def episode_spec(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
+                 params: Mapping[str, Any] | None = None, navigator: str | None = None,
+                 navigator_params: Mapping[str, Any] | None = None, seed: int | None = None,
+                 world_seed: int | None = None, clearance_m: float | None = None) -> EpisodeSpec:
     """The :class:`swarmnav.sim.episode.EpisodeSpec` of these arguments (``None``: the scenario's); the
     plugins are loaded here, once per call."""
     from swarmnav.sim.episode import EpisodeSpec
@@ -54,8 +78,9 @@ def episode_spec(scenario: Any, planner: str | None = None, params: dict[str, An
                        seed=seed, world_seed=world_seed, clearance_m=clearance_m)
 
 
-def plan(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
-         seed: int | None = None, clearance_m: float | None = None) -> PlanResult:
+def plan(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
+         params: Mapping[str, Any] | None = None, seed: int | None = None,
+         clearance_m: float | None = None) -> PlanResult:
     """Plan the scenario (its obstacles at t = 0) with a registered planner.
 
     Raises:
@@ -66,19 +91,20 @@ def plan(scenario: Any, planner: str | None = None, params: dict[str, Any] | Non
     return PlanResult(plan_episode(episode_spec(scenario, planner, params, seed=seed, clearance_m=clearance_m)))
 
 
-def given_episode(spec, waypoints: "np.ndarray", source: str):
+def given_episode(spec: EpisodeSpec, waypoints: np.ndarray, source: str) -> Any:
     """An episode whose path is the given waypoints instead of a plan (``run --waypoints``), composed as every
     run is (:func:`swarmnav.sim.episode.given_episode`)."""
     from swarmnav.sim.episode import given_episode as composed
     return composed(spec, waypoints, source)
 
 
-def run(scenario: Any, planner: str | None = None, params: dict[str, Any] | None = None,
-        navigator: str | None = None, navigator_params: dict[str, Any] | None = None,
-        seed: int | None = None, world_seed: int | None = None, clearance_m: float | None = None, *,
-        waypoints: "Sequence[Sequence[float]] | np.ndarray | str | os.PathLike | None" = None,
-        log: "str | os.PathLike | bool | None" = None, overwrite: bool = False,
-        video: "str | os.PathLike | None" = None, camera: str = "top", width: int = 640, height: int = 480,
+def run(scenario: str | os.PathLike[str] | Scenario, planner: str | None = None,
+        params: Mapping[str, Any] | None = None, navigator: str | None = None,
+        navigator_params: Mapping[str, Any] | None = None, seed: int | None = None, world_seed: int | None = None,
+        clearance_m: float | None = None, *,
+        waypoints: Sequence[Sequence[float]] | np.ndarray | str | os.PathLike[str] | None = None,
+        log: str | os.PathLike[str] | bool | None = None, overwrite: bool = False,
+        video: str | os.PathLike[str] | None = None, camera: str = "top", width: int = 640, height: int = 480,
         fps: float | None = None, stop_on_collision: bool | None = None, live: bool = False,
         on_live: Callable[[str], None] | None = None, log_format: str = "swarmnav") -> RunOutcome:
     """Plan (or take ``waypoints``) and drive the scenario in MuJoCo (:func:`run_spec` of :func:`episode_spec`).
@@ -140,7 +166,8 @@ def run_spec(spec: Any, *, waypoints: "Sequence[Sequence[float]] | np.ndarray | 
     return RunOutcome(episode, str(log_path) if log_path else None, str(video) if video else None)
 
 
-def run_study(file_or_spec: Any, out: str | os.PathLike | None = None, *, workers: int | None = None,
+def run_study(file_or_spec: str | os.PathLike[str] | Mapping[str, Any] | Study,
+              out: str | os.PathLike[str] | None = None, *, workers: int | None = None,
               engine: str = "local", address: str | None = None, logs: bool = False,
               quick: bool = False) -> dict[str, Any]:
     """Run a study (a bundled name, a ``.toml`` path, or the tables of a study file as a dict) into ``out``
@@ -152,8 +179,8 @@ def run_study(file_or_spec: Any, out: str | os.PathLike | None = None, *, worker
     load_plugins()
     if isinstance(file_or_spec, Study):
         study = file_or_spec
-    elif isinstance(file_or_spec, dict):
-        study = study_from_tables(file_or_spec, "<tables>", str(file_or_spec.get("name", "study")))
+    elif isinstance(file_or_spec, Mapping):
+        study = study_from_tables(dict(file_or_spec), "<tables>", str(file_or_spec.get("name", "study")))
     else:
         study = load_study(str(file_or_spec))
     if quick:
@@ -162,7 +189,7 @@ def run_study(file_or_spec: Any, out: str | os.PathLike | None = None, *, worker
     return execute(study, target, engine=engine, workers=workers, address=address, logs=logs)
 
 
-def register_planner(cls: type) -> type:
+def register_planner(cls: ComponentClass) -> ComponentClass:
     """Register a planner class in this process (a decorator, too); every command run from this process, and
     this API, then knows it by ``cls.name``.  To make it known to the ``swarmnav`` command and to study
     workers, declare it as an entry point (``swarmnav.planners``) of an installed package instead."""
@@ -170,7 +197,7 @@ def register_planner(cls: type) -> type:
     return register(cls)
 
 
-def register_navigator(cls: type) -> type:
+def register_navigator(cls: ComponentClass) -> ComponentClass:
     """Register a navigator class in this process (see :func:`register_planner`; group ``swarmnav.navigators``)."""
     from swarmnav.controllers.navigators import register
     return register(cls)

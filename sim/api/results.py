@@ -2,30 +2,38 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from swarmnav.planners.problem import Path, PlanStats, Problem
+    from swarmnav.sim.episode import Episode
+    from swarmnav.sim.run_result import RunResult
 
 
 class PlanResult:
     """A planned episode: ``path`` (waypoints ``(N, 2)`` metres and ``stats``), ``problem`` and the resolved
     ``spec``; ``to_dict()`` is what ``swarmnav plan --json`` prints."""
 
-    def __init__(self, episode: Any):
+    def __init__(self, episode: Episode):
         self.episode = episode
 
     @property
-    def path(self):
+    def path(self) -> Path:
         return self.episode.path
 
     @property
-    def waypoints(self):
+    def waypoints(self) -> np.ndarray:
         return self.episode.path.waypoints
 
     @property
-    def stats(self):
+    def stats(self) -> PlanStats:
         return self.episode.path.stats
 
     @property
-    def problem(self):
+    def problem(self) -> Problem:
         return self.episode.problem
 
     @property
@@ -35,56 +43,63 @@ class PlanResult:
     def to_dict(self) -> dict[str, Any]:
         return self.episode.plan_summary()
 
-    def plot(self, ax: Any = None):
+    def plot(self, ax: Any = None) -> Figure:
         """The scenario at t = 0 and the planned path; returns the Matplotlib figure."""
         return _plot(self.episode, None, ax)
 
     def __repr__(self) -> str:
-        return (f"PlanResult({self.episode.spec.scenario.name!r}, planner={self.episode.spec.planner!r}, "
+        return (f"PlanResult({self.episode.spec.scenario.name!r}, {_source(self.episode)}, "
                 f"length_m={self.length_m:.4f}, waypoints={len(self.waypoints)})")
 
 
 class RunOutcome(PlanResult):
-    """A driven episode: ``outcome`` (``goal_reached``, ``collision``, ``timeout``), ``reached``, ``success``
-    (reached with no collision), ``result`` (the full :class:`swarmnav.sim.runner.RunResult` with its arrays),
+    """A driven episode: ``outcome`` (``goal_reached``, ``collision``, ``timeout``, ``left_arena``), ``reached``,
+    ``success`` (reached with no collision, inside the arena), ``result`` (the full :class:`swarmnav.sim.runner.RunResult` with its arrays),
     ``log`` and ``video`` paths; ``to_dict()`` is what ``swarmnav run --json`` prints."""
 
-    def __init__(self, episode: Any, log: str | None = None, video: str | None = None):
+    def __init__(self, episode: Episode, log: str | None = None, video: str | None = None):
         super().__init__(episode)
         self.log = log
         self.video = video
 
     @property
-    def result(self):
+    def result(self) -> RunResult:
+        assert self.episode.result is not None  # a RunOutcome is made of a driven episode
         return self.episode.result
 
     @property
     def outcome(self) -> str:
-        return self.episode.result.outcome
+        return self.result.outcome
 
     @property
     def reached(self) -> bool:
-        return bool(self.episode.result.reached)
+        return bool(self.result.reached)
 
     @property
     def success(self) -> bool:
-        return bool(self.episode.result.success)
+        return bool(self.result.success)
 
     def to_dict(self) -> dict[str, Any]:
         return {**self.episode.summary(), "log": self.log, "video": self.video}
 
-    def plot(self, ax: Any = None):
+    def plot(self, ax: Any = None) -> Figure:
         """The scenario at t = 0, the planned path, the driven trajectory and the collisions."""
         return _plot(self.episode, self.episode.result, ax)
 
     def __repr__(self) -> str:
-        r = self.episode.result
-        return (f"RunOutcome({self.episode.spec.scenario.name!r}, planner={self.episode.spec.planner!r}, "
+        r = self.result
+        return (f"RunOutcome({self.episode.spec.scenario.name!r}, {_source(self.episode)}, "
                 f"navigator={self.episode.spec.navigator!r}, outcome={r.outcome!r}, collisions={r.collisions}, "
                 f"sim_time_s={r.sim_time_s:.2f})")
 
 
-def _plot(episode: Any, result: Any, ax: Any):
+def _source(episode: Any) -> str:
+    """Where the path came from: ``planner='astar'``, or ``given='plan.csv'`` for a given path."""
+    given = episode.path.stats.extra.get("given")
+    return f"given={given!r}" if given else f"planner={episode.spec.planner!r}"
+
+
+def _plot(episode: Episode, result: RunResult | None, ax: Any) -> Figure:
     import matplotlib.pyplot as plt
     from matplotlib.patches import Circle, Rectangle
 
@@ -114,7 +129,8 @@ def _plot(episode: Any, result: Any, ax: Any):
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    title = f"{scenario.name}: {episode.spec.planner}"
+    given = episode.path.stats.extra.get("given")
+    title = f"{scenario.name}: {'given path' if given else episode.spec.planner}"
     if result is not None:
         title += f" + {episode.spec.navigator}, {result.outcome}"
     ax.set_title(title, fontsize=10)

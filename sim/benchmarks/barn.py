@@ -59,6 +59,10 @@ STAND_IN = {"robot": {"radius_m": JACKAL_INSCRIBED_RADIUS_M, "max_speed_m_s": JA
 STAND_IN_TEXT = ("stand-in, not the protocol: disc robot r=0.215 m (the Jackal's inscribed radius), 2 m/s, "
                  "map known, 12-ray rangefinder ring")
 PROTOCOL_TEXT = "protocol: jackal, 270-degree laser (270 beams, 10 m), map unknown"
+PARTIAL = {k: v for k, v in PROTOCOL.items() if k != "knowledge"}
+PARTIAL_TEXT = ("partial, not the protocol: jackal (planned as its circumscribed circle), 270-degree laser "
+                "(270 beams, 10 m), map known")
+SETUPS = ("auto", "stand-in")
 
 
 def barn_dir(given: str | None = None) -> FilePath:
@@ -120,18 +124,28 @@ def start_jitter(world: int, run: int) -> tuple[float, float, float]:
     return float(dx), float(dy), float(rng.uniform(-HEADING_JITTER_DEG, HEADING_JITTER_DEG))
 
 
-def protocol_tables() -> tuple[dict[str, dict[str, Any]], str]:
-    """The scenario tables of the protocol's robot, laser and map when this installation has them, else the
-    stand-in's; and the text that labels the rows."""
+def protocol_tables(setup: str = "auto") -> tuple[dict[str, dict[str, Any]], str]:
+    """The scenario tables of the robot, laser and map, and the text that labels the rows: ``auto``, the
+    protocol's when this installation has them all; else the Jackal and its laser with the map known when it
+    has those (``partial``); else the stand-in.  ``stand-in``: the stand-in whatever is installed."""
+    if setup == "stand-in":
+        return STAND_IN, STAND_IN_TEXT
+    for tables, text in ((PROTOCOL, PROTOCOL_TEXT), (PARTIAL, PARTIAL_TEXT)):
+        if _loads(tables):
+            return tables, text
+    return STAND_IN, STAND_IN_TEXT
+
+
+def _loads(tables: dict[str, dict[str, Any]]) -> bool:
     from swarmnav.models.scenario import parse_scenario
     from swarmnav.models.world_scenario import _inline
     probe = ("name = \"probe\"\narena = { width_m = 4.0, height_m = 4.0 }\nstart = { x = 1.0, y = 1.0 }\n"
-             "goal = { x = 3.0, y = 3.0 }\n" + "".join(f"{k} = {_inline(v)}\n" for k, v in PROTOCOL.items()))
+             "goal = { x = 3.0, y = 3.0 }\n" + "".join(f"{k} = {_inline(v)}\n" for k, v in tables.items()))
     try:
         parse_scenario(probe, "<barn protocol probe>")
     except ConfigError:
-        return STAND_IN, STAND_IN_TEXT
-    return PROTOCOL, PROTOCOL_TEXT
+        return False
+    return True
 
 
 @dataclass(frozen=True)
@@ -220,8 +234,8 @@ def parse_planner(text: str | None) -> dict[str, Any] | None:
 
 
 def write_barn_suite(folder: str, quick: bool, worlds: tuple[int, ...] | None = None, runs: int | None = None,
-                     barn: str | None = None, generated: bool = False, planner: dict[str, Any] | None = None
-                     ) -> tuple[list[str], dict[str, BarnRun], str]:
+                     barn: str | None = None, generated: bool = False, planner: dict[str, Any] | None = None,
+                     setup_name: str = "auto") -> tuple[list[str], dict[str, BarnRun], str]:
     """The suite's scenario files under ``folder/scenarios``, their :class:`BarnRun` by scenario name, and the
     setup's label (:func:`protocol_tables`); ``generated``: BARN-like worlds of those seeds; ``planner`` (a
     planner table): the known-map track, every run planned by it on the map given."""
@@ -231,7 +245,7 @@ def write_barn_suite(folder: str, quick: bool, worlds: tuple[int, ...] | None = 
     worlds = worlds if worlds is not None else GENERATED_DEFAULT if generated else TEST_WORLDS if quick \
         else tuple(range(WORLD_COUNT))
     runs = runs if runs is not None else QUICK_RUNS if quick else 1
-    tables, setup = protocol_tables()
+    tables, setup = protocol_tables(setup_name)
     if planner is not None:
         tables = {**tables, "planner": planner}
         if "knowledge" in tables:

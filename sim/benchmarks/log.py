@@ -120,10 +120,12 @@ def benchmark_log(duration_s: float, video: bool = True) -> dict[str, Any]:
             figures[f"{name}: s"] = result["s"]
             figures[f"{name}: cpu s"] = result["cpu_s"]
             figures[f"{name}: peak MB"] = result["peak_mb"]
+            if result["exit"] != 0 and name.startswith("write"):  # nothing to measure: one line, exit 2
+                from swarmnav.models.errors import ConfigError
+                raise ConfigError("--duration", f"the {duration_s:g} s logged run failed (exit {result['exit']}: "
+                                                f"{result['error'] or 'no message'})")
             if result["exit"] != 0:
                 figures[f"{name}: exit"] = f"{result['exit']} ({result['error']})"
-                if name.startswith("write"):
-                    break
     return figures
 
 

@@ -135,3 +135,45 @@ def speed_lines(rows: list[dict[str, Any]], oracle: dict[str, Any], mppi: dict[s
                          f"{r['oracle_solvable_runs']} ({verdict(r['success_on_solvable'] >= ORACLE_SUCCESS_TARGET)} "
                          f"the target >= {ORACLE_SUCCESS_TARGET:g})")
     return lines
+
+
+CROWD_AGENTS = 20
+CROWD_STEPS = 500
+CROWD_TARGET_US = 50.0
+
+
+def crowd_step_cost(agents: int = CROWD_AGENTS, steps: int = CROWD_STEPS) -> dict[str, Any]:
+    """Microseconds per agent per control step (wall and this thread's CPU) of :class:`CrowdSession.advance`,
+    for ``agents`` ORCA agents and, apart, as many social-force agents, on a circle of radius 4 m each heading to
+    the opposite point (CrowdNav's circle crossing, denser), at 50 Hz, seeing a robot standing at the centre."""
+    import math
+
+    import numpy as np
+
+    from swarmnav.models.crowd_agents import AgentSpec, Crowd, CrowdSession
+    out: dict[str, Any] = {"agents": agents, "steps": steps, "load_average": load_average()}
+    for kind in ("orca", "social_force"):
+        specs = []
+        for k in range(agents):
+            a = 2.0 * math.pi * k / agents
+            x, y = 6.0 + 4.0 * math.cos(a), 6.0 + 4.0 * math.sin(a)
+            specs.append(AgentSpec(kind, (x, y), 0.3, ((12.0 - x, 12.0 - y),), 1.0, True))
+        crowd = Crowd(tuple(specs), np.zeros((0, 3)), np.zeros((0, 4)), (12.0, 12.0), False, 0.02, steps, 0)
+        session = CrowdSession(crowd)
+        robot = (6.0, 6.0, 0.0, 0.0, 0.3)
+        w0, c0 = time.perf_counter(), time.thread_time()
+        for step in range(steps):
+            session.advance(step, robot)
+        per = 1e6 / (steps * agents)
+        out[kind] = {"us_per_agent_step": round((time.perf_counter() - w0) * per, 2),
+                     "cpu_us_per_agent_step": round((time.thread_time() - c0) * per, 2)}
+    return out
+
+
+def crowd_line(cost: dict[str, Any]) -> str:
+    parts = [f"{kind} {cost[kind]['cpu_us_per_agent_step']:.1f} us CPU ({cost[kind]['us_per_agent_step']:.1f} wall)"
+             for kind in ("orca", "social_force")]
+    worst = max(cost[kind]["cpu_us_per_agent_step"] for kind in ("orca", "social_force"))
+    return (f"agents: {', '.join(parts)} per agent per control step with {cost['agents']} agents seeing the robot "
+            f"({'meets' if worst <= CROWD_TARGET_US else 'misses'} the target <= {CROWD_TARGET_US:g} us on CPU; "
+            f"load average {cost['load_average']:g})")

@@ -17,8 +17,17 @@ from swarmnav.sim.defaults import (  # noqa: F401  (re-exported: the CLI's own d
     SINGLE_THREAD_ENVIRONMENT, DEFAULT_FPS, LOG_FORMATS, MIN_FPS, MAX_FPS, MIN_DPI, MAX_DPI, BENCH_SIM_QUICK,
     BENCH_ENV_QUICK, BENCH_RENDER_QUICK_FRAMES, BENCH_PLANNERS_SCENARIOS, BENCH_PLANNERS_PLANNERS,
     BENCH_PLANNERS_SAMPLING, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
+from swarmnav.models.scenario_limits import (MAX_BENCH_DURATION_S, MAX_BENCH_FRAMES, MAX_BENCH_REPEATS, MAX_BENCH_RUNS,
+                                             MAX_BENCH_SEEDS, MAX_STUDY_RUNS, MAX_WORKERS)
 from swarmnav.sim.options import add_trust_code_argument  # noqa: F401
 from swarmnav.sim.cli import study as study_cli
+
+# The counts and durations of the benchmarks, each with its stated maximum (models/scenario_limits.py).
+DURATION = options.float_in(0.0, MAX_BENCH_DURATION_S)
+REPEATS = options.int_in(1, MAX_BENCH_REPEATS)
+RUNS = options.int_in(1, MAX_BENCH_RUNS)
+SEEDS = options.int_in(1, MAX_BENCH_SEEDS)
+WORKERS = options.int_in(1, MAX_WORKERS)
 
 Adder = Callable[[argparse.ArgumentParser], None]
 Runner = Callable[[argparse.Namespace], int]
@@ -26,8 +35,8 @@ Runner = Callable[[argparse.Namespace], int]
 
 def add_bench_sim_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default="dense-field-30")
-    parser.add_argument("--duration", type=options.positive_float, default=20.0, help="simulated seconds per measurement")
-    parser.add_argument("--repeats", type=options.positive_int, default=7, help="bare, closed-loop and logged runs back to back; medians over them (default 7)")
+    parser.add_argument("--duration", type=DURATION, default=20.0, help="simulated seconds per measurement")
+    parser.add_argument("--repeats", type=REPEATS, default=7, help="bare, closed-loop and logged runs back to back; medians over them (default 7)")
     parser.add_argument("--quick", action="store_true",
                         help="%g simulated seconds, %d repeats (under a minute)" % BENCH_SIM_QUICK)
     parser.add_argument("--json", action="store_true")
@@ -45,20 +54,20 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sampling", nargs="*", default=list(BENCH_PLANNERS_SAMPLING), choices=BENCH_PLANNERS_SAMPLING,
                         metavar="NAME", help=f"OMPL planners among {', '.join(BENCH_PLANNERS_SAMPLING)}, given "
                         "population x iterations collision checks (default all; none: --sampling alone)")
-    parser.add_argument("--seeds", type=options.positive_int, default=10, help="runs per planner and scenario (default 10)")
-    parser.add_argument("--population", type=options.positive_int, default=50)
-    parser.add_argument("--iterations", type=options.positive_int, default=100)
-    parser.add_argument("--clearance-m", type=options.non_negative_float, default=0.0,
+    parser.add_argument("--seeds", type=RUNS, default=10, help="runs per planner and scenario (default 10)")
+    parser.add_argument("--population", type=options.int_in(1, 1_000_000), default=50)
+    parser.add_argument("--iterations", type=options.int_in(1, 1_000_000), default=100)
+    parser.add_argument("--clearance-m", type=options.float_in(0.0, 100.0, low_open=False), default=0.0,
                         help="clearance beyond the robot radius (default 0, as in the papers)")
     parser.add_argument("--peer-scenario", default="gwo-scenario-1")
-    parser.add_argument("--peer-runs", type=options.non_negative_int, default=3, help="mealpy runs per peer (0: none)")
+    parser.add_argument("--peer-runs", type=options.int_in(0, MAX_BENCH_RUNS), default=3, help="mealpy runs per peer (0: none)")
     parser.add_argument("--modes", nargs="+", default=["paper", "robust"], choices=["paper", "robust"])
-    parser.add_argument("--fields", type=options.non_negative_int, default=10,
+    parser.add_argument("--fields", type=options.int_in(0, MAX_BENCH_RUNS), default=10,
                         help="random disc fields of 10-40 discs (default 10; 0: none)")
     parser.add_argument("--out", metavar="DIR", help="keep the quality studies' rows in DIR/scenarios and DIR/fields "
                         "(study folders: `swarmnav report DIR/scenarios`); a folder that holds them already resumes. "
                         "Default: a temporary folder")
-    parser.add_argument("--workers", type=options.positive_int, default=1,
+    parser.add_argument("--workers", type=WORKERS, default=1,
                         help="processes running the quality studies (default 1: in this process, plan times "
                         "measured alone and warm)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -73,11 +82,11 @@ def run_bench_planners(args: argparse.Namespace) -> int:
 
 def add_bench_grid_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--runs", type=options.positive_int, default=5, help="runs (seeds) per map and planner")
+    parser.add_argument("--runs", type=RUNS, default=5, help="runs (seeds) per map and planner")
     parser.add_argument("--maps", nargs="*", help="map scenario names (default: every bundled [map] scenario)")
     parser.add_argument("--all-pairs", action="store_true",
                         help="plan every start/goal pair of each map's [map].pairs, not only the scenario's")
-    parser.add_argument("--swarm-sample", type=options.positive_int, default=20,
+    parser.add_argument("--swarm-sample", type=RUNS, default=20,
                         help="Moving AI instances per map on which immas and iaco report their ratio")
     parser.add_argument("--out", metavar="DIR", help="keep the quality studies' rows in DIR/maps, DIR/restaurant and "
                         "DIR/movingai (study folders: `swarmnav report DIR/maps`); default: a temporary folder")
@@ -94,7 +103,7 @@ def add_bench_render_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default="dense-field-30")
     parser.add_argument("--width", type=int, default=640)
     parser.add_argument("--height", type=int, default=480)
-    parser.add_argument("--frames", type=int, default=150)
+    parser.add_argument("--frames", type=options.int_in(1, MAX_BENCH_FRAMES), default=150)
     parser.add_argument("--camera", choices=("top", "chase", "follow"), default="top",
                         help="top: the whole arena; chase: behind the robot; follow: straight down on the robot")
     parser.add_argument("--compare-defaults", action="store_true",
@@ -110,8 +119,8 @@ def run_bench_render(args: argparse.Namespace) -> int:
 
 def add_bench_env_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default="dense-field-30")
-    parser.add_argument("--duration", type=options.positive_float, default=20.0, help="simulated seconds per measurement")
-    parser.add_argument("--repeats", type=options.positive_int, default=3)
+    parser.add_argument("--duration", type=DURATION, default=20.0, help="simulated seconds per measurement")
+    parser.add_argument("--repeats", type=REPEATS, default=3)
     parser.add_argument("--quick", action="store_true",
                         help="%g simulated s x %d repeats (overrides the two above)" % BENCH_ENV_QUICK)
     parser.add_argument("--json", action="store_true")
@@ -123,7 +132,7 @@ def run_bench_env(args: argparse.Namespace) -> int:
 
 
 def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--seeds", type=options.positive_int, default=5, help="world seeds per scenario (default 5)")
+    parser.add_argument("--seeds", type=SEEDS, default=5, help="world seeds per scenario (default 5)")
     parser.add_argument("--navigator", action="append", help="only these navigators (repeatable)")
     parser.add_argument("--scenario", action="append", help="only these scenarios (repeatable; default: the dyn-* suite)")
     parser.add_argument("--navigator-set", action="append", metavar="KEY=VALUE",
@@ -152,20 +161,26 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
                              "jitter")
     parser.add_argument("--barn-worlds", metavar="test|all|A:B[:STEP]|I,J,...",
                         help="--suite barn: these worlds (default all 300; --quick: test, the 50 worlds 0, 6, ..., 294)")
+    parser.add_argument("--barn-setup", choices=("auto", "stand-in"),
+                        help="--suite barn / barn-like: auto (default): the protocol's Jackal, laser and unknown map "
+                             "as far as installed; stand-in: a disc of the Jackal's inscribed radius, map known")
+    parser.add_argument("--barn-oracle", action="store_true", default=None,
+                        help="--suite barn / barn-like: also run the clairvoyant oracle (off by default there: it "
+                             "collided in every stand-in run on BARN's worlds)")
     parser.add_argument("--barn-planner", metavar="NAME[:KEY=VALUE,...]",
                         help="--suite barn / barn-like: the known-map track, every run planned by this planner on the "
                              "map given (e.g. gwo:mode=robust, mmas:cell_m=0.15)")
     parser.add_argument("--quick", action="store_true",
                         help=f"1 world seed on {', '.join(BENCH_NAVIGATION_QUICK_SCENARIOS)} (under a minute); "
                              "with --suite dyn300: a stratified sample, 2 scenes per group")
-    parser.add_argument("--per-group", type=options.positive_int, metavar="N",
+    parser.add_argument("--per-group", type=SEEDS, metavar="N",
                         help="--suite dyn300 only: a stratified sample of N scenes per group (--quick: 2)")
-    parser.add_argument("--seed-offset", type=options.non_negative_int, default=0, metavar="N",
+    parser.add_argument("--seed-offset", type=options.int_in(0, 2**62), default=0, metavar="N",
                         help="--suite dyn300 only: every group's seeds shifted by N, a held-out set of the same "
                              "families (no shipped verdicts: the oracle decides each scene in the run)")
     parser.add_argument("--sensor-model", choices=("detector", "rangefinder"),
                         help="--suite dyn300 only: every scene with this sensing (rangefinder: 12 at 1 m)")
-    parser.add_argument("--workers", type=options.positive_int, default=1,
+    parser.add_argument("--workers", type=WORKERS, default=1,
                         help="local worker processes for the runs (default 1: in this process); with --engine "
                              "ray: the local instance's CPUs")
     parser.add_argument("--engine", choices=("local", "ray"), default="local",
@@ -181,17 +196,17 @@ def run_bench_navigation(args: argparse.Namespace) -> int:
 
 
 def add_bench_study_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--seeds", type=options.positive_int, default=20, help="seeds per scenario (2 scenarios: 40 cells by default)")
-    parser.add_argument("--iterations", type=options.positive_int, default=600,
+    parser.add_argument("--seeds", type=SEEDS, default=20, help="seeds per scenario (2 scenarios: 40 cells by default)")
+    parser.add_argument("--iterations", type=options.int_in(1, 1_000_000), default=600,
                         help="GWO iterations per cell (default 600: about 75 ms a cell, so a worker's start-up of "
                              "about a second is small against the work, as in a real study)")
-    parser.add_argument("--rounds", type=options.positive_int, default=3,
+    parser.add_argument("--rounds", type=REPEATS, default=3,
                         help="rounds of 1 worker then 2, back to back; medians over them (default 3)")
     parser.add_argument("--no-ray", action="store_true", help="skip the Ray comparison")
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--quick", action="store_true",
                         help="%d seeds per scenario, %d GWO iterations, no Ray (under a minute)" % BENCH_STUDY_QUICK)
-    parser.add_argument("--cells", type=options.positive_int, nargs="+", metavar="N",
+    parser.add_argument("--cells", type=options.int_in(1, MAX_STUDY_RUNS), nargs="+", metavar="N",
                         help="instead: how the driver scales, plan-only studies of about N cells each (astar and "
                              "straight on four scenarios, 2 workers), local and on Ray (unless --no-ray): cells/s, "
                              "the driver's peak memory, the ratio of each rate to the smallest study's; "
@@ -206,7 +221,7 @@ def run_bench_study(args: argparse.Namespace) -> int:
 
 
 def add_bench_cli_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--runs", type=options.positive_int, default=5, help="processes of each kind (default 5)")
+    parser.add_argument("--runs", type=RUNS, default=5, help="processes of each kind (default 5)")
     parser.add_argument("--quick", action="store_true", help="3 processes of each kind")
     parser.add_argument("--json", action="store_true")
 
@@ -217,7 +232,7 @@ def run_bench_cli(args: argparse.Namespace) -> int:
 
 
 def add_bench_log_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--duration", type=options.positive_float, default=3000.0,
+    parser.add_argument("--duration", type=DURATION, default=3000.0,
                         help="simulated seconds of the logged run (default 3000: about 750,000 messages)")
     parser.add_argument("--no-video", action="store_true", help="skip replay --video")
     parser.add_argument("--quick", action="store_true", help="a 300 s run (under a minute)")

@@ -57,16 +57,20 @@ class OneLineParser(argparse.ArgumentParser):
 
 def _load(args: argparse.Namespace):
     """The scenario (a bundled one, a plugin's: :func:`main` has loaded the plugins once for the command);
-    ``--trust-code``: its code parameters may run."""
+    ``--trust-code``: its code parameters may run; its own planner and navigator tables are checked on load,
+    whatever ``--planner`` overrides."""
+    from swarmnav.calls import check_components
     from swarmnav.models.scenario import load_scenario
-    return load_scenario(args.scenario, args.trust_code)
+    scenario = load_scenario(args.scenario, args.trust_code)
+    check_components(scenario, args.trust_code)
+    return scenario
 
 
-def _episode_spec(args: argparse.Namespace):
+def _episode_spec(args: argparse.Namespace, scenario):
     """The episode the command line asks for (``plan`` and ``run`` alike): the scenario, then ``--planner``/
     ``--set``, ``--navigator``/``--navigator-set`` and the two seeds on top."""
     from swarmnav.sim.episode import EpisodeSpec
-    return EpisodeSpec(_load(args), planner=args.planner, planner_params=parse_settings(args.set, "--set"),
+    return EpisodeSpec(scenario, planner=args.planner, planner_params=parse_settings(args.set, "--set"),
                        navigator=args.navigator,
                        navigator_params=parse_settings(args.navigator_set, "--navigator-set"),
                        seed=args.seed, world_seed=args.world_seed)
@@ -147,8 +151,13 @@ def cmd_generate(args: argparse.Namespace) -> int:
     from swarmnav.models.scenario_generator import GeneratorOptions, generate
     options = GeneratorOptions(**{f.name: getattr(args, f.name) for f in fields(GeneratorOptions)
                                   if getattr(args, f.name, None) is not None})
+    from swarmnav.sim.api.calls import check_components
     text = generate(args.kind, args.seed, options)
-    parse_scenario(text, args.out or "<generated>")
+    try:  # it must load back, its planner and navigator too
+        check_components(parse_scenario(text, args.out or "<generated>"))
+    except ConfigError as exc:
+        option = {"planner.name": "--planner", "navigator.name": "--navigator"}.get(exc.field)
+        raise ConfigError(option, exc.problem) if option else exc from None
     if args.out:
         out = FilePath(args.out)
         if out.exists() and not args.overwrite:
@@ -162,7 +171,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
 def _add_generate_options(p: argparse.ArgumentParser) -> None:
     from swarmnav.models.scenario_generator import KINDS, GeneratorOptions
     p.add_argument("kind", metavar="KIND", help=f"one of: {', '.join(KINDS)}")
-    p.add_argument("--seed", type=int, required=True, help="the layout's seed (same seed, same file)")
+    p.add_argument("--seed", type=options.seed, required=True, help="the layout's seed (same seed, same file)")
     p.add_argument("--out", help="write the TOML here (default: print it)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
     for name, kind in (("obstacles", int), ("speed_ratio", float), ("radius_min_m", float),
@@ -177,8 +186,9 @@ def _add_generate_options(p: argparse.ArgumentParser) -> None:
 
 def cmd_plan(args: argparse.Namespace) -> int:
     from swarmnav.sim.episode import plan_episode
+    scenario = _load(args)  # the file's own errors name the file, never an option
     try:
-        episode = plan_episode(_episode_spec(args))
+        episode = plan_episode(_episode_spec(args, scenario))
     except ConfigError as exc:
         raise _blame_options(args, exc) from None
     out = episode.plan_summary()
@@ -200,8 +210,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.video:
         from swarmnav.sim.video.render import check_video_size
         check_video_size(args.width, args.height, args.fps)  # before the plan: bad options fail at once
+    scenario = _load(args)  # the file's own errors name the file, never an option
     try:
-        outcome = run_spec(_episode_spec(args), waypoints=args.waypoints,
+        outcome = run_spec(_episode_spec(args, scenario), waypoints=args.waypoints,
                            log=False if args.no_log else (args.out or True), overwrite=args.overwrite,
                            video=args.video, camera=args.camera, width=args.width, height=args.height, fps=args.fps,
                            stop_on_collision=True if args.stop_on_collision else None, live=args.live,
@@ -218,10 +229,14 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(json.dumps(out))
     else:
         status = "reached the goal" if result.reached else f"did not reach the goal ({result.outcome})"
-        print(f"{out['scenario']}: {out['planner']} + {out['navigator']} (seed {out['seed']}, world seed "
+        if result.reached and result.outcome != "goal_reached":
+            status += f", but {result.outcome}"
+        given = out["plan"]["details"].get("given")  # a given path: nothing was planned
+        print(f"{out['scenario']}: {'given path ' + repr(given) if given else out['planner']} + {out['navigator']} "
+              f"(seed {out['seed']}, world seed "
               f"{out['world_seed']}) {status} in {result.sim_time_s:.2f} s sim "
               f"({result.wall_time_s:.2f} s wall); driven {result.path_length_m:.3f} m "
-              f"(planned {path.stats.length_m:.3f} m); collisions {result.collisions}"
+              f"({'given' if given else 'planned'} {path.stats.length_m:.3f} m); collisions {result.collisions}"
               + (f", first at {result.first_collision_s:.2f} s with {result.first_contact['obstacle']} at "
                  f"({result.first_contact['x_m']:.2f}, {result.first_contact['y_m']:.2f})"
                  if result.first_contact is not None else "")
@@ -277,7 +292,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_generate_options(gen)
     info = scenario_commands.add_parser("info", help="difficulty metrics and the clairvoyant oracle's verdict")
     info.add_argument("scenario", metavar="SCENARIO", help="a bundled name or a .toml path")
-    info.add_argument("--world-seed", type=int, help="seed of the random obstacle motions (default: the scenario's)")
+    info.add_argument("--world-seed", type=options.seed, help="seed of the random obstacle motions (default: the scenario's)")
     info.add_argument("--json", action="store_true", help="print one JSON object")
     from swarmnav.sim.cli import world_import
     imp = scenario_commands.add_parser("import", help="a Gazebo world's static cylinders and boxes as a scenario file")

@@ -29,6 +29,9 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
                    help="with --logs: swarmnav (Foxglove's schemas) or ros2 (CDR, standard ROS 2 types)")
     p.add_argument("--quick", action="store_true",
                    help="only the study's first quick_seeds seeds (a later full run into the same --out resumes)")
+    p.add_argument("--claims-only", action="store_true",
+                   help="only the arms the study's [[claims]] compare (their cells are the full study's: a later "
+                        "full run into the same --out resumes)")
     p.add_argument("--retry-errors", action="store_true",
                    help="run again the cells whose row is an error (by default a resume runs only cells without a row)")
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
@@ -84,6 +87,10 @@ def run_study(args: argparse.Namespace) -> int:
             print(f"swarmnav: warning: study {study.name!r} has no quick_seeds: --quick runs the full study",
                   file=sys.stderr)
         study = study.quick()
+    if args.claims_only:
+        if not study.claims:
+            raise ConfigError("--claims-only", f"study {study.name!r} has no [[claims]]")
+        study = study.claims_only()
     from swarmnav.sim.study.execute import run_study as execute
     out = args.out or str(FilePath("studies") / study.name)
     try:
@@ -160,6 +167,11 @@ def add_report_arguments(p: argparse.ArgumentParser) -> None:
                    help="print the README's table of claims from these claims.json files (or folders holding them, "
                         "e.g. models/studies/results) instead of a report")
     p.add_argument("--readme", help="with --readme-table: replace the table in this README file instead")
+    p.add_argument("--check-fresh", nargs="+", metavar="PATH",
+                   help="check that these claims.json files (or folders of them, e.g. models/studies/results) were "
+                        "produced by today's study files, component sources, scenarios and swarmnav version: "
+                        "exit 5 naming each stale claim and what changed, 0 when all are fresh")
+    p.add_argument("--names", action="store_true", help="with --check-fresh: print only the stale studies' names")
     p.add_argument("--ompl-log", metavar="OUT", help="also write the rows as OMPL benchmark logs, OUT/<scenario>.log "
                    "(one experiment each), for `ompl_benchmark_statistics OUT/*.log -d bench.db` and Planner Arena")
 
@@ -176,8 +188,27 @@ def _readme_table(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_fresh(args: argparse.Namespace) -> int:
+    from swarmnav.sim.study.provenance import check_fresh
+    lines, stale, notes = check_fresh(args.check_fresh)
+    if args.names:
+        print(" ".join(stale))
+        return 5 if stale else 0
+    for line in lines:
+        print(line)
+    for note in notes:
+        print(f"note: {note} (a dependency's version differs; not counted as stale)")
+    if not stale:
+        print("fresh: every claims.json matches today's inputs")
+    return 5 if stale else 0
+
+
 def run_report(args: argparse.Namespace) -> int:
     from swarmnav.models.errors import ConfigError
+    if args.check_fresh:
+        return _check_fresh(args)
+    if args.names:
+        raise ConfigError("--names", "needs --check-fresh")
     if args.readme_table:
         return _readme_table(args)
     if args.readme:

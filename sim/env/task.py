@@ -267,7 +267,7 @@ class NavigationTask(control.Task):
         return self.reward_value
 
     def get_termination(self, physics: SwarmnavPhysics) -> float | None:
-        if self.outcome in ("goal_reached", "collision"):
+        if self.outcome in ("goal_reached", "collision", "left_arena"):
             return 0.0
         if self.outcome == "timeout":
             return 1.0

@@ -141,7 +141,7 @@ def belief_update(obstacles, horizon_s: float, t_ns: int) -> SceneUpdate:
                        entities=entities)
 
 
-_WARNING_EVENTS = {"collision_begin", "stopped_on_collision", "timeout"}
+_WARNING_EVENTS = {"collision_begin", "stopped_on_collision", "timeout", "left_arena"}
 _ERROR_EVENTS = {"error", "interrupted"}
 _ARENA_Z_M = 0.002
 _FOOTPRINT_HEIGHT_M = 0.01

@@ -297,7 +297,7 @@ def outcome_text(log: RunLog) -> str:
             if key in log.outcome:
                 return str(log.outcome[key])
     kinds = [kind for _, kind, _ in log.events]
-    for kind in ("goal_reached", "timeout"):
+    for kind in ("goal_reached", "timeout", "left_arena"):
         if kind in kinds:
             return kind
     return "none: the run did not finish (no outcome recorded)"

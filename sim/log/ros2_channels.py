@@ -10,6 +10,7 @@ the live view are the recorder's, the same as for profile ``swarmnav``.
 
 from __future__ import annotations
 
+import importlib.metadata
 import math
 from typing import Any, Callable
 
@@ -51,6 +52,21 @@ _ZERO = {"x": 0.0, "y": 0.0, "z": 0.0}
 _PATH_Z_M = 0.01
 _SENSED_COLOUR = (0.2, 0.45, 0.95, 0.55)
 _SENSED_HEIGHT_M, _SENSED_Z_M = 0.05, 0.35
+
+
+# Latched topics: a late subscriber gets the last message (durability TRANSIENT_LOCAL, as tf2 and Nav2 publish them).
+LATCHED_TOPICS = ("/tf_static", "/map")
+
+
+def offered_qos(latched: bool) -> str:
+    """The channel's ``offered_qos_profiles`` (the MCAP ros2 profile asks for it; ``ros2 bag play`` republishes
+    each topic with it): one publisher, reliable, keep last, volatile or transient-local, every duration the
+    default (0 s).  The values are rmw's enums: history KEEP_LAST 1; reliability RELIABLE 1; durability
+    TRANSIENT_LOCAL 1, VOLATILE 2; liveliness AUTOMATIC 1."""
+    zero = "\n    sec: 0\n    nsec: 0"
+    return (f"- history: 1\n  depth: {1 if latched else 10}\n  reliability: 1\n  durability: {1 if latched else 2}\n"
+            f"  deadline:{zero}\n  lifespan:{zero}\n  liveliness: 1\n  liveliness_lease_duration:{zero}\n"
+            "  avoid_ros_namespace_conventions: false")
 
 
 def stamp(t_ns: int) -> dict[str, int]:
@@ -181,7 +197,8 @@ class Ros2Channels:
                 encode = self._encoders[schema] = serialize_dynamic(schema, msgdef(short))[schema]
             channel = foxglove.Channel(topic, schema=foxglove.Schema(name=schema, encoding="ros2msg",
                                                                      data=msgdef(short).encode()),
-                                       message_encoding="cdr", context=self._fox)
+                                       message_encoding="cdr", context=self._fox,
+                                       metadata={"offered_qos_profiles": offered_qos(topic in LATCHED_TOPICS)})
             entry = self._channels[topic] = (channel, encode)
         channel, encode = entry
         data = encode(message)
@@ -276,6 +293,10 @@ class Ros2Channels:
         self._log(ROS2_EVENTS_TOPIC, {"stamp": stamp(t_ns), "level": _LEVELS[event_severity(kind)], "name": "swarmnav",
                                       "msg": event_text(kind, details), "file": "", "function": "", "line": 0}, t_ns)
         return 1
+
+    def versions(self) -> dict[str, str]:
+        """The serialiser's version, recorded in the ``versions`` metadata beside the writer's."""
+        return {"mcap_ros2_support": importlib.metadata.version("mcap-ros2-support")}
 
     def close(self) -> None:
         """Nothing to release: the channels are the context's."""

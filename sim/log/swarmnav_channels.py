@@ -139,6 +139,10 @@ class SwarmnavChannels:
         self._events.log(event_log(t_ns, kind, details), log_time=t_ns)
         return 1
 
+    def versions(self) -> dict[str, str]:
+        """Versions of what encodes this profile's messages, beyond the writer's (none: the SDK's own)."""
+        return {}
+
     def close(self) -> None:
         for channel in self._json_channels:
             # foxglove keeps JSON channels in a registry of its own; closing is its public API.

@@ -23,7 +23,7 @@ from swarmnav.sim.log.reader import RunLog, outcome_text
 from swarmnav.sim.recording import RunContext, StepFrame
 
 # Outcomes of a run that reached its natural end; any other log stops early.
-FINISHED_OUTCOMES = ("goal_reached", "timeout", "collision", "stopped_on_collision")
+FINISHED_OUTCOMES = ("goal_reached", "timeout", "collision", "stopped_on_collision", "left_arena")
 
 
 @dataclass

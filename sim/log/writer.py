@@ -260,7 +260,7 @@ class McapRecorder:
             "navigator", {"name": context.navigator_name, "params": dumps(context.navigator_params)}
         )
         writer.write_metadata("run", run_metadata(context))
-        writer.write_metadata("versions", writer_versions(context.versions))
+        writer.write_metadata("versions", {**writer_versions(context.versions), **self._channels.versions()})
         writer.attach(
             log_time=0,
             create_time=0,

@@ -56,8 +56,9 @@ def _scenario_entry(ref: str, world_seed: int | None, study: Study) -> dict[str,
 
 
 def study_metadata(study: Study) -> dict[str, Any]:
+    from swarmnav.sim.study.provenance import study_inputs
     world_seed = study.world_seeds[0]
-    return {"claims": [c.as_dict() for c in study.claims],"name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
+    return {"inputs": study_inputs(study), "claims": [c.as_dict() for c in study.claims], "name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
             "reference": study.reference, "planners": [p.label for p in study.planners],
             "navigators": [n.label for n in study.navigators],
             "paper": [dataclasses.asdict(p) for p in study.paper],
@@ -77,11 +78,32 @@ def _write_metadata(study: Study, out_dir: FilePath) -> None:
         previous = old.get("name")
         # rows of an earlier version of the study stay in the folder: keep the geometry of their scenarios
         metadata["scenarios"] = {**old.get("scenarios", {}), **metadata["scenarios"]}
+        metadata["inputs"] = resumed_inputs(old.get("inputs"), metadata["inputs"], out_dir)
         if previous != study.name:
             raise ConfigError("--out", f"holds the rows of study {previous!r}, not {study.name!r} "
                                        "(choose another directory)", str(out_dir))
     out_dir.mkdir(parents=True, exist_ok=True)
     replace_file(path, json.dumps(metadata, indent=2) + "\n", "--out")
+
+
+def resumed_inputs(old: dict[str, Any] | None, new: dict[str, Any], out_dir: FilePath) -> dict[str, Any]:
+    """The inputs a resumed folder records: today's, unless rows already there were made by sources,
+    scenarios or a swarmnav version that have changed since; then the old record stays (with today's study
+    file, whose claims and comments decide no row, and the files of newly used components added), so that
+    ``report --check-fresh`` calls the mixed rows stale, and a warning says to start the folder afresh."""
+    from swarmnav.sim.study.provenance import stale_inputs
+    if not old or not (out_dir / "runs.parquet").exists():
+        return new
+    changes = [c for c in stale_inputs(old, new)[0] if not c.startswith("study file")
+               and not c.endswith("newly used") and not c.endswith("no longer used")]
+    if not changes:
+        return {**new, "sources": {**old.get("sources", {}), **new["sources"]},
+                "scenarios": {**old.get("scenarios", {}), **new["scenarios"]}}
+    print(f"swarmnav: warning: {out_dir} holds rows made before {'; '.join(changes)}: its verdicts will be stale "
+          "(delete the folder to rerun the study afresh)", file=sys.stderr)
+    return {**old, "study_file": new["study_file"],
+            "sources": {**new["sources"], **old.get("sources", {})},
+            "scenarios": {**new["scenarios"], **old.get("scenarios", {})}}
 
 
 class ProgressBar:

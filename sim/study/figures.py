@@ -27,6 +27,7 @@ from swarmnav.sim.study.statistics import OUTCOME_CLASSES, outcome_class, values
 PNG_DPI = 200
 MAX_WIDTH_IN = 10.0
 OUTCOME_COLOURS = {"success": palette.START, "collision": palette.COLLISION, "timeout": "#e69f00",
+                   "left arena": "#cc79a7",
                    "no path": "#7a7f87", "error": "#1b1b1b"}
 METRIC_LABELS = {"plan_length_m": "plan length (m)", "plan_time_s": "plan time (s)",
                  "path_length_m": "driven length (m)", "sim_time_s": "simulated time (s)",

@@ -59,7 +59,8 @@ def _settings(study: Study):
             for planner_params in planner.settings():
                 for navigator in study.navigators:
                     for navigator_params in navigator.settings():
-                        yield scenario, planner, planner_params, navigator, navigator_params
+                        if study.wants(scenario, planner.arm_label(planner_params), navigator.arm_label(navigator_params)):
+                            yield scenario, planner, planner_params, navigator, navigator_params
 
 
 def iter_cells(study: Study) -> Iterator[Cell]:
@@ -95,6 +96,8 @@ def iter_cells(study: Study) -> Iterator[Cell]:
 
 def count_cells(study: Study) -> int:
     """How many cells :func:`iter_cells` yields, without building them."""
+    if study.claim_arms is not None:
+        return sum(1 for _ in _settings(study)) * len(study.seed_pairs())
     settings = sum(len(p.settings()) for p in study.planners) * sum(len(n.settings()) for n in study.navigators)
     return len(study.scenarios) * settings * len(study.seed_pairs())
 

@@ -1,9 +1,12 @@
 """A study's rows as JUnit XML (``swarmnav study --junit FILE``), and its ``--min-success`` check.
 
 JUnit is what CI systems display: one ``<testsuite>`` per scenario, one ``<testcase>`` per row named by
-planner label, navigator label and seeds, and a ``<failure>`` for every row that is not a success (goal reached
-with no collision; plan-only rows: a collision-free plan), with its outcome and log path.  An ``error`` row
-(an exception or a dead worker) is a failure too: a CI check must not pass on a run that did not finish.
+planner label, navigator label and seeds; an ``<error>`` for every row whose outcome is ``error`` (an exception
+or a dead worker: the run did not finish), and a ``<failure>`` for every other row that is not a success (it ran
+and fell short: no path, the wall limit, a collision, the time limit, the robot left the arena; plan-only rows:
+a plan that is not collision-free), each with its outcome and log path.  Each suite's and the document's
+``tests``, ``failures``, ``errors``, ``skipped`` and ``time`` add up over their cases, as JUnit readers expect.
+Both kinds fail a CI check.
 """
 
 from __future__ import annotations
@@ -50,32 +53,45 @@ def junit_tree(study: str, rows: Iterable[dict[str, Any]]) -> ElementTree.Elemen
     for row in rows:
         by_scenario[str(row.get("scenario"))].append(row)
     root = ElementTree.Element("testsuites", name=study)
-    total = failed = 0
+    total = failed = errored = 0
+    total_s = 0.0
     for scenario, scenario_rows in by_scenario.items():
         suite = ElementTree.SubElement(root, "testsuite", name=f"{study}.{scenario}")
-        suite_failed = 0
+        suite_failed = suite_errored = 0
+        suite_s = 0.0
         scenario_rows.sort(key=lambda r: (str(r.get("label")), str(r.get("navigator_label")), r.get("seed") or 0,
                                           -1 if r.get("world_seed") is None else r["world_seed"]))
         for row in scenario_rows:
-            seconds = row.get("cell_wall_s") or 0.0
+            seconds = round(float(row.get("cell_wall_s") or 0.0), 3)
+            suite_s += seconds
             case = ElementTree.SubElement(suite, "testcase", name=_case_name(row), classname=f"{study}.{scenario}",
-                                          time=f"{float(seconds or 0.0):.3f}")
+                                          time=f"{seconds:.3f}")
             if not row_succeeded(row):
                 outcome, text = _failure_text(row)
-                failure = ElementTree.SubElement(case, "failure", message=outcome, type=outcome)
-                failure.text = text
-                suite_failed += 1
+                kind = "error" if row.get("outcome") == "error" else "failure"
+                element = ElementTree.SubElement(case, kind, message=outcome, type=outcome)
+                element.text = text
+                if kind == "error":
+                    suite_errored += 1
+                else:
+                    suite_failed += 1
             if row.get("log"):
                 out = ElementTree.SubElement(case, "system-out")
                 out.text = f"log: {row['log']}"
         suite.set("tests", str(len(scenario_rows)))
         suite.set("failures", str(suite_failed))
-        suite.set("errors", "0")
+        suite.set("errors", str(suite_errored))
+        suite.set("skipped", "0")
+        suite.set("time", f"{suite_s:.3f}")
         total += len(scenario_rows)
         failed += suite_failed
+        errored += suite_errored
+        total_s += suite_s
     root.set("tests", str(total))
     root.set("failures", str(failed))
-    root.set("errors", "0")
+    root.set("errors", str(errored))
+    root.set("skipped", "0")
+    root.set("time", f"{total_s:.3f}")
     return ElementTree.ElementTree(root)
 
 

@@ -13,14 +13,17 @@ than one), one run per study row, in the study's order.
 Each run reports (runs that found no path have empty values where there is no plan):
 
 * ``time REAL``: the plan time in seconds (the cell's wall time for a run without a plan);
-* ``solved BOOLEAN``: the row's ``success``; ``correct solution BOOLEAN``: the exact collision check;
+* ``solved BOOLEAN``: whether the planner found a plan (the row has one: OMPL's meaning, the planner's own
+  outcome); ``correct solution BOOLEAN``: the exact collision check of that plan;
 * ``solution length REAL`` (m), ``solution segments INTEGER``;
 * ``solution clearance REAL``: the smallest gap in metres between the planned path and the obstacle
   footprints at t = 0 beyond the robot radius (OMPL's "distance to invalid regions" for a disc robot),
   from the path and ``study.json``'s geometry;
 * ``evaluations INTEGER``, ``iterations INTEGER``, ``seed INTEGER``;
-* physics studies also ``reached BOOLEAN``, ``collisions INTEGER``, ``driven length REAL`` and
-  ``driven clearance REAL`` (the simulated run's minimum clearance).
+* physics studies also ``drive success BOOLEAN`` (the goal reached with no collision: the physics outcome, a
+  property of its own, so a plan whose drive failed still reads as solved), ``reached BOOLEAN``,
+  ``collisions INTEGER``, ``driven length REAL`` and ``driven clearance REAL`` (the simulated run's minimum
+  clearance).
 
 Progress properties (the run's best-cost history from ``progress.parquet``): ``best cost REAL``,
 ``evaluations INTEGER``, ``iteration INTEGER`` and ``time REAL``.  The study records evaluations, not
@@ -46,7 +49,7 @@ from swarmnav.sim.study.rows import PROGRESS, RUNS, read_table
 RUN_PROPERTIES = (("time", "REAL"), ("solved", "BOOLEAN"), ("correct solution", "BOOLEAN"),
                   ("solution length", "REAL"), ("solution segments", "INTEGER"), ("solution clearance", "REAL"),
                   ("evaluations", "INTEGER"), ("iterations", "INTEGER"), ("seed", "INTEGER"))
-PHYSICS_PROPERTIES = (("reached", "BOOLEAN"), ("collisions", "INTEGER"), ("driven length", "REAL"),
+PHYSICS_PROPERTIES = (("drive success", "BOOLEAN"), ("reached", "BOOLEAN"), ("collisions", "INTEGER"), ("driven length", "REAL"),
                       ("driven clearance", "REAL"))
 PROGRESS_PROPERTIES = (("time", "REAL"), ("best cost", "REAL"), ("evaluations", "INTEGER"),
                        ("iteration", "INTEGER"))
@@ -89,12 +92,12 @@ def path_clearance_m(waypoints: list[list[float]], geometry: dict[str, Any]) -> 
 def _run_values(row: dict[str, Any], geometry: dict[str, Any] | None, physics: bool) -> list[Any]:
     waypoints = json.loads(row["plan_waypoints"]) if row.get("plan_waypoints") else None
     time_s = row["plan_time_s"] if row.get("plan_time_s") is not None else row.get("cell_wall_s")
-    values = [time_s, bool(row.get("success")), row.get("plan_collision_free"), row.get("plan_length_m"),
+    values = [time_s, bool(waypoints) and row.get("outcome") == "ok", row.get("plan_collision_free"), row.get("plan_length_m"),
               len(waypoints) - 1 if waypoints else None,
               path_clearance_m(waypoints, geometry) if waypoints and geometry else None,
               row.get("plan_evaluations"), row.get("plan_iterations"), row.get("seed")]
     if physics:
-        values += [row.get("reached"), row.get("collisions"), row.get("path_length_m"), row.get("min_clearance_m")]
+        values += [bool(row.get("success")), row.get("reached"), row.get("collisions"), row.get("path_length_m"), row.get("min_clearance_m")]
     return values
 
 

@@ -41,15 +41,34 @@ def read_documents(paths: list[str]) -> list[dict[str, Any]]:
     return sorted(documents, key=lambda d: d.get("study", ""))
 
 
+def _n(c: dict[str, Any]) -> str:
+    n = c.get("n")
+    if not n:
+        return "–"
+    return f"{n[0]} / {n[1]}" + (" (single values)" if c.get("single_values") else "")
+
+
+def _difference(c: dict[str, Any]) -> str:
+    interval = c.get("interval") or [None, None]
+    if c.get("difference") is None:
+        return "–"
+    if interval[0] is None or interval[0] == interval[1]:
+        return number(c["difference"], 3)
+    return f"{number(c['difference'], 3)} [{number(interval[0], 3)}, {number(interval[1], 3)}]"
+
+
 def table_lines(documents: list[dict[str, Any]]) -> list[str]:
-    lines = ["| study | claim | paper | verdict | Holm p | A12 | seeds |", "|---|---|---|---|---|---|---|"]
+    lines = ["| study | claim | paper | verdict | n | Holm p | A12 | difference [95% CI] | seeds (rule) |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for document in documents:
+        rule = document.get("seed_rule") or {}
+        seeds = f"{document['seeds']} ({rule.get('seeds_needed', '?')})"
         for c in document["claims"]:
             statement = c["statement"].replace("|", "\\|")
-            lines.append(f"| {document['study']} | {statement} | {c['source']} | **{c['verdict']}** | "
-                         f"{p_value(c['p_holm'])} | {number(c['a12'], 2)} | {document['seeds']} |")
+            lines.append(f"| {document['study']} | {statement} | {c['source']} | **{c['verdict']}** | {_n(c)} | "
+                         f"{p_value(c['p_holm'])} | {number(c['a12'], 2)} | {_difference(c)} | {seeds} |")
     if len(lines) == 2:
-        lines.append("| – | no study has claims yet | – | – | – | – | – |")
+        lines.append("| – | no study has claims yet | – | – | – | – | – | – | – |")
     return lines
 
 

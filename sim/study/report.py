@@ -46,7 +46,8 @@ class _Document:
     """Builds the HTML and the Markdown side by side; writes figures and tables into ``files_dir``."""
 
     def __init__(self, title: str, files_dir: FilePath):
-        self.html = [f"<!doctype html><html><head><meta charset='utf-8'>"
+        # An empty icon: served over HTTP a page without one makes the browser ask for /favicon.ico (a 404).
+        self.html = [f"<!doctype html><html><head><meta charset='utf-8'><link rel='icon' href='data:,'>"
                      "<meta name='viewport' content='width=device-width, initial-scale=1'>"
                      f"<title>{html.escape(title)}</title><style>{STYLE}</style></head><body>",
                      f"<h1>{html.escape(title)}</h1>"]
@@ -181,20 +182,30 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
     if meta.get("description"):
         doc.paragraph(meta["description"])
     failed = sum(r["outcome"] != "ok" for r in runs)
-    doc.paragraph(f"{len(runs)} runs, {failed} failed (no path, error or wall-limit timeout; counted, never "
-                  f"dropped). Mode: {meta.get('mode', '?')}. Statistics compare each planner against the "
+    unsuccessful = sum(not r.get("success") for r in runs)
+    doc.paragraph(f"{len(runs)} runs, {len(runs) - unsuccessful} successful, {unsuccessful} not (of which {failed} "
+                  f"produced no result: no path, error or wall-limit timeout; the others collided or ran out of "
+                  f"simulated time; counted, never dropped). Mode: {meta.get('mode', '?')}. Statistics compare each planner against the "
                   f"reference planner {meta.get('reference', '?')!r}. Numbers to 4 significant digits, "
                   "p-values to 2.")
     claims = [Claim.from_dict(c) for c in meta.get("claims", [])]
-    document = claims_document(meta.get("name", directory.name), claims, runs)
+    document = claims_document(meta.get("name", directory.name), claims, runs, meta.get("inputs"))
     (html_path.parent / CLAIMS_FILE).write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
     if claims:
         doc.heading("Claims")
         doc.paragraph("Each claim of the paper the study tests, with its verdict: reproduces (every pair "
                       "significant in the claimed direction), contradicted (a pair significant in the opposite "
-                      "direction) or inconclusive; Holm-adjusted over all pairs of all claims, alpha 0.05. A12: "
+                      "direction), underpowered (too few runs for the test to reach alpha after Holm's "
+                      "correction, whatever they gave) or inconclusive (enough runs, no significant difference); "
+                      "Holm-adjusted over all pairs of all claims, alpha 0.05. A12: "
                       "Vargha-Delaney effect size, the probability that the claimed planner's run is better "
-                      "(0.5: no effect), of the weakest pair. n: runs tested / runs per side.")
+                      "(0.5: no effect), of the weakest pair; difference: claimed minus other (mean, or mean "
+                      "paired difference) with its 95% bootstrap interval. n: runs tested / runs per side; a "
+                      "deterministic side (one plan repeated) counts once and is compared as a single value.")
+        rule = document["seed_rule"]
+        doc.paragraph(f"Seed rule: {rule['rule']}. This study: m = {rule['pairs']} pairs, so each side needs at "
+                      f"least {rule['seeds_needed']} seeds; this run has {rule['seeds_run']} "
+                      f"({'met' if rule['met'] else 'NOT met: its verdicts are underpowered where a test cannot reach alpha'}).")
         doc.table(claims_table(document))
     _against_oracle(doc, runs)
     for scenario, arms in by_scenario(runs).items():

@@ -39,6 +39,9 @@ def merge_identical(arms: dict[str, list[dict[str, Any]]]) -> tuple[dict[str, li
     notes: dict[str, list[str]] = {}
     for name, rows in arms.items():
         label = rows[0]["label"]
+        if not any(r.get("outcome") == "ok" for r in rows):  # rows that all failed show no plan and no drive
+            out[name] = rows
+            continue
         sig = signature(rows)
         match = next((first for first, (lab, s) in kept.items() if lab == label and s == sig), None)
         if match is None:
@@ -138,9 +141,11 @@ def claims_table(document: dict[str, Any]) -> Table:
     rows = []
     for c in document["claims"]:
         n = "; ".join(f"{c['planner']} {p['n'][0]}/{p['runs'][0]} vs {p['than']} {p['n'][1]}/{p['runs'][1]}"
+                      + (f" ({p['test'].replace('_', ' ')})" if p.get("test", c["test"]) != c["test"] else "")
                       for p in c["pairs"])
+        interval = c.get("interval") or [None, None]
         rows.append([c["id"], c["statement"], c["source"], c["scenario"], c["test"], c["verdict"], c["p_holm"],
-                     c["a12"], n])
+                     c["a12"], c.get("difference"), interval[0], interval[1], n, c.get("seeds_needed")])
     return Table("claims", f"The claims of study {document['study']} and their verdicts",
-                 ["claim", "statement", "source", "scenario", "test", "verdict", "Holm p", "A12", "n"], rows,
-                 kinds={6: "p"})
+                 ["claim", "statement", "source", "scenario", "test", "verdict", "Holm p", "A12", "difference",
+                  "95% low", "95% high", "n", "seeds needed"], rows, kinds={6: "p"})

@@ -62,6 +62,7 @@ from swarmnav.controllers.navigators import make_navigator
 from swarmnav.models.contained_files import is_input_path, name_problem
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR
+from swarmnav.models.scenario_limits import MAX_STUDY_RUNS
 from swarmnav.models.toml_table import POSITIVE, TomlTable, above, parse_toml, read_text, within
 from swarmnav.planners.registry import make_planner
 from swarmnav.planners.swarm import Budget
@@ -71,7 +72,7 @@ from swarmnav.sim.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, Pa
                                               read_budget, read_clearance, read_components, read_paper,
                                               read_scenarios, read_seeds, refuse_scenario_code)
 
-MAX_CELLS = 2_000_000  # runs of one study (scenarios x settings x seed pairs), each a row
+MAX_CELLS = MAX_STUDY_RUNS  # runs of one study (scenarios x settings x seed pairs), each a row
 MAX_WALL_LIMIT_S = 1e6
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
@@ -101,6 +102,9 @@ class Study:
     claims: tuple[Claim, ...] = ()  # the paper's claims the rows test (the report's verdicts)
     trust_code: bool = False  # --trust-code: its files (study, scenarios) may name code to run
     budget: Budget | None = None  # every planner's budget, unless its entry names its own
+    # --claims-only: the (scenario stem, planner arm label, navigator arm label or None) the claims compare;
+    # None: every arm runs
+    claim_arms: frozenset[tuple[str, str, str | None]] | None = None
 
     def budget_of(self, planner: Component) -> Budget | None:
         """The budget a planner entry runs under: its own, else the study's."""
@@ -111,6 +115,20 @@ class Study:
         if self.paired_seeds:
             return list(zip(self.world_seeds, self.seeds))
         return [(w, s) for w in self.world_seeds for s in self.seeds]
+
+    def claims_only(self) -> "Study":
+        """The study restricted to the arms its claims compare (each claim's planner and ``than`` labels on its
+        scenario, with its navigator when it names one): the rows the verdicts need and no more.  Its cells
+        are the full study's cells (the same hashes), so a later full run into the same folder resumes."""
+        arms = frozenset((c.scenario, label, c.navigator) for c in self.claims for label in (c.planner, *c.than))
+        return replace(self, claim_arms=arms)
+
+    def wants(self, scenario: str, planner_label: str, navigator_label: str) -> bool:
+        """Whether the run grid includes this arm (always, unless :meth:`claims_only`)."""
+        if self.claim_arms is None:
+            return True
+        stem = FilePath(scenario).stem
+        return (stem, planner_label, navigator_label) in self.claim_arms or (stem, planner_label, None) in self.claim_arms
 
     def quick(self) -> "Study":
         """The study on its first ``quick_seeds`` seeds (its rows are the full study's rows for those seeds,
@@ -193,7 +211,7 @@ def _read_study(top: TomlTable, default_name: str, trust_code: bool) -> Study:
     if paired and len(world_seeds) != len(seeds):
         top.fail("paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                  f"{len(world_seeds) if top.has('world_seeds') else 'no'} world seeds")
-    settings = sum(len(c.settings()) for c in planners) * sum(len(c.settings()) for c in navigators)
+    settings = sum(c.count() for c in planners) * sum(c.count() for c in navigators)
     cells = len(scenarios) * settings * (len(seeds) if paired else len(seeds) * len(world_seeds))
     if cells > MAX_CELLS:
         top.fail("seeds", f"the grid has {cells:,} runs (scenarios x settings x seeds), at most {MAX_CELLS:,}")

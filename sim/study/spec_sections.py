@@ -7,6 +7,7 @@ from __future__ import annotations
 import fnmatch
 import glob
 import itertools
+import math
 from dataclasses import dataclass
 from pathlib import Path as FilePath
 from typing import Any, Callable
@@ -14,6 +15,7 @@ from typing import Any, Callable
 from swarmnav.controllers.navigators import NAVIGATORS
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import refuse_code
+from swarmnav.models.scenario_limits import MAX_STUDY_RUNS, MAX_SWEEP_VALUES
 from swarmnav.models.scenario import check_run_size, list_scenarios, load_scenario, resolve_scenario_path
 from swarmnav.models.toml_table import (NON_NEGATIVE, POSITIVE, TomlTable, check_array, check_integer,
                                         check_string, within)
@@ -39,6 +41,10 @@ class Component:
         if not self.swept:
             return self.label
         return self.label + "(" + ", ".join(f"{k}={setting[k]}" for k in self.swept) + ")"
+
+    def count(self) -> int:
+        """How many settings the sweep has, from the lists' lengths (nothing expanded)."""
+        return math.prod(len(self.params[k]) for k in self.swept)
 
     def settings(self) -> list[dict[str, Any]]:
         """Every parameter table of the sweep (the Cartesian product of the lists), in file order."""
@@ -122,8 +128,14 @@ def read_components(top: TomlTable, key: str, kind: str, make: Callable[..., Any
         for k in swept:
             if not params.data[k]:
                 params.fail(k, "empty grid: the sweep lists no value")
+            if len(params.data[k]) > MAX_SWEEP_VALUES:
+                params.fail(k, f"{len(params.data[k]):,} values, at most {MAX_SWEEP_VALUES:,} (MAX_SWEEP_VALUES)")
         budget = read_budget(entry.table("budget")) if entry.has("budget") else None
         component = Component(name, label, dict(params.data), swept, budget)
+        if component.count() > MAX_STUDY_RUNS:  # counted from the lists' lengths, before any is expanded
+            entry.fail("params", f"the sweep has {component.count():,} settings ("
+                                 + " x ".join(str(len(params.data[k])) for k in swept)
+                                 + f"), more than a study's {MAX_STUDY_RUNS:,} runs (MAX_STUDY_RUNS)")
         for setting in component.settings():
             try:
                 make(name, setting, top.source, trust_code=trust_code)

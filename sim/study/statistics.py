@@ -68,13 +68,14 @@ def summarise(rows: list[dict[str, Any]], metric: str) -> MetricSummary | None:
                          float(np.median(v)), best)
 
 
-OUTCOME_CLASSES = ("success", "collision", "timeout", "no path", "error")
+OUTCOME_CLASSES = ("success", "collision", "left arena", "timeout", "no path", "error")
 
 
 def outcome_class(row: dict[str, Any]) -> str:
     """What became of a run, one of :data:`OUTCOME_CLASSES`: success is the goal reached with no collision
     (plan-only: a collision-free plan); a collision is any contact on the way (plan-only: a plan that cuts an
-    obstacle); a timeout is the wall limit or, in physics, the simulated-time limit with no collision."""
+    obstacle); "left arena" a run whose robot left the arena (or drove a given path that leaves it), collisions
+    or not; a timeout is the wall limit or, in physics, the simulated-time limit with no collision."""
     outcome = row.get("outcome")
     if outcome == "no_path":
         return "no path"
@@ -82,6 +83,8 @@ def outcome_class(row: dict[str, Any]) -> str:
         return outcome
     if row.get("success"):
         return "success"
+    if row.get("run_outcome") == "left_arena":
+        return "left arena"
     if row.get("mode") == "physics":
         return "collision" if (row.get("collisions") or 0) > 0 else "timeout"
     return "collision"

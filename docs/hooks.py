@@ -1,0 +1,35 @@
+"""MkDocs hook: the source tree as it installs, for mkdocstrings to read.
+
+swarmnav installs four folders under one name (``pyproject.toml``'s ``package-dir``: ``sim/api`` is
+``swarmnav``, ``planners`` is ``swarmnav.planners``, ...), which no static reader can follow from the
+repository.  Before the build this links them, as they install, into ``build/docs-src/swarmnav/`` (``build/``
+is git-ignored), the folder mkdocs.yml's python handler searches.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from mkdocs.plugins import event_priority
+
+REPO = Path(__file__).resolve().parent.parent
+TREE = REPO / "build" / "docs-src" / "swarmnav"
+SUBPACKAGES = ("models", "planners", "controllers", "sim")
+
+
+def _link(link: Path, target: Path) -> None:
+    if link.is_symlink() and link.resolve() == target.resolve():
+        return
+    if link.is_symlink() or link.exists():
+        link.unlink()
+    link.symlink_to(target, target_is_directory=target.is_dir())
+
+
+@event_priority(100)  # before mkdocstrings' on_config, which keeps only search paths that exist
+def on_config(config):
+    TREE.mkdir(parents=True, exist_ok=True)
+    for source in (REPO / "sim" / "api").glob("*.py"):
+        _link(TREE / source.name, source)
+    for name in SUBPACKAGES:
+        _link(TREE / name, REPO / name)
+    return config

@@ -1,0 +1,156 @@
+"""The README's CrowdNav table, generated from the committed ``bench navigation --suite crowdnav --json`` result.
+
+``python -m swarmnav.sim.benchmarks.crowd_table [RESULT.json] [--readme FILE]`` prints (or, with ``--readme``,
+writes between its markers) one table per setting (the robot invisible to the humans, then visible), our rows
+first, then the figures Chen, Liu, Kreiss and Alahi (2019) publish for the same setting (5 ORCA humans, circle
+crossing, 500 test cases), under :data:`PUBLISHED_SOURCE`.  ``make readme-table`` runs it; a test fails when the
+README and the result differ.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path as FilePath
+from typing import Any
+
+from swarmnav.models.errors import ConfigError
+from swarmnav.sim.benchmarks.navigation_table import RESULTS_DIR, read_rows
+
+RESULT = RESULTS_DIR / "crowdnav.json"
+BEGIN = ("<!-- crowdnav-table: generated from models/suites/results/crowdnav.json by `make readme-table`; "
+         "do not edit by hand -->")
+END = "<!-- end of crowdnav-table -->"
+ORACLE = "oracle"
+
+# (success, collision, time to goal s, discomfort frequency); None: not found.  Chen et al. (2019), ICRA,
+# Table I (robot invisible) and the visible setting's table, as transcribed by a third-party reading note found
+# with `search` (the paper's own table text was not in the corpus: figures not checked against the PDF).
+PUBLISHED_SOURCE = ("Chen, Liu, Kreiss and Alahi (2019), Table I and the visible-setting table, as transcribed "
+                    "in a third-party reading note (not checked against the paper)")
+PUBLISHED = {
+    False: [("ORCA", (0.43, 0.57, 10.86, None)), ("CADRL", (0.78, 0.22, 10.80, None)),
+            ("LSTM-RL", (0.95, 0.03, 11.82, None)), ("SARL", (1.00, 0.00, 10.55, None))],
+    True: [("ORCA", (0.99, None, 12.29, None)), ("CADRL", None), ("LSTM-RL", None), ("SARL", None),
+           ("LM-SARL", (1.00, 0.00, 10.59, 0.03))],
+}
+
+
+def _cell(value: Any, spec: str) -> str:
+    return "–" if value is None else format(value, spec)
+
+
+def table_lines(rows: list[dict[str, Any]], seen: bool) -> list[str]:
+    lines = [f"Robot {'visible' if seen else 'invisible'} to the humans"
+             + (" (no clairvoyant yardstick: the humans react to the robot)" if seen else "") + ":", "",
+             "| method | runs | success | collision | timeout | time to goal s | discomfort | min separation m | "
+             "path irregularity rad/m | solved share | × real time (CPU) |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        name = f"{r['navigator']} (clairvoyant yardstick)" if r["navigator"] == ORACLE else f"`{r['navigator']}`"
+        if r.get("arm_of"):
+            name += f" (`{r['arm_of']}`: " + ", ".join(f"{k}={v}" for k, v in sorted(r["arm_params"].items())) + ")"
+        solved = r["success_on_solvable"] if r["navigator"] == ORACLE else r.get("solved_share")
+        lines.append(f"| {name} | {r['runs']} | {_cell(r['success_rate'], '.3f')} | "
+                     f"{_cell(r['collision_rate'], '.3f')} | {_cell(r['timeout_rate'], '.3f')} | "
+                     f"{_cell(r['mean_time_to_goal_s'], '.2f')} | "
+                     f"{_cell(r['discomfort_frequency'], '.3f')} | {_cell(r['mean_min_separation_m'], '.3f')} | "
+                     f"{_cell(r['mean_path_irregularity_rad_m'], '.3f')} | {_cell(solved, '.3f')} | "
+                     f"{_cell(r.get('realtime_factor_cpu'), '.1f')} |")
+    for method, figures in PUBLISHED[seen]:
+        if figures is None:
+            lines.append(f"| {method}, Chen et al. (2019) | 500 | not found | | | | | | | | |")
+            continue
+        success, collision, time_s, discomfort = figures
+        lines.append(f"| {method}, Chen et al. (2019) | 500 | {_cell(success, '.2f')} | {_cell(collision, '.2f')} | "
+                     f"– | {_cell(time_s, '.2f')} | {_cell(discomfort, '.2f')} | – | – | – | – |")
+    return lines
+
+
+BEST_TARGET = 0.99  # issue 35: the best navigator's success, with discomfort below DISCOMFORT_TARGET
+DISCOMFORT_TARGET = 0.05
+ONLINE_TARGET = 0.90  # every online navigator's success
+CROWD_TARGET_US = 50.0
+REALTIME_TARGET = 30.0
+
+
+def summary_lines(part: list[dict[str, Any]], seen: bool) -> list[str]:
+    """The targets of one setting, computed from its rows (never written by hand)."""
+    from swarmnav.controllers.navigators import NAVIGATORS
+    contenders = [r for r in part if r["navigator"] != ORACLE]
+    if not contenders:
+        return []
+    best = max(contenders, key=lambda r: (r["success_rate"], -(r["discomfort_frequency"] or 0.0)))
+    met = best["success_rate"] >= BEST_TARGET and (best["discomfort_frequency"] or 0.0) < DISCOMFORT_TARGET
+    lines = [f"Robot {'visible' if seen else 'invisible'}: the best, `{best['navigator']}`, succeeds in "
+             f"{best['success_rate']:.3f} of its {best['runs']} runs with discomfort "
+             f"{best['discomfort_frequency']:.4f} (target ≥ {BEST_TARGET:.2f} with discomfort < "
+             f"{DISCOMFORT_TARGET:.2f}: {'met' if met else 'not met'})."]
+    online = [r for r in contenders if not r.get("arm_of")
+              and getattr(NAVIGATORS.get(r["navigator"]), "uses_detections", True)]
+    below = [r for r in online if r["success_rate"] < ONLINE_TARGET]
+    lines.append(f"Every online navigator at its defaults ≥ {ONLINE_TARGET:.2f}: " + (
+        "met." if not below else "not met: " + ", ".join(f"`{r['navigator']}` {r['success_rate']:.3f}"
+                                                         for r in below) + "."))
+    timed = [r for r in part if r.get("realtime_factor_cpu") is not None]
+    if timed:
+        slow = min(timed, key=lambda r: r["realtime_factor_cpu"])
+        verdict = "met" if slow["realtime_factor_cpu"] >= REALTIME_TARGET else "not met"
+        lines.append(f"Real time on CPU: every row at {slow['realtime_factor_cpu']:.1f}× or more "
+                     f"(`{slow['navigator']}` the slowest; target ≥ {REALTIME_TARGET:g}×: {verdict}).")
+    crowd = next((r["crowd_step"] for r in part if r.get("crowd_step")), None)
+    if crowd:
+        worst = max(crowd[k]["cpu_us_per_agent_step"] for k in ("orca", "social_force"))
+        lines.append(f"Agents: {crowd['orca']['cpu_us_per_agent_step']:.1f} µs (ORCA) and "
+                     f"{crowd['social_force']['cpu_us_per_agent_step']:.1f} µs (social force) of CPU per agent per "
+                     f"control step with {crowd['agents']} agents (target ≤ {CROWD_TARGET_US:g} µs: "
+                     f"{'met' if worst <= CROWD_TARGET_US else 'not met'}).")
+    return lines
+
+
+def block(rows: list[dict[str, Any]]) -> str:
+    out = [BEGIN, ""]
+    for seen in (False, True):
+        part = [r for r in rows if r.get("robot_visible") is seen]
+        if part:
+            out += table_lines(part, seen) + [""] + summary_lines(part, seen) + [""]
+    out += [f"Published figures: {PUBLISHED_SOURCE}; their robot is holonomic, ours a differential drive in "
+            "MuJoCo.", "", END]
+    return "\n".join(out)
+
+
+def current_block(text: str) -> str | None:
+    start = text.find(BEGIN)
+    end = text.find(END, start) if start >= 0 else -1
+    return None if start < 0 or end < 0 else text[start:end + len(END)]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m swarmnav.sim.benchmarks.crowd_table",
+                                     description=__doc__.splitlines()[0])
+    parser.add_argument("result", nargs="?", default=str(RESULT), help="a `bench navigation --suite crowdnav --json`")
+    parser.add_argument("--readme", help="replace the table between the markers in this file")
+    args = parser.parse_args(argv)
+    try:
+        rows = read_rows(FilePath(args.result))
+        if not any("robot_visible" in r for r in rows):
+            raise ConfigError("crowdnav table", "has no robot_visible rows (not a --suite crowdnav result)",
+                              args.result)
+        generated = block(rows)
+        if args.readme:
+            path = FilePath(args.readme)
+            text = path.read_text(encoding="utf-8")
+            old = current_block(text)
+            if old is None:
+                raise ConfigError("--readme", "has no crowdnav-table markers", args.readme)
+            path.write_text(text.replace(old, generated), encoding="utf-8")
+        else:
+            print(generated)
+    except ConfigError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,191 @@
+"""What produced a study's verdicts, and whether today's code would still produce them.
+
+:func:`study_inputs` records, when a study runs (``study.json``'s ``inputs``, copied into ``claims.json``):
+
+* ``study_file``: the study file (path relative to the repository, SHA-256 of its bytes);
+* ``sources``: the SHA-256 of every source file of the components the study ran: each planner's module,
+  each navigator's module (physics studies only; a plan-only study never drives), and every project module
+  they import from ``planners/`` and ``controllers/``, followed transitively (a compiled helper is hashed by
+  its C source beside it).  Modules elsewhere (``sim/``, ``models/``) are not followed: the inputs are the
+  components, not the harness;
+* ``scenarios``: the SHA-256 of every scenario file the study ran, and of the map file each names;
+* ``versions``: swarmnav's version and those of its key dependencies (:data:`KEY_DEPENDENCIES`).
+
+:func:`stale_inputs` compares a recorded ``inputs`` with today's: a study is *stale* when its study file, a
+source or a scenario changed (or appeared or disappeared), or swarmnav's version changed; a dependency whose
+version differs is a note only (CI installs what the version ranges of ``pyproject.toml`` resolve to).
+``swarmnav report --check-fresh DIR`` runs it over every ``claims.json`` under DIR.
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+import inspect
+from importlib import metadata
+from pathlib import Path as FilePath
+from typing import Any, Iterable
+
+ROOT = FilePath(__file__).resolve().parents[2]
+#: The project folders whose modules count as a component's sources (imports are followed only inside them).
+COMPONENT_PACKAGES = ("planners", "controllers")
+KEY_DEPENDENCIES = ("numpy", "scipy", "mujoco", "ompl")
+
+
+def _sha256(path: FilePath) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _relative(path: FilePath) -> str:
+    try:
+        return path.resolve().relative_to(ROOT).as_posix()
+    except ValueError:
+        return path.resolve().as_posix()  # a plugin's module outside the repository
+
+
+def _module_file(module: str) -> FilePath | None:
+    """The source file of ``swarmnav.<package>.<...>`` inside :data:`COMPONENT_PACKAGES` (None otherwise)."""
+    parts = module.split(".")
+    if len(parts) < 2 or parts[0] != "swarmnav" or parts[1] not in COMPONENT_PACKAGES:
+        return None
+    base = ROOT.joinpath(*parts[1:])
+    for candidate in (base.with_suffix(".py"), base / "__init__.py", base.with_suffix(".c")):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _imports(path: FilePath) -> set[str]:
+    """The absolute module names a Python file imports (``from a.b import c`` gives ``a.b`` and ``a.b.c``)."""
+    if path.suffix != ".py":
+        return set()
+    names: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.add(node.module)
+            names.update(f"{node.module}.{alias.name}" for alias in node.names)
+    return names
+
+
+def source_closure(files: Iterable[FilePath]) -> list[FilePath]:
+    """``files`` and every project module of :data:`COMPONENT_PACKAGES` they import, transitively, sorted."""
+    seen: set[FilePath] = set()
+    todo = [f.resolve() for f in files]
+    while todo:
+        path = todo.pop()
+        if path in seen:
+            continue
+        seen.add(path)
+        for name in _imports(path):
+            found = _module_file(name)
+            if found is not None and found.resolve() not in seen:
+                todo.append(found.resolve())
+    return sorted(seen)
+
+
+def _class_file(cls: type) -> FilePath:
+    path = FilePath(inspect.getfile(cls))
+    source = path.with_name(path.name.split(".")[0] + ".c") if path.suffix == ".so" else path
+    return source if source.is_file() else path
+
+
+def component_files(study) -> list[FilePath]:
+    """The module of each planner (and, for a physics study, each navigator) the study names."""
+    from swarmnav.controllers.navigators import NAVIGATORS
+    from swarmnav.planners.registry import PLANNERS
+    files = [_class_file(PLANNERS[p.name]) for p in study.planners if p.name in PLANNERS]
+    if study.mode != "plan":
+        files += [_class_file(NAVIGATORS[n.name]) for n in study.navigators if n.name in NAVIGATORS]
+    return files
+
+
+def versions() -> dict[str, str | None]:
+    out: dict[str, str | None] = {}
+    for name in ("swarmnav",) + KEY_DEPENDENCIES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = None
+    return out
+
+
+def scenario_files(refs: Iterable[str]) -> list[FilePath]:
+    """The scenario files of ``refs`` (bundled names or paths) and the map file each names (``[map] file``,
+    beside the scenario or under ``models/maps/``)."""
+    import tomllib
+
+    from swarmnav.models.scenario import resolve_scenario_path
+    files: set[FilePath] = set()
+    for ref in refs:
+        path = FilePath(resolve_scenario_path(ref)).resolve()
+        files.add(path)
+        name = (tomllib.loads(path.read_text(encoding="utf-8")).get("map") or {}).get("file")
+        if isinstance(name, str):
+            found = next((c for c in (path.parent / name, ROOT / "models" / "maps" / name) if c.is_file()), None)
+            if found is not None:
+                files.add(found.resolve())
+    return sorted(files)
+
+
+def study_inputs(study) -> dict[str, Any]:
+    """What a run of ``study`` depends on (see the module docstring)."""
+    study_file = FilePath(study.source) if study.source else None
+    return {
+        "study_file": ({"path": _relative(study_file), "sha256": _sha256(study_file)}
+                       if study_file is not None and study_file.is_file() else None),
+        "sources": {_relative(f): _sha256(f) for f in source_closure(component_files(study))},
+        "scenarios": {_relative(f): _sha256(f) for f in scenario_files(study.scenarios)},
+        "versions": versions(),
+    }
+
+
+def stale_inputs(recorded: dict[str, Any], current: dict[str, Any]) -> tuple[list[str], list[str]]:
+    """(what changed, notes): each change a short phrase naming the file or version; notes for dependency
+    versions that differ (not a change of the study's inputs)."""
+    changes: list[str] = []
+    old_file, new_file = recorded.get("study_file") or {}, current.get("study_file") or {}
+    if old_file.get("sha256") != new_file.get("sha256"):
+        changes.append(f"study file {new_file.get('path') or old_file.get('path')} changed")
+    for key, what in (("sources", "source"), ("scenarios", "scenario")):
+        old, new = recorded.get(key) or {}, current.get(key) or {}
+        for path in sorted(set(old) | set(new)):
+            if path not in new:
+                changes.append(f"{what} {path} no longer used")
+            elif path not in old:
+                changes.append(f"{what} {path} newly used")
+            elif old[path] != new[path]:
+                changes.append(f"{what} {path} changed")
+    old_versions, new_versions = recorded.get("versions") or {}, current.get("versions") or {}
+    notes = []
+    for name in sorted(set(old_versions) | set(new_versions)):
+        if old_versions.get(name) != new_versions.get(name):
+            phrase = f"{name} {old_versions.get(name)} -> {new_versions.get(name)}"
+            (changes if name == "swarmnav" else notes).append(phrase)
+    return changes, notes
+
+
+def check_fresh(paths: list[str]) -> tuple[list[str], list[str], list[str]]:
+    """Every ``claims.json`` under ``paths`` (as ``--readme-table`` reads them) against today's inputs of its
+    study: (one line per stale study naming its claims and what changed, the stale studies' names, notes)."""
+    from swarmnav.models.errors import ConfigError
+    from swarmnav.sim.study.readme_table import read_documents
+    from swarmnav.sim.study.spec import load_study
+    lines, stale, notes = [], [], []
+    for document in read_documents(paths):
+        name = document.get("study", "?")
+        claims = ", ".join(c["id"] for c in document.get("claims", []))
+        recorded = document.get("inputs")
+        if not recorded:
+            changes = ["its claims.json records no inputs (run before provenance was recorded)"]
+        else:
+            try:
+                changes, study_notes = stale_inputs(recorded, study_inputs(load_study(name)))
+            except ConfigError as exc:
+                changes, study_notes = [f"its study cannot be loaded today ({exc})"], []
+            notes += [f"{name}: {n}" for n in study_notes]
+        if changes:
+            stale.append(name)
+            lines.append(f"stale: {name} (claims {claims}): {'; '.join(changes)}")
+    return lines, stale, notes

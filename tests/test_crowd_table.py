@@ -1,0 +1,48 @@
+"""The README's CrowdNav table is the one generated from the committed ``--suite crowdnav`` result."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from swarmnav.sim.benchmarks import crowd_table
+from swarmnav.sim.benchmarks.crowd_table import RESULT, block, current_block
+from swarmnav.sim.benchmarks.navigation_table import read_rows
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def test_the_readme_crowdnav_table_is_the_one_generated_from_the_committed_result(capsys):
+    assert crowd_table.main([str(RESULT)]) == 0
+    generated = capsys.readouterr().out.strip()
+    assert current_block((REPO / "README.md").read_text()) == generated, \
+        "run `make readme-table` (README and models/suites/results/crowdnav.json differ)"
+
+
+def test_the_committed_result_has_both_settings_and_no_oracle_where_the_humans_see_the_robot():
+    rows = read_rows(RESULT)
+    invisible = [r for r in rows if r["robot_visible"] is False]
+    visible = [r for r in rows if r["robot_visible"] is True]
+    assert {r["navigator"] for r in invisible} - {"oracle"} == {r["navigator"] for r in visible}
+    assert "oracle" in {r["navigator"] for r in invisible} and "oracle" not in {r["navigator"] for r in visible}
+    assert all(r["oracle_solvable_runs"] == 0 and r["yardstick"].startswith("none") for r in visible)
+    assert len({r["runs"] for r in rows}) == 1
+    assert all(r["discomfort_frequency"] is not None for r in rows)
+
+
+def test_the_table_follows_the_rows_and_a_bad_file_is_named(tmp_path, capsys):
+    rows = read_rows(RESULT)
+    changed = [dict(r, success_rate=0.123456) if r["navigator"] == "follow" else r for r in rows]
+    assert "| `follow` | " in block(changed) and "| 0.123 |" in block(changed) and block(changed) != block(rows)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps([{"navigator": "x", "scenario": None}]))
+    assert crowd_table.main([str(bad)]) == 2
+    assert "robot_visible" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("seen, methods", [(False, ["ORCA", "CADRL", "LSTM-RL", "SARL"]),
+                                           (True, ["ORCA", "CADRL", "LSTM-RL", "SARL", "LM-SARL"])])
+def test_every_published_method_has_a_line_found_or_not(seen, methods):
+    lines = crowd_table.table_lines([], seen)
+    for m in methods:
+        assert any(line.startswith(f"| {m}, Chen et al. (2019)") for line in lines)
