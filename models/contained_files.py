@@ -208,3 +208,16 @@ def replace_file(path: str | os.PathLike, text: str, field: str) -> None:
     with os.fdopen(fd, "w", encoding="utf-8") as out:
         out.write(text)
     os.replace(temporary, path)
+
+
+def check_output_target(path: str | os.PathLike, field: str, folder_ok: bool = True) -> None:
+    """Refuse an output path where something other than a regular file (or, with ``folder_ok``, a folder)
+    stands: writing there would feed a device or block on a FIFO, and replacing it atomically would put a
+    file where a device was."""
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return  # nothing there (or not reachable): the write itself says what is wrong
+    if stat.S_ISREG(mode) or stat.S_ISLNK(mode) or (folder_ok and stat.S_ISDIR(mode)):
+        return
+    raise ConfigError(field, f"{_kind(mode)}: swarmnav writes only regular files and folders", str(path))

@@ -30,6 +30,7 @@ study, a log) only when the user passes ``--trust-code`` for that invocation;
 from __future__ import annotations
 
 import dataclasses
+import functools
 import types
 import typing
 from typing import Any
@@ -111,7 +112,7 @@ def parameter_table(cls: type, extra: tuple[type, tuple[str, ...], dict[str, Any
 
 def numeric_parameters(cls: type) -> tuple[str, ...]:
     """The init fields whose type admits an int or a float (bool excluded)."""
-    hints = typing.get_type_hints(cls)
+    hints = _type_hints(cls)
     out = []
     for f in dataclasses.fields(cls):
         annotation = hints.get(f.name, Any)
@@ -150,6 +151,12 @@ def refuse_code(registry: dict[str, type], kind: str, name: str, params: dict[st
                               f"(or give it on the command line: {option} {key}=...)", source)
 
 
+@functools.lru_cache(maxsize=None)
+def _type_hints(cls: type) -> dict[str, Any]:
+    """``typing.get_type_hints`` of a component class, once per class (it re-evaluates every annotation)."""
+    return typing.get_type_hints(cls)
+
+
 def register_component(registry: dict[str, type], kind: str, cls: type) -> type:
     """Add a component class to a registry under its ``name``; a missing or taken name is an error."""
     name = getattr(cls, "name", None)
@@ -182,7 +189,7 @@ def build_component(registry: dict[str, type], kind: str, name: str, params: dic
         refuse_code(registry, kind, name, params, source)
     cls = registry[name]
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
-    hints = typing.get_type_hints(cls)
+    hints = _type_hints(cls)
     ranges, choices = parameter_ranges(cls), parameter_choices(cls)
     table = TomlTable({} if params is None else params, f"{kind}.params", source)
     kwargs = {}

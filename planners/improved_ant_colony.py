@@ -187,7 +187,8 @@ def prune_length(q: float, t_c: float, collar_length: float, negligible: float) 
     """
     if t_c <= 1.0:
         return math.inf
-    return collar_length + (math.log(q / negligible) / math.log(t_c)) ** (1.0 / 3.0)
+    # Q at or below the floor: every tour past the collar line deposits below it (never a complex root)
+    return collar_length + (max(0.0, math.log(q / negligible)) / math.log(t_c)) ** (1.0 / 3.0)
 
 
 @dataclass

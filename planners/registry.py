@@ -19,6 +19,7 @@ from swarmnav.planners.waiter_ant_colony import WaiterAntColonyPlanner
 from swarmnav.planners.grey_wolf import GreyWolfPlanner
 from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.particle_swarm import ParticleSwarmPlanner
+from swarmnav.planners.ompl_geometric import OMPL_GEOMETRIC_PLANNERS
 from swarmnav.planners.sampling_ompl import OMPL_PLANNERS
 from swarmnav.planners.errors import BudgetExceeded, GoalBlocked, NoPathFound, PlanningError, StartBlocked
 from swarmnav.models.errors import ConfigError
@@ -48,7 +49,7 @@ def register(cls: PlannerClass) -> PlannerClass:
 for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,
              ImprovedMaxMinAntSystemPlanner, ImprovedAntColonyPlanner, WaiterAntColonyPlanner, AntSystemPlanner,
              OptimalPlanner, BeeColonyPlanner, AdaptiveLimitBeeColonyPlanner, GreyWolfPlanner,
-             ParticleSwarmPlanner, MaxMinColonyPlanner, *OMPL_PLANNERS):
+             ParticleSwarmPlanner, MaxMinColonyPlanner, *OMPL_PLANNERS, *OMPL_GEOMETRIC_PLANNERS):
     register(_cls)
 
 

@@ -123,6 +123,12 @@ class RecorderGroup:
         for r in self.recorders:
             r.event(time_s, kind, details)
 
+    def occupancy(self, time_s: float, grid: Any) -> None:
+        """The sensed map (a :class:`models.occupancy.LogOddsGrid`) to the recorders that draw it (optional)."""
+        for r in self.recorders:
+            if hasattr(r, "occupancy"):
+                r.occupancy(time_s, grid)
+
     def finish(self, summary: dict[str, Any]) -> None:
         error: BaseException | None = None
         for r in self.recorders:

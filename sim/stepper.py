@@ -124,7 +124,11 @@ class EpisodeStepper:
         self.recorder = recorder
         self.context = context
         self.path_m = path_m
-        self.sense_obstacles = bool(sense_obstacles)
+        # With the map unknown and the rays as the sensing (Nav2's obstacle layer), every hit goes to the
+        # sensed map (controllers.world_map), moving obstacles' too: the ray tracker, which tells unknown
+        # hits from the known map's, has no map to tell them from, and makes no detections.
+        self.sense_obstacles = bool(sense_obstacles) and not (scenario.map_knowledge == "unknown"
+                                                              and scenario.sensor_model == "rangefinder")
         # L* of the SPL: the shortest path among the static obstacles (sim.reference).
         self.reference_length_m = shortest_static_length_m(scenario)
         self.stop_on_collision = scenario.sim.stop_on_collision if stop_on_collision is None else stop_on_collision

@@ -45,8 +45,9 @@ def test_layout_panels_read_topics_a_log_has(tmp_path):
     run_episode(EpisodeSpec(load_scenario("gwo-scenario-2")), [McapRecorder(path)])
     log = read_log(path)
     used = set().union(*(_topics(p) for p in panels))
-    # /navigator appears only in logs of navigators that sense; every other topic is in every log.
-    assert used - {"/navigator"} <= set(log.counts), used - set(log.counts)
+    # /navigator appears only in logs of navigators that sense, /map with the map unknown, /odom with the
+    # odometry pose; every other topic is in every log.
+    assert used - {"/navigator", "/map", "/odom"} <= set(log.counts), used - set(log.counts)
     assert {"/scene", "/obstacles", "/wheels", "/events", "/range/scan"} <= used
     wheels = next(p for p in panels if any(s["value"].startswith("/wheels.") for s in p["config"].get("paths", [])))
     fields = {s["value"].split(".", 1)[1] for s in wheels["config"]["paths"]}

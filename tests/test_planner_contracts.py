@@ -34,6 +34,8 @@ def small_budget(name: str) -> dict:
         params.update(ants=10, iterations=10)
     if "round_evaluations" in fields:  # the OMPL planners: a budget of collision checks
         params.update(max_evaluations=1000)
+    if "num_samples" in fields:  # FMT*'s batch: sampled (and checked) before it searches, so within the budget
+        params.update(num_samples=300)
     return params
 
 

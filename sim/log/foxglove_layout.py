@@ -24,7 +24,9 @@ from pathlib import Path
 from swarmnav.sim import palette
 from swarmnav.sim.log.format import (
     EVENTS_TOPIC,
+    MAP_TOPIC,
     NAVIGATOR_TOPIC,
+    ODOM_TOPIC,
     ROS2_EVENTS_TOPIC,
     ROS2_PROFILE,
     SCENE_TOPIC,
@@ -57,6 +59,12 @@ def build_layout(log_format: str = "swarmnav") -> str:
                                                     ("/joint_states", "measured", "solid"))]
     else:
         wheel_series = [(f"/wheels.{field}", label, style, colour) for field, label, style, colour in WHEEL_SERIES]
+        # The sensed map (only in logs with the map unknown): occupancy percent, from clear to dark grey; and
+        # the odometry pose (only with knowledge.pose = "odometry").
+        topics[MAP_TOPIC] = fl.BaseRendererGridTopicSettings(
+            visible=True, color_mode="gradient", color_field="occupancy", gradient=("#ffffff20", "#000000c0"),
+            min_value=0.0, max_value=100.0, draw_behind=True)
+        topics[ODOM_TOPIC] = fl.BaseRendererPoseTopicSettings(visible=True)
     scene = fl.ThreeDeePanel(title="scene (top view)", config=fl.ThreeDeeConfig(
         fixed_frame=WORLD_FRAME, follow_tf=WORLD_FRAME, follow_mode="follow-none", topics=topics,
         camera_state=fl.ThreeDeeCameraState(perspective=False, distance=16.0, target_offset=(5.0, 5.0, 0.0))))
