@@ -46,6 +46,8 @@ from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.errors import check_parameters
 from swarmnav.planners.sampling_ompl import OmplPlanner, PRMStarPlanner, _path_waypoints
 
+MIN_BORDER_FRACTION = 1e-3  # KPIECE's share of border expansions: OMPL throws below machine epsilon
+
 RANGE_M: Range = within(0, 1e6)
 
 
@@ -88,9 +90,8 @@ def _check_range(planner: OmplPlanner, range_m: float) -> None:
     check_parameters(planner, (("range_m", math.isfinite(range_m) and range_m >= 0, "must be a finite length >= 0"),))
 
 
-def _check_fraction(planner: OmplPlanner, name: str, value: float, low_open: bool = False) -> None:
-    ok = (0.0 < value <= 1.0) if low_open else (0.0 <= value <= 1.0)
-    check_parameters(planner, ((name, ok, "must lie in (0, 1]" if low_open else "must lie in [0, 1]"),))
+def _check_fraction(planner: OmplPlanner, name: str, value: float) -> None:
+    check_parameters(planner, ((name, 0.0 <= value <= 1.0, "must lie in [0, 1]"),))
 
 
 @dataclass
@@ -153,11 +154,14 @@ class LBKPIECE1Planner(_FirstSolutionPlanner):
     ompl_class: ClassVar[str] = "LBKPIECE1"
     range_m: float = 0.0
     border_fraction: float = 0.9
-    parameter_ranges: ClassVar[dict[str, Range]] = {"range_m": RANGE_M, "border_fraction": above(0, 1)}
+    # OMPL refuses a border fraction below machine epsilon (a RuntimeError): 0.001 is the stated floor
+    parameter_ranges: ClassVar[dict[str, Range]] = {"range_m": RANGE_M,
+                                                    "border_fraction": within(MIN_BORDER_FRACTION, 1)}
 
     def check_own_parameters(self) -> None:
         _check_range(self, self.range_m)
-        _check_fraction(self, "border_fraction", self.border_fraction, low_open=True)
+        check_parameters(self, (("border_fraction", MIN_BORDER_FRACTION <= self.border_fraction <= 1.0,
+                                 f"must lie in [{MIN_BORDER_FRACTION:g}, 1]"),))
 
     def configure(self, planner) -> None:
         if self.range_m:
