@@ -234,3 +234,70 @@ def test_an_option_added_later_is_swept_without_a_new_case(files, cached_parser,
     failures = sweep.failures()
     assert failures and all("--scratch-count" in o.describe() for o in failures)
     assert "bug" in failures[0].describe() and "ZeroDivisionError" in failures[0].describe()
+
+
+def test_a_handful_in_their_own_process_under_a_3_gb_address_space(files, tmp_path):
+    """In-process the sweep bounds time; these few run as the user runs them, under ``ulimit -v`` (3 GB), so
+    an allocation the bounds missed would fail here rather than be absorbed by the test process."""
+    import subprocess
+    import sys
+    fifo = tmp_path / "waypoints.fifo"
+    os.mkfifo(fifo)
+    discs = tmp_path / "discs.toml"
+    discs.write_text(FAST_SCENARIO.split("[[obstacles]]")[0]
+                     + "".join(f"[[obstacles]]\nx = 1.0\ny = 1.0\nradius_m = 0.01\n" for _ in range(12_000)))
+    values = ", ".join(str(v) for v in range(4, 3004))
+    study = tmp_path / "huge.toml"
+    study.write_text(f'name = "huge"\nscenarios = ["{files["scenario"]}"]\n[[planners]]\nname = "gwo"\n'
+                     f'params = {{ iterations = [{values}], population = [{values}] }}\n')
+    script = ("import resource, sys\nresource.setrlimit(resource.RLIMIT_AS, (3_000_000_000, 3_000_000_000))\n"
+              "from swarmnav.sim.cli.main import main\nsys.exit(main(sys.argv[1:]))\n")
+    cases = [["run", files["scenario"], "--waypoints", str(fifo), "--no-log"],
+             ["plan", files["scenario"], "--set", "x=" + sweep_lib.DEEP],
+             ["plan", str(discs)], ["study", str(study), "--out", str(tmp_path / "out")]]
+    for argv in cases:
+        t0 = time.perf_counter()
+        done = subprocess.run([sys.executable, "-c", script, *argv], capture_output=True, text=True, timeout=60,
+                              cwd=tmp_path)
+        lines = done.stderr.strip().splitlines()
+        assert done.returncode == 2 and len(lines) == 1 and "bug:" not in lines[0], (argv[:3], done.stderr[-500:])
+        assert time.perf_counter() - t0 < 60
+
+
+def test_a_parameter_added_later_is_swept_without_a_new_case(files, monkeypatch):
+    """A scratch planner registered now, with a parameter declared with no range and used carelessly: the
+    parameter sweep finds it through the registry and names the failure it brings."""
+    from dataclasses import dataclass
+
+    import numpy as np
+
+    from swarmnav.models.scenario import parse_scenario
+    from swarmnav.planners import registry
+    from swarmnav.planners.registry import make_planner
+    from swarmnav.planners.straight import StraightPlanner
+    from swarmnav.sim.episode import EpisodeSpec, plan_episode
+
+    @dataclass
+    class ScratchPlanner(StraightPlanner):
+        cells: float = 1.0  # no declared range
+
+        def plan(self, problem, rng):
+            np.zeros(int(self.cells))  # careless: 1e300 cells
+            return super().plan(problem, rng)
+
+    ScratchPlanner.name = "scratch"
+    monkeypatch.setitem(registry.PLANNERS, "scratch", ScratchPlanner)
+    rows = [(kind, name, row) for kind, name, row in component_parameters() if name == "scratch"]
+    assert [row["name"] for _, _, row in rows] == ["cells"]
+    scenario = parse_scenario(FAST_SCENARIO, files["scenario"])
+    sweep = Sweep(BUDGET_S)
+    for _, name, row in rows:
+        for value in EXERCISED:
+            params = {row["name"]: value}
+            if sweep.call("build", [name], lambda: make_planner(name, params)).code == 0:
+                sweep.call(f"plan with {name}.{row['name']}", ["planner", name, f"cells={value!r}"],
+                           lambda: plan_episode(EpisodeSpec(scenario, planner=name, planner_params=params)))
+    failures = sweep.failures()
+    described = "\n".join(o.describe() for o in failures)
+    assert "swarmnav planner scratch cells=-1" in described and "swarmnav planner scratch cells=1e+300" in described
+    assert all("bug" in o.describe() for o in failures)

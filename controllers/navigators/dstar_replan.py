@@ -78,6 +78,7 @@ from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationSt
 from swarmnav.controllers.navigators.replan import keep_outside
 from swarmnav.controllers.prediction import swept_discs
 from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario_limits import MAX_GRID_CELLS
 from swarmnav.models.world import rasterise
 from swarmnav.planners.dstar_lite import DStarLite

@@ -16,6 +16,7 @@ from foxglove.channels import LogChannel, PoseInFrameChannel, PosesInFrameChanne
 from foxglove.messages import FrameTransform, LaserScan, Pose, PoseInFrame, PosesInFrame, SceneUpdate, Vector3
 
 from swarmnav.sim.log.encoding import SceneEncoder, StepEncoder, timestamp_field
+from swarmnav.sim.log.map_channel import MapChannel
 from swarmnav.sim.log.format import (
     BASE_FRAME,
     CONTROLLER_SCHEMA,
@@ -59,6 +60,7 @@ class SwarmnavChannels:
         self._navigator: SceneUpdateChannel | None = None  # made at the first belief with obstacles
         self._odom: PoseInFrameChannel | None = None  # /odom, made at the first odometry pose
         self._belief_drawn = False
+        self._map: MapChannel | None = None  # /map, made at the first sensed map (only with the map unknown)
 
     def open(self, fox: foxglove.Context, context: RunContext) -> None:
         """Make the channels (before the run's metadata is written)."""
@@ -150,6 +152,13 @@ class SwarmnavChannels:
 
     def event(self, t_ns: int, kind: str, details: dict[str, Any]) -> int:
         self._events.log(event_log(t_ns, kind, details), log_time=t_ns)
+        return 1
+
+    def occupancy(self, t_ns: int, grid: Any) -> int:
+        """``/map``: the sensed map (:mod:`sim.log.map_channel`; the channel made at the first)."""
+        if self._map is None:
+            self._map = MapChannel(self._fox)
+        self._map.log(t_ns, grid)
         return 1
 
     def versions(self) -> dict[str, str]:
