@@ -118,6 +118,16 @@ def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
                      f"{f['success_rate']:.3f} vs "
                      f"{b['success_rate']:.3f} ({ds:+.3f}), score {f['barn_score']:.4f} vs {b['barn_score']:.4f} "
                      f"({dsc:+.4f}): {'within' if abs(ds) <= 0.05 and abs(dsc) <= 0.05 else 'NOT within'} 0.05.")
+    if lines:
+        from swarmnav.sim.benchmarks.barn_difficulty import METRICS
+
+        def means(rows: list[dict[str, Any]]) -> dict[str, float]:
+            worlds = {r["world"]: r["difficulty"] for r in rows if r.get("scenario") is not None and r.get("difficulty")}
+            return {k: sum(d[k] for d in worlds.values()) / len(worlds) for k in METRICS} if worlds else {}
+        b, f = means(base_rows), means(fresh_rows)
+        if b and f:
+            lines.append("Their worlds' mean difficulty, BARN-like against BARN's: " + "; ".join(
+                f"{k.replace('_', ' ')} {f[k]:.2f} vs {b[k]:.2f}" for k in METRICS) + ".")
     return lines + [""] if lines else []
 
 
