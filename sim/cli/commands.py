@@ -142,6 +142,11 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--arm", action="append", metavar="LABEL:NAVIGATOR[:KEY=VALUE,...]",
                         help="one more row: a navigator under its own label with its own parameters (repeatable), "
                              "e.g. iaco_local+evade:iaco_local:evade=true")
+    parser.add_argument("--map", choices=("known", "unknown"),
+                        help="every run's static map: given in advance (known) or built from the laser (unknown); "
+                        "default: each scenario's knowledge.map")
+    parser.add_argument("--pose", choices=("truth", "odometry"),
+                        help="every run's pose: the simulator's (truth) or wheel odometry; default: each scenario's")
     parser.add_argument("--by-scenario", action="store_true",
                         help="also one row per navigator and scenario, after the overall rows")
     parser.add_argument("--out", type=options.output_path, metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
