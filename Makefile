@@ -65,6 +65,7 @@ bench: $(STAMP)
 	$(BIN)/swarmnav bench navigation $(BENCH_FLAGS)
 	$(BIN)/swarmnav bench study $(BENCH_FLAGS)
 	$(BIN)/swarmnav bench cli $(BENCH_FLAGS)
+	$(BIN)/swarmnav bench odometry $(BENCH_FLAGS)
 
 # Every bundled study into studies/<name>/ (rows resume if interrupted), with report.html and report.md.
 # Quick by default (each study's quick_seeds, about 10 min on 2 cores); `make studies STUDY_RUN=` runs them in full
