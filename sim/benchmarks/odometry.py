@@ -107,11 +107,11 @@ def write(rows: list[dict[str, Any]], readme: Path) -> None:
 
 def run(args) -> int:
     """``bench odometry [--quick] [--json] [--write]``: the rows, as JSON lines or the Markdown table."""
+    if args.write and args.quick:  # refused before any run
+        from swarmnav.models.errors import ConfigError
+        raise ConfigError("--write", "writes the full benchmark's figures: not with --quick")
     rows = benchmark_odometry(time_limit_s=20.0 if args.quick else 60.0)
     if args.write:
-        if args.quick:
-            from swarmnav.models.errors import ConfigError
-            raise ConfigError("--write", "writes the full benchmark's figures: not with --quick")
         write(rows, Path(__file__).resolve().parents[2] / "README.md")
     if args.json:
         for row in rows:
