@@ -28,11 +28,14 @@ def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, car
     where the robot can drive to it straight past the known map (:class:`PathCarrot`)."""
     known = setup.map_problem
     geometry = setup.controller.geometry
-    carrot = PathCarrot(setup.path.waypoints, lookahead_m)
+    if setup.world_map is None:
+        carrot = PathCarrot(setup.path.waypoints, lookahead_m)
+        local = LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m)
+    else:  # the map unknown: the sensed map's obstacles, and the path replanned on it (controllers.guided)
+        carrot, local = setup.world_map.local_guidance(setup, lookahead_m)
     if carrot_in_sight:
         carrot.keep_in_sight(known.disc_centres_m, known.disc_radii_m, known.box_array_m, known.robot_radius_m)
-    return (geometry, setup.max_speed_m_s, known.robot_radius_m + margin_m,
-            LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m),
+    return (geometry, setup.max_speed_m_s, known.robot_radius_m + margin_m, local,
             carrot, np.array([setup.goal.x_m, setup.goal.y_m]))
 
 

@@ -102,6 +102,9 @@ class NavigationSetup:
             without the moving obstacles (the map); None = ``problem``.
         scenario: the scenario being run (its sensing model and moving obstacles'
             sizes and speeds give the ``policy`` navigator its observation layout).
+        world_map: with the map unknown, the map the laser builds (:class:`controllers.world_map.SensedMap`,
+            fed by the runner every step); :attr:`map_problem` is then its latest publication.  None: the
+            map is known (``known_problem``).
     """
 
     path: Path
@@ -114,11 +117,19 @@ class NavigationSetup:
     max_speed_m_s: float
     known_problem: Problem | None = None
     scenario: Scenario | None = None
+    world_map: Any = None
 
     @property
     def map_problem(self) -> Problem:
-        """The known map (static obstacles only) as a planning problem."""
+        """The map (static obstacles only) as a planning problem: the known one, or the sensed map's latest."""
+        if self.world_map is not None:
+            return self.world_map.problem()
         return self.known_problem if self.known_problem is not None else self.problem
+
+    @property
+    def map_revision(self) -> int:
+        """Grows whenever :attr:`map_problem` changes (always 0 with the map known)."""
+        return self.world_map.revision if self.world_map is not None else 0
 
 
 @dataclass(frozen=True, eq=False)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import errno
 import json
 import os
+import re
 import stat
 import tomllib
 from pathlib import Path as FilePath
@@ -112,6 +113,35 @@ def check_depth(value: Any, field: str, source: str | None, limit: int = MAX_NES
     return value
 
 
+_JSON_STRING = re.compile(r'"(?:[^"\\]|\\.)*"', re.S)
+_TOML_STRINGS_AND_COMMENTS = re.compile(r'"""(?:[^\\]|\\.)*?"""|\'\'\'.*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'|#[^\n]*',
+                                        re.S)
+_NOT_BRACKETS = re.compile(r"[^\[\]{}]+")
+
+
+def bracket_depth(text: str, toml: bool = False) -> int:
+    """How deep ``[`` and ``{`` nest in a JSON (or TOML) text, strings and comments left out, counted without
+    recursion and in C-speed passes: checked before a parser recurses into it (after a RecursionError a
+    CPython 3.11 process can misbehave, so the parsers never meet one)."""
+    if text.count("[") + text.count("{") <= MAX_NESTING_DEPTH:
+        return 0  # too few brackets to nest beyond the limit
+    import numpy as np
+    bare = (_TOML_STRINGS_AND_COMMENTS if toml else _JSON_STRING).sub("", text)
+    brackets = _NOT_BRACKETS.sub("", bare).encode("ascii")
+    if not brackets:
+        return 0
+    codes = np.frombuffer(brackets, dtype=np.uint8)
+    steps = np.where((codes == ord("[")) | (codes == ord("{")), 1, -1)
+    return int(np.cumsum(steps).max())
+
+
+def _check_brackets(text: str, source: str | None, field: str, toml: bool) -> None:
+    # a TOML table header ([table], [[array]]) opens at most two brackets: the limit leaves room for them
+    if bracket_depth(text, toml) > MAX_NESTING_DEPTH + (2 if toml else 0):
+        raise ConfigError(field, f"arrays or tables nested more than {MAX_NESTING_DEPTH} deep (MAX_NESTING_DEPTH)",
+                          source)
+
+
 def _parser_limit(exc: BaseException) -> str | None:
     """What a parser's own limit says, for the limits it meets before ours (None: not one of them)."""
     if isinstance(exc, RecursionError):
@@ -123,6 +153,7 @@ def _parser_limit(exc: BaseException) -> str | None:
 
 def loads_toml(text: str, source: str | None, field: str = "toml") -> dict[str, Any]:
     """A TOML document (malformed, too deep or a too-long integer: one ConfigError naming ``field``)."""
+    _check_brackets(text, source, field, toml=True)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -137,6 +168,7 @@ def loads_toml(text: str, source: str | None, field: str = "toml") -> dict[str, 
 
 def loads_json(text: str | bytes, source: str | None, field: str = "json") -> Any:
     """A JSON document (malformed, too deep or a too-long integer: one ConfigError naming ``field``)."""
+    _check_brackets(text.decode("utf-8", "replace") if isinstance(text, bytes) else text, source, field, toml=False)
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
@@ -208,3 +240,16 @@ def replace_file(path: str | os.PathLike, text: str, field: str) -> None:
     with os.fdopen(fd, "w", encoding="utf-8") as out:
         out.write(text)
     os.replace(temporary, path)
+
+
+def check_output_target(path: str | os.PathLike, field: str, folder_ok: bool = True) -> None:
+    """Refuse an output path where something other than a regular file (or, with ``folder_ok``, a folder)
+    stands: writing there would feed a device or block on a FIFO, and replacing it atomically would put a
+    file where a device was."""
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return  # nothing there (or not reachable): the write itself says what is wrong
+    if stat.S_ISREG(mode) or stat.S_ISLNK(mode) or (folder_ok and stat.S_ISDIR(mode)):
+        return
+    raise ConfigError(field, f"{_kind(mode)}: swarmnav writes only regular files and folders", str(path))

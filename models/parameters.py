@@ -30,6 +30,7 @@ study, a log) only when the user passes ``--trust-code`` for that invocation;
 from __future__ import annotations
 
 import dataclasses
+import functools
 import types
 import typing
 from typing import Any
@@ -60,19 +61,27 @@ def _init_fields(cls: type) -> list[dataclasses.Field]:
     return [f for f in dataclasses.fields(cls) if f.init] if dataclasses.is_dataclass(cls) else []
 
 
-def parameter_ranges(cls: type) -> dict[str, Range]:
-    """Every declared range of a component class: its fields' (:func:`param`) over the class-level
-    ``parameter_ranges`` of the older form (its own over its bases')."""
-    merged: dict[str, Range] = {}
+def _declared(cls: type, key: str, older: str | None = None) -> dict[str, Any]:
+    """What the fields (:func:`param`) declare under ``key``, a class's own over its bases' (a subclass that
+    only changes a field's default keeps its base's declaration), over the older class-level dict ``older``."""
+    merged: dict[str, Any] = {}
     for klass in reversed(cls.__mro__):
-        merged.update(vars(klass).get("parameter_ranges", {}))
-    merged.update({f.name: f.metadata[_RANGE] for f in _init_fields(cls) if _RANGE in f.metadata})
+        if older is not None:
+            merged.update(vars(klass).get(older, {}))
+        own = vars(klass).get("__dataclass_fields__", {})
+        merged.update({name: f.metadata[key] for name, f in own.items() if key in f.metadata})
     return merged
+
+
+def parameter_ranges(cls: type) -> dict[str, Range]:
+    """Every declared range of a component class: its fields' (:func:`param`), and the class-level
+    ``parameter_ranges`` of the older form, its own over its bases'."""
+    return _declared(cls, _RANGE, "parameter_ranges")
 
 
 def parameter_choices(cls: type) -> dict[str, tuple[str, ...]]:
     """The strings each parameter declared with ``choices`` may take."""
-    return {f.name: f.metadata[_CHOICES] for f in _init_fields(cls) if _CHOICES in f.metadata}
+    return _declared(cls, _CHOICES)
 
 
 def _shown_default(f: dataclasses.Field) -> Any:
@@ -111,7 +120,7 @@ def parameter_table(cls: type, extra: tuple[type, tuple[str, ...], dict[str, Any
 
 def numeric_parameters(cls: type) -> tuple[str, ...]:
     """The init fields whose type admits an int or a float (bool excluded)."""
-    hints = typing.get_type_hints(cls)
+    hints = _type_hints(cls)
     out = []
     for f in dataclasses.fields(cls):
         annotation = hints.get(f.name, Any)
@@ -150,6 +159,12 @@ def refuse_code(registry: dict[str, type], kind: str, name: str, params: dict[st
                               f"(or give it on the command line: {option} {key}=...)", source)
 
 
+@functools.lru_cache(maxsize=None)
+def _type_hints(cls: type) -> dict[str, Any]:
+    """``typing.get_type_hints`` of a component class, once per class (it re-evaluates every annotation)."""
+    return typing.get_type_hints(cls)
+
+
 def register_component(registry: dict[str, type], kind: str, cls: type) -> type:
     """Add a component class to a registry under its ``name``; a missing or taken name is an error."""
     name = getattr(cls, "name", None)
@@ -182,7 +197,7 @@ def build_component(registry: dict[str, type], kind: str, name: str, params: dic
         refuse_code(registry, kind, name, params, source)
     cls = registry[name]
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
-    hints = typing.get_type_hints(cls)
+    hints = _type_hints(cls)
     ranges, choices = parameter_ranges(cls), parameter_choices(cls)
     table = TomlTable({} if params is None else params, f"{kind}.params", source)
     kwargs = {}

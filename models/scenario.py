@@ -25,6 +25,7 @@ from swarmnav.models.scenario_boxes import read_boxes
 from swarmnav.models.scenario_map import check_grid_size, read_map_section
 from swarmnav.models.scenario_obstacles import MOTION_KINDS, Obstacle, ObstacleWorld, read_obstacles  # noqa: F401
 from swarmnav.models.seeds import Seeds
+from swarmnav.models.occupancy import MAX_MAP_CELLS
 from swarmnav.models.robots import ROBOTS
 from swarmnav.models.toml_table import NON_NEGATIVE, POSITIVE, TomlTable, above, parse_toml, read_text, within
 from swarmnav.models.world import Box, Disc, OccupancyGrid, Pose2D, Rect, endpoint_problem
@@ -44,6 +45,8 @@ class SimSettings:
 
 
 SENSOR_MODELS = ("rangefinder", "detector")
+MAP_KNOWLEDGE = ("known", "unknown")
+POSE_SOURCES = ("truth", "odometry")
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,6 +91,27 @@ class Scenario:
     robot_model: str = "diff_drive"
     # The rangefinders' field of view (degrees): 360 is a full ring, less a laser's fan centred ahead.
     sensor_fov_deg: float = 360.0
+    # [knowledge]: what the robot is given.  map "known" (the static obstacles, in advance) or "unknown"
+    # (mapped online from the laser at map_cell_m, controllers.world_map); pose "truth" (the simulator's)
+    # or "odometry" (integrated wheel speeds, with encoder_noise: the relative standard deviation of each
+    # measured wheel speed, drawn from the world seed's streams).
+    map_knowledge: str = "known"
+    pose_source: str = "truth"
+    map_cell_m: float = 0.05
+    encoder_noise: float = 0.0
+
+    def with_knowledge(self, map_knowledge: str | None = None, pose_source: str | None = None) -> "Scenario":
+        """This scenario with the map or the pose source overridden (``--map`` / ``--pose``, a study axis).
+
+        Raises:
+            ConfigError: a value that is not one of :data:`MAP_KNOWLEDGE` / :data:`POSE_SOURCES`.
+        """
+        for name, value, choices in (("map", map_knowledge, MAP_KNOWLEDGE), ("pose", pose_source, POSE_SOURCES)):
+            if value is not None and value not in choices:
+                raise ConfigError(f"knowledge.{name}", f"must be one of {', '.join(choices)}, got {value!r}",
+                                  self.source_path)
+        return replace(self, map_knowledge=map_knowledge or self.map_knowledge,
+                       pose_source=pose_source or self.pose_source)
 
     @property
     def bounds(self) -> Rect:
@@ -195,6 +219,14 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
     sensor_range_m = sensors.number("range_m", ROBOTS[robot_model].default_range_m, bounds=within(MIN_LENGTH_M))
     sensor_model = sensors.string("model", "rangefinder", choices=SENSOR_MODELS)
     sensors.close()
+    knowledge = top.table("knowledge", {})
+    map_knowledge = knowledge.string("map", "known", choices=MAP_KNOWLEDGE)
+    pose_source = knowledge.string("pose", "truth", choices=POSE_SOURCES)
+    map_cell_m = knowledge.number("map_cell_m", 0.05, bounds=within(MIN_LENGTH_M))
+    encoder_noise = knowledge.number("encoder_noise", 0.0, bounds=within(0.0, 1.0))
+    knowledge.close()
+    if map_knowledge == "unknown":
+        check_grid_size(width_m, height_m, map_cell_m, "knowledge.map_cell_m", source, MAX_MAP_CELLS)
     planner_name, planner_params = _component(top.table("planner", {}), "astar")
     navigator_name, navigator_params = _component(top.table("navigator", {}), "follow")
     sim, cell_m, cell_given = _sim(top.table("sim", {}))
@@ -226,7 +258,8 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
         navigator_name=navigator_name, navigator_params=navigator_params, obstacles=obstacles,
         sim=sim, cell_m=cell_m, source_text=text, source_path=source, boxes=boxes, world_seed=seed,
         map_grid=map_grid, map_pairs=section.pairs if section is not None else (), sensor_model=sensor_model,
-        trust_code=bool(trust_code), robot_model=robot_model, sensor_fov_deg=sensor_fov_deg)
+        trust_code=bool(trust_code), robot_model=robot_model, sensor_fov_deg=sensor_fov_deg,
+        map_knowledge=map_knowledge, pose_source=pose_source, map_cell_m=map_cell_m, encoder_noise=encoder_noise)
     _check_endpoints(scenario, source)
     return scenario
 

@@ -72,11 +72,12 @@ def read_map_section(top: TomlTable, scenario_dir: FilePath, width_m: float, hei
     return MapSection(merge_boxes(grid.occupied, cell_m), grid, cell_m, tuple(tuple(p) for p in pairs))
 
 
-def check_grid_size(width_m: float, height_m: float, cell_m: float, field_name: str, source: str | None) -> None:
-    """The planning grid of the arena at ``cell_m``, against :data:`MAX_GRID_CELLS`."""
+def check_grid_size(width_m: float, height_m: float, cell_m: float, field_name: str, source: str | None,
+                    limit: int = MAX_GRID_CELLS) -> None:
+    """The planning grid of the arena at ``cell_m``, against :data:`MAX_GRID_CELLS` (or ``limit``)."""
     cells = math.ceil(min(width_m / cell_m, 1e300)) * math.ceil(min(height_m / cell_m, 1e300))
-    if cells > MAX_GRID_CELLS:
-        smallest = math.sqrt(width_m * height_m / MAX_GRID_CELLS)
+    if cells > limit:
+        smallest = math.sqrt(width_m * height_m / limit)
         fail(field_name, f"a {width_m:g} x {height_m:g} m arena at {cell_m:g} m per cell needs "
-                         f"{min(cells, 1e300):.4g} grid cells (at most {MAX_GRID_CELLS:,}; a cell of about "
+                         f"{min(cells, 1e300):.4g} grid cells (at most {limit:,}; a cell of about "
                          f"{smallest:.3g} m or more fits)", source)

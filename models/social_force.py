@@ -1,7 +1,8 @@
 """Helbing and Molnár (1995)'s social force model of pedestrians, one explicit step for a group at once.
 
 "Social force model for pedestrian dynamics", Phys. Rev. E 51(5), 4282-4286.  Written from the paper (no
-library: see the README's crowd section for why); the equation numbers are the paper's:
+library: see the README's crowd section for why); the equation numbers are the paper's as we recall its layout
+(its text was not available here to check them against):
 
 * Eq. (2): the acceleration toward the desired velocity, ``(v0 e - v) / tau``.
 * Eqs. (3)-(4): the repulsion of pedestrian beta, ``f = -grad_r V(b)`` with ``V(b) = V0 exp(-b / sigma)`` and

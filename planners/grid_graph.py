@@ -22,6 +22,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from swarmnav.models.scenario_limits import MAX_GRID_CELLS as MAX_SCENARIO_GRID_CELLS
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.errors import GoalBlocked, StartBlocked
@@ -37,7 +38,7 @@ STEP_COSTS = (1.0, 1.0, 1.0, 1.0, SQRT2, SQRT2, SQRT2, SQRT2)
 Cell = tuple[int, int]
 #: Most cells a grid planner's grid may have (a 100 x 100 m arena at 0.05 m is 4 M);
 #: the neighbour table alone takes 64 bytes a cell.
-MAX_GRID_CELLS = 5_000_000
+MAX_GRID_CELLS = 5_000_000  # the cells a grid planner searches (README Limits: planner grid cells)
 
 
 def grid_problem(problem: Problem, cell_m: float | None, max_cells: int = MAX_GRID_CELLS) -> Problem:
@@ -59,7 +60,8 @@ def grid_problem(problem: Problem, cell_m: float | None, max_cells: int = MAX_GR
         rows = max(1, math.ceil(b.height_m / problem.cell_m - 1e-9))
         if rows * cols > max_cells:
             raise ConfigError(field, f"a {b.width_m:g} x {b.height_m:g} m workspace at {problem.cell_m:g} m a cell "
-                              f"needs {rows * cols:,} grid cells, more than the maximum {max_cells:,}")
+                              f"needs {rows * cols:,} grid cells, more than the {max_cells:,} a grid planner searches "
+                              f"(a scenario itself may hold up to {MAX_SCENARIO_GRID_CELLS:,}: give a coarser cell_m)")
     return problem
 
 

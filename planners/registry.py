@@ -6,6 +6,7 @@ Importing this module imports every planner (and SciPy with the ant colonies);
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, TypeVar
 
 from swarmnav.planners.ant_system import AntSystemPlanner
@@ -19,6 +20,7 @@ from swarmnav.planners.waiter_ant_colony import WaiterAntColonyPlanner
 from swarmnav.planners.grey_wolf import GreyWolfPlanner
 from swarmnav.planners.optimal import OptimalPlanner
 from swarmnav.planners.particle_swarm import ParticleSwarmPlanner
+from swarmnav.planners.ompl_geometric import OMPL_GEOMETRIC_PLANNERS
 from swarmnav.planners.sampling_ompl import OMPL_PLANNERS
 from swarmnav.planners.errors import BudgetExceeded, GoalBlocked, NoPathFound, PlanningError, StartBlocked
 from swarmnav.models.errors import ConfigError
@@ -41,6 +43,8 @@ def register(cls: PlannerClass) -> PlannerClass:
                         "of {'discs', 'boxes'}")
     if not callable(getattr(cls, "plan", None)):
         raise TypeError(f"{cls.__name__} has no plan(problem, rng) method (planners.problem.Planner)")
+    if not dataclasses.is_dataclass(cls):  # its fields are its parameters (models.parameters.build_component)
+        raise TypeError(f"{cls.__name__} must be a dataclass: its fields are its parameters")
     register_component(PLANNERS, "planner", cls)
     return cls
 
@@ -48,7 +52,7 @@ def register(cls: PlannerClass) -> PlannerClass:
 for _cls in (StraightPlanner, AStarPlanner, DijkstraPlanner, ThetaStarPlanner, DStarLitePlanner,
              ImprovedMaxMinAntSystemPlanner, ImprovedAntColonyPlanner, WaiterAntColonyPlanner, AntSystemPlanner,
              OptimalPlanner, BeeColonyPlanner, AdaptiveLimitBeeColonyPlanner, GreyWolfPlanner,
-             ParticleSwarmPlanner, MaxMinColonyPlanner, *OMPL_PLANNERS):
+             ParticleSwarmPlanner, MaxMinColonyPlanner, *OMPL_PLANNERS, *OMPL_GEOMETRIC_PLANNERS):
     register(_cls)
 
 

@@ -23,7 +23,10 @@ BENCH_PLANNERS_SCENARIOS = ("gwo-scenario-1", "gwo-scenario-2", "gwo-scenario-3"
                             "adl-abc-path-1", "adl-abc-path-2", "adl-abc-path-3",
                             "dense-field-30", "restaurant-table-2", "restaurant-table-5")
 BENCH_PLANNERS_PLANNERS = ("abc", "adl_abc", "gwo", "pso")
-BENCH_PLANNERS_SAMPLING = ("rrt_star", "informed_rrt_star", "bit_star", "prm_star")  # OMPL's
+BENCH_PLANNERS_SAMPLING = ("rrt_star", "informed_rrt_star", "bit_star", "prm_star")  # OMPL's, run by default
+# Every OMPL planner `bench planners --sampling` can name (planners/sampling_ompl.py, planners/ompl_geometric.py).
+BENCH_PLANNERS_SAMPLING_CHOICES = (*BENCH_PLANNERS_SAMPLING, "rrt", "rrt_connect", "kpiece1", "bkpiece1", "lbkpiece1",
+                                   "prm", "fmt_star", "bfmt_star", "aorrtc")
 # bench navigation --quick: one world seed on one scenario of each generated kind.
 BENCH_NAVIGATION_QUICK_SCENARIOS = ("dyn-crossing-1", "dyn-head-on-1", "dyn-overtake-1", "dyn-crowd-1")
 BENCH_STUDY_QUICK = (10, 300)  # bench study --quick: seeds per scenario, GWO iterations; no Ray

@@ -41,6 +41,8 @@ from swarmnav.controllers.navigator import NavigationSetup, Navigator
 from swarmnav.controllers.navigators import NAVIGATORS, make_driver
 from swarmnav.controllers.point_to_point import PointToPointController
 from swarmnav.controllers.safety_layer import SafetyLayer
+from swarmnav.controllers.world_map import SensedMap
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Scenario
 from swarmnav.models.parameters import refuse_code
 from swarmnav.models.seeds import Seeds
@@ -219,8 +221,15 @@ def plan_episode(spec: EpisodeSpec | Composition, scene: CompiledScene | None = 
         PlanningError: the planner found no path.
     """
     parts = compose(spec, drive)  # a bad parameter fails before planning
-    problem = scenario_problem(parts.spec.scenario)
-    path = parts.planner.plan(problem, np.random.default_rng(parts.spec.seed))
+    scenario = parts.spec.scenario
+    # With the map unknown the first plan sees no static obstacle (moving ones neither: nothing is sensed yet).
+    problem = scenario_problem(scenario) if scenario.map_knowledge == "known" else unknown_map_problem(scenario)
+    try:
+        path = parts.planner.plan(problem, np.random.default_rng(parts.spec.seed))
+    except ConfigError as exc:  # a limit the planner met on this scenario: name the file too
+        if exc.source is not None:
+            raise
+        raise ConfigError(exc.field, exc.problem, scenario.source_path) from None
     return parts.episode(problem, path, scene)
 
 
@@ -235,6 +244,11 @@ def given_episode(spec: EpisodeSpec | Composition, waypoints: np.ndarray, source
     parts = compose(spec)
     problem, path = given_path(parts.spec.scenario, waypoints, source)
     return parts.episode(problem, path)
+
+
+def unknown_map_problem(scenario: Scenario) -> Problem:
+    """What the robot knows at t = 0 with the map unknown: the arena, its start and goal, no obstacle."""
+    return scenario_problem(replace(scenario, obstacles=(), boxes=(), map_grid=None))
 
 
 def build_planner(spec: EpisodeSpec) -> tuple[Any, bool]:
@@ -267,13 +281,18 @@ def run_episode(episode: Episode | EpisodeSpec, recorders: Sequence[Recorder] = 
     navigator = planned.navigator
     if navigator is None:
         raise ValueError("this episode was planned without a navigator (plan_episode(drive=False)): nothing to run")
+    unknown = scenario.map_knowledge == "unknown"
+    known_problem = static_problem(scenario) if not unknown else planned.problem
+    world_map = SensedMap(planned.problem, scenario.bounds, scenario.map_cell_m) if unknown else None
     setup = NavigationSetup(
-        path=planned.path, problem=planned.problem, planner=planned.planner if navigator.uses_planner else None,
+        path=planned.path, problem=planned.problem,
+        # With the map unknown every navigator that plans replans its (guidance) path on the sensed map.
+        planner=planned.planner if navigator.uses_planner or unknown else None,
         rng=np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(NAVIGATOR_STREAM,))),
         controller=PointToPointController(simulation.scene.drive, max_speed_m_s=scenario.max_speed_m_s),
         goal=simulation.goal_checker(), control_dt_s=simulation.control_dt_s,
-        max_speed_m_s=scenario.max_speed_m_s, known_problem=static_problem(scenario),
-        scenario=scenario)
+        max_speed_m_s=scenario.max_speed_m_s, known_problem=known_problem,
+        scenario=scenario, world_map=world_map)
     recorder = RecorderGroup(list(recorders)) if recorders else None
     # The log records every resolved parameter (replaying them builds the same planner).
     context = simulation.context(spec.planner, planned.planner_params or spec.planner_params, spec.seed,

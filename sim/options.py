@@ -11,7 +11,7 @@ import argparse
 import math
 from typing import Any
 
-from swarmnav.models.contained_files import loads_toml
+from swarmnav.models.contained_files import check_output_target, loads_toml
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario_limits import MAX_SETTING_CHARS
 
@@ -79,6 +79,22 @@ def float_in(low: float, high: float, low_open: bool = True):
         return value
     number.__name__ = "number"
     return number
+
+
+MAX_PATH_CHARS = 4_096  # Linux's PATH_MAX
+
+
+def output_path(text: str) -> str:
+    """An argument type: a file or folder to write, named (never empty: an empty --out is not "the default")."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("must name a file or folder, got an empty path")
+    if len(text) > MAX_PATH_CHARS or "\x00" in text:
+        raise argparse.ArgumentTypeError(f"not a usable path ({len(text):,} characters)")
+    try:
+        check_output_target(text, "path")
+    except ConfigError as exc:  # a device, a FIFO or a socket where the output would go
+        raise argparse.ArgumentTypeError(f"{text}: {exc.problem}") from None
+    return text
 
 
 def _integer(text: str) -> int:

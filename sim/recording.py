@@ -74,6 +74,7 @@ class StepFrame:
         moving_obstacles_m: (M, 2) positions of the moving obstacles, in ObstacleInfo order
             (only those with ``moving=True``).
         belief: what the navigator acted on (a :class:`~controllers.navigator.Belief`), or None.
+        odometry: the pose the navigator saw (a :class:`~models.world.Pose2D`) with the odometry pose; else None.
     """
 
     time_s: float
@@ -88,6 +89,7 @@ class StepFrame:
     waypoint_index: int
     moving_obstacles_m: np.ndarray
     belief: Any = None
+    odometry: Any = None
 
 
 class Recorder(Protocol):
@@ -122,6 +124,12 @@ class RecorderGroup:
     def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
         for r in self.recorders:
             r.event(time_s, kind, details)
+
+    def occupancy(self, time_s: float, grid: Any) -> None:
+        """The sensed map (a :class:`models.occupancy.LogOddsGrid`) to the recorders that draw it (optional)."""
+        for r in self.recorders:
+            if hasattr(r, "occupancy"):
+                r.occupancy(time_s, grid)
 
     def finish(self, summary: dict[str, Any]) -> None:
         error: BaseException | None = None

@@ -30,6 +30,9 @@ from swarmnav.sim.stepper import (EpisodeStepper, goal_checker, obstacle_positio
 from swarmnav.sim.versions import software_versions
 
 
+MAP_LOG_PERIOD_S = 1.0  # the sensed map on /map: once a simulated second (Nav2 publishes its global costmap at 1 Hz)
+
+
 class Simulation:
     """A scenario's compiled scene with a fresh ``MjData`` per run."""
 
@@ -101,7 +104,14 @@ class Simulation:
                                    sense_obstacles=navigator.uses_detections or layer is not None)
             observation = stepper.reset()
             clock = time.perf_counter
+            world_map = setup.world_map  # with the map unknown: fed every scan, before the navigator reads it
+            next_map_log_s = 0.0
             while not stepper.outcome:
+                if world_map is not None:
+                    world_map.observe(observation)
+                    if recorder is not None and observation.time_s >= next_map_log_s - 1e-9:
+                        next_map_log_s = observation.time_s + MAP_LOG_PERIOD_S
+                        recorder.occupancy(observation.time_s, world_map.grid)
                 nav0 = clock()
                 decision = navigator.step(observation)
                 if layer is not None:

@@ -86,6 +86,9 @@ def test_barn_like_worlds_are_seeded_passable_and_barn_shaped():
     assert not space[cells[:, 1], cells[:, 0]].any()      # the reference path runs over free C-space cells
     assert cells[0, 1] == 0 and cells[-1, 1] == 29 and np.abs(np.diff(cells, axis=0)).max() == 1
     assert all(c.radius_m == 0.075 for c in world.cylinders)
+    from swarmnav.sim.benchmarks.barn_like import draw_field, clear_passage, passable
+    dense = draw_field(np.random.default_rng(0), 0.30, 2)        # BARN's densest pair: a passage is cut
+    assert not passable(dense) and passable(clear_passage(dense)) and clear_passage(dense)[:, [0, -1]].all()
     assert {round(c.x_m, 3) for c in world.cylinders if c.y_m < 5} == {-4.425, -0.075} | {
         round(0.15 * k - 4.575, 3) for k in range(2, 30)}  # the entry corridor's walls, as in BARN's files
 

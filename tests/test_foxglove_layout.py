@@ -45,8 +45,9 @@ def test_layout_panels_read_topics_a_log_has(tmp_path):
     run_episode(EpisodeSpec(load_scenario("gwo-scenario-2")), [McapRecorder(path)])
     log = read_log(path)
     used = set().union(*(_topics(p) for p in panels))
-    # /navigator appears only in logs of navigators that sense; every other topic is in every log.
-    assert used - {"/navigator"} <= set(log.counts), used - set(log.counts)
+    # /navigator appears only in logs of navigators that sense, /map with the map unknown, /odom with the
+    # odometry pose; every other topic is in every log.
+    assert used - {"/navigator", "/map", "/odom"} <= set(log.counts), used - set(log.counts)
     assert {"/scene", "/obstacles", "/wheels", "/events", "/range/scan"} <= used
     wheels = next(p for p in panels if any(s["value"].startswith("/wheels.") for s in p["config"].get("paths", [])))
     fields = {s["value"].split(".", 1)[1] for s in wheels["config"]["paths"]}
@@ -71,7 +72,8 @@ def test_ros2_layout_is_the_sdk_build_on_topics_a_ros2_log_has(tmp_path, capsys)
                 time_limit_s=2.0)
     log = read_log(path)
     used = set().union(*(_topics(p) for p in panels))
-    assert used - {"/navigator"} <= set(log.counts), used - set(log.counts)
+    # /navigator and /map are in logs of sensing navigators and of runs with the map unknown only.
+    assert used - {"/navigator", "/map"} <= set(log.counts), used - set(log.counts)
     assert {"/scene", "/obstacles", "/plan", "/scan", "/joint_states", "/wheels/command", "/rosout"} <= used
     scene = next(p for p in panels if p["panelType"] == "ThreeDee")
     with path.open("rb") as stream:

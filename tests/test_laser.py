@@ -80,3 +80,20 @@ def test_bad_laser_fields_name_the_field(field, value, text):
     kwargs["fov" if field == "fov_deg" else "count"] = value
     with pytest.raises(ConfigError, match=text):
         laser(**kwargs)
+
+
+@pytest.mark.parametrize("text, field", [('robot = { model = "roomba" }', "robot.model"),
+                                         ("sensors = { count = 12, fov_deg = 400.0 }", "sensors.fov_deg"),
+                                         ("sensors = { count = 5000 }", "sensors.count"),
+                                         ('knowledge = { map = "unknown", map_cell_m = 0.0001 }',
+                                          "knowledge.map_cell_m")])
+def test_bad_robot_laser_and_map_input_is_one_line_naming_the_field_exit_2(tmp_path, capsys, text, field):
+    from swarmnav.sim.cli.main import main
+    body = LASER.format(model="jackal", count=12, fov=360.0, heading=0.0)
+    key = text.split(" = ", 1)[0]
+    body = "\n".join(line for line in body.splitlines() if not line.startswith(key + " ")) + "\n" + text + "\n"
+    path = tmp_path / "bad.toml"
+    path.write_text(body)
+    code = main(["run", str(path), "--no-log"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and field in err[0] and "bad.toml" in err[0], err

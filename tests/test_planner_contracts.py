@@ -34,6 +34,8 @@ def small_budget(name: str) -> dict:
         params.update(ants=10, iterations=10)
     if "round_evaluations" in fields:  # the OMPL planners: a budget of collision checks
         params.update(max_evaluations=1000)
+    if "num_samples" in fields:  # FMT*'s batch: sampled (and checked) before it searches, so within the budget
+        params.update(num_samples=300)
     return params
 
 
@@ -70,6 +72,17 @@ def test_the_registry_holds_and_builds_planners_only():
     with pytest.raises(TypeError, match="no plan"):
         register(Planless)
     assert "planless" not in PLANNERS
+
+    class Plain:  # its parameters would be its dataclass fields: a plain class could not be built by name
+        name = "plain"
+        supports = frozenset({"discs"})
+
+        def plan(self, problem, rng):
+            raise NotImplementedError
+
+    with pytest.raises(TypeError, match="must be a dataclass"):
+        register(Plain)
+    assert "plain" not in PLANNERS
     for name in PLANNERS:
         assert isinstance(make_planner(name), Planner), name
 

@@ -71,12 +71,14 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.replan import keep_outside
 from swarmnav.controllers.prediction import swept_discs
 from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
+from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario_limits import MAX_GRID_CELLS
 from swarmnav.models.world import rasterise
 from swarmnav.planners.dstar_lite import DStarLite
@@ -116,6 +118,8 @@ class DStarReplanNavigator:
     def reset(self, setup: NavigationSetup) -> None:
         known = setup.map_problem
         self.known = known
+        self.setup = setup
+        self.map_revision = setup.map_revision
         self.controller = setup.controller
         if known.grid_override is not None:
             self.grid = known.grid_override
@@ -183,7 +187,7 @@ class DStarReplanNavigator:
     def _mark(self, observation: Observation) -> bool:
         """Mark this step's sweeps; True when any cell changed (and D* Lite was told)."""
         pose = observation.pose
-        occupied = self.static
+        occupied = self._map_cells()
         self.sweeps = []
         if observation.detections:
             self.sweeps = keep_outside(swept_discs(observation.detections, self.horizon_s),
@@ -197,6 +201,17 @@ class DStarReplanNavigator:
         self.current = occupied
         self.dstar.update_cells({(int(r), int(c)): bool(occupied[r, c]) for r, c in flips})
         return True
+
+    def _map_cells(self) -> np.ndarray:
+        """The map's blocked cells: fixed with a known map; with the map unknown, the sensed map's latest
+        publication rasterised on this grid (its changes reach D* Lite with the sweeps', as cell updates)."""
+        if self.setup.map_revision != self.map_revision:
+            self.map_revision = self.setup.map_revision
+            known = self.known = self.setup.map_problem
+            cells = rasterise(known.bounds, known.obstacles, known.boxes, known.inflation_m, self.grid.cell_m).occupied
+            if cells.shape == self.static.shape:
+                self.static = cells
+        return self.static
 
     def _rasterise(self, inflation_m: float) -> np.ndarray | None:
         """This step's sweeps on the grid's cells, grown by ``inflation_m`` (None with none)."""
@@ -243,6 +258,8 @@ class DStarReplanNavigator:
         if not on_path:
             return "left the path"
         rest = self.cells[self.at:]
+        if self.setup.world_map is not None and any(self.static[r, c] for r, c in rest):
+            return "blocked on the sensed map"
         # Blocked: a sweep grown by the bare inflation (without margin_m) covers a cell still to come.
         marks = self._rasterise(self.known.inflation_m)
         if marks is not None and any(marks[r, c] for r, c in rest):

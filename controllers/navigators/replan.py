@@ -56,6 +56,7 @@ from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_discs
+from swarmnav.controllers.guided import free_start
 from swarmnav.models.world import Disc, Pose2D, rasterise
 from swarmnav.planners.errors import PlanningError, StartBlocked
 from swarmnav.planners.problem import Path, Problem
@@ -120,9 +121,14 @@ class ReplanNavigator:
     retry_s: float = param(0.5, above(0, 1e6))
     planning_latency_s: float = param(0.0, within(0, 1e6))
 
+    @property
+    def known(self) -> Problem:
+        """The map it plans on (``NavigationSetup.map_problem``: the known map, or the sensed map's latest)."""
+        return self.setup.map_problem
+
     def reset(self, setup: NavigationSetup) -> None:
         self.setup = setup
-        self.known = setup.map_problem
+        self.checked_revision = setup.map_revision
         self.controller = setup.controller
         self.path = setup.path
         self.controller.reset(setup.path)
@@ -162,10 +168,15 @@ class ReplanNavigator:
         return self._finish(observation, command, events, new_path)
 
     def blocked(self, observation: Observation) -> str:
-        """A reason to replan ("blocked by sensed obstacle") or ""."""
+        """A reason to replan ("blocked by sensed obstacle", "blocked on the sensed map") or ""."""
+        pose = observation.pose
+        if self.setup.map_revision != self.checked_revision:  # the sensed map changed (never with a known map)
+            self.checked_revision = self.setup.map_revision
+            rest = path_ahead(pose, self.path.waypoints, self.controller.waypoint_index, math.inf)
+            if self.setup.world_map.blocks(rest):
+                return "blocked on the sensed map"
         if not observation.detections:
             return ""
-        pose = observation.pose
         ahead = path_ahead(pose, self.path.waypoints, self.controller.waypoint_index, self.lookahead_m)
         # The same discs a replan would plan around (kept off the robot), so a fresh path is not blocked at once.
         sweeps = keep_outside(swept_discs(observation.detections, self.horizon_s), [(pose.x_m, pose.y_m)],
@@ -188,8 +199,9 @@ class ReplanNavigator:
             try:
                 path = self.setup.planner.plan(problem, self.setup.rng)
             except StartBlocked:
-                # The robot has cut within the clearance of a known obstacle: plan with no clearance.
-                problem = replace(problem, clearance_m=0.0)
+                # The robot has cut within the clearance of a known obstacle: plan with no clearance
+                # (and, on a sensed map, whose cells are coarser than the obstacles, from the nearest free point).
+                problem = replace(problem, clearance_m=0.0) if self.setup.world_map is None else free_start(problem)
                 path = self.setup.planner.plan(problem, self.setup.rng)
             ok = problem.is_collision_free(path.waypoints, tolerance_m=1e-6)
             why = "" if ok else "the planner's path is not collision-free"

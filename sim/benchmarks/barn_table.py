@@ -19,7 +19,7 @@ from swarmnav.models.errors import ConfigError
 RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results"
 RESULTS = (RESULTS_DIR / "barn-test50.json", RESULTS_DIR / "barn-test10-dwa-vo.json", RESULTS_DIR / "barn.json",
            RESULTS_DIR / "barn-like.json", RESULTS_DIR / "barn-jackal-test10.json")
-ALL_300, FRESH = RESULTS[2], RESULTS[3]  # compared: BARN's 300 against BARN-like worlds at fresh seeds
+TEST_50, ALL_300, FRESH = RESULTS[0], RESULTS[2], RESULTS[3]  # compared: BARN-like worlds against BARN's
 BEGIN = "<!-- barn-table: generated from models/suites/results/barn*.json by `make readme-table`; do not edit by hand -->"
 END = "<!-- end of barn-table -->"
 ORACLE = "oracle"
@@ -100,16 +100,22 @@ def difficulty_lines(rows: list[dict[str, Any]]) -> list[str]:
 
 
 def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
-    """The BARN-like worlds' figures against the 300's, navigator by navigator (issue 34's check: within 0.05)."""
-    if ALL_300 not in results or FRESH not in results or not (ALL_300.is_file() and FRESH.is_file()):
+    """The BARN-like worlds' figures against BARN's (the 300 when committed, else the 50 test worlds), navigator
+    by navigator, same setup only (issue 34's check: within 0.05)."""
+    against = next((p for p in (ALL_300, TEST_50) if p in results and p.is_file()), None)
+    if against is None or FRESH not in results or not FRESH.is_file():
         return []
-    base = {r["navigator"]: r for r in read_result(ALL_300) if r.get("scenario") is None}
-    fresh = {r["navigator"]: r for r in read_result(FRESH) if r.get("scenario") is None}
+    base_rows, fresh_rows = read_result(against), read_result(FRESH)
+    base = {r["navigator"]: r for r in base_rows if r.get("scenario") is None}
+    fresh = {r["navigator"]: r for r in fresh_rows if r.get("scenario") is None}
     lines = []
     for name in [n for n in fresh if n in base]:
         b, f = base[name], fresh[name]
         ds, dsc = f["success_rate"] - b["success_rate"], (f["barn_score"] or 0.0) - (b["barn_score"] or 0.0)
-        lines.append(f"BARN-like worlds against BARN's 300, `{name}`: success {f['success_rate']:.3f} vs "
+        if f["barn_setup"] != b["barn_setup"]:
+            continue
+        lines.append(f"BARN-like worlds (`{FRESH.name}`) against BARN's (`{against.name}`), `{name}`: success "
+                     f"{f['success_rate']:.3f} vs "
                      f"{b['success_rate']:.3f} ({ds:+.3f}), score {f['barn_score']:.4f} vs {b['barn_score']:.4f} "
                      f"({dsc:+.4f}): {'within' if abs(ds) <= 0.05 and abs(dsc) <= 0.05 else 'NOT within'} 0.05.")
     return lines + [""] if lines else []

@@ -111,7 +111,9 @@ def _env_replay_steps_per_s(env, wheel_commands: np.ndarray) -> float:
     env.reset(seed=0)
     t0 = time.perf_counter()
     for command in wheel_commands:
-        env.step(command)
+        _, _, terminated, truncated, _ = env.step(command)
+        if terminated or truncated:  # a --duration beyond the scenario's time limit: the next episode
+            env.reset()
     return len(wheel_commands) / (time.perf_counter() - t0)
 
 

@@ -55,13 +55,14 @@ def _closed_loop(simulation: Simulation, planned: Episode, duration_s: float, re
 
 
 def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.0,
-                  repeats: int = 3, with_logging: bool = True) -> dict[str, float | int | str]:
+                  repeats: int = 3, with_logging: bool = True, sensing: bool = True) -> dict[str, float | int | str]:
     """Measure closed-loop and bare stepping rates; returns the figures ``bench sim`` prints.
 
     The closed loop is 500 Hz physics, 50 Hz control, 12 rangefinders, the
     collision and clearance checks, no logging; the logging row adds the MCAP
     recorder.  ``duration_s`` must be shorter than the run to the goal so that
-    every measurement covers the same simulated time.
+    every measurement covers the same simulated time.  ``sensing``: also the laser, sensed-map and Jackal
+    lines of :mod:`sim.benchmarks.sensing`.
     """
     scenario = load_scenario(scenario_name)
     if not duration_s * scenario.sim.control_hz <= MAX_CONTROL_STEPS:
@@ -109,6 +110,9 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
         figures["logging_steps_per_s"] = statistics.median(logging)
         figures["logging_ratio"] = statistics.median(logging_ratios)
         figures["target_logging_ratio"] = TARGET_LOGGING_RATIO
+    if sensing:
+        from swarmnav.sim.benchmarks.sensing import sensing_figures
+        figures.update(sensing_figures(duration_s, repeats))
     return figures
 
 

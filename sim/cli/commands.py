@@ -16,7 +16,7 @@ from swarmnav.sim import options
 from swarmnav.sim.defaults import (  # noqa: F401  (re-exported: the CLI's own defaults)
     SINGLE_THREAD_ENVIRONMENT, DEFAULT_FPS, LOG_FORMATS, MIN_FPS, MAX_FPS, MIN_DPI, MAX_DPI, BENCH_SIM_QUICK,
     BENCH_ENV_QUICK, BENCH_RENDER_QUICK_FRAMES, BENCH_PLANNERS_SCENARIOS, BENCH_PLANNERS_PLANNERS,
-    BENCH_PLANNERS_SAMPLING, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
+    BENCH_PLANNERS_SAMPLING, BENCH_PLANNERS_SAMPLING_CHOICES, BENCH_NAVIGATION_QUICK_SCENARIOS, BENCH_STUDY_QUICK)
 from swarmnav.models.scenario_limits import (MAX_BENCH_DURATION_S, MAX_BENCH_FRAMES, MAX_BENCH_REPEATS, MAX_BENCH_RUNS,
                                              MAX_BENCH_SEEDS, MAX_STUDY_RUNS, MAX_WORKERS)
 from swarmnav.sim.options import add_trust_code_argument  # noqa: F401
@@ -51,9 +51,11 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenarios", nargs="+", default=list(BENCH_PLANNERS_SCENARIOS), metavar="NAME")
     parser.add_argument("--planners", nargs="+", default=list(BENCH_PLANNERS_PLANNERS), choices=BENCH_PLANNERS_PLANNERS,
                         metavar="NAME", help=f"continuous planners among {', '.join(BENCH_PLANNERS_PLANNERS)}")
-    parser.add_argument("--sampling", nargs="*", default=list(BENCH_PLANNERS_SAMPLING), choices=BENCH_PLANNERS_SAMPLING,
-                        metavar="NAME", help=f"OMPL planners among {', '.join(BENCH_PLANNERS_SAMPLING)}, given "
-                        "population x iterations collision checks (default all; none: --sampling alone)")
+    parser.add_argument("--sampling", nargs="*", default=list(BENCH_PLANNERS_SAMPLING),
+                        choices=BENCH_PLANNERS_SAMPLING_CHOICES, metavar="NAME",
+                        help=f"OMPL planners among {', '.join(BENCH_PLANNERS_SAMPLING_CHOICES)}, given population x "
+                        f"iterations collision checks (default {', '.join(BENCH_PLANNERS_SAMPLING)}; "
+                        "none: --sampling alone)")
     parser.add_argument("--seeds", type=RUNS, default=10, help="runs per planner and scenario (default 10)")
     parser.add_argument("--population", type=options.int_in(1, 1_000_000), default=50)
     parser.add_argument("--iterations", type=options.int_in(1, 1_000_000), default=100)
@@ -64,7 +66,7 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--modes", nargs="+", default=["paper", "robust"], choices=["paper", "robust"])
     parser.add_argument("--fields", type=options.int_in(0, MAX_BENCH_RUNS), default=10,
                         help="random disc fields of 10-40 discs (default 10; 0: none)")
-    parser.add_argument("--out", metavar="DIR", help="keep the quality studies' rows in DIR/scenarios and DIR/fields "
+    parser.add_argument("--out", type=options.output_path, metavar="DIR", help="keep the quality studies' rows in DIR/scenarios and DIR/fields "
                         "(study folders: `swarmnav report DIR/scenarios`); a folder that holds them already resumes. "
                         "Default: a temporary folder")
     parser.add_argument("--workers", type=WORKERS, default=1,
@@ -88,7 +90,7 @@ def add_bench_grid_arguments(parser: argparse.ArgumentParser) -> None:
                         help="plan every start/goal pair of each map's [map].pairs, not only the scenario's")
     parser.add_argument("--swarm-sample", type=RUNS, default=20,
                         help="Moving AI instances per map on which immas and iaco report their ratio")
-    parser.add_argument("--out", metavar="DIR", help="keep the quality studies' rows in DIR/maps, DIR/restaurant and "
+    parser.add_argument("--out", type=options.output_path, metavar="DIR", help="keep the quality studies' rows in DIR/maps, DIR/restaurant and "
                         "DIR/movingai (study folders: `swarmnav report DIR/maps`); default: a temporary folder")
     parser.add_argument("--quick", action="store_true",
                         help="the two slowest maps, 2 runs, 50 Moving AI instances a map, 1 swarm sample (under a minute)")
@@ -142,7 +144,7 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
                              "e.g. iaco_local+evade:iaco_local:evade=true")
     parser.add_argument("--by-scenario", action="store_true",
                         help="also one row per navigator and scenario, after the overall rows")
-    parser.add_argument("--out", metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
+    parser.add_argument("--out", type=options.output_path, metavar="DIR", help="keep the runs (a study folder: `swarmnav report DIR`); "
                         "default: a temporary folder")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON (no progress bar)")
     parser.add_argument("--suite", choices=("dyn", "papers", "dyn300", "barn", "barn-like", "crowdnav"),
@@ -268,7 +270,7 @@ def run_log_info(args: argparse.Namespace) -> int:
 
 def add_log_recover_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", metavar="IN", help="a (possibly truncated) .mcap file")
-    parser.add_argument("target", metavar="OUT", help="the complete, indexed .mcap file to write")
+    parser.add_argument("target", metavar="OUT", type=options.output_path, help="the complete, indexed .mcap file to write")
 
 
 def run_log_recover(args: argparse.Namespace) -> int:
@@ -278,7 +280,7 @@ def run_log_recover(args: argparse.Namespace) -> int:
 
 def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", help="an .mcap run log")
-    parser.add_argument("--video", metavar="OUT.mp4", help="render the run to an MP4 (offscreen EGL)")
+    parser.add_argument("--video", type=options.output_path, metavar="OUT.mp4", help="render the run to an MP4 (offscreen EGL)")
     parser.add_argument("--camera", choices=("top", "chase", "follow"), default="top",
                         help="top: the whole arena; chase: behind the robot; follow: straight down on the robot")
     parser.add_argument("--width", type=int, default=640)
@@ -302,7 +304,7 @@ def run_replay(args: argparse.Namespace) -> int:
 
 def add_plot_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", help="an .mcap run log")
-    parser.add_argument("-o", "--out", required=True, help="image to write (.png, .svg, .pdf)")
+    parser.add_argument("-o", "--out", type=options.output_path, required=True, help="image to write (.png, .svg, .pdf)")
     parser.add_argument("--dpi", type=int, default=120, help=f"dots per inch, {MIN_DPI}..{MAX_DPI}")
 
 
@@ -312,7 +314,8 @@ def run_plot(args: argparse.Namespace) -> int:
 
 
 def add_foxglove_layout_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("-o", "--out", metavar="FILE", help="write the layout to FILE (default: print it)")
+    parser.add_argument("-o", "--out", type=options.output_path, metavar="FILE",
+                         help="write the layout to FILE (default: print it)")
     parser.add_argument("--log-format", choices=LOG_FORMATS, default="swarmnav",
                         help="the layout for logs of this format (run --log-format)")
 

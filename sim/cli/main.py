@@ -10,6 +10,7 @@ difference; 5 a CI check fell short (``run --expect``, ``study --min-success``).
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import os
 import signal
@@ -58,11 +59,13 @@ class OneLineParser(argparse.ArgumentParser):
 def _load(args: argparse.Namespace):
     """The scenario (a bundled one, a plugin's: :func:`main` has loaded the plugins once for the command);
     ``--trust-code``: its code parameters may run; its own planner and navigator tables are checked on load,
-    whatever ``--planner`` overrides."""
+    whatever ``--planner`` overrides.  ``run``'s ``--map`` / ``--pose`` override its ``[knowledge]``."""
     from swarmnav.calls import check_components
     from swarmnav.models.scenario import load_scenario
     scenario = load_scenario(args.scenario, args.trust_code)
     check_components(scenario, args.trust_code)
+    if getattr(args, "map", None) or getattr(args, "pose", None):
+        scenario = scenario.with_knowledge(getattr(args, "map", None), getattr(args, "pose", None))
     return scenario
 
 
@@ -172,7 +175,7 @@ def _add_generate_options(p: argparse.ArgumentParser) -> None:
     from swarmnav.models.scenario_generator import KINDS, GeneratorOptions
     p.add_argument("kind", metavar="KIND", help=f"one of: {', '.join(KINDS)}")
     p.add_argument("--seed", type=options.seed, required=True, help="the layout's seed (same seed, same file)")
-    p.add_argument("--out", help="write the TOML here (default: print it)")
+    p.add_argument("--out", type=options.output_path, help="write the TOML here (default: print it)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
     for name, kind in (("obstacles", int), ("speed_ratio", float), ("radius_min_m", float),
                        ("radius_max_m", float), ("arena_m", float), ("sensor_model", str), ("range_m", float),
@@ -305,22 +308,28 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("run", help="plan and simulate a scenario in MuJoCo")
     _add_run_options(p)
-    p.add_argument("--out", help="MCAP log path (default: logs/<scenario>_<planner>_seed<N>_<stamp>.mcap)")
+    p.add_argument("--out", type=options.output_path, help="MCAP log path (default: logs/<scenario>_<planner>_seed<N>_<stamp>.mcap)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
     p.add_argument("--no-log", action="store_true", help="write no MCAP log")
     p.add_argument("--log-format", choices=LOG_FORMATS, default="swarmnav",
                    help="swarmnav (Foxglove's schemas, the default) or ros2 (CDR, the standard ROS 2 types)")
     p.add_argument("--live", action="store_true", help="also serve the channels to Foxglove on 127.0.0.1")
-    p.add_argument("--video", help="render an MP4 while running (offscreen EGL)")
+    p.add_argument("--video", type=options.output_path, help="render an MP4 while running (offscreen EGL)")
     p.add_argument("--camera", default="top", choices=("top", "chase", "follow"),
                    help="top: the whole arena; chase: behind the robot; follow: straight down on the robot")
     p.add_argument("--width", type=int, default=640)
     p.add_argument("--height", type=int, default=480)
     p.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per simulated second, 0.1..240")
     p.add_argument("--stop-on-collision", action="store_true", help="stop at the first collision")
+    p.add_argument("--map", choices=("known", "unknown"),
+                   help="the static map given in advance (known) or built from the laser as the robot drives "
+                   "(unknown); default: the scenario's knowledge.map")
+    p.add_argument("--pose", choices=("truth", "odometry"),
+                   help="the pose the navigator sees: the simulator's (truth) or integrated wheel speeds "
+                   "(odometry); default: the scenario's knowledge.pose")
     p.add_argument("--waypoints", metavar="FILE", help="drive this path instead of planning: CSV with x,y columns, "
                    "a JSON list of [x, y] pairs, or the output of `plan --json`")
-    p.add_argument("--json-out", metavar="FILE", help="also write the `--json` object to FILE")
+    p.add_argument("--json-out", type=options.output_path, metavar="FILE", help="also write the `--json` object to FILE")
     p.add_argument("--expect", choices=("success", "reached"),
                    help=f"exit {EXIT_EXPECTATION} unless the goal is reached with no collision (success) or reached "
                    "at all (reached): a CI smoke check")
@@ -345,11 +354,19 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+@functools.cache
+def _parser() -> argparse.ArgumentParser:
+    """The parser, built once per process and reused (``parse_args`` leaves it as it was): a process that
+    calls :func:`main` many times (the tests, a script) spent most of each call building it, with
+    argparse's message look-ups for every option."""
+    return build_parser()
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``swarmnav`` console script."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, stop_signal.exit_on_signal)
-    parser = build_parser()
+    parser = _parser()
     args = parser.parse_args(argv)
     if args.command in PLUGIN_COMMANDS:
         from swarmnav.sim.plugins import load_plugins

@@ -12,6 +12,7 @@ import os
 import sys
 from pathlib import Path as FilePath
 
+from swarmnav.sim import options  # noqa: E402  (light: argparse types only)
 from swarmnav.sim.defaults import LOG_FORMATS
 
 WORKERS_PER_CORE = 8  # --workers at most this many per core of the machine
@@ -19,7 +20,7 @@ WORKERS_PER_CORE = 8  # --workers at most this many per core of the machine
 
 def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", help="bundled study name (see `swarmnav studies`) or path to a study .toml")
-    p.add_argument("--out", help="directory of the rows (default: studies/<study name>); run again to resume")
+    p.add_argument("--out", type=options.output_path, help="directory of the rows (default: studies/<study name>); run again to resume")
     p.add_argument("--workers", type=int, help="worker processes, or local Ray CPUs (default: the number of cores)")
     p.add_argument("--engine", choices=("local", "ray"), default="local",
                    help="local processes, or Ray tasks (needs the ray extra: pip install 'swarmnav[ray]')")
@@ -37,7 +38,7 @@ def add_study_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON summary; no progress bar")
     from swarmnav.sim.options import add_trust_code_argument
     add_trust_code_argument(p)
-    p.add_argument("--junit", metavar="FILE", help="write the study's rows as JUnit XML (one test suite per scenario, "
+    p.add_argument("--junit", type=options.output_path, metavar="FILE", help="write the study's rows as JUnit XML (one test suite per scenario, "
                    "a failure per row that is not a success)")
     p.add_argument("--min-success", type=_rate, metavar="RATE",
                    help="exit 5 when a configuration's (scenario, planner, navigator) success rate is below RATE")
@@ -160,7 +161,7 @@ def run_studies(args: argparse.Namespace) -> int:
 
 def add_report_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("dir", nargs="?", help="a study's output directory (holding runs.parquet)")
-    p.add_argument("--out", help="HTML report path (default: DIR/report.html); the Markdown twin and claims.json "
+    p.add_argument("--out", type=options.output_path, help="HTML report path (default: DIR/report.html); the Markdown twin and claims.json "
                                  "go beside it")
     p.add_argument("--json", action="store_true", help="print the claims' verdicts (claims.json) instead")
     p.add_argument("--readme-table", nargs="+", metavar="PATH",
@@ -172,7 +173,8 @@ def add_report_arguments(p: argparse.ArgumentParser) -> None:
                         "produced by today's study files, component sources, scenarios and swarmnav version: "
                         "exit 5 naming each stale claim and what changed, 0 when all are fresh")
     p.add_argument("--names", action="store_true", help="with --check-fresh: print only the stale studies' names")
-    p.add_argument("--ompl-log", metavar="OUT", help="also write the rows as OMPL benchmark logs, OUT/<scenario>.log "
+    p.add_argument("--ompl-log", type=options.output_path, metavar="OUT",
+                    help="also write the rows as OMPL benchmark logs, OUT/<scenario>.log "
                    "(one experiment each), for `ompl_benchmark_statistics OUT/*.log -d bench.db` and Planner Arena")
 
 

@@ -34,6 +34,13 @@ Channels (Foxglove well-known protobuf schemas unless said otherwise):
                         that use the sensing, from the first step they sensed something,
                         then every step until they sense nothing (one update that only
                         deletes).  Not in :data:`CHANNELS`: readers leave it alone.
+``/map``                Grid in ``world``: the occupancy grid the laser built, once a
+                        simulated second; only with the map unknown (``knowledge.map``).
+                        One int8 field ``occupancy``: percent, -1 never seen.  Optional.
+``/odom``               PoseInFrame in ``world``: the pose the navigator saw, integrated
+                        from the wheels' speeds, every control step; only with
+                        ``knowledge.pose = "odometry"`` (``/robot/pose`` stays the truth).
+                        Optional.
 ======================  ===============================================================
 
 Profile ``ros2`` (``--log-format ros2``): CDR messages with ``ros2msg`` schemas of the standard
@@ -59,8 +66,8 @@ ROS 2 types (:mod:`sim.log.ros2_types`), frames after REP 105 (``map`` -> ``odom
                         entity id); sent as ``/obstacles`` above
 ``/scene``              visualization_msgs/MarkerArray at t = 0: arena outline, footprint
 ``/navigator``          visualization_msgs/MarkerArray: what the navigator acted on (as above)
-``/map``                nav_msgs/OccupancyGrid: the map the robot builds, when the run's map
-                        is unknown (written only when the run carries one)
+``/map``                nav_msgs/OccupancyGrid in ``map``: the map the robot builds, when the
+                        run's map is unknown (the same cells as the Grid above)
 ``/rosout``             rcl_interfaces/Log: one per event, ``msg`` as ``/events`` above
 ``/clock``              rosgraph_msgs/Clock: simulation time, every control step
 ======================  ===============================================================
@@ -156,6 +163,8 @@ ARENA_ENTITY = "arena"
 FOOTPRINT_ENTITY = "robot_footprint"
 TOPICS = tuple(CHANNELS)
 NAVIGATOR_TOPIC = "/navigator"  # a foxglove.SceneUpdate; optional (see the table above)
+MAP_TOPIC = "/map"  # a foxglove.Grid; optional (see the table above)
+ODOM_TOPIC = "/odom"  # a foxglove.PoseInFrame; optional (see the table above)
 
 
 def events_topic(profile: str) -> str:
@@ -218,7 +227,7 @@ def metadata_value(text: str) -> Any:
     """The value :func:`metadata_text` wrote: JSON where the text is JSON, else the text itself."""
     try:
         return json.loads(text)
-    except ValueError:
+    except (ValueError, RecursionError):  # not JSON (or nested beyond the parser): the text itself
         return text
 
 

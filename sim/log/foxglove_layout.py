@@ -24,7 +24,9 @@ from pathlib import Path
 from swarmnav.sim import palette
 from swarmnav.sim.log.format import (
     EVENTS_TOPIC,
+    MAP_TOPIC,
     NAVIGATOR_TOPIC,
+    ODOM_TOPIC,
     ROS2_EVENTS_TOPIC,
     ROS2_PROFILE,
     SCENE_TOPIC,
@@ -45,18 +47,27 @@ def build_layout(log_format: str = "swarmnav") -> str:
 
     ros2 = log_format == ROS2_PROFILE
     path_topic, scan_topic = ("/plan", "/scan") if ros2 else ("/planner/path", "/range/scan")
-    topics = {topic: fl.BaseRendererSceneUpdateTopicSettings(visible=True)
-              for topic in (SCENE_TOPIC, "/obstacles", NAVIGATOR_TOPIC)}
+    markers = fl.BaseRendererRosMarkerTopicSettings if ros2 else fl.BaseRendererSceneUpdateTopicSettings
+    topics = {topic: markers(visible=True) for topic in (SCENE_TOPIC, "/obstacles", NAVIGATOR_TOPIC)}
     topics[path_topic] = fl.BaseRendererPosesTopicSettings(visible=True, type="line", line_width=0.04,
                                                            gradient=(palette.PLANNED, palette.PLANNED))
     topics[scan_topic] = fl.BaseRendererLaserScanTopicSettings(visible=True)
     if ros2:
+        # The sensed map (only in logs with the map unknown), drawn as Foxglove draws a ROS map.
+        topics[MAP_TOPIC] = fl.BaseRendererRosOccupancyGridTopicSettings(visible=True, color_mode="map",
+                                                                        draw_behind=True, alpha=0.6)
         wheel_series = [(f"{topic}.velocity[{side}]", f"{name} {label}", style, palette.PLANNERS[side])
                         for side, name in enumerate(("left", "right"))
                         for topic, label, style in (("/wheels/command", "commanded", "dashed"),
                                                     ("/joint_states", "measured", "solid"))]
     else:
         wheel_series = [(f"/wheels.{field}", label, style, colour) for field, label, style, colour in WHEEL_SERIES]
+        # The sensed map (only in logs with the map unknown): occupancy percent, from clear to dark grey; and
+        # the odometry pose (only with knowledge.pose = "odometry").
+        topics[MAP_TOPIC] = fl.BaseRendererGridTopicSettings(
+            visible=True, color_mode="gradient", color_field="occupancy", gradient=("#ffffff20", "#000000c0"),
+            min_value=0.0, max_value=100.0, draw_behind=True)
+        topics[ODOM_TOPIC] = fl.BaseRendererPoseTopicSettings(visible=True)
     scene = fl.ThreeDeePanel(title="scene (top view)", config=fl.ThreeDeeConfig(
         fixed_frame=WORLD_FRAME, follow_tf=WORLD_FRAME, follow_mode="follow-none", topics=topics,
         camera_state=fl.ThreeDeeCameraState(perspective=False, distance=16.0, target_offset=(5.0, 5.0, 0.0))))

@@ -12,7 +12,7 @@ read a truncated file as far as it goes, with a warning line
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
@@ -38,6 +38,7 @@ from swarmnav.sim.log.format import (
 from swarmnav.sim.log.columns import Rows
 from swarmnav.sim.log.records import LogError, RawLog, RawLogView, read_records
 from swarmnav.sim.log.ros2_reader import Ros2Rows
+from swarmnav.sim.log.run_metadata import checked_run_metadata
 
 
 # -- decoding into arrays ------------------------------------------------------
@@ -84,11 +85,11 @@ class RunLog(RawLogView):
     obstacle_tracks: dict[str, tuple[np.ndarray, np.ndarray]]
     events: list[tuple[float, str, dict[str, Any]]]
     outcome: dict[str, Any] | None
+    run: dict[str, Any] = field(default_factory=dict)  # the ``run`` record, checked (sim/log/run_metadata.py)
 
     def run_value(self, key: str, default: Any = None) -> Any:
-        """A value of the ``run`` metadata record, JSON-decoded."""
-        text = self.metadata.get("run", {}).get(key)
-        return default if text is None else json.loads(text)
+        """A value of the ``run`` metadata record, JSON-decoded and checked when the log was read."""
+        return self.run.get(key, default)
 
 
 def _decoder_for(raw: RawLog, channel: Channel, protobuf: DecoderFactory) -> Callable[[bytes], Any]:
@@ -236,10 +237,15 @@ class _Decoder:
         if "outcome" in raw.metadata:
             outcome = {k: metadata_value(v) for k, v in raw.metadata["outcome"].items()}
         attachment = raw.attachments.get(MJCF_ATTACHMENT)
+        run = checked_run_metadata(str(raw.path), raw.metadata.get("run", {}))
+        try:
+            mjcf_xml = attachment.data.decode() if attachment is not None else None
+        except UnicodeDecodeError as exc:
+            raise LogError(raw.path, f"its scene.xml is not UTF-8 text (byte {exc.start})") from None
         return RunLog(
             raw=raw,
             metadata=raw.metadata,
-            mjcf_xml=attachment.data.decode() if attachment is not None else None,
+            mjcf_xml=mjcf_xml,
             counts=raw.counts(),
             schema_names={c.topic: raw.schemas[c.schema_id].name if c.schema_id in raw.schemas else ""
                           for c in raw.channels.values()},
@@ -258,11 +264,12 @@ class _Decoder:
             angular_rad_s=controller[:, 2].copy(),
             waypoint_index=controller[:, 3].astype(int),
             paths=self.paths,
-            obstacles=json.loads(raw.metadata.get("run", {}).get("obstacles", "[]")),
+            obstacles=run.get("obstacles", []),
             obstacle_tracks={k: (rows.array()[:, 0].copy(), rows.array()[:, 1:3].copy())
                              for k, (rows, _) in self.tracks.items()},
             events=self.events,
             outcome=outcome,
+            run=run,
         )
 
 
@@ -282,7 +289,20 @@ def read_log(path: str | Path, *, allow_truncated: bool = False) -> RunLog:
     if not raw.complete and not allow_truncated:
         raise LogError(path, truncation_advice(raw))
     check_channels(raw)
+    check_has_steps(raw, len(decoder.tf))
     return decoder.run_log(raw)
+
+
+def check_has_steps(raw: RawLog, steps: int) -> None:
+    """The one truncation rule of every reader (``log info``, ``plot``, ``replay --video``, ``replay --verify``):
+    a log is read as far as it goes, and one that holds no step at all (no ``/tf`` message: cut before its
+    first step) is refused, the same one line for all of them.
+
+    Raises:
+        LogError: no step, naming what the file holds.
+    """
+    if steps == 0:
+        raise LogError(raw.path, f"holds no step (no /tf message): nothing to show or replay ({raw.recovery_line()})")
 
 
 def truncation_advice(raw: RawLog) -> str:

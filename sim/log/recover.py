@@ -8,6 +8,7 @@ from pathlib import Path
 from mcap.records import Message
 from mcap.writer import CompressionType, Writer
 
+from swarmnav.models.contained_files import check_output_target
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim.log.records import RawLog, read_records
 
@@ -27,6 +28,9 @@ def recover_log(source: str | Path, target: str | Path) -> RawLog:
         ConfigError: ``target`` is ``source``.
         OSError: ``target`` cannot be written (with its file name).
     """
+    if not str(target).strip() or Path(target).name in ("", ".", ".."):
+        raise ConfigError("OUT", "must name a file", str(target))
+    check_output_target(target, "OUT", folder_ok=False)  # never replace a device or a FIFO with the copy
     target = Path(target)
     if target.resolve() == Path(source).resolve():
         raise ConfigError("OUT", "is the source file: write the recovered copy elsewhere", str(target))

@@ -33,24 +33,39 @@ from swarmnav.sim.defaults import DEFAULT_FPS
 from swarmnav.sim.log.format import ranges_from_scan
 from swarmnav.sim.log.reader import RunLog, read_log, truncation_advice
 from swarmnav.sim.log.records import LogError
+from swarmnav.sim.log.scene_guard import compile_log_scene
+from swarmnav.models.contained_files import loads_json
 from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
 from swarmnav.sim.log.verify_report import TrajectoryCapture, VerifyReport, compare_with_log
 
 
 EXIT_DIFFERENT = 4  # replay --verify: the re-simulation differs from the log
 
+def _params(log: RunLog, record: str) -> dict:
+    """A component's ``params`` metadata: a JSON table (anything else is one LogError naming it)."""
+    text = log.metadata.get(record, {}).get("params", "{}")
+    try:
+        value = loads_json(text, str(log.raw.path), f"{record}.params")
+    except ConfigError as exc:
+        raise LogError(log.raw.path, f"metadata {record}.params: {exc.problem}") from None
+    if not isinstance(value, dict):
+        raise LogError(log.raw.path, f"metadata {record}.params: expected a JSON table, got {text[:60]!r}")
+    return value
+
+
 def context_from_log(log: RunLog) -> RunContext:
-    """The :class:`RunContext` a log was written with (as far as a renderer needs it)."""
-    if not log.mjcf_xml:
-        raise LogError(log.raw.path, "the log has no MJCF attachment (scene.xml)")
+    """The :class:`RunContext` a log was written with (as far as a renderer needs it); its scene is checked
+    and compiled once here (:func:`sim.log.scene_guard.compile_log_scene`), so a scene from elsewhere that
+    reaches beyond itself is refused before anything renders or re-simulates."""
+    compile_log_scene(log.mjcf_xml, str(log.raw.path))
     planner = log.metadata.get("planner", {})
     navigator = log.metadata.get("navigator", {})
     return RunContext(
         scenario_name=log.scenario_name,
         scenario_toml=log.metadata.get("scenario", {}).get("toml", ""),
         planner_name=planner.get("name", ""),
-        planner_params=json.loads(planner.get("params", "{}")),
-        seed=int(log.metadata.get("run", {}).get("seed", 0)),
+        planner_params=_params(log, "planner"),
+        seed=int(log.run_value("seed", 0)),
         mjcf_xml=log.mjcf_xml,
         control_dt_s=float(log.run_value("control_dt_s", 0.02)),
         physics_dt_s=float(log.run_value("physics_dt_s", 0.002)),
@@ -65,9 +80,8 @@ def context_from_log(log: RunLog) -> RunContext:
         versions=dict(log.metadata.get("versions", {})),
         arena_size_m=tuple(log.run_value("arena_size_m", [10.0, 10.0])),
         navigator_name=navigator.get("name", "follow"),
-        navigator_params=json.loads(navigator.get("params", "{}")),
-        world_seed=int(log.metadata.get("run", {}).get("seed" if "world_seed" not in log.metadata.get("run", {})
-                                                       else "world_seed", 0)),
+        navigator_params=_params(log, "navigator"),
+        world_seed=int(log.run_value("world_seed", log.run_value("seed", 0))),
         clearance_m=log.run_value("clearance_m", None),
     )
 
@@ -191,7 +205,7 @@ def verify_log(log: RunLog, named: dict | None = None, trust_code: bool = False)
     scenario = parse_scenario(context.scenario_toml, f"{source}[scenario]", trust_code=trust_code)
     spec = EpisodeSpec(scenario, context.planner_name, context.planner_params, context.navigator_name,
                        navigator_params, context.seed, context.world_seed, context.clearance_m)
-    model = mujoco.MjModel.from_xml_string(context.mjcf_xml)
+    model = compile_log_scene(context.mjcf_xml, source)
     # Reproduce how the logged run stopped: a timeout at T means the limit was T.
     kinds = [kind for _, kind, _ in log.events]
     options = {}
@@ -216,8 +230,6 @@ def run(args: argparse.Namespace) -> int:
         from swarmnav.sim.video.render import check_video_size
         check_video_size(args.width, args.height, args.fps)
     log = read_log(args.log, allow_truncated=True)  # as plot and log info: what was recovered, with a warning
-    if len(log.time_s) == 0:  # nothing to render or compare: one error line, no warning before it
-        raise LogError(args.log, f"holds no step to replay ({log.raw.recovery_line()})")
     if not log.complete:
         print(f"warning: {args.log}: {truncation_advice(log.raw)}", file=sys.stderr)
     results: dict = {"log": str(args.log), "complete": log.complete}

@@ -25,8 +25,9 @@ from mcap.reader import SeekingReader
 from mcap.records import Message
 
 from swarmnav.sim.log.format import events_topic, metadata_value
-from swarmnav.sim.log.reader import check_channels, event_decoder
+from swarmnav.sim.log.reader import check_channels, check_has_steps, event_decoder
 from swarmnav.sim.log.records import LogError, RawLog, RawLogView, open_regular, read_records
+from swarmnav.sim.log.run_metadata import checked_run_metadata
 
 
 @dataclass
@@ -122,7 +123,10 @@ def read_summary(path: str | Path) -> LogSummary:
     """
     path = Path(path)
     found = _from_summary(path)
-    return found if found is not None else from_records(path)
+    summary = found if found is not None else from_records(path)
+    checked_run_metadata(str(path), summary.raw.metadata.get("run", {}))  # as every other reader checks it
+    check_has_steps(summary.raw, summary.counts.get("/tf", 0))  # the one truncation rule
+    return summary
 
 
 def from_records(path: str | Path) -> LogSummary:

@@ -191,6 +191,11 @@ class McapRecorder:
         if self._pacer is not None:
             self._pacer.step(frame)
 
+    def occupancy(self, time_s: float, grid: Any) -> None:
+        """Log the sensed map on ``/map`` (a ``foxglove.Grid``, or a ``nav_msgs/OccupancyGrid`` in a ros2 log)."""
+        t_ns = time_ns(time_s)
+        self._after_write(t_ns, self._channels.occupancy(t_ns, grid))
+
     def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
         """Log a discrete event and flush, so it survives a crash right after."""
         t_ns = time_ns(time_s)

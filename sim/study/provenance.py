@@ -20,9 +20,9 @@ version differs is a note only (CI installs what the version ranges of ``pyproje
 
 from __future__ import annotations
 
-import ast
 import hashlib
 import inspect
+import re
 from importlib import metadata
 from pathlib import Path as FilePath
 from typing import Any, Iterable
@@ -59,17 +59,36 @@ def _module_file(module: str) -> FilePath | None:
     return None
 
 
+_FROM_IMPORT = re.compile(r"^[ \t]*from[ \t]+([\w.]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n#]*)", re.M)
+_IMPORT = re.compile(r"^[ \t]*import[ \t]+([^\n#]+)", re.M)
+
+
 def _imports(path: FilePath) -> set[str]:
-    """The absolute module names a Python file imports (``from a.b import c`` gives ``a.b`` and ``a.b.c``)."""
+    """The absolute module names a Python file imports (``from a.b import c`` gives ``a.b`` and ``a.b.c``).
+
+    Read from the import statements' text, not with :func:`ast.parse`: CPython 3.11.7's AST constructor raises
+    ``SystemError: AST constructor recursion depth mismatch`` in a process that has met a RecursionError before
+    (a 5,000-deep array refused earlier in the same process). A line of a docstring that reads like an import
+    only adds a file to hash.
+    """
     if path.suffix != ".py":
         return set()
+    # continuation lines joined and comments dropped (a '#' inside a string only cuts that line short)
+    text = re.sub(r"#[^\n]*", "", path.read_text(encoding="utf-8").replace("\\\n", " "))
     names: set[str] = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
-        if isinstance(node, ast.Import):
-            names.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            names.add(node.module)
-            names.update(f"{node.module}.{alias.name}" for alias in node.names)
+    for module, imported in _FROM_IMPORT.findall(text):
+        if module.startswith("."):
+            continue
+        names.add(module)
+        for alias in imported.strip("()").split(","):
+            words = alias.split()
+            if words and words[0].isidentifier():
+                names.add(f"{module}.{words[0]}")
+    for imported in _IMPORT.findall(text):
+        for alias in imported.split(","):
+            words = alias.split()
+            if words:
+                names.add(words[0])
     return names
 
 
