@@ -61,19 +61,27 @@ def _init_fields(cls: type) -> list[dataclasses.Field]:
     return [f for f in dataclasses.fields(cls) if f.init] if dataclasses.is_dataclass(cls) else []
 
 
-def parameter_ranges(cls: type) -> dict[str, Range]:
-    """Every declared range of a component class: its fields' (:func:`param`) over the class-level
-    ``parameter_ranges`` of the older form (its own over its bases')."""
-    merged: dict[str, Range] = {}
+def _declared(cls: type, key: str, older: str | None = None) -> dict[str, Any]:
+    """What the fields (:func:`param`) declare under ``key``, a class's own over its bases' (a subclass that
+    only changes a field's default keeps its base's declaration), over the older class-level dict ``older``."""
+    merged: dict[str, Any] = {}
     for klass in reversed(cls.__mro__):
-        merged.update(vars(klass).get("parameter_ranges", {}))
-    merged.update({f.name: f.metadata[_RANGE] for f in _init_fields(cls) if _RANGE in f.metadata})
+        if older is not None:
+            merged.update(vars(klass).get(older, {}))
+        own = vars(klass).get("__dataclass_fields__", {})
+        merged.update({name: f.metadata[key] for name, f in own.items() if key in f.metadata})
     return merged
+
+
+def parameter_ranges(cls: type) -> dict[str, Range]:
+    """Every declared range of a component class: its fields' (:func:`param`), and the class-level
+    ``parameter_ranges`` of the older form, its own over its bases'."""
+    return _declared(cls, _RANGE, "parameter_ranges")
 
 
 def parameter_choices(cls: type) -> dict[str, tuple[str, ...]]:
     """The strings each parameter declared with ``choices`` may take."""
-    return {f.name: f.metadata[_CHOICES] for f in _init_fields(cls) if _CHOICES in f.metadata}
+    return _declared(cls, _CHOICES)
 
 
 def _shown_default(f: dataclasses.Field) -> Any:

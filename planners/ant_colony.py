@@ -32,7 +32,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from swarmnav.models.errors import ConfigError
-from swarmnav.models.parameters import Range, within
+from swarmnav.models.parameters import Range, param, within
 from swarmnav.models.scenario_limits import MAX_COLONY_WALK_CELLS
 from swarmnav.planners.colony_walk import STEP_LENGTHS, ColonyWalk, GridGraph, walk_colony
 from swarmnav.planners.errors import NoPathFound, check_parameters
@@ -46,8 +46,6 @@ MAX_ANTS = 10_000
 #: Most cells a grid colony's grid may have: the colony's tables take about 600 bytes a cell.
 MAX_COLONY_CELLS = 500_000
 
-#: A parameter check: (parameter name, passes, what it must be), as :func:`planners.errors.check_parameters` takes.
-Check = tuple[str, bool, str]
 
 
 def roulette(weights: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -83,7 +81,7 @@ def deposit(tau: np.ndarray, indices: np.ndarray, amounts: np.ndarray | float) -
 
 @dataclass
 class AntColonyPlanner(SwarmPlanner):
-    """The parameters every ant colony shares, and their checks (subclasses add their paper's).
+    """The parameters every ant colony shares, each declared with its range on its field (subclasses add their paper's).
 
     Attributes:
         ants: colony size m (at most :data:`MAX_ANTS`, 10,000).
@@ -96,31 +94,15 @@ class AntColonyPlanner(SwarmPlanner):
             evaluation, so a budgeted iteration sends out only the ants the budget has left.
     """
 
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "ants": within(1, MAX_ANTS), "iterations": within(1, 1_000_000), "alpha": within(0, 100),
-        "rho": within(0, 1), "max_evaluations": within(0, 1e9)}  # models.parameters: checked on build
+    # Each parameter's range or choices on its field (models.parameters.param; a subclass that changes a
+    # default keeps the range): the reader checks them when the planner is built.
     name: ClassVar[str]
-    #: What ``rho`` must be, as the checks word it.
-    rho_requirement: ClassVar[str] = "must lie in [0, 1)"
-    ants: int = 50
-    iterations: int = 100
-    alpha: float = 1.0
-    rho: float = 0.5
+    ants: int = param(50, within(1, MAX_ANTS))
+    iterations: int = param(100, within(1, 1_000_000))
+    alpha: float = param(1.0, within(0, 100))
+    rho: float = param(0.5, Range(0, 1, high_open=True))
     shortcut: bool = True
-    max_evaluations: int | None = None
-
-    def __post_init__(self) -> None:
-        check_parameters(self, self.parameter_checks())
-
-    def parameter_checks(self) -> tuple[Check, ...]:
-        """The checks of this planner's parameters, the shared ones first (a subclass adds its own)."""
-        return (
-            ("ants", 1 <= self.ants <= MAX_ANTS, f"must lie in [1, {MAX_ANTS:,}]"),
-            ("iterations", self.iterations >= 1, "must be at least 1"),
-            ("alpha", self.alpha >= 0, "must not be negative"),
-            ("rho", 0.0 <= self.rho < 1.0, self.rho_requirement),
-            ("max_evaluations", self.max_evaluations is None or self.max_evaluations >= 0, "must not be negative"),
-        )
+    max_evaluations: int | None = param(None, within(0, 1e9))
 
     def colony_size(self, state: SwarmState) -> int:
         """The ants of this iteration: ``ants``, or fewer when the budget has less left (a tour is
@@ -148,22 +130,17 @@ class GridColonyPlanner(AntColonyPlanner):
             :data:`MAX_COLONY_CELLS` (500,000) cells.
     """
 
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "beta": within(0, 100), "max_steps": within(0, 100_000_000),
-        "cell_m": within(1e-6, 100)}  # models.parameters: checked on build
-    beta: float = 5.0
-    max_steps: int = 0
-    cell_m: float | None = None
+    beta: float = param(5.0, within(0, 100))
+    max_steps: int = param(0, within(0, 100_000_000))
+    cell_m: float | None = param(None, within(1e-6, 100))
 
-    def parameter_checks(self) -> tuple[Check, ...]:
-        return super().parameter_checks() + (
-            ("beta", self.beta >= 0, "must not be negative"),
-            ("max_steps", self.max_steps >= 0, "must not be negative"),
+    def __post_init__(self) -> None:
+        # The one rule between two parameters (each one's own range is on its field).
+        check_parameters(self, (
             ("max_steps", self.ants * self.max_steps <= MAX_COLONY_WALK_CELLS,
              f"ants x max_steps is {self.ants * self.max_steps:,} tour cells, at most {MAX_COLONY_WALK_CELLS:,} "
              "(MAX_COLONY_WALK_CELLS: an iteration's tours are drawn up front)"),
-            ("cell_m", self.cell_m is None or self.cell_m > 0, "must be positive"),
-        )
+        ))
 
     # ------------------------------------------------------------ the paper's parts
     def init_trails(self, state: SwarmState, problem: Problem, start: tuple[int, int], goal: tuple[int, int]) -> None:

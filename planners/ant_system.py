@@ -36,8 +36,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above
-from swarmnav.planners.ant_colony import Check, GridColonyPlanner, deposit, evaporate
+from swarmnav.models.parameters import above, param
+from swarmnav.planners.ant_colony import GridColonyPlanner, deposit, evaporate
 from swarmnav.planners.colony_walk import STEP_LENGTHS, ColonyWalk
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmState
@@ -63,21 +63,12 @@ class AntSystemPlanner(GridColonyPlanner):
     """
 
     name: ClassVar[str] = "aco"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "q": above(0, 1e12), "initial_pheromone": above(0, 1e12)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     rho: float = 0.5
     beta: float = 5.0
-    q: float = 100.0
-    initial_pheromone: float = 1.0
-    heuristic: str = "goal"
-
-    def parameter_checks(self) -> tuple[Check, ...]:
-        return super().parameter_checks() + (
-            ("q", self.q > 0, "must be positive"),
-            ("initial_pheromone", self.initial_pheromone > 0, "must be positive"),
-            ("heuristic", self.heuristic in HEURISTICS, f"must be one of {', '.join(HEURISTICS)}"),
-        )
+    q: float = param(100.0, above(0, 1e12))
+    initial_pheromone: float = param(1.0, above(0, 1e12))
+    heuristic: str = param("goal", choices=HEURISTICS)
 
     def init_trails(self, state: SwarmState, problem: Problem, start: tuple[int, int], goal: tuple[int, int]) -> None:
         data = state.data

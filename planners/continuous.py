@@ -64,7 +64,7 @@ Robust options (:mod:`planners.run_settings` has the table):
   than the detour saves; measured on dense-field-30 and gwo-scenario-1, 100 leaves most
   dense-field optima inside a disc, 10000 traps GWO and PSO in infeasible basins);
 * ``population_fallback``: when the best fails the exact check, the cheapest member of the
-  final population (then the seeds' fits) that passes it;
+  final population (then the guesses' fits) that passes it;
 * ``repair_rounds``: failing that, a short local search around the best candidate on a
   *finer* penalty (ten times the samples, ``repair_rounds`` batches of ``population``
   Gaussian steps, shrinking), stopping at the first candidate that passes.  It runs as the
@@ -78,8 +78,8 @@ Robust options (:mod:`planners.run_settings` has the table):
   close a gap the robot fits through (:func:`planners.path_guess.gap_margins_m`; our choice);
 * ``stall_evaluations``: the search stops early once that many evaluations in a row have
   not lowered the best cost by more than ``stall_tolerance`` (relative).  Started from a
-  seeded population, the swarm mostly refines the guess's fit, and on the random fields
-  the best stops improving within a few iterations (the default stops only a seeded
+  guided population, the swarm mostly refines the guess's fit, and on the random fields
+  the best stops improving within a few iterations (the default stops only a guided
   search: from a uniform random start a swarm may stall for a while and then find a
   feasible basin).  A stop on lack of improvement is the
   "improvement-based" criterion of Zielinski & Laur (2008, "Stopping criteria for
@@ -104,7 +104,7 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import BudgetExceeded, NoPathFound, check_parameters
 from swarmnav.planners.exact_check import ContinuousState, ExactCheckStage
 from swarmnav.planners.path_cost import PathObjective
-from swarmnav.planners.path_guess import MAX_AUTO_VIA_POINTS, fit_via_points, pushed_fit_via_points, seeded_population
+from swarmnav.planners.path_guess import MAX_AUTO_VIA_POINTS, fit_via_points, population_around, pushed_fit_via_points
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
 from swarmnav.planners.run_settings import (GUESSES, MODES, PAPER_VIA_POINTS, RunSettings, mode_value,
                                             resolve_settings)
@@ -141,22 +141,22 @@ class ContinuousPlanner(ExactCheckStage):
         waypoint_spacing_m: spacing of the returned waypoints along the spline; the
             polyline through them is what the exact check verifies.
         mode: "paper" (default) or "robust" (see :mod:`planners.run_settings`).
-        guess_fraction: share of the first population seeded from the geometric guess.
-        guess_spread_m: largest standard deviation of the seeds' perturbation.
+        guess_fraction: share of the first population drawn around the geometric guess.
+        guess_spread_m: largest standard deviation of the perturbation around the guess's fit.
         guess_cell_m: cell of the A* guess's grid (``None``: the problem's).
         polish_rounds: compass-search rounds on the result.
         polish_step_m: the compass search's first step.
         via_point_growth: doublings of ``k`` when nothing passes.
-        guess: ``"tangent"``, ``"grid"`` or ``"none"``: the geometric guess of the seeds and
+        guess: ``"tangent"``, ``"grid"`` or ``"none"``: the geometric guess of the guided members and
             of ``k`` (``None``: "none" in paper mode; in robust mode "tangent" up to
             :data:`planners.path_guess.MAX_TANGENT_DISCS` discs, "grid" above).
         guess_margin_m: how much the tangent guess grows the inflated discs (``None``: each
             disc's penalty margin, so that the guess clears the discs the penalty sees).
-        fit_push_rounds: rounds that push the seeds' fit out of the discs (it stops early
+        fit_push_rounds: rounds that push the guess's fit out of the discs (it stops early
             once the fit is clear).
         stall_evaluations: end the search once this many evaluations in a row have not
             improved the best (``None``: never in paper mode; in robust mode 10 x
-            ``population`` when the first population is seeded, never otherwise; 0: never).
+            ``population`` when the first population is guided, never otherwise; 0: never).
         stall_tolerance: the relative drop of the best cost that counts as an improvement.
         gap_margins: whether each disc's penalty margin shrinks to keep narrow gaps open
             (:func:`planners.path_guess.gap_margins_m`).  The tangent guess then grows each
@@ -318,22 +318,22 @@ class ContinuousPlanner(ExactCheckStage):
 
     def initial_solutions(self, state: ContinuousState, count: int, rng: np.random.Generator) -> np.ndarray:
         """The first population: :meth:`random_solutions` (the papers'), except that with a
-        ``guess_fraction`` and guesses that share of it is seeded from the guesses (first,
+        ``guess_fraction`` and guesses that share of it is drawn around the guesses' fits (first,
         split evenly between them)."""
         settings = state.settings
-        seeded = int(round(settings.guess_fraction * count)) if settings.guesses else 0
-        if seeded == 0:
+        guided = int(round(settings.guess_fraction * count)) if settings.guesses else 0
+        if guided == 0:
             return self.random_solutions(state, count, rng)
-        shares = np.diff(np.linspace(0, seeded, len(settings.guesses) + 1).round().astype(int))
+        shares = np.diff(np.linspace(0, guided, len(settings.guesses) + 1).round().astype(int))
         objective = state.objective
-        state.seed_fits = [np.clip(pushed_fit_via_points(objective.curve, guess, objective.centres_m,
+        state.guess_fits = [np.clip(pushed_fit_via_points(objective.curve, guess, objective.centres_m,
                                                          objective.penalty_radii_m, settings.push_rounds)
                                    if settings.push_rounds else fit_via_points(objective.curve, guess),
                                    state.lower, state.upper)
                            for guess, share in zip(settings.guesses, shares) if share]
-        seeds = [seeded_population(fit, int(share), self.guess_spread_m, state.lower, state.upper, rng)
-                 for fit, share in zip(state.seed_fits, [share for share in shares if share])]
-        return np.vstack(seeds + [self.random_solutions(state, count - seeded, rng)])
+        around = [population_around(fit, int(share), self.guess_spread_m, state.lower, state.upper, rng)
+                  for fit, share in zip(state.guess_fits, [share for share in shares if share])]
+        return np.vstack(around + [self.random_solutions(state, count - guided, rng)])
 
     def evaluate(self, state: ContinuousState, population: np.ndarray,
                  objective: PathObjective | None = None, offer: bool = True) -> np.ndarray:

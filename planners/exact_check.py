@@ -47,7 +47,7 @@ class ContinuousState(SwarmState):
         repair_step_m: the repair's current step size.
         improved_at, reference_cost: the evaluation count when the best last improved by
             more than ``stall_tolerance``, and the best cost then (for ``stall_evaluations``).
-        seed_fits: the fits of the guesses the first population was seeded from (the scan's
+        guess_fits: the fits of the guesses the first population was drawn around (the scan's
             last candidates).
     """
 
@@ -65,7 +65,7 @@ class ContinuousState(SwarmState):
     repair_step_m: float = 0.0
     improved_at: int = 0
     reference_cost: float = math.inf
-    seed_fits: list[np.ndarray] = dataclasses.field(default_factory=list)
+    guess_fits: list[np.ndarray] = dataclasses.field(default_factory=list)
 
 
 class ExactCheckStage(SwarmPlanner):
@@ -91,7 +91,7 @@ class ExactCheckStage(SwarmPlanner):
 
     def needs_repair(self, state: ContinuousState, problem: Problem) -> bool:
         """Check the best once; with ``population_fallback``, then the final population (cheapest
-        first) and the seeds' fits, for a candidate that passes the exact check; repair while
+        first) and the guesses' fits, for a candidate that passes the exact check; repair while
         there is none."""
         if not state.scanned:
             state.scanned = True
@@ -101,7 +101,7 @@ class ExactCheckStage(SwarmPlanner):
                 candidates.extend(np.asarray(state.population[i], dtype=float) for i in order
                                   if math.isfinite(state.costs[i]))
             if state.settings.population_fallback:
-                candidates.extend(state.seed_fits)    # a swarm that moves every member may have lost them
+                candidates.extend(state.guess_fits)    # a swarm that moves every member may have lost them
             for rank, solution in enumerate(candidates):
                 if self.passes_exact_check(problem, self.dense_waypoints(state.objective, solution), state):
                     state.chosen, state.repaired = solution, ("population" if rank > 0 else None)

@@ -68,8 +68,8 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
-from swarmnav.models.parameters import Range, above, within
-from swarmnav.planners.ant_colony import Check, GridColonyPlanner, deposit, evaporate
+from swarmnav.models.parameters import Range, above, param, within
+from swarmnav.planners.ant_colony import GridColonyPlanner, deposit, evaporate
 from swarmnav.planners.colony_walk import STEP_LENGTHS, ColonyWalk, cosine_table
 from swarmnav.planners.grid_graph import Cell, grid_line_of_sight, line_cells
 from swarmnav.planners.problem import Problem
@@ -243,32 +243,20 @@ class ImprovedAntColonyPlanner(GridColonyPlanner):
     """
 
     name: ClassVar[str] = "iaco"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "q": above(0, 1e12), "t_c": above(0, 1e6), "delta": within(0, 100), "kappa": above(0, 1),
-        "initial_pheromone": above(0, 1e12), "collar_pheromone": within(0, 1e12), "tau_floor": above(0, 1e6),
-        "exponent_limit": within(0, 700), "step_ratio": above(0, 1000),
-        "prune_ratio": above(0, 1000)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     rho: float = 0.3
     beta: float = 5.0
-    q: float = 100.0
-    t_c: float = 1.5
-    delta: float = 2.0
-    kappa: float = 0.7
-    initial_pheromone: float = 2.0
-    collar_pheromone: float = 4.0
-    tau_floor: float = 1e-12
-    exponent_limit: float = 3.0
-    step_ratio: float = 1.25
-    prune_ratio: float = 1.0
-
-    def parameter_checks(self) -> tuple[Check, ...]:
-        return super().parameter_checks() + (
-            ("kappa", 0.0 < self.kappa < 1.0, "must lie in (0, 1)"),
-            ("t_c", self.t_c >= 1.0, "must be at least 1 (below 1, Eq. (7) would reward longer tours "
-                                     "without bound; Table 1's values are 1 to 5)"),
-            ("q", self.q > 0, "must be positive"),
-        )
+    q: float = param(100.0, above(0, 1e12))
+    # t_c >= 1: below 1, Eq. (7) would reward longer tours without bound (Table 1's values are 1 to 5).
+    t_c: float = param(1.5, within(1, 1e6))
+    delta: float = param(2.0, within(0, 100))
+    kappa: float = param(0.7, Range(0, 1, low_open=True, high_open=True))
+    initial_pheromone: float = param(2.0, above(0, 1e12))
+    collar_pheromone: float = param(4.0, within(0, 1e12))
+    tau_floor: float = param(1e-12, above(0, 1e6))
+    exponent_limit: float = param(3.0, within(0, 700))
+    step_ratio: float = param(1.25, above(0, 1000))
+    prune_ratio: float = param(1.0, above(0, 1000))
 
     def init_trails(self, state: SwarmState, problem: Problem, start: tuple[int, int], goal: tuple[int, int]) -> None:
         """tau_0 on every free cell, more on the cells the collar line crosses (§3.1), and Eq. (6)'s goal guidance."""

@@ -37,8 +37,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above
-from swarmnav.planners.ant_colony import Check, GridColonyPlanner, deposit
+from swarmnav.models.parameters import Range, param
+from swarmnav.planners.ant_colony import GridColonyPlanner, deposit
 from swarmnav.planners.colony_walk import ColonyWalk
 from swarmnav.planners.max_min_trails import P_BEST, TrailLimits, trail_limits
 from swarmnav.planners.problem import Problem
@@ -64,19 +64,11 @@ class MaxMinColonyPlanner(GridColonyPlanner):
     """
 
     name: ClassVar[str] = "mmas"
-    parameter_ranges: ClassVar[dict[str, Range]] = {"p_best": above(0, 1)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
-    rho_requirement: ClassVar[str] = "must lie in [0, 1) (the trail persistence)"
     rho: float = 0.98
     beta: float = 2.0
-    p_best: float = P_BEST
-    deposit: str = "iteration_best"
-
-    def parameter_checks(self) -> tuple[Check, ...]:
-        return super().parameter_checks() + (
-            ("p_best", 0.0 < self.p_best < 1.0, "must lie in (0, 1)"),
-            ("deposit", self.deposit in DEPOSITS, f"must be one of {', '.join(DEPOSITS)}"),
-        )
+    p_best: float = param(P_BEST, Range(0, 1, low_open=True, high_open=True))
+    deposit: str = param("iteration_best", choices=DEPOSITS)
 
     def init_trails(self, state: SwarmState, problem: Problem, start: tuple[int, int], goal: tuple[int, int]) -> None:
         data = state.data

@@ -12,7 +12,7 @@ Three of the robust options of :class:`planners.continuous.ContinuousPlanner` st
   discs (``guess_cell_m`` to choose another cell).  On dense-field-30 it is 1.007 x the
   exact optimum in about 10 ms (the exact tangent graph, :mod:`planners.tangent_graph`, now
   takes about 7 ms there, so it is the default guess up to 100 discs).  A coarser grid is faster but closes narrow gaps: on one random 33-disc
-  field the 0.1 m guess is 1.14 x the optimum, the 0.05 m one 1.013 x; seeding with both
+  field the 0.1 m guess is 1.14 x the optimum, the 0.05 m one 1.013 x; starting from both
   let the wrong one win (its fit is clear of the discs, the right one's cuts a little);
 * the number of via-points chosen from the scene: for the tangent guess
   :func:`via_points_for_turns` (two per turn plus seven), for the grid guess
@@ -20,10 +20,10 @@ Three of the robust options of :class:`planners.continuous.ContinuousPlanner` st
   papers') and :data:`MAX_AUTO_VIA_POINTS` (with the grid guess on dense-field-30, 5, 8
   and 13 via-points gave the same median length, 1.002-1.003 x the optimum; 3 cannot
   follow its six bends);
-* the seeds, :func:`fit_via_points`: the via-points whose curve is nearest the guess in
+* the guess's fit, :func:`fit_via_points`: the via-points whose curve is nearest the guess in
   the least-squares sense (the curve is linear in the via-points, so this is one
   ``lstsq``), moved out of the discs it cuts (:func:`pushed_fit_via_points`), then
-  perturbed copies (:func:`seeded_population`).
+  perturbed copies (:func:`population_around`).
 
 Seeding an initial population with a heuristic solution is the standard hybrid
 initialisation of population methods (e.g. Kazimipour, Li & Qin 2014, "A review of
@@ -212,7 +212,7 @@ def pushed_fit_via_points(curve: ViaPointCurve, waypoints: np.ndarray, centres_m
     return np.concatenate([via[:, 0], via[:, 1]])
 
 
-def seeded_population(fit: np.ndarray, count: int, spread_m: float, lower: np.ndarray,
+def population_around(fit: np.ndarray, count: int, spread_m: float, lower: np.ndarray,
                       upper: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """``count`` copies of ``fit``: the first exact, the others with Gaussian noise whose
     standard deviation grows linearly up to ``spread_m``; clipped to the search box."""

@@ -6,6 +6,7 @@ Importing this module imports every planner (and SciPy with the ant colonies);
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, TypeVar
 
 from swarmnav.planners.ant_system import AntSystemPlanner
@@ -42,6 +43,8 @@ def register(cls: PlannerClass) -> PlannerClass:
                         "of {'discs', 'boxes'}")
     if not callable(getattr(cls, "plan", None)):
         raise TypeError(f"{cls.__name__} has no plan(problem, rng) method (planners.problem.Planner)")
+    if not dataclasses.is_dataclass(cls):  # its fields are its parameters (models.parameters.build_component)
+        raise TypeError(f"{cls.__name__} must be a dataclass: its fields are its parameters")
     register_component(PLANNERS, "planner", cls)
     return cls
 

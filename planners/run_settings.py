@@ -22,7 +22,7 @@
 ``mode = "robust"`` is swarmnav's hybrid, not a paper's algorithm: it **starts from the exact
 tangent-graph route** (the ``optimal`` planner's, :mod:`planners.tangent_guess`; a grid A*
 route above :data:`planners.path_guess.MAX_TANGENT_DISCS` discs), fits the via-points to it,
-seeds half the first population there, runs the swarm, and polishes.  Each of its
+draws half the first population around it, runs the swarm, and polishes.  Each of its
 mechanisms is a named option, set on its own in either mode (an explicit value always wins
 over the mode's default):
 
@@ -37,7 +37,7 @@ option                        paper       robust      what it does
 ``repair_rounds``             0           10          fine-penalty local search when nothing passes
 ``guess``                     ``"none"``  tangent     the geometric guess (``"tangent"``, ``"grid"``,
                                                       ``"none"``)
-``guess_fraction``            0           0.5         share of the first population seeded from it
+``guess_fraction``            0           0.5         share of the first population drawn around it
 ``via_points``                3           from guess  free via-points
 ``via_point_growth``          0           2           doublings of the via-points when nothing passes
 ``fit_push_rounds``           0           40          push the guess's fit out of the discs
@@ -68,7 +68,7 @@ GUESSES = ("grid", "tangent", "none")
 PAPER_VIA_POINTS = 3
 
 #: Each mode's value of the options left unset (``None``).  ``stall_evaluations`` of the robust
-#: mode is in populations, and applies only to a seeded search.
+#: mode is in populations, and applies only to a guided search.
 MODE_DEFAULTS: dict[str, dict[str, Any]] = {
     "paper": {"penalty_weight": 1000.0, "penalty_margin_m": 0.02, "bounds_penalty": False,
               "population_fallback": False, "repair_rounds": 0, "guess_fraction": 0.0, "polish_rounds": 0,
@@ -94,11 +94,11 @@ class RunSettings:
     Attributes:
         mode: "paper" or "robust".
         via_points: ``k`` of this attempt.
-        guess_fraction: share of the first population seeded from ``guesses``.
+        guess_fraction: share of the first population drawn around ``guesses``.
         polish_rounds: compass-search rounds on the chosen candidate.
         growth: how many more times ``k`` may double when nothing passes.
-        guesses: the geometric guesses, (N, 2) waypoints each (empty: no seeding).
-        push_rounds: rounds that push the seeds' fit out of the discs.
+        guesses: the geometric guesses, (N, 2) waypoints each (empty: none).
+        push_rounds: rounds that push the guesses' fits out of the discs.
         stall_evaluations: evaluations without improvement that end the search (0: never).
         margins_m: (n,) the penalty margin of each disc.
         guess: the kind of the guesses ("tangent", "grid" or "none").

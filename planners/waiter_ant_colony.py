@@ -54,8 +54,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
-from swarmnav.planners.ant_colony import AntColonyPlanner, Check, deposit, evaporate, roulette
+from swarmnav.models.parameters import above, param, within
+from swarmnav.planners.ant_colony import AntColonyPlanner, deposit, evaporate, roulette
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Problem
@@ -169,27 +169,15 @@ class WaiterAntColonyPlanner(AntColonyPlanner):
     """
 
     name: ClassVar[str] = "maco"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "nodes": within(1, MAX_NODES), "corridor_m": above(0, 1000), "p0": within(0, 1),
-        "q": above(0, 1e12)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
     ants: int = 20
     iterations: int = 50
     rho: float = 0.9
-    nodes: int = 15
-    corridor_m: float = 1.5
-    p0: float = 0.9
-    q: float = 1.0
-    route: str = "maco"
-
-    def parameter_checks(self) -> tuple[Check, ...]:
-        return super().parameter_checks() + (
-            ("route", self.route in ROUTES, f"must be one of {', '.join(ROUTES)}"),
-            ("nodes", 1 <= self.nodes <= MAX_NODES, f"must lie in [1, {MAX_NODES:,}]"),
-            ("p0", 0.0 <= self.p0 <= 1.0, "must lie in [0, 1]"),
-            ("corridor_m", self.corridor_m > 0, "must be positive"),
-            ("q", self.q > 0, "must be positive"),
-        )
+    nodes: int = param(15, within(1, MAX_NODES))
+    corridor_m: float = param(1.5, above(0, 1000))
+    p0: float = param(0.9, within(0, 1))
+    q: float = param(1.0, above(0, 1e12))
+    route: str = param("maco", choices=ROUTES)
 
     def init_state(self, state: SwarmState, problem: Problem, rng: np.random.Generator) -> None:
         pts = random_nodes(problem, self.nodes, self.corridor_m, rng)

@@ -19,6 +19,8 @@ import math
 from pathlib import Path as FilePath
 from typing import Any, Sequence
 
+import warnings
+
 import numpy as np
 
 from swarmnav.models.contained_files import loads_json, read_input_text
@@ -39,7 +41,24 @@ def _finite_pair(value: Any, where: str, source: str) -> tuple[float, float]:
     return x, y
 
 
-def _from_json(data: Any, source: str) -> list[tuple[float, float]]:
+def _fast_pairs(rows: Any) -> np.ndarray | None:
+    """A list of finite ``[x, y]`` number pairs as an ``(N, 2)`` array in NumPy's bulk calls, or None for
+    anything else (then the row-by-row reader names the first bad row)."""
+    if not rows or len(rows) > MAX_WAYPOINTS:
+        return None
+    try:
+        array = np.array(rows)
+    except (ValueError, TypeError, OverflowError):  # ragged, or an integer beyond 64 bits
+        return None
+    if array.ndim != 2 or array.shape[1] != 2 or array.dtype.kind not in "fi":
+        return None
+    array = array.astype(float, copy=False)
+    if not np.all(np.isfinite(array)) or any(type(v) is bool for pair in rows for v in pair):  # noqa: E721
+        return None
+    return array
+
+
+def _from_json(data: Any, source: str) -> list[tuple[float, float]] | np.ndarray:
     key = ""
     if isinstance(data, dict):
         if "waypoints" not in data:
@@ -50,10 +69,35 @@ def _from_json(data: Any, source: str) -> list[tuple[float, float]]:
         raise ConfigError(FIELD, "expected a JSON list of [x, y] pairs", source)
     if len(data) > MAX_WAYPOINTS:
         raise ConfigError(FIELD, f"{len(data)} waypoints (at most {MAX_WAYPOINTS:,})", source)
+    fast = _fast_pairs(data)
+    if fast is not None:
+        return fast
     return [_finite_pair(v, f"{key}[{i}]", source) for i, v in enumerate(data)]
 
 
-def _from_csv(text: str, source: str) -> list[tuple[float, float]]:
+def _fast_csv(text: str) -> np.ndarray | None:
+    """The common CSV, a header of x and y and numbers below it, read by NumPy's C reader; None for anything
+    else (a bad row, a quoted cell, more than MAX_WAYPOINTS rows): the row-by-row reader then names the problem."""
+    header, _, body = text.partition("\n")
+    columns = [c.strip().lower() for c in header.split(",")]
+    if "x" not in columns or "y" not in columns or '"' in text:
+        return None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "input contained no data": the row-by-row reader says it
+            array = np.loadtxt(io.StringIO(body), delimiter=",", usecols=(columns.index("x"), columns.index("y")),
+                               ndmin=2, dtype=float, max_rows=MAX_WAYPOINTS + 1, comments=None)
+    except (ValueError, IndexError):
+        return None
+    if len(array) > MAX_WAYPOINTS or not np.all(np.isfinite(array)):
+        return None
+    return array
+
+
+def _from_csv(text: str, source: str) -> list[tuple[float, float]] | np.ndarray:
+    fast = _fast_csv(text)
+    if fast is not None:
+        return fast
     rows = csv.reader(io.StringIO(text))
     out: list[tuple[float, float]] = []
     number, ix, iy = 0, 0, 0

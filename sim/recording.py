@@ -74,6 +74,7 @@ class StepFrame:
         moving_obstacles_m: (M, 2) positions of the moving obstacles, in ObstacleInfo order
             (only those with ``moving=True``).
         belief: what the navigator acted on (a :class:`~controllers.navigator.Belief`), or None.
+        odometry: the pose the navigator saw (a :class:`~models.world.Pose2D`) with the odometry pose; else None.
     """
 
     time_s: float
@@ -88,6 +89,7 @@ class StepFrame:
     waypoint_index: int
     moving_obstacles_m: np.ndarray
     belief: Any = None
+    odometry: Any = None
 
 
 class Recorder(Protocol):

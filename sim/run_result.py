@@ -45,6 +45,8 @@ class RunResult:
     # Among agents (orca / social_force obstacles) only: discomfort_frequency, min_separation_m,
     # path_irregularity_rad_m (sim.crowd_stepping.crowd_metrics); None without agents (and not in the summary).
     crowd: dict[str, float] | None = None
+    # With knowledge.pose = "odometry": {"pose_error_m": final, "max_pose_error_m": largest} (truth vs odometry).
+    odometry: dict[str, float] | None = None
 
     @property
     def success(self) -> bool:
@@ -75,7 +77,7 @@ class RunResult:
                 "success": self.success, "time_to_goal_s": round(self.sim_time_s, 6) if self.reached else None,
                 "spl": self.spl, "time_in_danger_s": round(self.time_in_danger_s, 6), "replans": self.replans,
                 "replan_wall_s": round(self.replan_wall_s, 4), "stopped_s": round(self.stopped_s, 6),
-                "safety_triggers": self.safety_triggers, **(self.crowd or {})}
+                "safety_triggers": self.safety_triggers, **(self.crowd or {}), **(self.odometry or {})}
 
     def log_summary(self) -> dict[str, Any]:
         """:meth:`summary` without wall-clock figures other than ``wall_*`` (which the log writer drops)."""

@@ -50,6 +50,7 @@ from swarmnav.sim.control_period import control_periods, steps_per_control
 from swarmnav.sim.crowd_stepping import ReactiveCrowd, crowd_metrics, human_columns
 from swarmnav.sim.detector import ObstacleSensing
 from swarmnav.sim.laser import LaserCaster
+from swarmnav.controllers.odometry import WheelOdometry
 from swarmnav.sim.recording import Recorder, RunContext, StepFrame
 from swarmnav.sim.reference import reference_length_m as shortest_static_length_m
 from swarmnav.sim.run_result import RunResult
@@ -287,6 +288,13 @@ class EpisodeStepper:
         contiguous = len(adr) > 0 and np.array_equal(adr, np.arange(adr[0], adr[0] + len(adr)))
         self._range_raw = data.sensordata[adr[0]:adr[0] + len(adr)] if contiguous else None
         self._laser = LaserCaster(scene, data) if scene.laser_site_id >= 0 else None
+        self._odometry = None
+        if self.scenario.pose_source == "odometry":
+            model = self.model
+            self._wheel_qpos_adr = np.array([model.joint(f"{side}_wheel_hinge").qposadr[0] for side in ("left", "right")])
+            self._odometry = WheelOdometry(self.scenario.start, scene.drive.wheel_radius_m, scene.drive.track_m,
+                                           self.scenario.encoder_noise, self.scenario.world_seed)
+            self.pose_error_m = self.max_pose_error_m = 0.0
         self.sensing = ObstacleSensing(self.scenario, self.obstacle_track_m, self._radii_m, self.dt_s,
                                        scene.range_angles_rad, scene.range_offset_m)
         if self._crowd is not None:
@@ -330,7 +338,7 @@ class EpisodeStepper:
                 self._crowd.advance(step, self._base_qpos, self._base_qvel)
             self._mocap_pos[self.mocap_index, :2] = self.obstacle_track_m[step]
         self.observation = observation = self._observe()
-        pose = observation.pose
+        pose = self._truth  # the goal, the arena and the result judge the true pose (odometry is the robot's)
         if self.goal.reached(pose):
             outcome = "left_arena" if self.path_leaves_arena else "goal_reached"
             self._reached = True
@@ -383,7 +391,17 @@ class EpisodeStepper:
             self.in_danger = gap < self.danger_m
             self._contact_free = gap > self.contact_free_gap_m
         vx, vy, _, _, _, omega = self._base_qvel.tolist()
-        pose = Pose2D(x, y, heading)
+        pose = self._truth = Pose2D(x, y, heading)
+        if self._odometry is not None:  # the robot sees its dead-reckoned pose (controllers.odometry)
+            angles = self._qpos[self._wheel_qpos_adr]
+            if step:  # each wheel's mean speed over the period: its encoder angle's change / dt
+                left, right = ((angles - self._wheel_angles) / self.dt_s).tolist()
+                self._odometry.update(left, right, self.dt_s)
+            self._wheel_angles = angles.copy()
+            pose = self._odometry.pose
+            error = math.hypot(pose.x_m - x, pose.y_m - y)
+            self.pose_error_m = error
+            self.max_pose_error_m = max(self.max_pose_error_m, error)
         scene = self.scene
         if self._laser is not None:
             ranges = self._laser.scan(heading)
@@ -404,7 +422,7 @@ class EpisodeStepper:
         recorder = self.recorder
         if recorder is not None:
             recorder.step(self._frame(observation, ControlCommand.stop(self.waypoint_index)))
-            pose = observation.pose
+            pose = self._truth
             recorder.event(observation.time_s, outcome if outcome != "collision" else "stopped_on_collision",
                            {"x_m": pose.x_m, "y_m": pose.y_m})
         step, monitor = self.step_index, self.monitor
@@ -421,7 +439,9 @@ class EpisodeStepper:
             replans=self.replans, safety_triggers=self.safety_triggers, reference_length_m=self.reference_length_m,
             crowd=crowd_metrics(self.poses[:step + 1], self.obstacle_track_m[:step + 1, self._humans],
                                 self._radii_m[self._humans], self.scenario.robot_radius_m, self.length_m)
-            if len(self._humans) else None)
+            if len(self._humans) else None,
+            odometry={"pose_error_m": round(self.pose_error_m, 6), "max_pose_error_m": round(self.max_pose_error_m, 6)}
+            if self._odometry is not None else None)
         if self._unfinished:
             self._unfinished = False
             recorder.finish(self.result.log_summary())
@@ -429,7 +449,8 @@ class EpisodeStepper:
     def _frame(self, observation: Observation, command: ControlCommand, belief: Belief | None = None) -> StepFrame:
         base_qpos = self._base_qpos.copy()  # one fresh copy; position and quaternion are views of it
         wheels = command.wheels
-        return StepFrame(observation.time_s, base_qpos[:3], base_qpos[3:], observation.pose.heading_rad,
+        return StepFrame(observation.time_s, base_qpos[:3], base_qpos[3:], self._truth.heading_rad,
                          observation.ranges_m, np.array((wheels.left_rad_s, wheels.right_rad_s)),
                          self._qvel[self._wheel_qvel_adr], command.linear_m_s, command.angular_rad_s,
-                         command.waypoint_index, self.obstacle_track_m[self.step_index].copy(), belief)
+                         command.waypoint_index, self.obstacle_track_m[self.step_index].copy(), belief,
+                         observation.pose if self._odometry is not None else None)

@@ -9,6 +9,7 @@ import sys
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -39,6 +40,34 @@ def test_import_swarmnav_is_light_and_public():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
     assert out[0] == "[]"
     assert out[1] == "True True Problem"
+
+
+def test_a_folder_named_swarmnav_in_the_working_directory(tmp_path):
+    (tmp_path / "swarmnav" / "models").mkdir(parents=True)  # a clone of the repository, say
+    # installed as `make install` does (the package on the path): the installed package wins
+    done = subprocess.run([sys.executable, "-c", "import swarmnav; print(callable(swarmnav.run))"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=60)
+    assert done.stdout.strip() == "True", done.stderr
+    # with the editable install's import hook alone the folder shadows the package: one line naming it, exit 2
+    hook_only = "import sys; sys.path = [p for p in sys.path if not p.endswith('/typing')]; import swarmnav.sim.cli.main"
+    done = subprocess.run([sys.executable, "-c", hook_only], cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    if "shadows" not in done.stderr and done.returncode == 0:
+        pytest.skip("swarmnav is not an editable install here: nothing can shadow it")
+    assert done.returncode == 2 and done.stderr.count("\n") == 1
+    assert f"the folder {tmp_path / 'swarmnav'} shadows the installed swarmnav package" in done.stderr
+
+
+def test_the_readme_limits_name_every_max_constant():
+    import re
+    text = (ROOT / "README.md").read_text()
+    limits = text[text.index("### Limits"):]
+    limits = limits[:limits.index("\n## ")]
+    defined = set()
+    for layer in ("models", "planners", "controllers", "sim"):
+        for path in (ROOT / layer).rglob("*.py"):
+            defined |= set(re.findall(r"^(MAX_[A-Z0-9_]+)\s*(?::[^=\n]*)?=", path.read_text(), re.MULTILINE))
+    assert len(defined) > 40
+    assert sorted(name for name in defined if f"`{name}`" not in limits and f"`{name}` (" not in limits) == []
 
 
 def test_run_to_dict_is_what_run_json_prints(capsys):
@@ -112,6 +141,21 @@ def test_a_given_path_that_leaves_the_arena_is_no_success(tmp_path, capsys):
     assert "given='waypoints'" in repr(slightly)
     assert main(["run", "gwo-scenario-1", "--waypoints", str(outside), "--no-log"]) == 0
     assert capsys.readouterr().out.startswith(f"gwo-scenario-1: given path {str(outside)!r} + follow")
+
+
+def test_the_bulk_readers_of_waypoint_files_agree_with_the_row_reader(tmp_path):
+    from swarmnav.sim.given_path import _from_csv, _from_json, read_waypoints
+    points = np.random.default_rng(3).uniform(-5.0, 15.0, (500, 2))
+    csv_file, json_file = tmp_path / "w.csv", tmp_path / "w.json"
+    csv_file.write_text("y, x ,speed\n" + "".join(f"{y!r},{x!r},1\n\n" for x, y in points.tolist()))
+    json_file.write_text(json.dumps({"waypoints": points.tolist(), "collision_free": True}))
+    assert np.array_equal(read_waypoints(csv_file), points) and np.array_equal(read_waypoints(json_file), points)
+    # the row-by-row readers (what a file the bulk readers refuse goes through) give the same numbers
+    quoted = "".join(f'"{y!r}",{x!r},1\n' for x, y in points.tolist())
+    assert np.array_equal(np.asarray(_from_csv("y,x,speed\n" + quoted, "q")), points)
+    assert np.array_equal(np.asarray(_from_json([[1, 2.5], *points.tolist()], "j")), [[1.0, 2.5], *points])
+    with pytest.raises(swarmnav.ConfigError, match=r"\[1\]: expected an \[x, y\] pair"):
+        _from_json([[1.0, 2.0], [True, 3.0]], "j")  # a boolean is no number, in bulk as row by row
 
 
 @pytest.mark.parametrize("text,where", [("x,y\n0,0\nfoo,1\n", "row 3"), ("a,b\n0,0\n", "row 1"),

@@ -134,14 +134,27 @@ def test_an_odometry_estimate_goes_to_odom_and_map_to_odom_carries_its_error(tmp
     assert np.isnan(log.range_m[0, 1]) and log.range_m[0, 0] == pytest.approx(0.7)
 
 
-def test_an_occupancy_grid_decodes_with_unknown_cells(tmp_path):
-    from swarmnav.sim.log.ros2_channels import occupancy_grid
-    from mcap_ros2._dynamic import serialize_dynamic
-    grid = np.array([[0.0, 1.0, np.nan], [0.5, -1.0, 0.2]])
-    encode = serialize_dynamic("nav_msgs/msg/OccupancyGrid", msgdef("nav_msgs/OccupancyGrid"))["nav_msgs/msg/OccupancyGrid"]
-    message = HUMBLE.deserialize_cdr(encode(occupancy_grid(5, grid, 0.1, (-1.0, 2.0))), "nav_msgs/msg/OccupancyGrid")
-    assert (message.info.width, message.info.height) == (3, 2) and message.info.origin.position.y == 2.0
-    assert message.data.tolist() == [0, 100, -1, 50, -1, 20]
+def test_with_the_map_unknown_map_is_the_sensed_grid_as_nav_msgs_occupancy_grid(tmp_path):
+    """The map a run builds (``knowledge = { map = "unknown" }``) goes to /map in both profiles: the same cells."""
+    from mcap.reader import make_reader
+    from mcap_protobuf.decoder import DecoderFactory
+    from swarmnav.models.scenario import load_scenario
+    from swarmnav.sim.episode import EpisodeSpec, run_episode
+    from swarmnav.sim.log.writer import McapRecorder
+    scenario = load_scenario("gwo-scenario-1").with_knowledge("unknown")
+    for log_format in ("ros2", "swarmnav"):
+        run_episode(EpisodeSpec(scenario, navigator="replan"),
+                    [McapRecorder(tmp_path / f"{log_format}.mcap", log_format=log_format)], time_limit_s=3.0)
+    maps = _decoded(tmp_path / "ros2.mcap")["/map"]
+    with (tmp_path / "swarmnav.mcap").open("rb") as stream:
+        grids = [m for *_, m in make_reader(stream, decoder_factories=[DecoderFactory()])
+                 .iter_decoded_messages(topics=["/map"])]
+    assert len(maps) == len(grids) >= 2
+    last, grid = maps[-1], grids[-1]
+    assert last.header.frame_id == "map" and last.info.width == grid.column_count
+    assert math.isclose(last.info.resolution, grid.cell_size.x, rel_tol=1e-6)
+    assert last.data.tobytes() == grid.data  # the same cells: percent, -1 never seen
+    assert (last.data == -1).any() and ((last.data >= 0) & (last.data < 50)).any() and last.data.max() <= 100
 
 
 def test_bad_log_format_is_refused_by_run_study_and_env(capsys):

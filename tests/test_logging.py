@@ -5,6 +5,7 @@ Real runs, real MCAP files, real EGL rendering (MUJOCO_GL=egl).
 
 from __future__ import annotations
 
+import json
 import os
 
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -270,6 +271,10 @@ def test_log_info_prints_channels_and_outcome(full_run, capsys):
     assert SCENARIO in out and "goal_reached" in out
     for topic in TOPICS:
         assert topic in out
+    navigator = full_run[1].spec.navigator  # the scenario's, as the run resolved it
+    assert f"navigator:  {navigator} " in out
+    assert main(["log", "info", str(full_run[0]), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["navigator"] == navigator
 
 
 @pytest.mark.parametrize("command", [["log info"], ["replay", "--verify"], ["plot", "-o", "p.png"]])

@@ -72,6 +72,17 @@ def test_the_registry_holds_and_builds_planners_only():
     with pytest.raises(TypeError, match="no plan"):
         register(Planless)
     assert "planless" not in PLANNERS
+
+    class Plain:  # its parameters would be its dataclass fields: a plain class could not be built by name
+        name = "plain"
+        supports = frozenset({"discs"})
+
+        def plan(self, problem, rng):
+            raise NotImplementedError
+
+    with pytest.raises(TypeError, match="must be a dataclass"):
+        register(Plain)
+    assert "plain" not in PLANNERS
     for name in PLANNERS:
         assert isinstance(make_planner(name), Planner), name
 

@@ -95,3 +95,9 @@ def test_catalogue_robots_drive_dense_field_30_with_replan(model, speed):
                        max_speed_m_s=speed or robot.max_speed_m_s, sensor_range_m=robot.default_range_m)
     result = run_episode(EpisodeSpec(scenario, navigator="replan")).result
     assert result.reached and result.collisions == 0
+
+
+@pytest.mark.parametrize("model", ["jackal", "turtlebot3_burger"])
+def test_the_logged_footprint_of_a_box_robot_is_the_disc_planners_plan_for(model):
+    from swarmnav.sim.log.messages import chassis_radius_m
+    assert chassis_radius_m(compile_scene(probe(model)).xml) == pytest.approx(ROBOTS[model].planning_radius_m)

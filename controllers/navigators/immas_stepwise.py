@@ -43,8 +43,8 @@ random walkers do not see the robot and may step onto its cell, or cross its
 move, while it turns or waits, and the robot has no rule for that (no replanning).
 
 Beyond the paper, each a named option off by default (the defaults are the paper's robot): ``evade``
-(the safety layer's evasion, :mod:`controllers.safety_layer`), ``lookahead_cells`` and ``carrot_m`` (drive through the walk instead of stopping
-at each cell, :mod:`controllers.navigators.immas_drive`) and ``predict_s`` (a longer Dobstacle for that walk);
+(the safety layer's evasion, :mod:`controllers.safety_layer`), ``lookahead_cells`` and ``carrot_m`` (drive
+through the walk instead of stopping at each cell, :mod:`controllers.navigators.immas_drive`) and ``predict_s`` (a longer Dobstacle for that walk);
 the next cell stays Eq. (3)'s choice at every cell reached.  The class docstring says why, with figures.
 """
 

@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path as FilePath
 from typing import ClassVar
 
@@ -17,6 +18,7 @@ from swarmnav import ConfigError, NoPathFound, Path, PlanningError, Problem, Run
 
 
 @swarmnav.register_planner
+@dataclass
 class StraightThenGiveUp:
     """The straight line when it is clear, else no path: the planner seam in a few lines."""
 

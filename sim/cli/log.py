@@ -1,6 +1,6 @@
 """``swarmnav log info LOG`` and ``swarmnav log recover IN OUT``.
 
-``info`` prints the scenario, planner, seed, duration, outcome and every channel
+``info`` prints the scenario, planner, navigator, seed, duration, outcome and every channel
 with its message count and schema, from the file's summary section
 (:mod:`sim.log.summary`: a log of any length answers at once).  A file without
 footer (a killed run) is read as ``plot`` reads it: what was recovered, with a
@@ -23,11 +23,12 @@ from swarmnav.sim.log.summary import LogSummary, read_summary
 
 def describe(log: LogSummary) -> list[str]:
     """Lines for ``swarmnav log info``."""
-    planner = log.metadata.get("planner", {})
+    planner, navigator = log.metadata.get("planner", {}), log.metadata.get("navigator", {})
     lines = [
         f"log:        {log.raw.path}",
         f"scenario:   {log.scenario_name}",
         f"planner:    {planner.get('name', '?')} {planner.get('params', '')}",
+        f"navigator:  {navigator.get('name', '?')} {navigator.get('params', '')}",
         f"seed:       {log.metadata.get('run', {}).get('seed', '?')}",
         f"duration:   {log.duration_s:.3f} s (simulation)",
         f"outcome:    {outcome_text(log)}",
@@ -67,6 +68,7 @@ def run_info(args: argparse.Namespace) -> int:
         "log": str(args.log),
         "scenario": log.scenario_name,
         "planner": log.metadata.get("planner", {}).get("name"),
+        "navigator": log.metadata.get("navigator", {}).get("name"),
         "seed": log.metadata.get("run", {}).get("seed"),
         "duration_s": log.duration_s,
         "outcome": log.outcome,

@@ -10,6 +10,7 @@ difference; 5 a CI check fell short (``run --expect``, ``study --min-success``).
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import os
 import signal
@@ -353,11 +354,19 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+@functools.cache
+def _parser() -> argparse.ArgumentParser:
+    """The parser, built once per process and reused (``parse_args`` leaves it as it was): a process that
+    calls :func:`main` many times (the tests, a script) spent most of each call building it, with
+    argparse's message look-ups for every option."""
+    return build_parser()
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``swarmnav`` console script."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, stop_signal.exit_on_signal)
-    parser = build_parser()
+    parser = _parser()
     args = parser.parse_args(argv)
     if args.command in PLUGIN_COMMANDS:
         from swarmnav.sim.plugins import load_plugins

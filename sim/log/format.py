@@ -66,8 +66,8 @@ ROS 2 types (:mod:`sim.log.ros2_types`), frames after REP 105 (``map`` -> ``odom
                         entity id); sent as ``/obstacles`` above
 ``/scene``              visualization_msgs/MarkerArray at t = 0: arena outline, footprint
 ``/navigator``          visualization_msgs/MarkerArray: what the navigator acted on (as above)
-``/map``                nav_msgs/OccupancyGrid: the map the robot builds, when the run's map
-                        is unknown (written only when the run carries one)
+``/map``                nav_msgs/OccupancyGrid in ``map``: the map the robot builds, when the
+                        run's map is unknown (the same cells as the Grid above)
 ``/rosout``             rcl_interfaces/Log: one per event, ``msg`` as ``/events`` above
 ``/clock``              rosgraph_msgs/Clock: simulation time, every control step
 ======================  ===============================================================

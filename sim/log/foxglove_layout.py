@@ -47,12 +47,15 @@ def build_layout(log_format: str = "swarmnav") -> str:
 
     ros2 = log_format == ROS2_PROFILE
     path_topic, scan_topic = ("/plan", "/scan") if ros2 else ("/planner/path", "/range/scan")
-    topics = {topic: fl.BaseRendererSceneUpdateTopicSettings(visible=True)
-              for topic in (SCENE_TOPIC, "/obstacles", NAVIGATOR_TOPIC)}
+    markers = fl.BaseRendererRosMarkerTopicSettings if ros2 else fl.BaseRendererSceneUpdateTopicSettings
+    topics = {topic: markers(visible=True) for topic in (SCENE_TOPIC, "/obstacles", NAVIGATOR_TOPIC)}
     topics[path_topic] = fl.BaseRendererPosesTopicSettings(visible=True, type="line", line_width=0.04,
                                                            gradient=(palette.PLANNED, palette.PLANNED))
     topics[scan_topic] = fl.BaseRendererLaserScanTopicSettings(visible=True)
     if ros2:
+        # The sensed map (only in logs with the map unknown), drawn as Foxglove draws a ROS map.
+        topics[MAP_TOPIC] = fl.BaseRendererRosOccupancyGridTopicSettings(visible=True, color_mode="map",
+                                                                        draw_behind=True, alpha=0.6)
         wheel_series = [(f"{topic}.velocity[{side}]", f"{name} {label}", style, palette.PLANNERS[side])
                         for side, name in enumerate(("left", "right"))
                         for topic, label, style in (("/wheels/command", "commanded", "dashed"),

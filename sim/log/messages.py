@@ -165,14 +165,20 @@ def _colour(hex_colour: str, alpha: float = 1.0) -> Color:
 
 
 def chassis_radius_m(mjcf_xml: str) -> float:
-    """The robot's footprint radius: the size of the ``chassis`` geom of the run's MJCF.
+    """The robot's footprint radius: the size of the ``chassis`` geom of the run's MJCF (a cylinder's radius);
+    for a box chassis (the catalogue's Jackal and Burger) its circumscribed circle about the base origin, the
+    disc the planners plan for (``models.robots``).
 
     Raises:
         ValueError: the MJCF has no chassis geom with a size.
     """
     for geom in ElementTree.fromstring(mjcf_xml).iter("geom"):
         if geom.get("name") == "chassis" and geom.get("size"):
-            return float(geom.get("size").split()[0])
+            size = [float(v) for v in geom.get("size").split()]
+            if geom.get("type") == "box":
+                x, y = ([float(v) for v in geom.get("pos", "0 0 0").split()] + [0.0, 0.0])[:2]
+                return max(math.hypot(x + sx * size[0], y + sy * size[1]) for sx in (-1, 1) for sy in (-1, 1))
+            return size[0]
     raise ValueError("the scene has no chassis geom with a size")
 
 

@@ -30,6 +30,7 @@ from swarmnav.sim.log.format import (
     WORLD_FRAME,
     event_text,
 )
+from swarmnav.sim.log.map_channel import occupancy_percent
 from swarmnav.sim.log.messages import chassis_radius_m, event_severity
 from swarmnav.sim.log.ros2_types import (
     LOG_ERROR,
@@ -149,18 +150,16 @@ def belief_markers(obstacles, horizon_s: float, t_ns: int) -> list[dict[str, Any
     return markers
 
 
-def occupancy_grid(t_ns: int, occupancy: np.ndarray, resolution_m: float,
-                   origin_xy_m: tuple[float, float]) -> dict[str, Any]:
-    """A ``nav_msgs/OccupancyGrid`` in ``map`` from an (rows, cols) array of occupancy probabilities
-    (row 0 at ``origin_xy_m``'s y, column 0 at its x; NaN or negative for unknown): 0..100, -1 unknown."""
-    grid = np.asarray(occupancy, dtype=float)
-    cells = np.where(np.isnan(grid) | (grid < 0), -1, np.rint(np.clip(grid, 0.0, 1.0) * 100)).astype(np.int8)
+def occupancy_grid(t_ns: int, cells: np.ndarray, resolution_m: float, origin_xy_m: tuple[float, float]) -> dict[str, Any]:
+    """A ``nav_msgs/OccupancyGrid`` in ``map`` from (rows, cols) cells in percent (0..100, -1 unknown; row 0 at
+    ``origin_xy_m``'s y, column 0 at its x: :func:`sim.log.map_channel.occupancy_percent` of a log-odds grid)."""
+    grid = np.asarray(cells, dtype=np.int8)
     return {"header": header(t_ns, MAP_FRAME),
             "info": {"map_load_time": stamp(t_ns), "resolution": float(resolution_m),
                      "width": int(grid.shape[1]), "height": int(grid.shape[0]),
                      "origin": {"position": {"x": float(origin_xy_m[0]), "y": float(origin_xy_m[1]), "z": 0.0},
                                 "orientation": _IDENTITY}},
-            "data": cells.ravel().tolist()}
+            "data": grid.ravel().tolist()}
 
 
 class Ros2Channels:
@@ -168,9 +167,8 @@ class Ros2Channels:
 
     Each method writes its messages and returns how many it wrote.  A run that estimates
     odometry hands the estimate on ``StepFrame.odometry`` (x_m, y_m, heading_rad, the pose in
-    ``odom``); a run whose map is unknown hands what it has built on ``StepFrame.occupancy``
-    (``occupancy``, ``resolution_m``, ``origin_xy_m``, see :func:`occupancy_grid`).  Without
-    them odometry is the simulator's pose and there is no ``/map``.
+    ``odom``); without it odometry is the simulator's pose.  A run whose map is unknown hands the
+    map it builds to :meth:`occupancy` (the recorder's ``occupancy``), written on ``/map``.
     """
 
     profile = ROS2_PROFILE
@@ -181,7 +179,6 @@ class Ros2Channels:
         self._moving: tuple[ObstacleInfo, ...] = ()
         self._belief_drawn = False
         self._previous: tuple[int, float, float, float] | None = None  # t_ns, x, y, yaw of the last step
-        self._map_written: Any = None
 
     def open(self, fox: foxglove.Context, context: RunContext) -> None:
         self._fox = fox
@@ -287,11 +284,17 @@ class Ros2Channels:
         if "/plan" in late and self._last_path is not None:
             self._log("/plan", self._last_path, t_ns)
             written += 1
-        return written + self._log_belief(frame.belief, t_ns) + self._log_map(getattr(frame, "occupancy", None), t_ns)
+        return written + self._log_belief(frame.belief, t_ns)
 
     def event(self, t_ns: int, kind: str, details: dict[str, Any]) -> int:
         self._log(ROS2_EVENTS_TOPIC, {"stamp": stamp(t_ns), "level": _LEVELS[event_severity(kind)], "name": "swarmnav",
                                       "msg": event_text(kind, details), "file": "", "function": "", "line": 0}, t_ns)
+        return 1
+
+    def occupancy(self, t_ns: int, grid: Any) -> int:
+        """``/map``: a sensed :class:`models.occupancy.LogOddsGrid` as a ``nav_msgs/OccupancyGrid`` (the same
+        cells in percent as the ``swarmnav`` profile's ``foxglove.Grid``)."""
+        self._log("/map", occupancy_grid(t_ns, occupancy_percent(grid.log_odds), grid.cell_m, grid.origin_m), t_ns)
         return 1
 
     def versions(self) -> dict[str, str]:
@@ -331,12 +334,4 @@ class Ros2Channels:
         self._log("/navigator", {"markers": belief_markers(obstacles, belief.horizon_s if belief is not None else 0.0,
                                                            t_ns)}, t_ns)
         self._belief_drawn = bool(obstacles)
-        return 1
-
-    def _log_map(self, built: Any, t_ns: int) -> int:
-        """``/map`` when the run hands a map it builds, each time it is a new one."""
-        if built is None or built is self._map_written:
-            return 0
-        self._log("/map", occupancy_grid(t_ns, built.occupancy, built.resolution_m, built.origin_xy_m), t_ns)
-        self._map_written = built
         return 1

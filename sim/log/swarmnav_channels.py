@@ -12,16 +12,18 @@ from typing import Any
 
 import foxglove
 import numpy as np
-from foxglove.channels import LogChannel, PosesInFrameChannel, SceneUpdateChannel
+from foxglove.channels import LogChannel, PoseInFrameChannel, PosesInFrameChannel, SceneUpdateChannel
 from foxglove.messages import FrameTransform, LaserScan, Pose, PoseInFrame, PosesInFrame, SceneUpdate, Vector3
 
 from swarmnav.sim.log.encoding import SceneEncoder, StepEncoder, timestamp_field
+from swarmnav.sim.log.map_channel import MapChannel
 from swarmnav.sim.log.format import (
     BASE_FRAME,
     CONTROLLER_SCHEMA,
     EVENTS_TOPIC,
     LOG_PROFILE,
     NAVIGATOR_TOPIC,
+    ODOM_TOPIC,
     SCENE_TOPIC,
     WHEELS_SCHEMA,
     WORLD_FRAME,
@@ -56,7 +58,9 @@ class SwarmnavChannels:
         self._moving_infos: tuple[ObstacleInfo, ...] = ()
         self._json_channels: list[foxglove.Channel] = []
         self._navigator: SceneUpdateChannel | None = None  # made at the first belief with obstacles
+        self._odom: PoseInFrameChannel | None = None  # /odom, made at the first odometry pose
         self._belief_drawn = False
+        self._map: MapChannel | None = None  # /map, made at the first sensed map (only with the map unknown)
 
     def open(self, fox: foxglove.Context, context: RunContext) -> None:
         """Make the channels (before the run's metadata is written)."""
@@ -133,10 +137,28 @@ class SwarmnavChannels:
         if "/planner/path" in late and self._last_path is not None:
             self._path.log(self._last_path, log_time=t_ns)
             written += 1
+        if frame.odometry is not None:
+            written += self._log_odometry(frame.odometry, t_ns)
         return written + self._log_belief(frame.belief, t_ns)
+
+    def _log_odometry(self, pose: Any, t_ns: int) -> int:
+        """``/odom``: the pose the navigator saw (integrated wheel speeds), in ``world`` (only with it)."""
+        if self._odom is None:
+            self._odom = PoseInFrameChannel(ODOM_TOPIC, context=self._fox)
+        self._odom.log(PoseInFrame(timestamp=stamp(t_ns), frame_id=WORLD_FRAME,
+                                   pose=Pose(position=Vector3(x=float(pose.x_m), y=float(pose.y_m), z=0.01),
+                                             orientation=yaw_quaternion(float(pose.heading_rad)))), log_time=t_ns)
+        return 1
 
     def event(self, t_ns: int, kind: str, details: dict[str, Any]) -> int:
         self._events.log(event_log(t_ns, kind, details), log_time=t_ns)
+        return 1
+
+    def occupancy(self, t_ns: int, grid: Any) -> int:
+        """``/map``: the sensed map (:mod:`sim.log.map_channel`; the channel made at the first)."""
+        if self._map is None:
+            self._map = MapChannel(self._fox)
+        self._map.log(t_ns, grid)
         return 1
 
     def versions(self) -> dict[str, str]:

@@ -37,13 +37,11 @@ import foxglove
 import numpy as np
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
-from swarmnav.sim.log.map_channel import MapChannel
 from swarmnav.sim.log.live_view import DEFAULT_LIVE_HOST, DEFAULT_LIVE_PORT, LiveServer
 from swarmnav.sim.log.file import LogFile
 from swarmnav.sim.log.format import (
     LOG_FORMATS,
     MJCF_ATTACHMENT,
-    ROS2_PROFILE,
     TOPICS,
     default_log_path,
     dumps,
@@ -139,7 +137,6 @@ class McapRecorder:
         self._writer = None
         self._next_flush_ns = 0
         self._last_ns = 0
-        self._map: MapChannel | None = None  # /map, made at the first sensed map (only with the map unknown)
 
     # -- Recorder protocol -------------------------------------------------
 
@@ -195,14 +192,9 @@ class McapRecorder:
             self._pacer.step(frame)
 
     def occupancy(self, time_s: float, grid: Any) -> None:
-        """Log the sensed map on ``/map`` (:mod:`sim.log.map_channel`; the channel made at the first)."""
-        if self._channels.profile == ROS2_PROFILE:  # a ROS 2 log's /map would be a nav_msgs one: not written
-            return
+        """Log the sensed map on ``/map`` (a ``foxglove.Grid``, or a ``nav_msgs/OccupancyGrid`` in a ros2 log)."""
         t_ns = time_ns(time_s)
-        if self._map is None:
-            self._map = MapChannel(self._fox)
-        self._map.log(t_ns, grid)
-        self._after_write(t_ns, 1)
+        self._after_write(t_ns, self._channels.occupancy(t_ns, grid))
 
     def event(self, time_s: float, kind: str, details: dict[str, Any]) -> None:
         """Log a discrete event and flush, so it survives a crash right after."""
