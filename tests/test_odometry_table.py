@@ -1,17 +1,16 @@
-"""The README's odometry table is generated from the committed results (models/suites/results/odometry.json):
+"""docs/sensing.md's odometry table is generated from the committed results (models/suites/results/odometry.json):
 it fails when either drifts from the other, or when a committed row is no longer what the run gives."""
 
 import json
-from pathlib import Path
 
 from swarmnav.models.robots import ROBOTS
 from swarmnav.sim.benchmarks import odometry
 
-README = Path(__file__).resolve().parent.parent / "README.md"
+PAGE = odometry.PAGE
 
 
-def test_readme_block_is_generated_from_the_committed_results():
-    assert odometry.current_block(README.read_text(encoding="utf-8")) == odometry.block()
+def test_the_page_block_is_generated_from_the_committed_results():
+    assert odometry.current_block(PAGE.read_text(encoding="utf-8")) == odometry.block()
 
 
 def test_committed_rows_cover_every_robot_and_contact_drifts_more_per_metre():

@@ -227,8 +227,8 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
         run_seeds = None
     else:
         names, run_seeds = scenarios or suite_names(), seeds
-    # the BARN suites run no oracle unless asked: on BARN's worlds it collided in every one of 26 stand-in runs
-    # (barn-test50), so it is no yardstick there (sim/benchmarks/barn.py)
+    # the BARN suites run no oracle unless asked: on BARN's 50 test worlds (stand-in) it succeeded in 7 of 50 runs
+    # (18 collisions, 25 timeouts: models/suites/results/barn-test50.json), so it is no yardstick there
     yardstick = [ORACLE] if barn_meta is None or (barn or {}).get("oracle") else []
     tables = {**navigation_study(run_seeds, contenders + yardstick, names, navigator_params, list(arms)),
               **(knowledge or {})}

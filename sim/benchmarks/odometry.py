@@ -8,7 +8,7 @@ is one run: ``pose_error_m`` (final), ``max_pose_error_m``, ``distance_m`` (the 
 ratio ``error_per_m``, ``collisions`` and ``outcome``.  Every robot runs at the lower of its top speed and
 0.5 m/s, for ``time_limit_s`` simulated seconds at most.
 
-The README's table between the ``odometry-table`` markers is :func:`block` of the committed
+The table of docs/sensing.md between the ``odometry-table`` markers is :func:`block` of the committed
 :data:`RESULTS` (``tests/test_odometry_table.py`` fails when they drift).
 """
 
@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 RESULTS = Path(__file__).resolve().parents[2] / "models" / "suites" / "results" / "odometry.json"
+PAGE = Path(__file__).resolve().parents[2] / "docs" / "sensing.md"  # the page that holds the table
 BEGIN = "<!-- odometry-table: generated from models/suites/results/odometry.json by `swarmnav bench odometry --write`; do not edit by hand -->"
 END = "<!-- end of odometry-table -->"
 SPEED_M_S = 0.5
@@ -83,26 +84,26 @@ def table(rows: list[dict[str, Any]]) -> str:
 
 
 def block(rows: list[dict[str, Any]] | None = None) -> str:
-    """The README block (markers included) of ``rows``, by default the committed :data:`RESULTS`."""
+    """The page's block (markers included) of ``rows``, by default the committed :data:`RESULTS`."""
     if rows is None:
         rows = json.loads(RESULTS.read_text(encoding="utf-8"))
     return f"{BEGIN}\n{table(rows)}\n{END}"
 
 
-def current_block(readme: str) -> str:
-    """The README's block as it stands (markers included; empty when absent)."""
-    start, end = readme.find(BEGIN), readme.find(END)
-    return readme[start:end + len(END)] if start >= 0 and end > start else ""
+def current_block(page: str) -> str:
+    """The page's block as it stands (markers included; empty when absent)."""
+    start, end = page.find(BEGIN), page.find(END)
+    return page[start:end + len(END)] if start >= 0 and end > start else ""
 
 
-def write(rows: list[dict[str, Any]], readme: Path) -> None:
-    """Commit-ready output: ``rows`` as :data:`RESULTS` and the README's block regenerated from them."""
+def write(rows: list[dict[str, Any]], page: Path) -> None:
+    """Commit-ready output: ``rows`` as :data:`RESULTS` and the page's block regenerated from them."""
     RESULTS.write_text(json.dumps(rows, indent=1) + "\n", encoding="utf-8")
-    text = readme.read_text(encoding="utf-8")
+    text = page.read_text(encoding="utf-8")
     old = current_block(text)
     if not old:
-        raise ValueError(f"{readme}: no odometry-table markers")
-    readme.write_text(text.replace(old, block(rows)), encoding="utf-8")
+        raise ValueError(f"{page}: no odometry-table markers")
+    page.write_text(text.replace(old, block(rows)), encoding="utf-8")
 
 
 def run(args) -> int:
@@ -112,7 +113,7 @@ def run(args) -> int:
         raise ConfigError("--write", "writes the full benchmark's figures: not with --quick")
     rows = benchmark_odometry(time_limit_s=20.0 if args.quick else 60.0)
     if args.write:
-        write(rows, Path(__file__).resolve().parents[2] / "README.md")
+        write(rows, PAGE)
     if args.json:
         for row in rows:
             print(json.dumps(row))
