@@ -1,9 +1,11 @@
-"""The BARN page's tables (``docs/barn.md``, once the README's), generated from the committed ``bench navigation --suite barn --by-scenario --json``
-results (``models/suites/results/barn-test50.json``, ``barn.json``) beside the published figures.
+"""The BARN page's tables (``docs/barn.md``, once the README's), generated from the committed ``bench
+navigation --suite barn --by-scenario --json`` results (``models/suites/results/barn*.json``) beside the
+published figures.
 
 ``python -m swarmnav.sim.benchmarks.barn_table [--readme FILE]`` prints the block (or replaces it between its
-markers in FILE: ``docs/barn.md``); ``make readme-table`` runs it; ``tests/test_barn_table.py`` fails when the page drifts from
-the JSON.  Every figure in the block is read from a result file or is a published one cited beside it.
+markers in FILE: ``docs/barn.md``); ``make readme-table`` runs it; ``tests/test_barn_table.py`` fails when the
+page drifts from the JSON.  Every figure in the block is read from a result file or is a published one cited
+beside it.
 """
 
 from __future__ import annotations
