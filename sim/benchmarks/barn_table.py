@@ -18,7 +18,8 @@ from swarmnav.models.errors import ConfigError
 
 RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results"
 RESULTS = (RESULTS_DIR / "barn-test50.json", RESULTS_DIR / "barn-test10-dwa-vo.json", RESULTS_DIR / "barn.json",
-           RESULTS_DIR / "barn-like.json", RESULTS_DIR / "barn-jackal-test10.json")
+           RESULTS_DIR / "barn-like.json", RESULTS_DIR / "barn-jackal-test10.json",
+           RESULTS_DIR / "barn-protocol-test10.json")
 TEST_50, ALL_300, FRESH = RESULTS[0], RESULTS[2], RESULTS[3]  # compared: BARN-like worlds against BARN's
 BEGIN = "<!-- barn-table: generated from models/suites/results/barn*.json by `make readme-table`; do not edit by hand -->"
 END = "<!-- end of barn-table -->"
@@ -118,6 +119,16 @@ def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
                      f"{f['success_rate']:.3f} vs "
                      f"{b['success_rate']:.3f} ({ds:+.3f}), score {f['barn_score']:.4f} vs {b['barn_score']:.4f} "
                      f"({dsc:+.4f}): {'within' if abs(ds) <= 0.05 and abs(dsc) <= 0.05 else 'NOT within'} 0.05.")
+    if lines:
+        from swarmnav.sim.benchmarks.barn_difficulty import METRICS
+
+        def means(rows: list[dict[str, Any]]) -> dict[str, float]:
+            worlds = {r["world"]: r["difficulty"] for r in rows if r.get("scenario") is not None and r.get("difficulty")}
+            return {k: sum(d[k] for d in worlds.values()) / len(worlds) for k in METRICS} if worlds else {}
+        b, f = means(base_rows), means(fresh_rows)
+        if b and f:
+            lines.append("Their worlds' mean difficulty, BARN-like against BARN's: " + "; ".join(
+                f"{k.replace('_', ' ')} {f[k]:.2f} vs {b[k]:.2f}" for k in METRICS) + ".")
     return lines + [""] if lines else []
 
 

@@ -4,7 +4,8 @@
 
 * ``study_file``: the study file (path relative to the repository, SHA-256 of its bytes);
 * ``sources``: the SHA-256 of every source file of the components the study ran: each planner's module,
-  each navigator's module (physics studies only; a plan-only study never drives), and every project module
+  each navigator's module and the safety layer the stepper applies after it (physics studies only; a
+  plan-only study never drives), and every project module
   they import from ``planners/`` and ``controllers/``, followed transitively (a compiled helper is hashed by
   its C source beside it).  Modules elsewhere (``sim/``, ``models/``) are not followed: the inputs are the
   components, not the harness;
@@ -30,6 +31,9 @@ ROOT = FilePath(__file__).resolve().parents[2]
 #: The project folders whose modules count as a component's sources (imports are followed only inside them).
 COMPONENT_PACKAGES = ("planners", "controllers")
 KEY_DEPENDENCIES = ("numpy", "scipy", "mujoco", "ompl")
+#: Component modules a physics run uses whatever its navigator imports: the safety layer the stepper applies
+#: after every navigator's step.
+PHYSICS_LAYERS = (ROOT / "controllers" / "safety_layer.py",)
 
 
 def _sha256(path: FilePath) -> str:
@@ -111,12 +115,20 @@ def _class_file(cls: type) -> FilePath:
 
 
 def component_files(study) -> list[FilePath]:
-    """The module of each planner (and, for a physics study, each navigator) the study names."""
+    """The module of each planner (and, for a physics study, each navigator) the study runs (with
+    ``--claims-only``: those of the arms its claims compare)."""
     from swarmnav.controllers.navigators import NAVIGATORS
     from swarmnav.planners.registry import PLANNERS
-    files = [_class_file(PLANNERS[p.name]) for p in study.planners if p.name in PLANNERS]
+    from swarmnav.sim.study.claim_spec import arm_labels
+    wanted = None if study.claim_arms is None else {label for _, label, _ in study.claim_arms}
+    planners = [p for p in study.planners if wanted is None or set(arm_labels([p])) & wanted]
+    files = [_class_file(PLANNERS[p.name]) for p in planners if p.name in PLANNERS]
     if study.mode != "plan":
-        files += [_class_file(NAVIGATORS[n.name]) for n in study.navigators if n.name in NAVIGATORS]
+        claimed = None if study.claim_arms is None else {nav for _, _, nav in study.claim_arms}
+        navs = None if claimed is None or None in claimed else claimed
+        navigators = [n for n in study.navigators if navs is None or set(arm_labels([n])) & navs]
+        files += [_class_file(NAVIGATORS[n.name]) for n in navigators if n.name in NAVIGATORS]
+        files += [f for f in PHYSICS_LAYERS if f.is_file()]
     return files
 
 
@@ -152,6 +164,7 @@ def study_inputs(study) -> dict[str, Any]:
     """What a run of ``study`` depends on (see the module docstring)."""
     study_file = FilePath(study.source) if study.source else None
     return {
+        "claims_only": study.claim_arms is not None,
         "study_file": ({"path": _relative(study_file), "sha256": _sha256(study_file)}
                        if study_file is not None and study_file.is_file() else None),
         "sources": {_relative(f): _sha256(f) for f in source_closure(component_files(study))},
@@ -200,7 +213,9 @@ def check_fresh(paths: list[str]) -> tuple[list[str], list[str], list[str]]:
             changes = ["its claims.json records no inputs (run before provenance was recorded)"]
         else:
             try:
-                changes, study_notes = stale_inputs(recorded, study_inputs(load_study(name)))
+                study = load_study(name)
+                changes, study_notes = stale_inputs(recorded, study_inputs(
+                    study.claims_only() if recorded.get("claims_only") else study))
             except ConfigError as exc:
                 changes, study_notes = [f"its study cannot be loaded today ({exc})"], []
             notes += [f"{name}: {n}" for n in study_notes]
