@@ -65,6 +65,7 @@ bench: $(STAMP)
 	$(BIN)/swarmnav bench navigation $(BENCH_FLAGS)
 	$(BIN)/swarmnav bench study $(BENCH_FLAGS)
 	$(BIN)/swarmnav bench cli $(BENCH_FLAGS)
+	$(BIN)/swarmnav bench odometry $(BENCH_FLAGS)
 
 # Every bundled study into studies/<name>/ (rows resume if interrupted), with report.html and report.md.
 # Quick by default (each study's quick_seeds, about 10 min on 2 cores); `make studies STUDY_RUN=` runs them in full
@@ -75,10 +76,12 @@ studies: $(STAMP)
 		$(BIN)/swarmnav study $$s $(STUDY_RUN) --out studies/$$s && $(BIN)/swarmnav report studies/$$s || exit 1; \
 	done
 
-# The README's claims table: each bundled study with [[claims]] run in full into a fresh
-# studies/readme-table/<name>/, its verdicts copied to models/studies/results/<name>/claims.json (committed),
-# and the table between the README's claims-table markers regenerated from them; then the README's navigation
-# table from the committed `bench navigation --suite dyn300 --json` result (models/suites/results/dyn300.json).
+# The generated tables (the marker blocks; the README moved into docs/): the claims table of
+# docs/reference/studies.md (each bundled study with [[claims]] run in full into a fresh
+# studies/readme-table/<name>/, its verdicts copied to models/studies/results/<name>/claims.json, committed,
+# and the table regenerated from them); the navigation tables of docs/navigation.md and the headline table of
+# README.md and docs/results.md from the committed `bench navigation --json` results (models/suites/results/);
+# the BARN and CrowdNav tables of docs/barn.md and docs/crowds.md.
 CLAIM_STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin) if s['claims']))")
 # Each study runs only the arms its claims compare (--claims-only), on every seed of the study file (the seed
 # rule's count); CLAIMS_RUN=--quick runs the quick seeds instead (not for committing: their verdicts are
@@ -91,10 +94,11 @@ readme-table: $(STAMP)
 		$(BIN)/swarmnav report studies/readme-table/$$s && mkdir -p models/studies/results/$$s && \
 		cp studies/readme-table/$$s/claims.json models/studies/results/$$s/claims.json || exit 1; \
 	done
-	$(BIN)/swarmnav report --readme-table models/studies/results --readme README.md
-	for r in dyn300 dyn300-rangefinder dyn; do $(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/$$r.json --readme README.md || exit 1; done
-	$(BIN)/python -m swarmnav.sim.benchmarks.barn_table --readme README.md
-	$(BIN)/python -m swarmnav.sim.benchmarks.crowd_table models/suites/results/crowdnav.json --readme README.md
+	$(BIN)/swarmnav report --readme-table models/studies/results --readme docs/reference/studies.md
+	for r in dyn300 dyn300-rangefinder dyn; do $(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/$$r.json --readme docs/navigation.md || exit 1; done
+	for page in README.md docs/results.md; do $(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/dyn300.json --readme $$page || exit 1; done
+	$(BIN)/python -m swarmnav.sim.benchmarks.barn_table --readme docs/barn.md
+	$(BIN)/python -m swarmnav.sim.benchmarks.crowd_table models/suites/results/crowdnav.json --readme docs/crowds.md
 
 rerun-stale: $(STAMP)
 	$(MAKE) readme-table CLAIM_STUDIES="$$($(BIN)/swarmnav report --check-fresh models/studies/results --names)"

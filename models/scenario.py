@@ -99,6 +99,8 @@ class Scenario:
     pose_source: str = "truth"
     map_cell_m: float = 0.05
     encoder_noise: float = 0.0
+    # with_knowledge gave map or pose (--map / --pose, a study axis): the run logs them, so a replay has them.
+    knowledge_overridden: bool = False
 
     def with_knowledge(self, map_knowledge: str | None = None, pose_source: str | None = None) -> "Scenario":
         """This scenario with the map or the pose source overridden (``--map`` / ``--pose``, a study axis).
@@ -111,7 +113,8 @@ class Scenario:
                 raise ConfigError(f"knowledge.{name}", f"must be one of {', '.join(choices)}, got {value!r}",
                                   self.source_path)
         return replace(self, map_knowledge=map_knowledge or self.map_knowledge,
-                       pose_source=pose_source or self.pose_source)
+                       pose_source=pose_source or self.pose_source,
+                       knowledge_overridden=self.knowledge_overridden or bool(map_knowledge or pose_source))
 
     @property
     def bounds(self) -> Rect:

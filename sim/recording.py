@@ -55,6 +55,8 @@ class RunContext:
     navigator_params: dict[str, Any] = field(default_factory=dict)
     world_seed: int = 0
     clearance_m: float | None = None  # the planning clearance the run used (None: the scenario file's)
+    map_knowledge: str | None = None  # knowledge.map given over the file's (--map, a study axis); None: the file's
+    pose_source: str | None = None  # knowledge.pose given over the file's (--pose, a study axis); None: the file's
 
 
 @dataclass

@@ -68,6 +68,8 @@ class Simulation:
             planner_name=planner_name, planner_params=dict(planner_params), seed=seed, mjcf_xml=self.scene.xml,
             navigator_name=navigator_name, navigator_params=dict(navigator_params or {}),
             world_seed=self.scenario.world_seed, clearance_m=self.scenario.clearance_m,
+            map_knowledge=self.scenario.map_knowledge if self.scenario.knowledge_overridden else None,
+            pose_source=self.scenario.pose_source if self.scenario.knowledge_overridden else None,
             control_dt_s=self.control_dt_s, physics_dt_s=float(model.opt.timestep),
             sensor_angles_rad=self.scene.range_angles_rad.copy(), sensor_range_m=self.scene.range_cutoff_m,
             sensor_offset_m=self.scene.range_offset_m, sensor_height_m=self.scene.range_height_m,

@@ -99,8 +99,11 @@ def cheap_settings(files: dict[str, str]) -> dict[tuple[str, ...], list[str]]:
 
 @pytest.fixture
 def cached_parser(monkeypatch):
-    """main() builds the parser once for the whole sweep (building it is most of a refused call's time)."""
+    """A parser of its own for the sweep, built once and used by every main() call of the test (main keeps one
+    per process, ``_parser``; a scratch option added here never reaches the other tests)."""
     parser = cli_main.build_parser()
+    if hasattr(cli_main, "_parser"):
+        monkeypatch.setattr(cli_main, "_parser", lambda: parser)
     monkeypatch.setattr(cli_main, "build_parser", lambda: parser)
     return parser
 

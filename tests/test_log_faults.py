@@ -198,9 +198,18 @@ def test_a_json_tf_channel_from_another_tool_is_refused(tmp_path, capsys):
 def test_full_disk_is_one_line_with_the_path_and_exit_2(capsys):
     if not os.path.exists("/dev/full"):
         pytest.skip("no /dev/full on this system")
-    assert main(["run", "gwo-scenario-1", "--out", "/dev/full", "--overwrite"]) == 2
+    # The CLI writes no log onto a device (issue 36: --out is a regular file or a new one), one line, exit 2 ...
+    with pytest.raises(SystemExit) as info:
+        main(["run", "gwo-scenario-1", "--out", "/dev/full", "--overwrite"])
     err = one_error_line(capsys)
-    assert "/dev/full" in err and os.strerror(errno.ENOSPC) in err
+    assert info.value.code == 2 and "/dev/full" in err and "device" in err
+    # ... and a disk that fills under the log file is kept as the OSError naming it (the CLI's one line)
+    from swarmnav.sim.log.file import LogFile
+    log = LogFile("/dev/full", overwrite=True)
+    with pytest.raises(OSError) as full:
+        log.write(b"x" * 4096)
+    log.close()
+    assert full.value.errno == errno.ENOSPC and log.error.filename == "/dev/full"
 
 
 FILE_SIZE_LIMITED_RUN = """

@@ -134,6 +134,26 @@ def test_an_odometry_estimate_goes_to_odom_and_map_to_odom_carries_its_error(tmp
     assert np.isnan(log.range_m[0, 1]) and log.range_m[0, 0] == pytest.approx(0.7)
 
 
+def test_an_odometry_run_logs_the_estimate_on_odom_and_the_true_pose_through_map_to_odom(tmp_path):
+    """knowledge.pose = "odometry": /odom is the dead-reckoned pose (it drifts), map -> odom -> base_link the truth."""
+    from swarmnav.models.scenario import load_scenario
+    from swarmnav.sim.episode import EpisodeSpec, run_episode
+    from swarmnav.sim.log.reader import read_log
+    from swarmnav.sim.log.writer import McapRecorder
+    scenario = load_scenario("gwo-scenario-1").with_knowledge(pose_source="odometry")
+    result = run_episode(EpisodeSpec(scenario), [McapRecorder(tmp_path / "odo.mcap", log_format="ros2")],
+                         time_limit_s=4.0).result
+    messages = _decoded(tmp_path / "odo.mcap")
+    assert {(t.header.frame_id, t.child_frame_id) for t in messages["/tf"][-1].transforms} == \
+        {("map", "odom"), ("odom", "base_link")}
+    last = messages["/odom"][-1].pose.pose.position
+    x, y, _ = result.poses[-1]
+    drift_m = math.hypot(last.x - x, last.y - y)
+    assert 0 < drift_m < 0.2  # the estimate is not the truth, and not far from it after 4 s
+    log = read_log(tmp_path / "odo.mcap")
+    np.testing.assert_allclose(log.position_m[:, :2], result.poses[:, :2], atol=1e-9)
+
+
 def test_with_the_map_unknown_map_is_the_sensed_grid_as_nav_msgs_occupancy_grid(tmp_path):
     """The map a run builds (``knowledge = { map = "unknown" }``) goes to /map in both profiles: the same cells."""
     from mcap.reader import make_reader

@@ -1,4 +1,5 @@
-"""The README's navigation tables are the ones generated from the committed results (dyn300, the dyn-* scenes)."""
+"""The navigation tables of the docs (docs/navigation.md) and the README's headline table (dyn300, also on
+docs/results.md) are the ones generated from the committed results (dyn300, the dyn-* scenes)."""
 
 import json
 from pathlib import Path
@@ -12,12 +13,20 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 @pytest.mark.parametrize("result", RESULTS, ids=lambda p: p.name)
-def test_the_readme_navigation_table_is_the_one_generated_from_the_committed_result(result, capsys):
+def test_the_docs_navigation_table_is_the_one_generated_from_the_committed_result(result, capsys):
     assert navigation_table.main([str(result)]) == 0
     generated = capsys.readouterr().out.strip()
-    readme = (REPO / "README.md").read_text()
-    assert current_block(readme, result) == generated, \
-        "run `make readme-table` (README and models/suites/results differ)"
+    page = (REPO / "docs" / "navigation.md").read_text()
+    assert current_block(page, result) == generated, \
+        "run `make readme-table` (docs/navigation.md and models/suites/results differ)"
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/results.md"])
+def test_the_headline_table_is_the_one_generated_from_the_committed_dyn300_result(page, capsys):
+    assert navigation_table.main([str(RESULT)]) == 0
+    generated = capsys.readouterr().out.strip()
+    assert current_block((REPO / page).read_text(), RESULT) == generated, \
+        f"run `make readme-table` ({page} and models/suites/results/dyn300.json differ)"
 
 
 def test_the_committed_dyn_result_runs_every_bundled_dyn_scene_for_every_default_navigator():

@@ -460,3 +460,18 @@ def test_the_convergence_curve_by_evaluations_is_the_recorded_step_function():
                     np.array([0, 19, 20, 60, 61, 149, 150, 400]))
     assert np.isnan(costs[:2]).all()  # nothing was scored before the first population
     assert costs[2:].tolist() == [9.0, 9.0, 7.0, 7.0, 4.0, 4.0]
+
+
+def test_the_maps_and_poses_axes_run_each_value_and_rows_carry_it(tmp_path, capsys):
+    path = write(tmp_path, 'name = "knowledge"\nscenarios = ["gwo-scenario-1"]\nmode = "physics"\ntime_limit_s = 2.0\n'
+                           'seeds = [0]\nmaps = ["known", "unknown"]\nposes = ["odometry"]\n'
+                           '[[planners]]\nname = "astar"\n[[navigators]]\nname = "replan"\n')
+    assert main(["study", str(path), "--out", str(tmp_path / "out"), "--workers", "1", "--json"]) == 0
+    rows = pd.read_parquet(tmp_path / "out" / "runs.parquet")
+    assert sorted(rows.map_knowledge) == ["known", "unknown"] and set(rows.pose_source) == {"odometry"}
+    assert rows.config_hash.nunique() == 2 and (rows.outcome != "error").all(), rows.error.tolist()
+    bad = write(tmp_path, path.read_text().replace('"unknown"]', '"blurry"]'), "bad.toml")
+    capsys.readouterr()
+    assert main(["study", str(bad), "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "maps" in err and "blurry" in err, err

@@ -152,3 +152,21 @@ def test_an_arms_settings_split_at_keys_only():
     arm = parse_arm("drive:immas_stepwise:evade=true, lookahead_cells=6,predict_s=1")
     assert arm.params == {"evade": True, "lookahead_cells": 6, "predict_s": 1}
     assert parse_arm("plain:follow:").params == {}
+
+
+def test_bench_navigation_map_and_pose_reach_every_run_and_row(tmp_path, capsys):
+    import json
+
+    from swarmnav.sim.cli.main import main
+    path = tmp_path / "short.toml"
+    text = generate("crossing", 5, GeneratorOptions(obstacles=2, arena_m=5.0))
+    path.write_text(text.replace("time_limit_s = 65", "time_limit_s = 4"))
+    argv = ["bench", "navigation", "--scenario", str(path), "--seeds", "1", "--navigator", "replan", "--map",
+            "unknown", "--pose", "odometry", "--json", "--out", str(tmp_path / "out")]
+    assert main(argv) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert {r["navigator"] for r in rows} == {"replan", ORACLE}
+    assert {(r["map_knowledge"], r["pose_source"]) for r in rows} == {("unknown", "odometry")}
+    import pandas as pd
+    runs = pd.read_parquet(tmp_path / "out" / "runs.parquet")
+    assert set(runs.map_knowledge) == {"unknown"} and set(runs.pose_source) == {"odometry"} and len(runs) == 2

@@ -79,3 +79,22 @@ def test_planning_navigators_reach_the_goal_on_the_sensed_map_and_log_it(tmp_pat
     rim_gap = np.abs(np.hypot(*(occupied[:, None, :] - centres[None]).transpose(2, 0, 1)) - radii).min(axis=1)
     assert len(occupied) >= 5 and rim_gap.max() < 1.5 * math.sqrt(2) * cell_m
     assert cells[int(9.8 / cell_m), int(0.2 / cell_m)] == -1
+
+
+def test_a_run_with_map_and_pose_given_on_the_command_line_replays(tmp_path):
+    """--map / --pose are logged in the run record, so replay --verify re-simulates the same run."""
+    import json
+    import re
+
+    from swarmnav.sim.cli.main import main
+    from swarmnav.sim.log.reader import read_log
+
+    text = re.sub(r"(?m)^time_limit_s\s*=.*$", "time_limit_s = 4.0", load_scenario("gwo-scenario-1").source_text)
+    path = tmp_path / "short.toml"
+    path.write_text(text)
+    out = tmp_path / "run.mcap"
+    argv = ["run", str(path), "--navigator", "replan", "--map", "unknown", "--pose", "odometry", "--out", str(out)]
+    assert main(argv) in (0, 5)
+    run = read_log(str(out)).metadata["run"]
+    assert json.loads(run["map_knowledge"]) == "unknown" and json.loads(run["pose_source"]) == "odometry"
+    assert main(["replay", str(out), "--verify"]) == 0

@@ -71,7 +71,6 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation

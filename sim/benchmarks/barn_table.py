@@ -1,9 +1,11 @@
-"""The README's BARN tables, generated from the committed ``bench navigation --suite barn --by-scenario --json``
-results (``models/suites/results/barn-test50.json``, ``barn.json``) beside the published figures.
+"""The BARN page's tables (``docs/barn.md``, once the README's), generated from the committed ``bench
+navigation --suite barn --by-scenario --json`` results (``models/suites/results/barn*.json``) beside the
+published figures.
 
 ``python -m swarmnav.sim.benchmarks.barn_table [--readme FILE]`` prints the block (or replaces it between its
-markers in FILE); ``make readme-table`` runs it; ``tests/test_barn_table.py`` fails when the README drifts from
-the JSON.  Every figure in the block is read from a result file or is a published one cited beside it.
+markers in FILE: ``docs/barn.md``); ``make readme-table`` runs it; ``tests/test_barn_table.py`` fails when the
+page drifts from the JSON.  Every figure in the block is read from a result file or is a published one cited
+beside it.
 """
 
 from __future__ import annotations
@@ -18,7 +20,8 @@ from swarmnav.models.errors import ConfigError
 
 RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results"
 RESULTS = (RESULTS_DIR / "barn-test50.json", RESULTS_DIR / "barn-test10-dwa-vo.json", RESULTS_DIR / "barn.json",
-           RESULTS_DIR / "barn-like.json", RESULTS_DIR / "barn-jackal-test10.json")
+           RESULTS_DIR / "barn-like.json", RESULTS_DIR / "barn-jackal-test10.json",
+           RESULTS_DIR / "barn-protocol-test10.json", RESULTS_DIR / "barn-protocol-test10-more.json")
 TEST_50, ALL_300, FRESH = RESULTS[0], RESULTS[2], RESULTS[3]  # compared: BARN-like worlds against BARN's
 BEGIN = "<!-- barn-table: generated from models/suites/results/barn*.json by `make readme-table`; do not edit by hand -->"
 END = "<!-- end of barn-table -->"
@@ -118,6 +121,16 @@ def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
                      f"{f['success_rate']:.3f} vs "
                      f"{b['success_rate']:.3f} ({ds:+.3f}), score {f['barn_score']:.4f} vs {b['barn_score']:.4f} "
                      f"({dsc:+.4f}): {'within' if abs(ds) <= 0.05 and abs(dsc) <= 0.05 else 'NOT within'} 0.05.")
+    if lines:
+        from swarmnav.sim.benchmarks.barn_difficulty import METRICS
+
+        def means(rows: list[dict[str, Any]]) -> dict[str, float]:
+            worlds = {r["world"]: r["difficulty"] for r in rows if r.get("scenario") is not None and r.get("difficulty")}
+            return {k: sum(d[k] for d in worlds.values()) / len(worlds) for k in METRICS} if worlds else {}
+        b, f = means(base_rows), means(fresh_rows)
+        if b and f:
+            lines.append("Their worlds' mean difficulty, BARN-like against BARN's: " + "; ".join(
+                f"{k.replace('_', ' ')} {f[k]:.2f} vs {b[k]:.2f}" for k in METRICS) + ".")
     return lines + [""] if lines else []
 
 

@@ -191,19 +191,21 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                          quick: bool = False, sensor_model: str | None = None,
                          workers: int = 1, speed: bool = True, per_group: int | None = None,
                          arms: list[Arm] = (), engine: str = "local", address: str | None = None,
-                         seed_offset: int = 0, barn: dict[str, Any] | None = None) -> list[dict[str, Any]]:
+                         seed_offset: int = 0, barn: dict[str, Any] | None = None,
+                         knowledge: dict[str, Any] | None = None) -> list[dict[str, Any]]:
     """One row per navigator and the oracle's (see the module docstring); ``navigator_params``: per navigator
     name.  With ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key;
     the overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given;
     ``suite`` (e.g. ``dyn300``) runs a generated suite instead of ``scenarios``; ``arms``: more rows, each a
     navigator under its own label with its own parameters (the rows are keyed by label); ``engine="ray"``:
     the runs on Ray (a local instance of ``workers`` CPUs, or the cluster at ``address``); ``suite="barn"``: the
-    BARN worlds (:mod:`sim.benchmarks.barn`; ``barn``: its ``worlds``, ``runs`` and ``dir``), with its score."""
+    BARN worlds (:mod:`sim.benchmarks.barn`; ``barn``: its ``worlds``, ``runs`` and ``dir``), with its score;
+    ``knowledge``: the study axes ``maps`` / ``poses`` (``--map`` / ``--pose``), every row says its values."""
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
             return benchmark_navigation(seeds, navigators, scenarios, progress, navigator_params, by_scenario,
                                         folder, suite, quick, sensor_model, workers, speed, per_group, arms,
-                                        engine, address, seed_offset, barn)
+                                        engine, address, seed_offset, barn, knowledge)
     from swarmnav.sim.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
@@ -225,10 +227,11 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
         run_seeds = None
     else:
         names, run_seeds = scenarios or suite_names(), seeds
-    # the BARN suites run no oracle unless asked: on BARN's worlds it collided in every one of 26 stand-in runs
-    # (barn-test50), so it is no yardstick there (sim/benchmarks/barn.py)
+    # the BARN suites run no oracle unless asked: on BARN's 50 test worlds (stand-in) it succeeded in 7 of 50 runs
+    # (18 collisions, 25 timeouts: models/suites/results/barn-test50.json), so it is no yardstick there
     yardstick = [ORACLE] if barn_meta is None or (barn or {}).get("oracle") else []
-    tables = navigation_study(run_seeds, contenders + yardstick, names, navigator_params, list(arms))
+    tables = {**navigation_study(run_seeds, contenders + yardstick, names, navigator_params, list(arms)),
+              **(knowledge or {})}
     rows = run_study_tables(tables, out_dir, show_progress=progress, workers=workers, engine=engine,
                             address=address)
     verdicts = oracle_verdicts(rows)
@@ -254,6 +257,9 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
             for nav, arm in runs.items():
                 table.append({"scenario": name, **_row(nav, [r for r in arm if r["scenario"] == name], verdicts,
                                                        shipped), **extra})
+    given = {key: "+".join(sorted({str(r[key]) for r in rows})) for key in ("map_knowledge", "pose_source")}
+    for row in table:  # what the runs were given (the oracle keeps the true map: controllers.world_map)
+        row.update(given)
     if barn_meta is not None:
         barn_suite.add_scores(table, rows, barn_meta, barn_setup, by_scenario, (barn or {}).get("dir"))
     return table
@@ -321,6 +327,12 @@ def _plain_row(navigator: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+def knowledge_axes(args: argparse.Namespace) -> dict[str, list[str]]:
+    """``--map`` / ``--pose`` as the study axes ``maps`` / ``poses`` (absent: each scenario's [knowledge])."""
+    return {key: [value] for key, value in (("maps", getattr(args, "map", None)), ("poses", getattr(args, "pose", None)))
+            if value is not None}
+
+
 def run(args: argparse.Namespace) -> int:
     from swarmnav.models.errors import ConfigError
     if args.seeds < 1:
@@ -333,7 +345,8 @@ def run(args: argparse.Namespace) -> int:
             raise ConfigError("--engine", "ray applies to the dyn and dyn300 suites (papers runs in this process)")
         from swarmnav.sim.benchmarks.paper_navigation import (PAPER_SUITE, benchmark_paper_navigation,
                                                               print_table)
-        paper_rows = benchmark_paper_navigation(args.seeds, tuple(args.scenario or PAPER_SUITE), args.out)
+        paper_rows = benchmark_paper_navigation(args.seeds, tuple(args.scenario or PAPER_SUITE), args.out,
+                                                knowledge_axes(args))
         print(json.dumps(paper_rows)) if args.json else print_table(paper_rows)
         return 0
     from swarmnav.sim.options import parse_settings
@@ -358,7 +371,8 @@ def run(args: argparse.Namespace) -> int:
                                 workers=getattr(args, "workers", 1) or 1, per_group=getattr(args, "per_group", None),
                                 arms=arms, engine=getattr(args, "engine", "local"),
                                 address=getattr(args, "address", None),
-                                seed_offset=getattr(args, "seed_offset", 0) or 0, barn=barn)
+                                seed_offset=getattr(args, "seed_offset", 0) or 0, barn=barn,
+                                knowledge=knowledge_axes(args))
     if args.json:
         print(json.dumps(rows))
         return 0

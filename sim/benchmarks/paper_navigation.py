@@ -49,21 +49,23 @@ def _slug(label: str) -> str:
 
 
 def contender_tables(base, label: str, navigator: str, params: dict[str, Any], planner: str | None,
-                     seeds: int) -> dict[str, Any]:
+                     seeds: int, knowledge: dict[str, Any] | None = None) -> dict[str, Any]:
     """One contender on one scenario as a physics study: the scenario's planner seed, world seeds 0..N-1."""
     return {"name": "bench-paper-navigation", "scenarios": [base.name], "mode": "physics", "seeds": [base.seed],
             "world_seeds": list(range(seeds)),
             "planners": [{"name": planner or base.planner_name}],
-            "navigators": [{"name": navigator, "label": _slug(label), "params": params}]}
+            "navigators": [{"name": navigator, "label": _slug(label), "params": params}], **(knowledge or {})}
 
 
 def benchmark_paper_navigation(seeds: int = 1, scenarios: tuple[str, ...] = PAPER_SUITE,
-                               out_dir: str | None = None) -> list[dict[str, Any]]:
+                               out_dir: str | None = None, knowledge: dict[str, Any] | None = None
+                               ) -> list[dict[str, Any]]:
     """One row per scenario x contender x world seed (see the module docstring), from the rows of one
-    physics study per scenario and contender, all kept in ``out_dir`` when given."""
+    physics study per scenario and contender, all kept in ``out_dir`` when given; ``knowledge``: the study
+    axes ``maps`` / ``poses`` (``--map`` / ``--pose``)."""
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-paper-navigation-") as folder:
-            return benchmark_paper_navigation(seeds, scenarios, folder)
+            return benchmark_paper_navigation(seeds, scenarios, folder, knowledge)
     from swarmnav.sim.study.execute import run_study_tables
 
     rows = []
@@ -74,7 +76,7 @@ def benchmark_paper_navigation(seeds: int = 1, scenarios: tuple[str, ...] = PAPE
             if navigator not in NAVIGATORS or (navigator == "iaco_local" and base.navigator_name != "iaco_local"
                                                and label != "paper"):
                 continue
-            runs = run_study_tables(contender_tables(base, label, navigator, params, planner, seeds), out_dir)
+            runs = run_study_tables(contender_tables(base, label, navigator, params, planner, seeds, knowledge), out_dir)
             mine = sorted((r for r in runs if r["scenario"] == name and r["navigator_label"] == _slug(label)
                            and r["planner"] == (planner or base.planner_name)), key=lambda r: r["world_seed"])
             rows += [_paper_row(name, label, r) for r in mine]
@@ -91,7 +93,8 @@ def _paper_row(scenario: str, label: str, run: dict[str, Any]) -> dict[str, Any]
             "collisions": run["collisions"], "time_s": round(run["sim_time_s"], 2) if drove else None,
             "path_length_m": round(run["path_length_m"], 3) if drove else None,
             "turns": run["driven_turns"], "replans": run["replans"] + escapes if drove else None,
-            "moves": walk.get("moves"), "total_arc_cost": walk.get("total_arc_cost")}
+            "moves": walk.get("moves"), "total_arc_cost": walk.get("total_arc_cost"),
+            "map_knowledge": run["map_knowledge"], "pose_source": run["pose_source"]}
 
 
 def print_table(rows: list[dict[str, Any]]) -> None:

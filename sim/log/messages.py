@@ -217,6 +217,8 @@ def run_metadata(context: RunContext) -> dict[str, str]:
         "seed": str(int(context.seed)),
         "world_seed": str(int(context.world_seed)),
         **({} if context.clearance_m is None else {"clearance_m": repr(float(context.clearance_m))}),
+        **({} if context.map_knowledge is None else {"map_knowledge": dumps(context.map_knowledge)}),
+        **({} if context.pose_source is None else {"pose_source": dumps(context.pose_source)}),
         "control_dt_s": repr(float(context.control_dt_s)),
         "physics_dt_s": repr(float(context.physics_dt_s)),
         "sensor_angles_rad": dumps([float(a) for a in context.sensor_angles_rad]),

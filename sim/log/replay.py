@@ -83,6 +83,8 @@ def context_from_log(log: RunLog) -> RunContext:
         navigator_params=_params(log, "navigator"),
         world_seed=int(log.run_value("world_seed", log.run_value("seed", 0))),
         clearance_m=log.run_value("clearance_m", None),
+        map_knowledge=log.run_value("map_knowledge", None),
+        pose_source=log.run_value("pose_source", None),
     )
 
 
@@ -203,6 +205,7 @@ def verify_log(log: RunLog, named: dict | None = None, trust_code: bool = False)
         raise LogError(source, "holds no step to replay")
     navigator_params = code_for_verify(context, named or {}, trust_code, source)
     scenario = parse_scenario(context.scenario_toml, f"{source}[scenario]", trust_code=trust_code)
+    scenario = scenario.with_knowledge(context.map_knowledge, context.pose_source)  # --map / --pose, as run
     spec = EpisodeSpec(scenario, context.planner_name, context.planner_params, context.navigator_name,
                        navigator_params, context.seed, context.world_seed, context.clearance_m)
     model = compile_log_scene(context.mjcf_xml, source)

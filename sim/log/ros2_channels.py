@@ -165,9 +165,10 @@ def occupancy_grid(t_ns: int, cells: np.ndarray, resolution_m: float, origin_xy_
 class Ros2Channels:
     """The ``ros2`` profile's channels of one run, on one ``foxglove.Context``.
 
-    Each method writes its messages and returns how many it wrote.  A run that estimates
-    odometry hands the estimate on ``StepFrame.odometry`` (x_m, y_m, heading_rad, the pose in
-    ``odom``); without it odometry is the simulator's pose.  A run whose map is unknown hands the
+    Each method writes its messages and returns how many it wrote.  A run with
+    ``knowledge.pose = "odometry"`` hands its dead-reckoned pose on ``StepFrame.odometry`` (a ``Pose2D``
+    in ``odom``): ``/odom`` is that estimate and ``map`` -> ``odom`` carries its error; without it
+    odometry is the simulator's pose.  A run whose map is unknown hands the
     map it builds to :meth:`occupancy` (the recorder's ``occupancy``), written on ``/map``.
     """
 
@@ -239,7 +240,7 @@ class Ros2Channels:
     def step(self, frame: StepFrame, t_ns: int, late: set[str] | tuple = ()) -> int:
         position = np.asarray(frame.position_m, dtype=float).tolist()
         qw, qx, qy, qz = np.asarray(frame.quaternion_wxyz, dtype=float).tolist()
-        odometry = getattr(frame, "odometry", None)
+        odometry = frame.odometry  # a Pose2D with knowledge.pose = "odometry", else None
         written = 0
         if not self._static_written or "/tf_static" in late:
             static = self._static + ([] if odometry is not None else [self._static_map_odom])

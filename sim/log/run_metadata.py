@@ -12,6 +12,7 @@ from typing import Any
 
 from swarmnav.models.contained_files import loads_json
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.scenario import MAP_KNOWLEDGE, POSE_SOURCES
 from swarmnav.models.scenario_limits import MAX_MOVING_OBSTACLES, MAX_SENSORS, MAX_STATIC_OBSTACLES
 from swarmnav.sim.log.records import LogError
 
@@ -41,6 +42,8 @@ RUN_FIELDS = {
     "world_seed": ("an integer seed from 0 to 2**63 - 1",
                    lambda v: isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= MAX_SEED),
     "clearance_m": ("a finite number of at least 0", lambda v: _number(v) and v >= 0),
+    "map_knowledge": (f"one of {', '.join(MAP_KNOWLEDGE)}", lambda v: v in MAP_KNOWLEDGE),
+    "pose_source": (f"one of {', '.join(POSE_SOURCES)}", lambda v: v in POSE_SOURCES),
     "control_dt_s": ("a positive finite number", lambda v: _number(v) and v > 0),
     "physics_dt_s": ("a positive finite number", lambda v: _number(v) and v > 0),
     "sensor_angles_rad": (f"a list of at most {MAX_SENSORS} numbers", lambda v: _numbers(v, most=MAX_SENSORS)),

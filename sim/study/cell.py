@@ -169,6 +169,8 @@ def run_cell(cell: Cell, logs_dir: str | None = None,
     try:
         with _WallLimit(cell.wall_limit_s):
             scenario = load_scenario(cell.scenario, trust_code=cell.trust_code)
+            scenario = scenario.with_knowledge(cell.map_knowledge, cell.pose_source)  # the maps / poses axes
+            row.update(map_knowledge=scenario.map_knowledge, pose_source=scenario.pose_source)
             row["straight_line_m"] = math.hypot(scenario.goal.x_m - scenario.start.x_m,
                                                 scenario.goal.y_m - scenario.start.y_m)
             spec = EpisodeSpec(scenario, cell.planner, cell.planner_params, cell.navigator, cell.navigator_params,

@@ -40,6 +40,8 @@ class Cell:
     clearance_m: float | None = None  # the study's planning clearance override (None: the scenario's)
     trust_code: bool = False  # the study's --trust-code (not part of the hash: it decides no result)
     budget: dict[str, Any] | None = None  # the planner's budget, {"evaluations": N} or {"time_s": T} (None: none)
+    map_knowledge: str | None = None  # the study's maps axis value (None: the scenario's knowledge.map)
+    pose_source: str | None = None  # the study's poses axis value (None: the scenario's knowledge.pose)
 
     @property
     def physics(self) -> bool:
@@ -71,7 +73,7 @@ def iter_cells(study: Study) -> Iterator[Cell]:
     for scenario, planner, planner_params, navigator, navigator_params in _settings(study):
         label = planner.arm_label(planner_params)
         navigator_label = navigator.arm_label(navigator_params)
-        for world_seed, seed in pairs:
+        for (map_knowledge, pose_source), (world_seed, seed) in ((k, p) for k in study.knowledge for p in pairs):
             config = {"scenario_sha256": scenario_digest[scenario], "planner": planner.name,
                       "label": planner.label, "navigator_label": navigator.label,
                       "planner_params": planner_params, "navigator": navigator.name,
@@ -79,6 +81,10 @@ def iter_cells(study: Study) -> Iterator[Cell]:
                       "world_seed": world_seed, "mode": study.mode, "time_limit_s": study.time_limit_s}
             if study.clearance_m is not None:  # absent otherwise: earlier hashes hold
                 config["clearance_m"] = study.clearance_m
+            if map_knowledge is not None:  # likewise
+                config["map_knowledge"] = map_knowledge
+            if pose_source is not None:
+                config["pose_source"] = pose_source
             budget = study.budget_of(planner)
             if budget is not None:  # likewise
                 config["budget"] = budget.as_dict()
@@ -91,15 +97,16 @@ def iter_cells(study: Study) -> Iterator[Cell]:
                 mode=study.mode, time_limit_s=study.time_limit_s,
                 wall_limit_s=study.wall_limit_s, config_hash=config_hash(config),
                 clearance_m=study.clearance_m, trust_code=study.trust_code,
-                budget=None if budget is None else budget.as_dict())
+                budget=None if budget is None else budget.as_dict(),
+                map_knowledge=map_knowledge, pose_source=pose_source)
 
 
 def count_cells(study: Study) -> int:
     """How many cells :func:`iter_cells` yields, without building them."""
     if study.claim_arms is not None:
-        return sum(1 for _ in _settings(study)) * len(study.seed_pairs())
+        return sum(1 for _ in _settings(study)) * len(study.knowledge) * len(study.seed_pairs())
     settings = sum(len(p.settings()) for p in study.planners) * sum(len(n.settings()) for n in study.navigators)
-    return len(study.scenarios) * settings * len(study.seed_pairs())
+    return len(study.scenarios) * settings * len(study.knowledge) * len(study.seed_pairs())
 
 
 def expand(study: Study) -> list[Cell]:

@@ -45,6 +45,7 @@ RUN_SCHEMA = pa.schema([
     ("seed", pa.int64()), ("world_seed", pa.int64()), ("mode", pa.string()), ("versions", pa.string()),
     ("outcome", pa.string()), ("success", pa.bool_()), ("error", pa.string()), ("cell_wall_s", pa.float64()),
     ("straight_line_m", pa.float64()), ("clearance_m", pa.float64()),
+    ("map_knowledge", pa.string()), ("pose_source", pa.string()),
     ("plan_length_m", pa.float64()), ("plan_time_s", pa.float64()), ("plan_iterations", pa.int64()),
     ("plan_evaluations", pa.int64()), ("plan_collision_free", pa.bool_()), ("plan_waypoints", pa.string()),
     ("plan_bends", pa.int64()), ("plan_convergence_iteration", pa.int64()), ("plan_extra", pa.string()),

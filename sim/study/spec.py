@@ -12,6 +12,9 @@ TOML, bundled under ``models/studies/`` (named by file stem, as scenarios are) o
     paired_seeds = false             # optional: true runs the k-th seed with the k-th world seed only (same
                                      # count), instead of every seed with every world seed
     wall_limit_s = 120               # per run; past it the run becomes an outcome "timeout" row
+    maps = ["known", "unknown"]      # optional axis: the static map given in advance or mapped online, for
+                                     # every scenario (as `run --map`; default: each scenario's [knowledge])
+    poses = ["truth", "odometry"]    # optional axis: the pose the navigator sees (as `run --pose`)
     clearance_m = 0.0                # optional: the planning clearance beyond the robot radius for every
                                      # scenario (default: each scenario's robot.clearance_m)
     reference = "gwo"                # the planner label (or one swept arm, "maco(p0=0.9)") the statistics
@@ -69,7 +72,7 @@ from swarmnav.planners.swarm import Budget
 from swarmnav.sim.plugins import load_plugins
 from swarmnav.sim.study.claim_spec import Claim, read_claims
 from swarmnav.sim.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, PaperValue, check_time_limit,  # noqa: F401
-                                              read_budget, read_clearance, read_components, read_paper,
+                                              read_budget, read_clearance, read_components, read_knowledge, read_paper,
                                               read_scenarios, read_seeds, refuse_scenario_code)
 
 MAX_CELLS = MAX_STUDY_RUNS  # runs of one study (scenarios x settings x seed pairs), each a row
@@ -77,7 +80,7 @@ MAX_WALL_LIMIT_S = 1e6
 STUDY_DIR = SCENARIO_DIR.parent / "studies"  # bundled studies sit beside the bundled scenarios
 MODES = ("plan", "physics")
 TOP_KEYS = {"name", "description", "scenarios", "mode", "seeds", "quick_seeds", "world_seeds", "wall_limit_s",
-            "time_limit_s", "reference", "planners", "navigators", "paper", "clearance_m",
+            "time_limit_s", "reference", "planners", "navigators", "paper", "clearance_m", "maps", "poses",
             "paired_seeds", "budget", "claims"}
 
 
@@ -105,6 +108,8 @@ class Study:
     # --claims-only: the (scenario stem, planner arm label, navigator arm label or None) the claims compare;
     # None: every arm runs
     claim_arms: frozenset[tuple[str, str, str | None]] | None = None
+    # maps x poses: the (map, pose) every run of a setting is given ((None, None): the scenario's own)
+    knowledge: tuple[tuple[str | None, str | None], ...] = ((None, None),)
 
     def budget_of(self, planner: Component) -> Budget | None:
         """The budget a planner entry runs under: its own, else the study's."""
@@ -212,11 +217,12 @@ def _read_study(top: TomlTable, default_name: str, trust_code: bool) -> Study:
         top.fail("paired_seeds", f"pairs the seeds with the world seeds: {len(seeds)} seeds but "
                                  f"{len(world_seeds) if top.has('world_seeds') else 'no'} world seeds")
     settings = sum(c.count() for c in planners) * sum(c.count() for c in navigators)
-    cells = len(scenarios) * settings * (len(seeds) if paired else len(seeds) * len(world_seeds))
+    knowledge = read_knowledge(top)
+    cells = len(scenarios) * settings * len(knowledge) * (len(seeds) if paired else len(seeds) * len(world_seeds))
     if cells > MAX_CELLS:
         top.fail("seeds", f"the grid has {cells:,} runs (scenarios x settings x seeds), at most {MAX_CELLS:,}")
     claims = read_claims(top, scenarios, planners, navigators)
     budget = read_budget(top.table("budget")) if top.has("budget") else None
     return Study(name, description, top.source, scenarios, mode, seeds, world_seeds, wall_limit_s, time_limit_s,
                  reference, planners, navigators, paper, quick_seeds, read_clearance(top, scenarios), paired,
-                 claims, bool(trust_code), budget)
+                 claims, bool(trust_code), budget, knowledge=knowledge)

@@ -16,7 +16,7 @@ from swarmnav.controllers.navigators import NAVIGATORS
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import refuse_code
 from swarmnav.models.scenario_limits import MAX_STUDY_RUNS, MAX_SWEEP_VALUES
-from swarmnav.models.scenario import check_run_size, list_scenarios, load_scenario, resolve_scenario_path
+from swarmnav.models.scenario import MAP_KNOWLEDGE, POSE_SOURCES, check_run_size, list_scenarios, load_scenario, resolve_scenario_path
 from swarmnav.models.toml_table import (NON_NEGATIVE, POSITIVE, TomlTable, check_array, check_integer,
                                         check_string, within)
 from swarmnav.planners.registry import PLANNERS
@@ -191,6 +191,25 @@ def read_paper(top: TomlTable, scenarios: tuple[str, ...], labels: list[str]) ->
         out.append(PaperValue(scenario, planner, metric, entry.number("value"), entry.string("note", "",
                                                                                              non_empty=True)))
     return tuple(out)
+
+
+def read_knowledge(top: TomlTable) -> tuple[tuple[str | None, str | None], ...]:
+    """``maps`` (``"known"`` / ``"unknown"``) and ``poses`` (``"truth"`` / ``"odometry"``): axes of the grid,
+    each value given to every scenario as ``--map`` / ``--pose`` would be.  Absent: ``(None,)``, the
+    scenario's own ``[knowledge]``.  Returns the (map, pose) pairs in the grid's order (maps outer)."""
+    axes = []
+    for key, choices in (("maps", MAP_KNOWLEDGE), ("poses", POSE_SOURCES)):
+        if not top.has(key):
+            axes.append((None,))
+            continue
+        values = top.array(key, what=f"an array of {' / '.join(choices)}", non_empty=True)
+        for value in values:
+            if value not in choices:
+                top.fail(key, f"each must be one of {', '.join(choices)}, got {value!r}")
+        if len(set(values)) != len(values):
+            top.fail(key, "a value is repeated")
+        axes.append(tuple(values))
+    return tuple((m, p) for m in axes[0] for p in axes[1])
 
 
 def read_clearance(top: TomlTable, scenarios: tuple[str, ...]) -> float | None:
