@@ -46,10 +46,20 @@ def check_components(scenario: "Scenario", trust_code: bool = False) -> None:
     Raises:
         ConfigError: ``planner.name``, ``planner.params.KEY`` (or the navigator's) and the file.
     """
-    from swarmnav.controllers.navigators import make_navigator
-    from swarmnav.planners.registry import make_planner
-    make_planner(scenario.planner_name, scenario.planner_params, scenario.source_path, trust_code=trust_code)
-    make_navigator(scenario.navigator_name, scenario.navigator_params, scenario.source_path, trust_code=trust_code)
+    from swarmnav.controllers.navigators import NAVIGATORS, make_navigator
+    from swarmnav.models.parameters import code_parameters
+    from swarmnav.planners.registry import PLANNERS, make_planner
+
+    def names_code(registry: dict[str, type], name: str, params: Any) -> bool:
+        # Such a table is left to the run's composition, which refuses it without --trust-code unless the command
+        # line replaced the code (``--navigator-set policy=...``): nothing is imported or built here.
+        return (not trust_code and bool(params) and name in registry
+                and any(k in params for k in code_parameters(registry[name])))
+    if not names_code(PLANNERS, scenario.planner_name, scenario.planner_params):
+        make_planner(scenario.planner_name, scenario.planner_params, scenario.source_path, trust_code=trust_code)
+    if not names_code(NAVIGATORS, scenario.navigator_name, scenario.navigator_params):
+        make_navigator(scenario.navigator_name, scenario.navigator_params, scenario.source_path,
+                       trust_code=trust_code)
 
 
 def _scenario(scenario: str | os.PathLike[str] | Scenario) -> Scenario:
