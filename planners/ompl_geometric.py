@@ -44,7 +44,7 @@ from typing import ClassVar
 
 from swarmnav.models.parameters import Range, above, within
 from swarmnav.planners.errors import check_parameters
-from swarmnav.planners.sampling_ompl import OmplPlanner, PRMStarPlanner, _path_waypoints
+from swarmnav.planners.sampling_ompl import OmplPlanner, PRMStarPlanner, _path_waypoints, solve_in_rounds
 
 MIN_BORDER_FRACTION = 1e-3  # KPIECE's share of border expansions: OMPL throws below machine epsilon
 
@@ -68,18 +68,7 @@ class _FirstSolutionPlanner(OmplPlanner):
                 return float(own.bestCost().value())
             return problem.getSolutionPath().length() if problem.hasExactSolution() else math.inf
 
-        progress.record(math.inf, checks.made)
-        next_round = [checks.made + self.round_evaluations]
-
-        def stop() -> bool:
-            if checks.made >= next_round[0]:
-                progress.record(best(), checks.made)
-                next_round[0] = checks.made + self.round_evaluations
-            return checks.spent
-
-        planner.solve(ob.PlannerTerminationCondition(stop))
-        if checks.made > progress.checks[-1] or best() < progress.costs[-1]:
-            progress.record(best(), checks.made)
+        solve_in_rounds(ob, planner, checks, progress, best, self.round_evaluations, record_last_improvement=True)
         held.clear()
         if not pdef.hasExactSolution():
             return None, len(progress.costs) - 1

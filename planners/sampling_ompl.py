@@ -57,7 +57,7 @@ import threading
 import time
 import dataclasses
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import Callable, ClassVar
 
 import numpy as np
 
@@ -200,6 +200,25 @@ class OmplPlanner:
         raise NotImplementedError
 
 
+def solve_in_rounds(ob, planner, checks: CollisionChecks, progress: _Progress, best: Callable[[], float],
+                    round_evaluations: int, record_last_improvement: bool = False) -> None:
+    """One ``solve`` under a termination condition that ends at the budget and records ``best()`` after each
+    round of ``round_evaluations`` collision checks, then once more for the checks of the last part round
+    (``record_last_improvement``: also when only the best cost moved since the last record)."""
+    progress.record(math.inf, checks.made)
+    next_round = [checks.made + round_evaluations]
+
+    def stop() -> bool:
+        if checks.made >= next_round[0]:
+            progress.record(best(), checks.made)
+            next_round[0] = checks.made + round_evaluations
+        return checks.spent
+
+    planner.solve(ob.PlannerTerminationCondition(stop))
+    if checks.made > progress.checks[-1] or (record_last_improvement and best() < progress.costs[-1]):
+        progress.record(best(), checks.made)
+
+
 def _path_waypoints(path) -> np.ndarray:
     return np.array([(s[0], s[1]) for s in path.getStates()], dtype=float).reshape(-1, 2)
 
@@ -210,19 +229,7 @@ class _TreePlanner(OmplPlanner):
     one ``solve`` under a termination condition that also closes each round."""
 
     def search(self, ob, planner, pdef, checks, progress):
-        best = lambda: planner.bestCost().value()  # noqa: E731
-        progress.record(math.inf, checks.made)
-        next_round = [checks.made + self.round_evaluations]
-
-        def stop() -> bool:
-            if checks.made >= next_round[0]:
-                progress.record(best(), checks.made)
-                next_round[0] = checks.made + self.round_evaluations
-            return checks.spent
-
-        planner.solve(ob.PlannerTerminationCondition(stop))
-        if checks.made > progress.checks[-1]:
-            progress.record(best(), checks.made)
+        solve_in_rounds(ob, planner, checks, progress, lambda: planner.bestCost().value(), self.round_evaluations)
         if not pdef.hasExactSolution():
             return None, planner.numIterations()
         return _path_waypoints(pdef.getSolutionPath()), planner.numIterations()
