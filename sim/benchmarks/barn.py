@@ -32,6 +32,7 @@ mean over every run (failures count 0), beside ``success_rate``, ``collision_rat
 
 from __future__ import annotations
 
+import functools
 import os
 from dataclasses import dataclass
 from pathlib import Path as FilePath
@@ -165,14 +166,22 @@ class BarnRun:
 
 def world_source(world: int, generated: bool, barn: str | None = None):
     """A world's obstacles (:class:`models.gazebo_world.GazeboWorld`) and reference path cells: BARN's world
-    ``world`` from the data, or the BARN-like world of seed ``world`` (:mod:`sim.benchmarks.barn_like`)."""
+    ``world`` from the data, or the BARN-like world of seed ``world`` (:mod:`sim.benchmarks.barn_like`).
+    Each is read (or generated) once per process (the suite's files and its difficulty metrics share it)."""
+    return _world_source(world, generated, None if generated else str(barn_dir(barn)))
+
+
+@functools.lru_cache(maxsize=None)
+def _world_source(world: int, generated: bool, folder: str | None):
     if generated:
         from swarmnav.sim.benchmarks.barn_like import generate
         parsed, cells, _ = generate(world)
-        return parsed, cells
-    from swarmnav.models.gazebo_world import read_world
-    folder = barn_dir(barn)
-    return read_world(folder / "worlds" / f"world_{world}.world.gz"), reference_cells(folder, world)
+    else:
+        from swarmnav.models.gazebo_world import read_world
+        parsed = read_world(FilePath(folder) / "worlds" / f"world_{world}.world.gz")
+        cells = reference_cells(FilePath(folder), world)
+    cells.setflags(write=False)
+    return parsed, cells
 
 
 MAX_GENERATED_SEED = 10**6
