@@ -147,22 +147,24 @@ def chassis_box_m(setup) -> tuple[float, float, float, float] | None:
 def guarded_turn(command: ControlCommand, pose, controller, problem, box_m, latched: float,
                  back_m_s: float = 0.2) -> tuple[ControlCommand, float]:
     """A turn on the spot (no forward speed) checked against the chassis box: (the command, the turn
-    direction to keep).  When turning ``latched`` (else the command's) way would bring the box onto an
-    obstacle (:func:`turn_blocked`) and the other way would not, the robot turns the other way (kept until
-    the controller drives forward again); when both would, it backs straight off at ``back_m_s`` if the
-    corridor behind it is free for 5 cm, else the command is kept."""
+    direction to keep).  The command's way (or the ``latched`` one) if it does not bring the box onto an
+    obstacle (:func:`turn_blocked`); else backing straight off at ``back_m_s`` when the corridor behind is free
+    for 5 cm (a corner that would hit turns clear once the robot has moved away); else the other way round
+    if that is clear (kept until the controller drives forward again); else the command as it is."""
     geometry = getattr(controller, "geometry", None)
     if geometry is None or box_m is None or command.linear_m_s > 1e-9 or command.angular_rad_s == 0.0:
         return command, 0.0
     sign = latched or math.copysign(1.0, command.angular_rad_s)
     i = command.waypoint_index
     if turn_blocked(problem, pose, sign, box_m):
+        x0, y0, _, y1 = box_m
+        behind = type(pose)(pose.x_m, pose.y_m, pose.heading_rad + math.pi)
+        if free_ahead_m(problem, behind, -x0, max(-y0, y1)) > 0.05:
+            return ControlCommand(wheel_speeds(-back_m_s, 0.0, geometry), -back_m_s, 0.0, i), latched
         if turn_blocked(problem, pose, -sign, box_m):
-            x0, y0, _, y1 = box_m
-            behind = type(pose)(pose.x_m, pose.y_m, pose.heading_rad + math.pi)
-            if free_ahead_m(problem, behind, -x0, max(-y0, y1)) > 0.05:
-                return ControlCommand(wheel_speeds(-back_m_s, 0.0, geometry), -back_m_s, 0.0, i), 0.0
-            return command, sign
+            return command, latched
         sign = -sign
+    elif not latched:
+        return command, 0.0
     omega = sign * abs(command.angular_rad_s)
     return ControlCommand(wheel_speeds(0.0, omega, geometry), 0.0, omega, i), sign

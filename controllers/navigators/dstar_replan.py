@@ -57,6 +57,15 @@ path, which hugs the marked cells, leads along or ahead of it; when the robot st
 path (the controller turns on the spot), the obstacle runs into it.  A grid of swept cells without time cannot
 say "step aside now"; the evasion does.  ``evade = false`` gives the earlier behaviour.
 
+**A box chassis** (ours; all off by default, :mod:`controllers.footprint`): ``footprint = "box"`` blocks
+the cells by the robot's inscribed circle instead of its circumscribed one (a Jackal's 0.215 m instead of
+0.333 m, which closes BARN's 0.75 m passages), and checks every turn on the spot against the box (backing off,
+or turning the other way, when a corner would hit); ``cost_weight`` > 0 adds D* Lite cell penalties
+``cost_weight`` x (1 - d / ``cost_reach_m``)^2 near blocked cells, so that paths keep to the middle of
+passages (and string pulling never cuts nearer the obstacles than the cells); ``max_decel_m_s2`` > 0 caps the
+forward speed to stop before the path's next sharp turn and before the nearest mapped obstacle in the
+chassis' corridor ahead.  BARN's configuration: ``footprint=box, cost_weight=10, max_decel_m_s2=2`` (docs/barn.md).
+
 ``cell_m`` = 0 uses the scenario's ``sim.cell_m`` (a map scenario's own cells
 always).  The optional safety filter (``safety_filter``) is the same layer's.
 Planning wall time (``replan_wall_s``) counts the D* Lite repairs only.
@@ -101,6 +110,11 @@ class DStarReplanNavigator:
         improvement_m: a new path replaces a still-free one only when shorter by more than this.
         update_period_s: the sweeps are marked (and D* Lite repaired) at most this often.
         planner: the planner of every path followed: ``"dstar_lite"`` (the only one; see the module docstring).
+        footprint: ``"circle"`` (cells blocked by the robot radius) or ``"box"`` (by the chassis' inscribed
+            circle, turns on the spot checked against the box).
+        cost_weight: D* Lite's penalty on cells beside blocked ones (0: none).
+        cost_reach_m: how far from a blocked cell the penalty reaches.
+        max_decel_m_s2: the braking the forward speed is capped by (0: no cap).
     """
 
     name: ClassVar[str] = "dstar_replan"

@@ -285,8 +285,11 @@ def write_barn_suite(folder: str, quick: bool, worlds: tuple[int, ...] | None = 
 
 
 def add_scores(table: list[dict[str, Any]], rows: list[dict[str, Any]], meta: dict[str, BarnRun], setup: str,
-               with_difficulty: bool = False, barn: str | None = None) -> None:
-    """BARN's columns on the benchmark's rows: ``barn_score`` (mean over the rows' runs), ``barn_setup``; a
+               with_difficulty: bool = False, barn: str | None = None,
+               params: dict[str, dict[str, Any]] | None = None) -> None:
+    """BARN's columns on the benchmark's rows: ``barn_score`` (mean over the rows' runs), ``barn_setup``,
+    ``navigator_params`` (the parameters the row's navigator was given, ``params`` by row label: a BARN
+    configuration such as ``dstar_replan``'s ``footprint=box``; {} for its defaults); a
     per-scenario row (one run) also gets ``world``, ``run``, ``reference_length_m``, ``optimal_time_s``,
     ``time_s`` (AT: the run's simulated time) and, ``with_difficulty``, the world's metrics
     (:mod:`sim.benchmarks.barn_difficulty`) as ``difficulty``."""
@@ -316,6 +319,7 @@ def add_scores(table: list[dict[str, Any]], rows: list[dict[str, Any]], meta: di
         # the plan against the reference path (a yardstick): its length over the reference's, collision-free plans
         row["mean_plan_over_reference"] = sum(planned) / len(planned) if planned else None
         row["barn_setup"] = setup
+        row["navigator_params"] = dict((params or {}).get(label, {}))
         if row["scenario"] is not None:
             run = meta[row["scenario"]]
             row.update(world=run.world, run=run.run, reference_length_m=run.reference_length_m,
