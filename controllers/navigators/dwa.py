@@ -41,7 +41,13 @@ Where we differ or the paper is silent (our choices):
   robot's frame, at reset; each step takes the block of lattice pairs inside
   the dynamic window (on an axis where the window holds no lattice value, the
   value nearest the measured one) and moves the obstacles into the robot's
-  frame instead of the arcs into the world's.
+  frame instead of the arcs into the world's.  The speed lattice is made fine
+  enough for the window: at least ``ceil(2 v_max / (accel_m_s2 window_s)) + 1``
+  speeds (at most 50, ``v_samples``' bound), so that the window (+-0.125 m/s at the defaults) always holds two or
+  more of them (a bug fix: at 1 m/s the 7 default speeds were 0.167 m/s apart,
+  the window from standing held 0 alone and the robot never moved; at or
+  below 0.75 m/s, dyn300's 0.2 m/s included, the lattice is the 7 speeds as
+  before).
 """
 
 from __future__ import annotations
@@ -70,7 +76,8 @@ class DynamicWindowNavigator:
         accel_m_s2, angular_accel_rad_s2: the acceleration limits of the window.
         window_s: the time over which the window is open (the paper's cycle, 0.25 s).
         max_angular_rad_s: turn-rate limit.
-        v_samples, omega_samples: the velocity lattice over [0, v_max] x [-omega_max, omega_max].
+        v_samples, omega_samples: the velocity lattice over [0, v_max] x [-omega_max, omega_max] (the speeds
+            at least as many as keep two in the window: see the module's note on sampling).
         horizon_s, sim_step_s: how far and how finely arcs are simulated.
         dist_cap_m: ``dist`` beyond this counts as free.
         margin_m: extra distance kept beyond the robot radius.
@@ -116,7 +123,10 @@ class DynamicWindowNavigator:
         self.times = np.arange(1, int(round(self.horizon_s / self.sim_step_s)) + 1) * self.sim_step_s  # (T,)
         self.reach = self.max_speed * self.horizon_s + 1.0
         # The lattice V_s and its arcs in the robot's frame (start at the origin facing +x).
-        self.speeds = np.linspace(0.0, self.max_speed, self.v_samples) if self.v_samples > 1 \
+        dv = self.accel_m_s2 * self.window_s
+        n_speeds = max(self.v_samples, min(math.ceil(2.0 * self.max_speed / dv - 1e-9) + 1, 50)) \
+            if self.v_samples > 1 else 1                                                    # 50: v_samples' bound
+        self.speeds = np.linspace(0.0, self.max_speed, n_speeds) if n_speeds > 1 \
             else np.array([self.max_speed])                                                 # (V,)
         self.turns = np.linspace(-self.max_angular_rad_s, self.max_angular_rad_s, self.omega_samples) \
             if self.omega_samples > 1 else np.zeros(1)                                      # (W,)
