@@ -60,7 +60,7 @@ class Observation:
         range_offset_m: distance of the sensor sites from the base's centre.
         detections: moving obstacles as sensed: exact within range with the ``detector``
             sensing model, the tracker's estimates from the rays' unknown hits with
-            ``rangefinder`` (both computed in ``sim/detector.py``).
+            ``rangefinder`` (both computed in ``sim/runtime/detector.py``).
         range_cutoff_m: the rangefinders' reach (``inf``: unknown).
     """
 

@@ -11,7 +11,7 @@ from swarmnav.models.scenario import list_scenarios, load_scenario, parse_scenar
 import json
 
 from swarmnav.planners.registry import PLANNERS, make_planner
-from swarmnav.sim.cli import main as cli
+from swarmnav.cli import main as cli
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.models.geometry import segment_box_distance, segment_box_distances

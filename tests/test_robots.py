@@ -99,5 +99,5 @@ def test_catalogue_robots_drive_dense_field_30_with_replan(model, speed):
 
 @pytest.mark.parametrize("model", ["jackal", "turtlebot3_burger"])
 def test_the_logged_footprint_of_a_box_robot_is_the_disc_planners_plan_for(model):
-    from swarmnav.sim.log.messages import chassis_radius_m
+    from swarmnav.log.messages import chassis_radius_m
     assert chassis_radius_m(compile_scene(probe(model)).xml) == pytest.approx(ROBOTS[model].planning_radius_m)

@@ -13,7 +13,7 @@ from swarmnav.models.occupancy import LogOddsGrid
 from swarmnav.models.scenario import load_scenario, parse_scenario
 from swarmnav.models.world import Rect
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
-from swarmnav.sim.log.writer import McapRecorder
+from swarmnav.log.writer import McapRecorder
 
 
 def cell_value(grid: LogOddsGrid, x_m: float, y_m: float) -> float:
@@ -86,8 +86,8 @@ def test_a_run_with_map_and_pose_given_on_the_command_line_replays(tmp_path):
     import json
     import re
 
-    from swarmnav.sim.cli.main import main
-    from swarmnav.sim.log.reader import read_log
+    from swarmnav.cli.main import main
+    from swarmnav.log.reader import read_log
 
     text = re.sub(r"(?m)^time_limit_s\s*=.*$", "time_limit_s = 4.0", load_scenario("gwo-scenario-1").source_text)
     path = tmp_path / "short.toml"

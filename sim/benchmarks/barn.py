@@ -165,9 +165,9 @@ class BarnRun:
 
 def world_source(world: int, generated: bool, barn: str | None = None):
     """A world's obstacles (:class:`models.gazebo_world.GazeboWorld`) and reference path cells: BARN's world
-    ``world`` from the data, or the BARN-like world of seed ``world`` (:mod:`sim.benchmarks.barn_like`)."""
+    ``world`` from the data, or the BARN-like world of seed ``world`` (:mod:`swarmnav.benchmarks.barn_like`)."""
     if generated:
-        from swarmnav.sim.benchmarks.barn_like import generate
+        from swarmnav.benchmarks.barn_like import generate
         parsed, cells, _ = generate(world)
         return parsed, cells
     from swarmnav.models.gazebo_world import read_world
@@ -280,10 +280,10 @@ def add_scores(table: list[dict[str, Any]], rows: list[dict[str, Any]], meta: di
     """BARN's columns on the benchmark's rows: ``barn_score`` (mean over the rows' runs), ``barn_setup``; a
     per-scenario row (one run) also gets ``world``, ``run``, ``reference_length_m``, ``optimal_time_s``,
     ``time_s`` (AT: the run's simulated time) and, ``with_difficulty``, the world's metrics
-    (:mod:`sim.benchmarks.barn_difficulty`) as ``difficulty``."""
+    (:mod:`swarmnav.benchmarks.barn_difficulty`) as ``difficulty``."""
     difficulty = None
     if with_difficulty:
-        from swarmnav.sim.benchmarks.barn_difficulty import world_metrics
+        from swarmnav.benchmarks.barn_difficulty import world_metrics
         difficulty = {}
         for world, generated in sorted({(m.world, m.generated) for m in meta.values()}):
             parsed, cells = world_source(world, generated, barn)

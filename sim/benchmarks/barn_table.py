@@ -2,7 +2,7 @@
 navigation --suite barn --by-scenario --json`` results (``models/suites/results/barn*.json``) beside the
 published figures.
 
-``python -m swarmnav.sim.benchmarks.barn_table [--readme FILE]`` prints the block (or replaces it between its
+``python -m swarmnav.benchmarks.barn_table [--readme FILE]`` prints the block (or replaces it between its
 markers in FILE: ``docs/barn.md``); ``make readme-table`` runs it; ``tests/test_barn_table.py`` fails when the
 page drifts from the JSON.  Every figure in the block is read from a result file or is a published one cited
 beside it.
@@ -86,7 +86,7 @@ def published_lines() -> list[str]:
 
 def difficulty_lines(rows: list[dict[str, Any]]) -> list[str]:
     """Success against BARN's difficulty metrics, per navigator, from the per-run rows."""
-    from swarmnav.sim.benchmarks.barn_difficulty import METRICS, success_against_difficulty
+    from swarmnav.benchmarks.barn_difficulty import METRICS, success_against_difficulty
     per_run = [r for r in rows if r.get("scenario") is not None and r.get("difficulty")]
     names = [n for n in dict.fromkeys(r["navigator"] for r in per_run)]
     if not per_run:
@@ -122,7 +122,7 @@ def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
                      f"{b['success_rate']:.3f} ({ds:+.3f}), score {f['barn_score']:.4f} vs {b['barn_score']:.4f} "
                      f"({dsc:+.4f}): {'within' if abs(ds) <= 0.05 and abs(dsc) <= 0.05 else 'NOT within'} 0.05.")
     if lines:
-        from swarmnav.sim.benchmarks.barn_difficulty import METRICS
+        from swarmnav.benchmarks.barn_difficulty import METRICS
 
         def means(rows: list[dict[str, Any]]) -> dict[str, float]:
             worlds = {r["world"]: r["difficulty"] for r in rows if r.get("scenario") is not None and r.get("difficulty")}
@@ -161,7 +161,7 @@ def current_block(text: str) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m swarmnav.sim.benchmarks.barn_table",
+    parser = argparse.ArgumentParser(prog="python -m swarmnav.benchmarks.barn_table",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("--readme", help="replace the block between the markers in this file")
     args = parser.parse_args(argv)

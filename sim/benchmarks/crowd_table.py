@@ -1,6 +1,6 @@
 """The README's CrowdNav table, generated from the committed ``bench navigation --suite crowdnav --json`` result.
 
-``python -m swarmnav.sim.benchmarks.crowd_table [RESULT.json] [--readme FILE]`` prints (or, with ``--readme``,
+``python -m swarmnav.benchmarks.crowd_table [RESULT.json] [--readme FILE]`` prints (or, with ``--readme``,
 writes between its markers) one table per setting (the robot invisible to the humans, then visible), our rows
 first, then the figures Chen, Liu, Kreiss and Alahi (2019) publish for the same setting (5 ORCA humans, circle
 crossing, 500 test cases), under :data:`PUBLISHED_SOURCE`.  ``make readme-table`` runs it; a test fails when the
@@ -15,7 +15,7 @@ from pathlib import Path as FilePath
 from typing import Any
 
 from swarmnav.models.errors import ConfigError
-from swarmnav.sim.benchmarks.navigation_table import RESULTS_DIR, read_rows
+from swarmnav.benchmarks.navigation_table import RESULTS_DIR, read_rows
 
 RESULT = RESULTS_DIR / "crowdnav.json"
 BEGIN = ("<!-- crowdnav-table: generated from models/suites/results/crowdnav.json by `make readme-table`; "
@@ -126,7 +126,7 @@ def current_block(text: str) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m swarmnav.sim.benchmarks.crowd_table",
+    parser = argparse.ArgumentParser(prog="python -m swarmnav.benchmarks.crowd_table",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("result", nargs="?", default=str(RESULT), help="a `bench navigation --suite crowdnav --json`")
     parser.add_argument("--readme", help="replace the table between the markers in this file")

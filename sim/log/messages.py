@@ -1,6 +1,6 @@
 """The foxglove messages of a run log, built from what a recorder receives.
 
-Pure construction, no I/O: :class:`sim.log.writer.McapRecorder` logs them.
+Pure construction, no I/O: :class:`swarmnav.log.writer.McapRecorder` logs them.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from foxglove.messages import (
 )
 
 from swarmnav.sim import palette
-from swarmnav.sim.log.format import (
+from swarmnav.log.format import (
     ARENA_ENTITY,
     BASE_FRAME,
     FOOTPRINT_ENTITY,
@@ -80,7 +80,7 @@ def _obstacle_primitive(info: ObstacleInfo, x_m: float, y_m: float, with_pose: b
 
 
 def obstacle_template(info: ObstacleInfo) -> tuple[str, float, bytes]:
-    """What :class:`sim.log.encoding.SceneEncoder` needs to encode :func:`obstacle_entity` at any
+    """What :class:`swarmnav.log.encoding.SceneEncoder` needs to encode :func:`obstacle_entity` at any
     position: the primitive list's name ("cylinders" or "cubes"), the centre's height and the
     primitive's encoding without its pose (size, scales, colour); the pose is the position and
     the identity orientation."""

@@ -1,9 +1,9 @@
 """The channels of a log of profile ``ros2``: CDR messages of the standard ROS 2 types.
 
-What :class:`sim.log.writer.McapRecorder` writes on each channel when ``log_format`` is
-``ros2`` (the table is in :mod:`sim.log.format`).  Messages are built as plain dicts and
+What :class:`swarmnav.log.writer.McapRecorder` writes on each channel when ``log_format`` is
+``ros2`` (the table is in :mod:`swarmnav.log.format`).  Messages are built as plain dicts and
 serialised to CDR by ``mcap-ros2-support``'s serialiser for the schema's definition
-(:mod:`sim.log.ros2_types`), the one its ``mcap_ros2.writer.Writer`` uses; the bytes are
+(:mod:`swarmnav.log.ros2_types`), the one its ``mcap_ros2.writer.Writer`` uses; the bytes are
 logged on the recorder's ``foxglove.Context``, so the file, the metadata, the flushing and
 the live view are the recorder's, the same as for profile ``swarmnav``.
 """
@@ -19,7 +19,7 @@ import numpy as np
 from mcap_ros2._dynamic import serialize_dynamic
 
 from swarmnav.sim import palette
-from swarmnav.sim.log.format import (
+from swarmnav.log.format import (
     BASE_FRAME,
     MAP_FRAME,
     ODOM_FRAME,
@@ -30,9 +30,9 @@ from swarmnav.sim.log.format import (
     WORLD_FRAME,
     event_text,
 )
-from swarmnav.sim.log.map_channel import occupancy_percent
-from swarmnav.sim.log.messages import chassis_radius_m, event_severity
-from swarmnav.sim.log.ros2_types import (
+from swarmnav.log.map_channel import occupancy_percent
+from swarmnav.log.messages import chassis_radius_m, event_severity
+from swarmnav.log.ros2_types import (
     LOG_ERROR,
     LOG_INFO,
     LOG_WARN,
@@ -152,7 +152,7 @@ def belief_markers(obstacles, horizon_s: float, t_ns: int) -> list[dict[str, Any
 
 def occupancy_grid(t_ns: int, cells: np.ndarray, resolution_m: float, origin_xy_m: tuple[float, float]) -> dict[str, Any]:
     """A ``nav_msgs/OccupancyGrid`` in ``map`` from (rows, cols) cells in percent (0..100, -1 unknown; row 0 at
-    ``origin_xy_m``'s y, column 0 at its x: :func:`sim.log.map_channel.occupancy_percent` of a log-odds grid)."""
+    ``origin_xy_m``'s y, column 0 at its x: :func:`swarmnav.log.map_channel.occupancy_percent` of a log-odds grid)."""
     grid = np.asarray(cells, dtype=np.int8)
     return {"header": header(t_ns, MAP_FRAME),
             "info": {"map_load_time": stamp(t_ns), "resolution": float(resolution_m),

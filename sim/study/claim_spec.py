@@ -16,7 +16,7 @@
 
 :func:`read_claims` validates them against the study (its scenarios, its planner and navigator labels, the
 row columns); every problem is one :class:`ConfigError` naming the file and the field.  The verdicts are
-:mod:`swarmnav.sim.study.claims`'s.
+:mod:`swarmnav.study.claims`'s.
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ def numeric_columns() -> tuple[str, ...]:
     """The row columns a numeric claim may test: every integer or floating-point column of ``runs.parquet``."""
     import pyarrow as pa
 
-    from swarmnav.sim.study.rows import RUN_SCHEMA
+    from swarmnav.study.rows import RUN_SCHEMA
     return tuple(f.name for f in RUN_SCHEMA if pa.types.is_integer(f.type) or pa.types.is_floating(f.type))
 
 

@@ -10,7 +10,7 @@ The flow of one run: an :class:`EpisodeSpec` (what the user named) is resolved o
 (:meth:`EpisodeSpec.resolved`), its components are built once (:func:`compose`: the
 planner under its budget, the navigator and the safety layer after it), the path is
 planned (or given), and :func:`run_episode` hands the same components to the stepper's
-closed loop (:meth:`sim.runner.Simulation.run`).
+closed loop (:meth:`sim.simulation.Simulation.run`).
 
 Parameters resolve in one place (:meth:`EpisodeSpec.resolved`): a scenario's own
 planner (navigator) parameters apply when the spec names the same planner
@@ -26,7 +26,7 @@ or the world seed :meth:`Scenario.with_world_seed` set).  The planner draws from
 :func:`compose` builds the planner, the navigator and its safety layer once (a bad
 parameter of any fails before planning); :func:`plan_episode` plans with them;
 :func:`run_episode` runs that planned episode with them, on a
-:class:`~sim.runner.Simulation` compiled once per episode.
+:class:`~sim.simulation.Simulation` compiled once per episode.
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ from swarmnav.planners.problem import Path, Planner, Problem, scenario_problem
 from swarmnav.planners.swarm import Budget, apply_budget
 from swarmnav.sim.recording import Recorder, RecorderGroup
 from swarmnav.sim.reference import reference_length_m, static_problem
-from swarmnav.sim.runner import Simulation
+from swarmnav.sim.simulation import Simulation
 from swarmnav.sim.scene import CompiledScene
 from swarmnav.sim.run_result import RunResult
 
