@@ -3,7 +3,7 @@
 Every navigator reads the static world through ``NavigationSetup.map_problem`` (a
 :class:`~planners.problem.Problem`).  With the map known (the default) that is the scenario's static
 obstacles, fixed for the run.  With ``knowledge = { map = "unknown" }`` the setup carries a
-:class:`SensedMap` instead, Nav2's costmap in small: the runner (``sim.runner``) feeds it every
+:class:`SensedMap` instead, Nav2's costmap in small: the runner (``sim.simulation``) feeds it every
 observation before the navigator's step (the obstacle layer: a log-odds grid from the laser,
 :mod:`models.occupancy`), and at ``publish_hz`` it publishes the occupied cells as the map problem:
 each cell a disc about its centre that covers it (radius half its diagonal), the one obstacle kind every
@@ -51,11 +51,14 @@ class SensedMap:
         arena: the arena the grid covers.
         cell_m: the grid's resolution (``knowledge.map_cell_m``).
         publish_hz: how often the planning map is republished (the grid integrates every scan).
+        unknown_cost: with a positive value, :meth:`planning_problem` carries the never-seen cells and this
+            weight (``knowledge.unknown_cost``; the grid searches read them: :mod:`planners.unknown_cost`).
     """
 
     def __init__(self, empty: Problem, arena: Rect, cell_m: float, publish_hz: float = PUBLISH_HZ,
-                 model: SensorModel = SensorModel()):
+                 model: SensorModel = SensorModel(), unknown_cost: float = 0.0):
         self.empty = replace(empty, obstacles=(), boxes=(), grid_override=None)
+        self.unknown_cost = float(unknown_cost)
         self.grid = LogOddsGrid(arena, cell_m, model)
         self.period_s = 1.0 / publish_hz
         self.revision = 0
@@ -100,7 +103,11 @@ class SensedMap:
             centres, radii = grown_discs(self._occupied, self.grid.log_odds < 0.0, self._driven, cell,
                                          self.grid.origin_m)
             discs = tuple(Disc(x, y, r) for (x, y), r in zip(centres.tolist(), radii.tolist()))
-            self._planning = (self.revision, replace(self.empty, obstacles=discs, cell_m=cell))
+            problem = replace(self.empty, obstacles=discs, cell_m=cell)
+            if self.unknown_cost > 0.0:
+                unknown = OccupancyGrid(~self.grid.known & ~self._driven, cell, self.grid.origin_m)
+                problem = replace(problem, unknown_cells=unknown, unknown_cost=self.unknown_cost)
+            self._planning = (self.revision, problem)
         return self._planning[1]
 
     def _drive_over(self, x_m: float, y_m: float) -> None:

@@ -3,7 +3,7 @@ including it with floor, light and camera, as MuJoCo Menagerie lays out its mode
 swarmnav needs to know of each without reading MuJoCo.
 
 A scenario picks one with ``robot = { model = "jackal" }``; its other ``robot`` fields override the entry's
-defaults (the planning radius, the top speed).  Every robot file follows the same names, which ``sim/scene.py``
+defaults (the planning radius, the top speed).  Every robot file follows the same names, which ``sim/runtime/scene.py``
 reads: a ``base_link`` body with the free joint ``base_free``, the collision footprint ``chassis``, the wheel
 bodies ``left_wheel`` / ``right_wheel`` (their tyres ``left_wheel_tyre`` / ..., hinges ``left_wheel_hinge`` /
 ..., speed sensors ``left_wheel_speed`` / ...), the actuators ``left_wheel_motor`` / ``right_wheel_motor``

@@ -117,15 +117,19 @@ def write(rows: list[dict[str, Any]], page: Path) -> None:
 
 
 def run(args) -> int:
-    """``bench sensed-map [--only NAME] [--json] [--write]``: the rows, as JSON lines or the Markdown table;
+    """``bench sensed-map [--scenario NAME ...] [--only NAME] [--json] [--write]``: the rows, as JSON lines or
+    the Markdown table;
     exit 5 when a combination succeeds with the map known and not unknown."""
     from swarmnav.models.errors import ConfigError
     names = set(REPLAN_PLANNERS) | set(LOCAL_NAVIGATORS) | {"replan"}
     if args.only is not None and args.only not in names:
         raise ConfigError("--only", f"must be one of {', '.join(sorted(names))}, got {args.only!r}")
-    if args.write and args.only is not None:  # refused before any run
-        raise ConfigError("--write", "writes the whole matrix: not with --only")
-    rows = benchmark(only=args.only)
+    if args.write and (args.only is not None or args.scenario):  # refused before any run
+        raise ConfigError("--write", "writes the whole matrix: not with --only or --scenario")
+    from swarmnav.models.scenario import load_scenario
+    for name in args.scenario or ():
+        load_scenario(name)  # a bad name or file: one line naming it, exit 2, before any run
+    rows = benchmark(tuple(args.scenario) if args.scenario else SCENES, only=args.only)
     if args.write:
         write(rows, PAGE)
     if args.json:

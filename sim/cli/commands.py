@@ -264,6 +264,8 @@ def run_bench_odometry(args: argparse.Namespace) -> int:
 
 
 def add_bench_sensed_map_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenario", action="append", metavar="NAME",
+                        help="a scenario instead of dense-field-30 and gwo-scenario-1 (repeatable)")
     parser.add_argument("--only", metavar="NAME", help="only the runs of this navigator or planner")
     parser.add_argument("--json", action="store_true", help="one JSON object per run")
     parser.add_argument("--write", action="store_true",
@@ -271,7 +273,7 @@ def add_bench_sensed_map_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_sensed_map(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import sensed_map
+    from swarmnav.benchmarks import sensed_map
     return sensed_map.run(args)
 
 

@@ -292,7 +292,8 @@ def run_episode(episode: Episode | EpisodeSpec, recorders: Sequence[Recorder] = 
         raise ValueError("this episode was planned without a navigator (plan_episode(drive=False)): nothing to run")
     unknown = scenario.map_knowledge == "unknown"
     known_problem = static_problem(scenario) if not unknown else planned.problem
-    world_map = SensedMap(planned.problem, scenario.bounds, scenario.map_cell_m) if unknown else None
+    world_map = SensedMap(planned.problem, scenario.bounds, scenario.map_cell_m,
+                          unknown_cost=scenario.unknown_cost) if unknown else None
     setup = NavigationSetup(
         path=planned.path, problem=planned.problem,
         # With the map unknown every navigator that plans replans its (guidance) path on the sensed map.
