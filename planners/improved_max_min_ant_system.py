@@ -46,9 +46,9 @@ Where the paper's prose and its algorithms disagree (our choices):
   evaporation rate rho value of 0.98".  We follow Algorithm 1 and §4.2 by default; the prose is
   the named option ``evaporation_doubling`` (rho, which the paper calls the evaporation rate,
   doubles after every expansion: every trail beyond a route cost of about 2.4 sits at
-  ``tau_max``, 98 % of the reached cells of ``immas-env4-blocks``, and the tour runs on clean and
-  eta alone).  Even without the doubling the factor 1.4 drives diagonal chains to ``tau_max``:
-  50 % of that map's reached cells sit there, where only clean and eta tell cells apart.
+  ``tau_max``, and the tour runs on clean and eta alone).  Even without the doubling the factor 1.4
+  drives diagonal chains to ``tau_max``, where only clean and eta tell cells apart (the shares of
+  cells measured: ``docs/papers.md``).
 * **Deposit.**  Eq. (2)'s ``1 / f(s_best)`` has no solution cost in a propagation that has not
   reached the start yet; we deposit 1 per step (the "1" that §3.2 multiplies by 1.4 or 1).
 

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from swarmnav.models.errors import ConfigError
-from swarmnav.sim.study.claim_spec import Claim
-from swarmnav.sim.study.claims import CONTRADICTED, INCONCLUSIVE, REPRODUCES, UNDERPOWERED, verdicts
-from swarmnav.sim.study.readme_table import table_lines
-from swarmnav.sim.study.spec import load_study, parse_study
+from swarmnav.study.claim_spec import Claim
+from swarmnav.study.claims import CONTRADICTED, INCONCLUSIVE, REPRODUCES, UNDERPOWERED, verdicts
+from swarmnav.study.readme_table import table_lines
+from swarmnav.study.spec import load_study, parse_study
 
 
 def _rows(label, scenario, values, outcome="ok"):

@@ -16,11 +16,11 @@ from swarmnav.planners.pheromone_propagation import analyse_environment, mmas_li
 from swarmnav.planners.max_min_ant_system import MaxMinColonyPlanner
 from swarmnav.planners.max_min_trails import check_limits, trail_limits
 from swarmnav.planners.registry import PLANNERS, make_planner
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from swarmnav.sim.episode import scenario_problem
-from swarmnav.sim.study.grid import expand
-from swarmnav.sim.study.rows import RUN_SCHEMA
-from swarmnav.sim.study.spec import STUDY_DIR, load_study
+from swarmnav.study.grid import expand
+from swarmnav.study.rows import RUN_SCHEMA
+from swarmnav.study.spec import STUDY_DIR, load_study
 
 IMMAS_ENVS = ["immas-env1-scattered", "immas-env2-rings", "immas-env3-curves", "immas-env4-blocks",
               "immas-env5-arcs", "immas-env6-rows"]

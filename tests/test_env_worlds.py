@@ -6,7 +6,7 @@ from gymnasium.utils.env_checker import check_env
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.env import NavigateEnv
+from swarmnav.env import NavigateEnv
 
 GENERATOR = {"kinds": ["crossing", "crowd"], "obstacles": [2, 5], "speed_ratio": [0.3, 0.8],
              "radius_max_m": [0.3, 0.45], "sensor_model": "detector"}

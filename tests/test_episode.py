@@ -12,7 +12,7 @@ import pytest
 from swarmnav.controllers.navigators import NAVIGATORS
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Seeds, parse_scenario
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -252,7 +252,7 @@ def test_a_navigator_that_does_not_declare_what_it_uses_is_refused_at_registrati
 
 
 def test_only_the_composition_resolves_a_spec_or_builds_an_episode():
-    """sim/episode.py is the one place (compose, plan_episode, given_episode): the CLI, the API, studies,
+    """sim/runtime/episode.py is the one place (compose, plan_episode, given_episode): the CLI, the API, studies,
     given paths and the environment all go through it."""
     import pathlib
     import re

@@ -15,7 +15,7 @@ from swarmnav.planners.ompl_geometric import OMPL_GEOMETRIC_PLANNERS
 from swarmnav.planners.problem import scenario_problem
 from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.planners.sampling_ompl import OMPL_PLANNERS
-from swarmnav.sim.cli import main as cli
+from swarmnav.cli import main as cli
 from swarmnav.sim.defaults import BENCH_PLANNERS_SAMPLING_CHOICES
 
 from test_ompl_planners import RING_SCENARIO

@@ -23,5 +23,5 @@ def test_the_python_api_pages_plan_example_runs_collision_free():
 
 def test_abc_at_its_defaults_plans_abdulla_and_hadis_first_scenario(capsys):
     """(gwo's is tests/test_fair_comparison.py's; adl_abc's on Kamil et al.'s scenes tests/test_kamil_variants.py's.)"""
-    from swarmnav.sim.cli.main import main
+    from swarmnav.cli.main import main
     assert main(["plan", "gwo-scenario-1", "--planner", "abc", "--seed", "0"]) == 0

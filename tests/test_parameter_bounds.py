@@ -215,7 +215,7 @@ def test_a_value_out_of_range_names_the_field_and_the_range():
     ("seeds = 90000\nworld_seeds = 90000", "seeds"),
 ])
 def test_every_study_field_is_bounded(line, field):
-    from swarmnav.sim.study.spec import parse_study
+    from swarmnav.study.spec import parse_study
     with pytest.raises(ConfigError) as caught:
         parse_study(f'scenarios = ["gwo-scenario-1"]\n{line}\n[[planners]]\nname = "gwo"\n', "s.toml")
     assert caught.value.field == field and "\n" not in str(caught.value)

@@ -16,10 +16,10 @@ from scipy import stats
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.planners.errors import PlanningError
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
-from swarmnav.sim.study.grid import expand
-from swarmnav.sim.study.spec import list_studies, load_study
+from swarmnav.study.grid import expand
+from swarmnav.study.spec import list_studies, load_study
 
 TINY = """
 name = "tiny"
@@ -92,7 +92,7 @@ def test_resume_after_a_kill_runs_each_cell_once(tmp_path):
     path = write(tmp_path, 'name = "resume"\nscenarios = ["gwo-scenario-1"]\nseeds = 40\n'
                            '[[planners]]\nname = "gwo"\nparams = { population = 20, iterations = 40 }\n')
     out = tmp_path / "out"
-    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out), "--workers", "1",
+    command = [sys.executable, "-m", "swarmnav.cli", "study", str(path), "--out", str(out), "--workers", "1",
                "--json"]
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
@@ -256,7 +256,7 @@ def test_studies_lists_every_bundled_study(capsys):
 
 
 def test_paper_values_are_flagged_where_impossible():
-    from swarmnav.sim.study.statistics import impossible
+    from swarmnav.study.statistics import impossible
     rows = [{"planner": "gwo", "outcome": "ok", "plan_length_m": 14.3, "straight_line_m": 14.142},
             {"planner": "optimal", "outcome": "ok", "plan_length_m": 14.2, "straight_line_m": 14.142}]
     assert "straight line" in impossible("plan_length_m", 14.0, rows)
@@ -317,7 +317,7 @@ def test_logs_keep_one_mcap_per_run_that_replays(tmp_path):
 
 
 def test_paired_seeds_run_the_kth_seed_with_the_kth_world_seed(tmp_path):
-    from swarmnav.sim.study.spec import parse_study
+    from swarmnav.study.spec import parse_study
     text = 'scenarios = ["gwo-scenario-2"]\nseeds = [3, 4, 5]\nworld_seeds = [7, 8, 9]\n{}[[planners]]\nname = "astar"\n'
     paired = expand(parse_study(text.format("paired_seeds = true\n")))
     crossed = expand(parse_study(text.format("")))
@@ -350,7 +350,7 @@ def test_the_progress_bar_appears_only_on_a_terminal(tmp_path, capsys):
     path = write(tmp_path, PLAN_ONLY)
     assert main(["study", str(path), "--workers", "1", "--out", str(tmp_path / "piped")]) == 0
     assert capsys.readouterr().err == ""  # stderr is not a terminal here
-    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--workers", "1"]
+    command = [sys.executable, "-m", "swarmnav.cli", "study", str(path), "--workers", "1"]
     leader, follower = pty.openpty()
     try:
         on_terminal = subprocess.run(command + ["--out", str(tmp_path / "tty")], stdout=subprocess.PIPE,
@@ -374,8 +374,8 @@ def test_the_progress_bar_appears_only_on_a_terminal(tmp_path, capsys):
 
 def test_off_the_main_thread_the_wall_limit_is_checked_after_the_run():
     import threading
-    from swarmnav.sim.study.cell import run_cell
-    from swarmnav.sim.study.spec import parse_study
+    from swarmnav.study.cell import run_cell
+    from swarmnav.study.spec import parse_study
     cell = expand(parse_study(PLAN_ONLY.replace("seeds = 2\n", "seeds = 1\nwall_limit_s = 0.0001\n")))[0]
     result = {}
     thread = threading.Thread(target=lambda: result.update(row=run_cell(cell)[0]))
@@ -400,7 +400,7 @@ def test_an_unreachable_ray_address_is_one_line_naming_the_option(tmp_path):
     import socket
 
     from swarmnav.models.errors import ConfigError
-    from swarmnav.sim.study.ray_engine import check_reachable
+    from swarmnav.study.ray_engine import check_reachable
 
     with socket.socket() as listener:  # a port that surely refuses: bound, never listening
         listener.bind(("127.0.0.1", 0))
@@ -422,8 +422,8 @@ ABC_PLAN_ONLY = ('name = "abc-progress"\nscenarios = ["restaurant-table-2"]\nsee
 def test_progress_rows_are_the_planners_own_evaluation_history():
     """A study's progress rows for a cell equal the history the planner records for the same seed, and
     ABC's evaluations per iteration differ (scouts), so they are no even spread."""
-    from swarmnav.sim.study.cell import run_cell
-    from swarmnav.sim.study.spec import parse_study
+    from swarmnav.study.cell import run_cell
+    from swarmnav.study.spec import parse_study
     for cell in expand(parse_study(ABC_PLAN_ONLY)):
         row, progress = run_cell(cell)
         assert row["outcome"] == "ok", row.get("error")
@@ -440,8 +440,8 @@ def test_a_planner_without_an_evaluation_history_gets_an_even_spread_marked_esti
     import dataclasses
 
     from swarmnav.planners.problem import Path as PlannedPath
-    from swarmnav.sim.study.cell import _progress_rows
-    from swarmnav.sim.study.spec import parse_study
+    from swarmnav.study.cell import _progress_rows
+    from swarmnav.study.spec import parse_study
     cell = expand(parse_study(ABC_PLAN_ONLY))[0]
     episode = plan_episode(EpisodeSpec(load_scenario(cell.scenario), cell.planner, cell.planner_params,
                                        seed=cell.seed))
@@ -455,7 +455,7 @@ def test_a_planner_without_an_evaluation_history_gets_an_even_spread_marked_esti
 
 
 def test_the_convergence_curve_by_evaluations_is_the_recorded_step_function():
-    from swarmnav.sim.study.anytime import on_grid
+    from swarmnav.study.anytime import on_grid
     costs = on_grid(np.array([20, 61, 101, 150]), np.array([9.0, 7.0, 7.0, 4.0]),
                     np.array([0, 19, 20, 60, 61, 149, 150, 400]))
     assert np.isnan(costs[:2]).all()  # nothing was scored before the first population

@@ -37,13 +37,14 @@ TARGET = 0.9
 
 def count(planner: str, scenario: str, seeds: int) -> dict[str, Any]:
     """Plan ``scenario`` with ``planner`` at its defaults on seeds 0 .. seeds - 1; count the plans found."""
-    import swarmnav
+    from swarmnav.models.scenario import load_scenario
     from swarmnav.planners.errors import PlanningError
+    from swarmnav.sim.episode import EpisodeSpec, plan_episode
     started = time.perf_counter()
     found, reasons = 0, []
     for seed in range(seeds):
         try:
-            swarmnav.plan(scenario, planner=planner, seed=seed)
+            plan_episode(EpisodeSpec(load_scenario(scenario), planner=planner, seed=seed))
             found += 1
         except PlanningError as exc:
             reasons.append(str(exc).split(";")[0])

@@ -32,7 +32,7 @@ from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.swarm import Budget
 from swarmnav.sim.plugins import load_plugins
 from swarmnav.sim.episode import EpisodeSpec, compose, json_safe, plan_episode, resolved_params, run_episode
-from swarmnav.sim.study.grid import Cell
+from swarmnav.study.grid import Cell
 from swarmnav.sim.trajectory_metrics import bends, count_turns
 from swarmnav.sim.versions import software_versions
 
@@ -186,7 +186,7 @@ def run_cell(cell: Cell, logs_dir: str | None = None,
                 tally = EventTally()
                 recorders = [tally]
                 if logs_dir is not None:
-                    from swarmnav.sim.log.writer import McapRecorder
+                    from swarmnav.log.writer import McapRecorder
                     log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
                     recorders.append(McapRecorder(log_path, overwrite=True, log_format=log_format))
                     row["log"] = str(log_path)

@@ -18,11 +18,11 @@
 An **aggregate** claim (a paper's average over many start/goal pairs, e.g. Hasan et al. 2023's 30 pairs) takes
 ``test = "signed_rank_scenarios"`` and a ``scenario`` that is a glob over the study's scenario names (``"*"``,
 ``"immas-env*"``) matching two or more: each side's mean over its completed runs of each scenario, paired by
-scenario, Wilcoxon signed-rank over the scenarios (:mod:`swarmnav.sim.study.claims`).
+scenario, Wilcoxon signed-rank over the scenarios (:mod:`swarmnav.study.claims`).
 
 :func:`read_claims` validates them against the study (its scenarios, its planner and navigator labels, the
 row columns); every problem is one :class:`ConfigError` naming the file and the field.  The verdicts are
-:mod:`swarmnav.sim.study.claims`'s.
+:mod:`swarmnav.study.claims`'s.
 """
 
 from __future__ import annotations
@@ -71,7 +71,7 @@ def numeric_columns() -> tuple[str, ...]:
     """The row columns a numeric claim may test: every integer or floating-point column of ``runs.parquet``."""
     import pyarrow as pa
 
-    from swarmnav.sim.study.rows import RUN_SCHEMA
+    from swarmnav.study.rows import RUN_SCHEMA
     return tuple(f.name for f in RUN_SCHEMA if pa.types.is_integer(f.type) or pa.types.is_floating(f.type))
 
 

@@ -1,4 +1,4 @@
-"""Verdicts on a study's claims (``[[claims]]``, see :mod:`swarmnav.sim.study.claim_spec`) from its rows.
+"""Verdicts on a study's claims (``[[claims]]``, see :mod:`swarmnav.study.claim_spec`) from its rows.
 
 Each claim compares its planner with every label of ``than`` on its scenario (and navigator, when given):
 
@@ -19,11 +19,11 @@ each pair states n per side (runs tested / runs).  The p-values of every pair of
 Holm-adjusted together (Holm 1979).  A claim **reproduces** when each of its pairs is significant (adjusted
 p < 0.05) in the claimed direction, is **contradicted** when any pair is significant in the opposite
 direction, is **underpowered** when a pair's runs could not reach significance whatever they gave (the
-seed rule of :mod:`swarmnav.sim.study.power`: too few runs, or none, for the study's Holm correction), and
+seed rule of :mod:`swarmnav.study.power`: too few runs, or none, for the study's Holm correction), and
 is **inconclusive** otherwise (enough runs, no significant difference).  A side that is one plan repeated (a
 deterministic planner) counts once: two such sides compare single values (no test; verdict by the sign of
 the difference, **equal** when there is none), one such side is tested by the one-sample signed-rank test of the other side against it
-(:mod:`swarmnav.sim.study.power`).
+(:mod:`swarmnav.study.power`).
 
 The effect size is the Vargha–Delaney (2000) A12, oriented by the claim: the probability that a run of the
 claimed planner is *better* (lower or higher, as the claim says) than a run of the other, ties counting half;
@@ -40,9 +40,9 @@ from typing import Any, Iterable
 import numpy as np
 from scipy import stats
 
-from swarmnav.sim.study import power
-from swarmnav.sim.study.claim_spec import AGGREGATE, SUCCESS, Claim, claim_scenarios
-from swarmnav.sim.study.statistics import holm, ranksum_p
+from swarmnav.study import power
+from swarmnav.study.claim_spec import AGGREGATE, SUCCESS, Claim, claim_scenarios
+from swarmnav.study.statistics import holm, ranksum_p
 
 ALPHA = 0.05
 REPRODUCES, CONTRADICTED, INCONCLUSIVE, UNDERPOWERED = "reproduces", "contradicted", "inconclusive", "underpowered"

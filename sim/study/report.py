@@ -18,14 +18,14 @@ import re
 from pathlib import Path as FilePath
 from typing import Any
 
-from swarmnav.sim.study import against_oracle, anytime, figures
-from swarmnav.sim.study.claim_spec import Claim
-from swarmnav.sim.study.claims import claims_document
-from swarmnav.sim.study.report_tables import (claims_table, count_table, merge_identical, paper_values_table,
+from swarmnav.study import against_oracle, anytime, figures
+from swarmnav.study.claim_spec import Claim
+from swarmnav.study.claims import claims_document
+from swarmnav.study.report_tables import (claims_table, count_table, merge_identical, paper_values_table,
                                               statistics_section, summary_tables)
-from swarmnav.sim.study.rows import load_progress_rows, load_runs
-from swarmnav.sim.study.statistics import by_scenario, paper_table
-from swarmnav.sim.study.tables import Table
+from swarmnav.study.rows import load_progress_rows, load_runs
+from swarmnav.study.statistics import by_scenario, paper_table
+from swarmnav.study.tables import Table
 
 CLAIMS_FILE = "claims.json"
 STYLE = ("body{font-family:sans-serif;max-width:1200px;margin:auto;padding:0 12px}"
@@ -34,6 +34,12 @@ STYLE = ("body{font-family:sans-serif;max-width:1200px;margin:auto;padding:0 12p
          "td,th{border:1px solid #bbb;padding:3px 5px;font-size:13px;text-align:right;white-space:nowrap}th{white-space:normal}"
          "th{background:#eee}td:first-child,th:first-child{text-align:left}"
          "td.t{text-align:left;white-space:normal;min-width:8em}")
+
+
+def no_yardstick(row: dict[str, Any]) -> bool:
+    """The oracle's refused run on a scene whose agents react to the robot (its verdict ``none``): no yardstick
+    there, so a report counts it nowhere (neither a run nor a failure)."""
+    return row.get("navigator") == "oracle" and row.get("oracle_verdict") == "none"
 
 
 def load_rows(directory: FilePath) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
@@ -133,8 +139,8 @@ def ordered_runs(runs: list[dict[str, Any]], meta: dict[str, Any]) -> list[dict[
 def _driven(arms: dict[str, list[dict[str, Any]]]) -> tuple[dict[str, tuple], str]:
     """The driven trajectory and collision points of each arm's path-figure run, read from its MCAP log
     (kept by ``swarmnav study --logs``); and a sentence saying where there were none."""
-    from swarmnav.sim.log.reader import read_log
-    from swarmnav.sim.plot import collision_points_m
+    from swarmnav.log.reader import read_log
+    from swarmnav.log.plot import collision_points_m
     out, missing = {}, []
     for name, rows in arms.items():
         ok = sorted((r for r in rows if r.get("plan_waypoints")), key=lambda r: (r["seed"], str(r["world_seed"])))
@@ -175,6 +181,8 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
     meta_path = directory / "study.json"
     meta = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
     runs = ordered_runs(runs, meta)
+    refused = [r for r in runs if no_yardstick(r)]
+    runs = [r for r in runs if not no_yardstick(r)]
     title = f"Study {meta.get('name', directory.name)}"
     markdown_path = html_path.with_suffix(".md")
     html_path.parent.mkdir(parents=True, exist_ok=True)
@@ -188,6 +196,10 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
                   f"simulated time; counted, never dropped). Mode: {meta.get('mode', '?')}. Statistics compare each planner against the "
                   f"reference planner {meta.get('reference', '?')!r}. Numbers to 4 significant digits, "
                   "p-values to 2.")
+    if refused:
+        doc.paragraph(f"No yardstick: {len(refused)} runs of the clairvoyant oracle on scenes whose agents react to "
+                      "the robot (sees_robot), where no clairvoyant yardstick exists; the oracle refuses them, and "
+                      "they are left out of every total and table above and below.")
     claims = [Claim.from_dict(c) for c in meta.get("claims", [])]
     document = claims_document(meta.get("name", directory.name), claims, runs, meta.get("inputs"))
     (html_path.parent / CLAIMS_FILE).write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")

@@ -70,8 +70,8 @@ from swarmnav.models.toml_table import POSITIVE, TomlTable, above, parse_toml, r
 from swarmnav.planners.registry import make_planner
 from swarmnav.planners.swarm import Budget
 from swarmnav.sim.plugins import load_plugins
-from swarmnav.sim.study.claim_spec import Claim, claim_scenarios, read_claims
-from swarmnav.sim.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, PaperValue, check_time_limit,  # noqa: F401
+from swarmnav.study.claim_spec import Claim, claim_scenarios, read_claims
+from swarmnav.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, PaperValue, check_time_limit,  # noqa: F401
                                               read_budget, read_clearance, read_components, read_knowledge, read_paper,
                                               read_scenarios, read_seeds, refuse_scenario_code)
 
