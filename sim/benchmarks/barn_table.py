@@ -21,7 +21,8 @@ from swarmnav.models.errors import ConfigError
 RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results"
 RESULTS = (RESULTS_DIR / "barn-test50.json", RESULTS_DIR / "barn-test10-dwa-vo.json", RESULTS_DIR / "barn.json",
            RESULTS_DIR / "barn-like.json", RESULTS_DIR / "barn-jackal-test10.json",
-           RESULTS_DIR / "barn-protocol-test10.json", RESULTS_DIR / "barn-protocol-test10-more.json")
+           RESULTS_DIR / "barn-protocol-test10.json", RESULTS_DIR / "barn-protocol-test10-more.json",
+           RESULTS_DIR / "barn-protocol-test50.json")
 TEST_50, ALL_300, FRESH = RESULTS[0], RESULTS[2], RESULTS[3]  # compared: BARN-like worlds against BARN's
 BEGIN = "<!-- barn-table: generated from models/suites/results/barn*.json by `make readme-table`; do not edit by hand -->"
 END = "<!-- end of barn-table -->"
@@ -64,6 +65,8 @@ def result_lines(path: FilePath, rows: list[dict[str, Any]]) -> list[str]:
              "|---|---:|---:|---:|---:|---:|---:|"]
     for r in overall:
         name = f"{r['navigator']} (clairvoyant yardstick)" if r["navigator"] == ORACLE else r["navigator"]
+        if r.get("navigator_params"):
+            name += " (" + ", ".join(f"{k}={v}" for k, v in r["navigator_params"].items()) + ")"
         lines.append(f"| {name} | {r['runs']} | {r['success_rate']:.3f} | {r['collision_rate']:.3f} | "
                      f"{r['timeout_rate']:.3f} | {_f(r['barn_score'], '.4f')} | {_f(r['mean_time_to_goal_s'], '.2f')} |")
     contenders = [r for r in overall if r["navigator"] != ORACLE]
