@@ -32,7 +32,7 @@ def test_the_committed_matrix_is_whole_and_meets_the_criterion_but_for_the_named
 def test_a_committed_row_is_what_the_run_gives_today():
     """abc replanning on gwo-scenario-1 with the map unknown: every replan failed before the sensed cells were
     grown for the planners (best candidate 0.23 m inside a cell's disc), and the run took 140 s."""
-    row = next(r for r in committed()
-               if (r["scenario"], r["navigator"], r["planner"], r["map"]) == ("gwo-scenario-1", "replan", "abc", "unknown"))
+    key = ("gwo-scenario-1", "replan", "abc", "unknown")
+    row = next(r for r in committed() if (r["scenario"], r["navigator"], r["planner"], r["map"]) == key)
     again = sensed_map.run_one("gwo-scenario-1", "replan", "abc", "unknown")
     assert {k: v for k, v in again.items() if k != "wall_s"} == row and row["success"]

@@ -11,8 +11,9 @@ its own sensors: 12 rays of 0.4 m), the planner's and navigator's defaults:
 
 The criterion: with the map unknown, every combination reaches the goal with no collision wherever it does
 with the map known (:func:`unmet`), but for the exceptions named with their reason in :data:`UNMET`.
-The table of docs/sensing.md between the ``sensed-map-table`` markers is :func:`block` of the committed :data:`RESULTS` (``tests/test_sensed_map_table.py`` fails when they
-drift, and when a committed row is no longer what the run gives).
+The table of docs/sensing.md between the ``sensed-map-table`` markers is :func:`block` of the committed
+:data:`RESULTS` (``tests/test_sensed_map_table.py`` fails when they drift, and when a committed row is no
+longer what the run gives).
 """
 
 from __future__ import annotations
