@@ -206,7 +206,8 @@ def grown_discs(occupied: np.ndarray, seen_free: np.ndarray, driven: np.ndarray,
         c = np.clip(np.floor((moved[:, 0] - origin_m[0]) / cell_m).astype(np.int64), 0, cols - 1)
         r = np.clip(np.floor((moved[:, 1] - origin_m[1]) / cell_m).astype(np.int64), 0, rows - 1)
         # The distance from the moved centre to the nearest free centre is at least its cell's less the offset.
-        off = np.hypot(moved[:, 0] - ((c + 0.5) * cell_m + origin_m[0]), moved[:, 1] - ((r + 0.5) * cell_m + origin_m[1]))
+        off = np.hypot(moved[:, 0] - ((c + 0.5) * cell_m + origin_m[0]),
+                       moved[:, 1] - ((r + 0.5) * cell_m + origin_m[1]))
         take = open_ & (radii == half_diagonal) & (distance[r, c] - off >= rho)
         out[take], radii[take] = moved[take], rho
     return out, radii

@@ -44,6 +44,8 @@ class RobotModel:
         default_range_m: the default ``sensors.range_m`` (the robot's usual laser).
         max_angular_rad_s: the published turn-rate limit, the PTP controller's ``max_angular_rad_s`` (None:
             the controller's default, 1.2 rad/s).
+        ptp_limits: the PTP controller's drift and corner limits for this robot (``max_drift_m``,
+            ``max_deceleration_m_s2``: :mod:`controllers.point_to_point`); None: off, the paper's controller.
         sources: where every figure of the robot file comes from (also in the file's header comment).
     """
 
@@ -56,6 +58,7 @@ class RobotModel:
     default_range_m: float
     sources: str
     max_angular_rad_s: float | None = None
+    ptp_limits: tuple[float, float] | None = None
 
     @property
     def scene_xml(self) -> FilePath:
@@ -75,6 +78,8 @@ class RobotModel:
 
 
 ROBOTS: dict[str, RobotModel] = {}
+#: The real platforms' PTP limits: 0.05 m of drift (the default planning clearance), braking at 2.0 m/s^2.
+PTP_LIMITS = (0.05, 2.0)
 
 
 def _register(robot: RobotModel) -> None:
@@ -94,14 +99,14 @@ _register(RobotModel(
             "track 0.37559 m, wheelbase 0.262 m, +-26 rad/s); Clearpath Robotics Jackal specifications "
             "(508 x 430 x 250 mm, 2.0 m/s, skid-steer); Clearpath jackal_control config/control.yaml "
             "(wheel_separation_multiplier 1.5, angular max_velocity 4.0 rad/s)",
-    max_angular_rad_s=4.0))
+    max_angular_rad_s=4.0, ptp_limits=PTP_LIMITS))
 _register(RobotModel(
     name="turtlebot3_burger", folder=MODELS_DIR / "turtlebot3_burger", footprint_m=(-0.102, -0.089, 0.038, 0.089),
     round_chassis=False, max_speed_m_s=0.22, ring_sensors=False, default_range_m=3.5,
     sources="ROBOTIS e-Manual TurtleBot3 specifications (138 x 178 x 192 mm, 0.22 m/s, 2.84 rad/s); ROBOTIS "
             "turtlebot3 burger.yaml (wheel radius 0.033 m, separation 0.160 m) and turtlebot3_burger.urdf "
             "(base box, wheel, caster and LDS positions)",
-    max_angular_rad_s=2.84))
+    max_angular_rad_s=2.84, ptp_limits=PTP_LIMITS))
 
 
 def robot_model(name: str) -> RobotModel:

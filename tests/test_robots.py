@@ -87,8 +87,10 @@ def test_an_unknown_robot_model_names_the_field():
         parse_scenario(EMPTY.format(model="roomba", heading=0.0))
 
 
-@pytest.mark.parametrize("model, speed", [("jackal", 0.5), ("turtlebot3_burger", None)])
+@pytest.mark.parametrize("model, speed", [("jackal", None), ("turtlebot3_burger", None)])
 def test_catalogue_robots_drive_dense_field_30_with_replan(model, speed):
+    """At their published top speeds (the Jackal at 2.0 m/s: 12 collisions before the PTP controller's drift and
+    corner limits and the effective track)."""
     base = load_scenario("dense-field-30")
     robot = ROBOTS[model]
     scenario = replace(base, robot_model=model, robot_radius_m=robot.planning_radius_m,

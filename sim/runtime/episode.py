@@ -248,10 +248,13 @@ def given_episode(spec: EpisodeSpec | Composition, waypoints: np.ndarray, source
 
 def point_to_point(drive, scenario: Scenario) -> PointToPointController:
     """The run's PTP controller: the model's drive geometry, the scenario's top speed, the robot's published
-    turn-rate limit (``models.robots``; the controller's default when it has none)."""
+    turn-rate limit and its drift and corner limits (``models.robots``; the controller's defaults when it has
+    none: the disc robot's, the paper's)."""
     from swarmnav.models.robots import robot_model
-    limit = robot_model(scenario.robot_model).max_angular_rad_s
-    extra = {} if limit is None else {"max_angular_rad_s": limit}
+    robot = robot_model(scenario.robot_model)
+    extra = {} if robot.max_angular_rad_s is None else {"max_angular_rad_s": robot.max_angular_rad_s}
+    if robot.ptp_limits is not None:
+        extra["max_drift_m"], extra["max_deceleration_m_s2"] = robot.ptp_limits
     return PointToPointController(drive, max_speed_m_s=scenario.max_speed_m_s, **extra)
 
 
