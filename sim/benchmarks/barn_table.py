@@ -106,12 +106,17 @@ def difficulty_lines(rows: list[dict[str, Any]]) -> list[str]:
 
 
 def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
-    """The BARN-like worlds' figures against BARN's (the 300 when committed, else the 50 test worlds), navigator
-    by navigator, same setup only (issue 34's check: within 0.05)."""
-    against = next((p for p in (ALL_300, TEST_50) if p in results and p.is_file()), None)
-    if against is None or FRESH not in results or not FRESH.is_file():
+    """The BARN-like worlds' figures against BARN's (the 300 when committed in the same setup, else the 50 test
+    worlds), navigator by navigator, same setup only (issue 34's check: within 0.05)."""
+    if FRESH not in results or not FRESH.is_file():
         return []
-    base_rows, fresh_rows = read_result(against), read_result(FRESH)
+    fresh_rows = read_result(FRESH)
+    setups = {r["barn_setup"] for r in fresh_rows}
+    against = next((p for p in (ALL_300, TEST_50) if p in results and p.is_file()
+                    and setups & {r["barn_setup"] for r in read_result(p)}), None)  # the same setup only
+    if against is None:
+        return []
+    base_rows = read_result(against)
     base = {r["navigator"]: r for r in base_rows if r.get("scenario") is None}
     fresh = {r["navigator"]: r for r in fresh_rows if r.get("scenario") is None}
     lines = []
