@@ -2,10 +2,16 @@
 ``reference_speed_m_s`` (its noise and carrot scaled with the top speed)."""
 
 import numpy as np
+import pytest
 
+from swarmnav.controllers.goal import GoalChecker
+from swarmnav.controllers.kinematics import DriveGeometry
+from swarmnav.controllers.navigator import NavigationSetup
+from swarmnav.controllers.navigators import make_navigator
+from swarmnav.controllers.point_to_point import PointToPointController
 from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.scenario_generator import GeneratorOptions, generate
-from swarmnav.sim.episode import EpisodeSpec, run_episode
+from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode, static_problem
 
 
 def _one_human(seconds: float):
@@ -32,3 +38,19 @@ def test_mppi_reference_speed_lets_a_1_m_s_robot_drive_fast_and_changes_nothing_
     assert _speed_m_s(plain) < 0.4 < 0.7 < _speed_m_s(scaled), (_speed_m_s(plain), _speed_m_s(scaled))
     same = run_episode(EpisodeSpec(scenario, navigator="mppi", navigator_params={"reference_speed_m_s": 1.0})).result
     assert np.array_equal(plain.poses, same.poses)
+
+
+@pytest.mark.parametrize("top_speed_m_s, speeds", [(0.2, 7), (1.0, 17)])
+def test_dwa_lattice_is_the_7_speeds_at_dyn300s_speed_and_fine_enough_for_the_window_at_1_m_s(top_speed_m_s, speeds):
+    scenario = _one_human(2.0)
+    episode = plan_episode(EpisodeSpec(scenario, navigator="dwa"))
+    geometry = DriveGeometry(wheel_radius_m=0.05, track_m=0.3, max_wheel_speed_rad_s=40.0)
+    setup = NavigationSetup(episode.path, episode.problem, None, np.random.default_rng(0),
+                            PointToPointController(geometry, max_speed_m_s=top_speed_m_s),
+                            GoalChecker(scenario.goal.x_m, scenario.goal.y_m, 0.3), 0.02, top_speed_m_s,
+                            known_problem=static_problem(scenario))
+    nav = make_navigator("dwa")
+    nav.reset(setup)
+    assert np.allclose(nav.speeds, np.linspace(0.0, top_speed_m_s, speeds))
+    window = nav.accel_m_s2 * nav.window_s
+    assert np.count_nonzero(nav.speeds <= window + 1e-9) >= 2  # from standing, a speed above 0 is reachable
