@@ -98,7 +98,8 @@ _register(RobotModel(
     sources="MuJoCo Menagerie clearpath_jackal/jackal.xml (masses, inertia, wheel radius 0.095 m, "
             "track 0.37559 m, wheelbase 0.262 m, +-26 rad/s); Clearpath Robotics Jackal specifications "
             "(508 x 430 x 250 mm, 2.0 m/s, skid-steer); Clearpath jackal_control config/control.yaml "
-            "(wheel_separation_multiplier 1.5, angular max_velocity 4.0 rad/s)",
+            "(wheel_separation_multiplier 1.5, angular max_velocity 4.0 rad/s); the effective track "
+            "(track_multiplier 1.95) calibrated on the model by spins on the spot (robot.xml)",
     max_angular_rad_s=4.0, ptp_limits=PTP_LIMITS))
 _register(RobotModel(
     name="turtlebot3_burger", folder=MODELS_DIR / "turtlebot3_burger", footprint_m=(-0.102, -0.089, 0.038, 0.089),
