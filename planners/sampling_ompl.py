@@ -61,7 +61,7 @@ from typing import Callable, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.ompl_checks import CollisionChecks, motion_validator_type, ompl_modules
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
@@ -96,13 +96,10 @@ class OmplPlanner:
     #: The OMPL class (in ``ompl.geometric``) this planner runs.
     ompl_class: ClassVar[str]
 
-    max_evaluations: int | None = 5000
-    time_s: float | None = None
-    round_evaluations: int = 100
+    max_evaluations: int | None = param(5000, within(0, 100_000_000))
+    time_s: float | None = param(None, within(0, 86_400))
+    round_evaluations: int = param(100, within(1, 100_000_000))
     # models.parameters checks these on build: collision checks are a few microseconds each, so 10^8 is minutes.
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "max_evaluations": within(0, 100_000_000), "time_s": within(0, 86_400),
-        "round_evaluations": within(1, 100_000_000)}
 
     def with_budget(self, budget) -> "OmplPlanner":
         """A copy that runs to a study's budget: ``evaluations`` as collision checks (this planner's own unit
@@ -249,11 +246,9 @@ class RRTStarPlanner(_TreePlanner):
     name: ClassVar[str] = "rrt_star"
     ompl_class: ClassVar[str] = "RRTstar"
 
-    range_m: float = 0.0
-    goal_bias: float = 0.05
-    rewire_factor: float = 1.1
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "range_m": within(0, 1e6), "goal_bias": within(0, 1), "rewire_factor": above(0, 1e3)}
+    range_m: float = param(0.0, within(0, 1e6))
+    goal_bias: float = param(0.05, within(0, 1))
+    rewire_factor: float = param(1.1, above(0, 1e3))
 
     def check_own_parameters(self) -> None:
         check_parameters(self, (
@@ -295,10 +290,8 @@ class BITStarPlanner(_TreePlanner):
     name: ClassVar[str] = "bit_star"
     ompl_class: ClassVar[str] = "BITstar"
 
-    samples_per_batch: int = 100
-    rewire_factor: float = 1.1
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "samples_per_batch": within(1, 1_000_000), "rewire_factor": above(0, 1e3)}
+    samples_per_batch: int = param(100, within(1, 1_000_000))
+    rewire_factor: float = param(1.1, above(0, 1e3))
 
     def check_own_parameters(self) -> None:
         check_parameters(self, (
