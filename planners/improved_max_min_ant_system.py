@@ -97,6 +97,7 @@ from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.grid_graph import (DIRECTIONS, Cell, cell_clearance_m, cells_to_waypoints, count_bends,
                                           grid_endpoints, grid_problem)
 from swarmnav.planners.grid_shortcut import exact_shortcut
+from swarmnav.planners.map_arc_cost import map_arc_cost
 from swarmnav.planners.max_min_trails import P_BEST
 from swarmnav.planners.pheromone_propagation import PROPAGATIONS, EnvironmentAnalysis, analyse_environment
 from swarmnav.planners.problem import Problem
@@ -263,6 +264,7 @@ class ImprovedMaxMinAntSystemPlanner(SwarmPlanner):
             "closing_reverted": a.closing_reverted,
             "moves": len(data["cells"]) - 1,
             "total_arc_cost": data["arc_cost"],
+            "map_arc_cost": map_arc_cost(grid.occupied, data["goal"], cells),
             "propagation_expansions": a.expansions,
             "fallback_moves": data["fallbacks"],
             "bends": count_bends(cells),

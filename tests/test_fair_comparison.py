@@ -217,7 +217,7 @@ def test_case_b_feasible_variant_plans(path):
     variant = load_scenario(str(STUDIES / "adl-abc-case-b-feasible" / f"adl-abc-case-b-feasible-path-{path}.toml"))
     assert variant.robot_radius_m == 0.05
     assert {(ob.x_m, ob.y_m): ob.radius_m for ob in variant.obstacles} == pytest.approx(
-        {k: 0.8 * r for k, r in printed.items()})
+        {k: 0.6 * r for k, r in printed.items()})
     optimum = OptimalPlanner().plan(scenario_problem(variant), np.random.default_rng(0))
     assert scenario_problem(variant).is_collision_free(optimum.waypoints)
 

@@ -261,7 +261,8 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     for row in table:  # what the runs were given (the oracle keeps the true map: controllers.world_map)
         row.update(given)
     if barn_meta is not None:
-        barn_suite.add_scores(table, rows, barn_meta, barn_setup, by_scenario, (barn or {}).get("dir"))
+        barn_suite.add_scores(table, rows, barn_meta, barn_setup, by_scenario, (barn or {}).get("dir"),
+                              {**navigator_params, **{a.label: a.params for a in arms}})
     return table
 
 

@@ -41,6 +41,7 @@ EXTRA_COLUMNS = {"raw_length_m": "plan_raw_length_m",  # the tour before shortcu
                  "gates_raised": "plan_gates_raised",  # IMMAS (Hasan et al. 2023), GateRaiseState
                  "tunnels_closed": "plan_tunnels_closed",  # IMMAS, Algorithm 2 (tight tunnels)
                  "total_arc_cost": "plan_arc_cost",  # IMMAS, the arc cost of its tour
+                 "map_arc_cost": "plan_map_arc_cost",  # IMMAS and MMAS: the tour's arc cost on the map as given
                  "moves": "plan_moves",  # grid planners: cell moves of the raw tour (IMMAS's Table 1 iterations)
                  "mean_cell_clearance_m": "plan_cell_clearance_m",  # grid planners: mean obstacle distance of the cells
                  "nodes_visited": "plan_nodes_visited"}  # M-ACO (Habib et al. 2021): random nodes on the route

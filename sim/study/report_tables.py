@@ -16,7 +16,7 @@ METRICS = (("plan_length_m", "plan length (m)"), ("plan_time_s", "plan time (s)"
            ("plan_evaluations", "evaluations"), ("plan_iterations", "iterations"),
            ("plan_convergence_iteration", "convergence iteration"), ("plan_bends", "bends"),
            ("plan_raw_length_m", "raw length (m)"), ("plan_gates_raised", "gates"),
-           ("plan_tunnels_closed", "tunnels"), ("plan_arc_cost", "arc cost"),
+           ("plan_tunnels_closed", "tunnels"), ("plan_arc_cost", "arc cost"), ("plan_map_arc_cost", "map arc cost"),
            ("path_length_m", "driven length (m)"), ("sim_time_s", "simulated time (s)"),
            ("min_clearance_m", "min clearance (m)"), ("collisions", "collisions"))
 UNITS = dict(METRICS)
