@@ -19,7 +19,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import param, within
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners._grid_search import astar
@@ -155,9 +155,8 @@ class GridPlanner:
 
     name: ClassVar[str] = ""
     honours_unknown_cost: ClassVar[bool] = False  # astar and dijkstra: Problem.unknown_cost (planners.unknown_cost)
-    parameter_ranges: ClassVar[dict[str, Range]] = {"cell_m": within(1e-6, 100)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
-    cell_m: float | None = None
+    cell_m: float | None = param(None, within(1e-6, 100))
     shortcut: bool = True
 
     def __post_init__(self) -> None:
