@@ -25,6 +25,7 @@ def test_the_committed_matrix_is_whole_and_meets_the_criterion_but_for_the_named
     for row, (scene, navigator, planner, map_knowledge) in zip(rows, expected):
         assert (row["scenario"], row["navigator"], row["map"]) == (scene, navigator, map_knowledge)
         assert planner is None or row["planner"] == planner
+        assert row["planner_params"] == sensed_map.PLANNER_PARAMS.get(row["planner"], {})  # what the run was given
     assert set(sensed_map.unmet(rows)) == set(sensed_map.UNMET)
     assert all(r["collisions"] == 0 for r in rows if r["success"])
 

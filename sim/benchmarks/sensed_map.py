@@ -2,7 +2,7 @@
 scenes of issue 33's criterion (``dense-field-30`` and ``gwo-scenario-1``).
 
 Each row is one run (``swarmnav run SCENE --navigator NAV --planner PLANNER --map MAP``, the scenario's seeds,
-its own sensors: 12 rays of 0.4 m), the planner's and navigator's defaults:
+its own sensors: 12 rays of 0.4 m), the planner's and navigator's defaults but for :data:`PLANNER_PARAMS`:
 
 * ``replan`` with each planner of :data:`REPLAN_PLANNERS` (the swarm planners of the papers, the grid colonies,
   the grid searches, the exact tangent graph and two of OMPL's);
@@ -32,12 +32,13 @@ MAPS = ("known", "unknown")
 REPLAN_PLANNERS = ("gwo", "pso", "abc", "adl_abc", "aco", "mmas", "iaco", "immas", "astar", "theta_star",
                    "dijkstra", "dstar_lite", "optimal", "rrt_connect", "prm_star")
 LOCAL_NAVIGATORS = ("dstar_replan", "dwa", "velocity_obstacle", "mppi")
-#: Combinations that succeed with the map known and not unknown, and why (measured; docs/sensing.md).
-UNMET = {
-    "dense-field-30 replan rrt_connect": "RRT-Connect stops at its first solution: each of its 10 replans on the "
-    "growing map draws a new random route (5-17 m), and the 150 s run times out; with the map known its one "
-    "route takes 115.7 s (seed 1: 111.0 s known, timeout unknown; seed 2: 108.0 s known, 134.0 s unknown)",
-}
+#: Planner parameters the matrix sets (both maps), and why (measured; docs/sensing.md).  RRT-Connect stops at its
+#: first solution, a random route: on the sensed map each of its ~10 replans drew a new one (5-17 m), and with
+#: the default single attempt dense-field-30 timed out with the map unknown (seeds 0 and 1; seed 2: 134.0 s).
+#: The shortest of 4 attempts (MoveIt's ``num_planning_attempts``), on the same budget, reaches the goal.
+PLANNER_PARAMS: dict[str, dict[str, Any]] = {"rrt_connect": {"attempts": 4}}
+#: Combinations that succeed with the map known and not unknown, and why (measured; docs/sensing.md): none.
+UNMET: dict[str, str] = {}
 
 
 def combinations(scenes: tuple[str, ...] = SCENES) -> list[tuple[str, str, str | None]]:
@@ -54,13 +55,15 @@ def run_one(scene: str, navigator: str, planner: str | None, map_knowledge: str)
     from swarmnav.sim.episode import EpisodeSpec, run_episode
 
     scenario = load_scenario(scene).with_knowledge(map_knowledge)
+    params = PLANNER_PARAMS.get(planner or "", {})
     wall0 = time.perf_counter()
-    episode = run_episode(EpisodeSpec(scenario, planner=planner, navigator=navigator))
+    episode = run_episode(EpisodeSpec(scenario, planner=planner, navigator=navigator,
+                                      planner_params=dict(params) or None))
     wall_s = time.perf_counter() - wall0
     result = episode.result
     summary = result.summary()
     return {"scenario": scene, "navigator": navigator, "planner": planner or scenario.planner_name,
-            "map": map_knowledge, "outcome": str(result.outcome), "success": bool(result.success),
+            "planner_params": dict(params), "map": map_knowledge, "outcome": str(result.outcome), "success": bool(result.success),
             "collisions": int(result.collisions), "sim_time_s": round(float(result.sim_time_s), 2),
             "replans": int(summary.get("replans", 0) or 0), "wall_s": round(wall_s, 1)}
 
@@ -93,9 +96,11 @@ def table(rows: list[dict[str, Any]]) -> str:
     by = {(r["scenario"], r["navigator"], r["planner"], r["map"]): r for r in rows}
     head = "| navigator | planner | " + " | ".join(f"{s} known | {s} unknown" for s in scenes) + " |"
     lines = [head, "|---|---|" + "---|---|" * len(scenes)]
+    params = {(r["navigator"], r["planner"]): r.get("planner_params") or {} for r in rows}
     for navigator, planner in dict.fromkeys((r["navigator"], r["planner"]) for r in rows):
         cells = [cell(by.get((s, navigator, planner, m))) for s in scenes for m in MAPS]
-        lines.append(f"| {navigator} | {planner} | " + " | ".join(cells) + " |")
+        named = "".join(f" ({k} = {v})" for k, v in params[navigator, planner].items())
+        lines.append(f"| {navigator} | {planner}{named} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
