@@ -26,13 +26,13 @@ $(STAMP): pyproject.toml Makefile planners/_colony_walk.c planners/_grid_search.
 
 # The editable install maps swarmnav, swarmnav.sim, ... to their folders with an import hook, which type checkers
 # do not run: mypy would not find swarmnav at all. A folder of symbolic links, $(VENV)/typing/swarmnav (the files
-# of sim/api/ and the folders models, planners, controllers and sim, so a module added later is there too), put on
+# of sim/api/ and a link per folder of pyproject.toml's package-dir, so a module added later is there too), put on
 # the path by a static .pth file, is the package as a wheel lays it out, py.typed included.
 TYPING_TREE := $(CURDIR)/$(VENV)/typing
 typing-path:
 	@rm -rf $(TYPING_TREE) && mkdir -p $(TYPING_TREE)/swarmnav
 	@for f in sim/api/*.py sim/api/py.typed; do ln -s $(CURDIR)/$$f $(TYPING_TREE)/swarmnav/; done
-	@for d in models planners controllers sim; do ln -s $(CURDIR)/$$d $(TYPING_TREE)/swarmnav/$$d; done
+	@$(BIN)/python -c "import os, sys, tomllib; folders = tomllib.load(open('pyproject.toml', 'rb'))['tool']['setuptools']['package-dir']; [os.symlink(os.path.abspath(folder), os.path.join(sys.argv[1], name.split('.', 1)[1])) for name, folder in folders.items() if name != 'swarmnav']" $(TYPING_TREE)/swarmnav
 	@$(BIN)/python -c "import sys, sysconfig; open(sysconfig.get_paths()['purelib'] + '/swarmnav_typing.pth', 'w').write(sys.argv[1] + '\n')" $(TYPING_TREE)
 
 install: $(STAMP)
@@ -95,10 +95,10 @@ readme-table: $(STAMP)
 		cp studies/readme-table/$$s/claims.json models/studies/results/$$s/claims.json || exit 1; \
 	done
 	$(BIN)/swarmnav report --readme-table models/studies/results --readme docs/reference/studies.md
-	for r in dyn300 dyn300-rangefinder dyn; do $(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/$$r.json --readme docs/navigation.md || exit 1; done
-	for page in README.md docs/results.md; do $(BIN)/python -m swarmnav.sim.benchmarks.navigation_table models/suites/results/dyn300.json --readme $$page || exit 1; done
-	$(BIN)/python -m swarmnav.sim.benchmarks.barn_table --readme docs/barn.md
-	$(BIN)/python -m swarmnav.sim.benchmarks.crowd_table models/suites/results/crowdnav.json --readme docs/crowds.md
+	for r in dyn300 dyn300-rangefinder dyn; do $(BIN)/python -m swarmnav.benchmarks.navigation_table models/suites/results/$$r.json --readme docs/navigation.md || exit 1; done
+	for page in README.md docs/results.md; do $(BIN)/python -m swarmnav.benchmarks.navigation_table models/suites/results/dyn300.json --readme $$page || exit 1; done
+	$(BIN)/python -m swarmnav.benchmarks.barn_table --readme docs/barn.md
+	$(BIN)/python -m swarmnav.benchmarks.crowd_table models/suites/results/crowdnav.json --readme docs/crowds.md
 
 rerun-stale: $(STAMP)
 	$(MAKE) readme-table CLAIM_STUDIES="$$($(BIN)/swarmnav report --check-fresh models/studies/results --names)"

@@ -60,7 +60,7 @@ class Observation:
         range_offset_m: distance of the sensor sites from the base's centre.
         detections: moving obstacles as sensed: exact within range with the ``detector``
             sensing model, the tracker's estimates from the rays' unknown hits with
-            ``rangefinder`` (both computed in ``sim/detector.py``).
+            ``rangefinder`` (both computed in ``sim/runtime/detector.py``).
         range_cutoff_m: the rangefinders' reach (``inf``: unknown).
     """
 
@@ -125,6 +125,14 @@ class NavigationSetup:
         if self.world_map is not None:
             return self.world_map.problem()
         return self.known_problem if self.known_problem is not None else self.problem
+
+    @property
+    def plan_problem(self) -> Problem:
+        """The map as the planners see it: :attr:`map_problem`, or with the map unknown the sensed map's
+        cells grown into the space not seen free behind them (:meth:`~controllers.world_map.SensedMap.planning_problem`)."""
+        if self.world_map is not None:
+            return self.world_map.planning_problem()
+        return self.map_problem
 
     @property
     def map_revision(self) -> int:

@@ -1,6 +1,6 @@
 """What a learned policy sees and what it answers: one convention for the environment and the ``policy`` navigator.
 
-The environment (``swarmnav.sim.env``) and the ``policy`` navigator both lay
+The environment (``swarmnav.env``) and the ``policy`` navigator both lay
 out their observations with :func:`observation_layout` and fill them with
 :class:`PolicyObserver`, and both turn actions into wheel commands with
 :func:`action_command`, so a policy trained in the environment runs unchanged

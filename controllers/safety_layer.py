@@ -3,7 +3,7 @@
 Nav2 keeps its Collision Monitor after the controller, as a node of its own, so that no controller
 carries a copy of it; here likewise no navigator carries the safety filter or the evasion.  The run's
 composition (:func:`sim.episode.plan_episode`) builds one :class:`SafetyLayer` per run beside the
-navigator, and :meth:`sim.runner.Simulation.run` passes every :class:`~controllers.navigator.NavigationStep`
+navigator, and :meth:`sim.simulation.Simulation.run` passes every :class:`~controllers.navigator.NavigationStep`
 through :meth:`SafetyLayer.after` before the stepper applies it.  Two stages, in this order:
 
 1. the evasion (``evade``, :mod:`controllers.evasion`): velocity-obstacle avoidance takes over while a

@@ -1,20 +1,24 @@
 """MkDocs hook: the source tree as it installs, for mkdocstrings to read.
 
-swarmnav installs four folders under one name (``pyproject.toml``'s ``package-dir``: ``sim/api`` is
-``swarmnav``, ``planners`` is ``swarmnav.planners``, ...), which no static reader can follow from the
-repository.  Before the build this links them, as they install, into ``build/docs-src/swarmnav/`` (``build/``
+swarmnav installs its folders under one name (``pyproject.toml``'s ``package-dir``: ``sim/api`` is
+``swarmnav``, ``planners`` is ``swarmnav.planners``, ``sim/runtime`` is ``swarmnav.sim``, ...), which no static
+reader can follow from the repository.  Before the build this links them, as they install, into ``build/docs-src/swarmnav/`` (``build/``
 is git-ignored), the folder mkdocs.yml's python handler searches.
 """
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 
 from mkdocs.plugins import event_priority
 
 REPO = Path(__file__).resolve().parent.parent
 TREE = REPO / "build" / "docs-src" / "swarmnav"
-SUBPACKAGES = ("models", "planners", "controllers", "sim")
+# swarmnav.X -> its folder, as pyproject.toml maps it (the package swarmnav itself, sim/api, is linked file by file)
+SUBPACKAGES = {name.split(".", 1)[1]: folder for name, folder in tomllib.loads(
+    (REPO / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["setuptools"]["package-dir"].items()
+    if name != "swarmnav"}
 
 
 def _link(link: Path, target: Path) -> None:
@@ -30,6 +34,6 @@ def on_config(config):
     TREE.mkdir(parents=True, exist_ok=True)
     for source in (REPO / "sim" / "api").glob("*.py"):
         _link(TREE / source.name, source)
-    for name in SUBPACKAGES:
-        _link(TREE / name, REPO / name)
+    for name, folder in SUBPACKAGES.items():
+        _link(TREE / name, REPO / folder)
     return config

@@ -35,11 +35,17 @@ class DStarLite:
         expansions: vertices expanded so far, over every (re)plan.
     """
 
-    def __init__(self, occupied: np.ndarray, start: Cell, goal: Cell):
+    def __init__(self, occupied: np.ndarray, start: Cell, goal: Cell, penalty: np.ndarray | None = None):
         occ = np.asarray(occupied, dtype=bool)
         check_cells(occ, start, goal)
         self.rows, self.cols = occ.shape
         self.free = (~occ).tolist()
+        # Optional cell penalties (a costmap): a move between cells u and v costs w (1 + (p_u + p_v) / 2),
+        # w its length in cells; symmetric, so the graph stays undirected, and >= w, so the octile
+        # heuristic stays admissible.  None: every move costs its length (the paper's grid).
+        self.penalty: list[float] | None = None
+        if penalty is not None:
+            self.penalty = self._checked_penalty(penalty)
         n = self.rows * self.cols
         self.g = [INF] * n
         self.rhs = [INF] * n
@@ -69,12 +75,16 @@ class DStarLite:
         if not free[r][c]:
             return
         rows, cols = self.rows, self.cols
+        pen = self.penalty
         for (dr, dc), w in zip(DIRECTIONS, STEP_COSTS):
             nr, nc = r + dr, c + dc
             if 0 <= nr < rows and 0 <= nc < cols and free[nr][nc]:
                 if dr and dc and not (free[r][nc] and free[nr][c]):
                     continue
-                yield nr * cols + nc, w
+                if pen is None:
+                    yield nr * cols + nc, w
+                else:
+                    yield nr * cols + nc, w * (1.0 + 0.5 * (pen[v] + pen[nr * cols + nc]))
 
     # -- queue ---------------------------------------------------------------
     def _key(self, v: int) -> tuple[float, float]:
@@ -199,6 +209,33 @@ class DStarLite:
                     nr, nc = r + dr, c + dc
                     if 0 <= nr < self.rows and 0 <= nc < self.cols:
                         touched.add(nr * self.cols + nc)
+        self._repair(touched)
+
+    def update_penalty(self, penalty: np.ndarray) -> int:
+        """Replace the cell penalties (see ``__init__``) and repair the vertices whose moves changed cost
+        (each changed cell and its 8 neighbours); returns the number of changed cells."""
+        new = self._checked_penalty(penalty)
+        old = self.penalty if self.penalty is not None else [0.0] * len(new)
+        self.penalty = new
+        changed = np.flatnonzero(np.asarray(new) != np.asarray(old))
+        touched: set[int] = set()
+        for v in changed.tolist():
+            r, c = divmod(v, self.cols)
+            for dr in (-1, 0, 1):
+                for dc in (-1, 0, 1):
+                    nr, nc = r + dr, c + dc
+                    if 0 <= nr < self.rows and 0 <= nc < self.cols:
+                        touched.add(nr * self.cols + nc)
+        self._repair(touched)
+        return len(changed)
+
+    def _checked_penalty(self, penalty: np.ndarray) -> list[float]:
+        pen = np.asarray(penalty, dtype=float)
+        if pen.shape != (self.rows, self.cols) or not np.all(np.isfinite(pen)) or np.any(pen < 0):
+            raise ValueError(f"penalty must be a finite, non-negative {self.rows} x {self.cols} array")
+        return pen.reshape(-1).tolist()
+
+    def _repair(self, touched: set[int]) -> None:
         for v in sorted(touched):
             if not self.free[v // self.cols][v % self.cols]:
                 self.g[v] = INF

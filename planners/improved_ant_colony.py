@@ -42,21 +42,8 @@ Readings of the paper where its text is ambiguous (our choices):
   ``tau_floor`` under Eq. (7) (:func:`prune_length`); our additions: the paper does
   not say how its ants leave dead ends, and pruning only saves time.
 
-Parameters without effect (the ``iaco-parameters`` study, Table 1's values one at a time, 10 seeds):
-on the four bundled maps ``t_c`` above 1 leaves every path unchanged, ``kappa`` and the initial
-``rho`` change the mean length by at most 0.1 % (on ``iaco-baffle`` only; the same on the other
-three), and ``alpha`` above 2 nothing.  This is the algorithm as read, not a bug: the collar line joins cell
-centres at any angle, so it is shorter than every 8-connected tour (``iaco-complex``: 73.0 cells
-against the best tour's 76.9; ``iaco-baffle``: 150.2 against 162.8), and Eq. (7)'s cubic exponent
-then gives every arrived tour ``Q_m = Q t_c^-((L_m - L_GL)^3)``, at most 7e-9 on ``iaco-complex``
-(seed 0, ``t_c = 1.5``) against ``tau_0 = 2``.  The deposits are nil, so the trails are ``tau_0``
-and the collar's extra pheromone evaporating by one common factor per iteration, which the
-roulette's normalisation cancels: ``rho`` (hence ``kappa``, Eq. (11)) changes nothing until a trail
-reaches ``tau_floor`` (the 0.1 % on the baffle map), and a larger ``t_c`` only makes nil deposits
-smaller.  ``t_c = 1`` is the exception: Eq. (7) is then the constant ``Q`` and the ants do deposit
-(baffle: mean 86.9 m against 66.8 m at ``t_c = 1.5``).  The paper's Table 1 shows effects for all four (its
-``t_c = 1`` row is also its worst), so its ``L_GL`` is probably measured otherwise (e.g. along the
-grid) or its Eq. (7) differs from our reading of the garbled text; neither can be settled from it.
+What Table 1's parameters change on the bundled maps (the ``iaco-parameters`` study) and why, and how the
+defaults the paper does not give were chosen: ``docs/papers.md``.
 """
 
 from __future__ import annotations
@@ -213,26 +200,15 @@ class ImprovedAntColonyPlanner(GridColonyPlanner):
             no value; ours: 2, i.e. about one ant's Eq. (8) deposit, so the first tours do not
             take over at once).
         collar_pheromone: pheromone added to the cells the collar line crosses (§3.1 gives no
-            amount; ours: 4, so collar cells start at 3 x tau_0).  Tuned on the bundled maps
-            over 10 seeds: with tau_0 = 1 and +1 on the collar the colony rarely reaches the
-            goal early on long maps (baffle: 1 run in 10 within 1.05 x the A* length, arcs 5,
-            rows 6; with these defaults 10, 8 and 10).  Stronger guidance helps wherever the
-            collar line lies in the optimal homotopy and hurts where it does not (trough:
-            the greedy §3.1.2 line goes round the other side, 3 runs in 10 find the
-            shorter side with the weak collar, none with these defaults; curves: no run
-            found the shorter corridor at any setting we tried).
+            amount; ours: 4, so collar cells start at 3 x tau_0; how it was chosen: ``docs/papers.md``).
         tau_floor: smallest pheromone a cell keeps.
-        exponent_limit: upper cap of Eq. (7)'s exponent (ours: 3, tuned on the bundled maps;
-            at 30 the first path shorter than the collar line takes over and the colony
-            stagnates).  There is no cap below: a cap of -3 would give every tour longer
-            than the collar line the same Q_m and make Eq. (7) a constant on maps whose
-            collar line is shorter than any grid path (baffle).
+        exponent_limit: upper cap of Eq. (7)'s exponent (ours: 3); there is no cap below (a cap
+            below would make Eq. (7) a constant for every tour longer than the collar line).
         max_steps: NumPy steps after which an ant fails; 0 means ``step_ratio`` x the
             iteration's length limit (see ``prune_ratio``), at least rows + cols and at
             most half the number of cells.
-        step_ratio: see ``max_steps`` (ours: 1.25; backtracking ants otherwise walk
-            for long without a chance to arrive, and an iteration lasts as long as its
-            slowest ant; 1.25 about halves the time on the baffle map at the same lengths).
+        step_ratio: see ``max_steps`` (ours: 1.25: a backtracking ant otherwise walks long
+            without a chance to arrive, and an iteration lasts as long as its slowest ant).
         prune_ratio: an ant stops once its tour is longer than this multiple of the best
             length so far and than :func:`prune_length` (1: it could not become the best,
             and its Eq. (7) deposit would lie below ``tau_floor``); before any best, the

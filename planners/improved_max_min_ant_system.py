@@ -46,9 +46,9 @@ Where the paper's prose and its algorithms disagree (our choices):
   evaporation rate rho value of 0.98".  We follow Algorithm 1 and §4.2 by default; the prose is
   the named option ``evaporation_doubling`` (rho, which the paper calls the evaporation rate,
   doubles after every expansion: every trail beyond a route cost of about 2.4 sits at
-  ``tau_max``, 98 % of the reached cells of ``immas-env4-blocks``, and the tour runs on clean and
-  eta alone).  Even without the doubling the factor 1.4 drives diagonal chains to ``tau_max``:
-  50 % of that map's reached cells sit there, where only clean and eta tell cells apart.
+  ``tau_max``, and the tour runs on clean and eta alone).  Even without the doubling the factor 1.4
+  drives diagonal chains to ``tau_max``, where only clean and eta tell cells apart (the shares of
+  cells measured: ``docs/papers.md``).
 * **Deposit.**  Eq. (2)'s ``1 / f(s_best)`` has no solution cost in a propagation that has not
   reached the start yet; we deposit 1 per step (the "1" that §3.2 multiplies by 1.4 or 1).
 
@@ -91,12 +91,13 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.planners.ant_colony import roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.grid_graph import (DIRECTIONS, Cell, cell_clearance_m, cells_to_waypoints, count_bends,
                                           grid_endpoints, grid_problem)
 from swarmnav.planners.grid_shortcut import exact_shortcut
+from swarmnav.planners.map_arc_cost import map_arc_cost
 from swarmnav.planners.max_min_trails import P_BEST
 from swarmnav.planners.pheromone_propagation import PROPAGATIONS, EnvironmentAnalysis, analyse_environment
 from swarmnav.planners.problem import Problem
@@ -137,25 +138,21 @@ class ImprovedMaxMinAntSystemPlanner(SwarmPlanner):
     """
 
     name: ClassVar[str] = "immas"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "alpha": within(0, 100), "beta": within(0, 100), "rho": above(0, 1), "clean_weight": within(0, 1e6),
-        "diagonal_factor": within(1, 10), "iterations": within(0, 10_000_000), "cell_m": within(1e-6, 100),
-        "max_evaluations": within(0, 1e9), "p_best": above(0, 1)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
-    alpha: float = 3.0
-    beta: float = 1.0
-    rho: float = 0.98
-    clean_weight: float = 0.5
-    diagonal_factor: float = 1.4
+    alpha: float = param(3.0, within(0, 100))
+    beta: float = param(1.0, within(0, 100))
+    rho: float = param(0.98, above(0, 1))
+    clean_weight: float = param(0.5, within(0, 1e6))
+    diagonal_factor: float = param(1.4, within(1, 10))
     close_gates_and_tunnels: bool = True
     propagation: str = "mmas"
     evaporation_doubling: bool = False
-    p_best: float = P_BEST
+    p_best: float = param(P_BEST, above(0, 1))
     selection: str = "best"
-    iterations: int = 0
-    cell_m: float | None = None
+    iterations: int = param(0, within(0, 10_000_000))
+    cell_m: float | None = param(None, within(1e-6, 100))
     shortcut: bool = True
-    max_evaluations: int | None = None
+    max_evaluations: int | None = param(None, within(0, 1e9))
 
     def __post_init__(self) -> None:
         check_parameters(self, (
@@ -267,6 +264,7 @@ class ImprovedMaxMinAntSystemPlanner(SwarmPlanner):
             "closing_reverted": a.closing_reverted,
             "moves": len(data["cells"]) - 1,
             "total_arc_cost": data["arc_cost"],
+            "map_arc_cost": map_arc_cost(grid.occupied, data["goal"], cells),
             "propagation_expansions": a.expansions,
             "fallback_moves": data["fallbacks"],
             "bends": count_bends(cells),

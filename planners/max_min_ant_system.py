@@ -40,6 +40,7 @@ import numpy as np
 from swarmnav.models.parameters import Range, param
 from swarmnav.planners.ant_colony import GridColonyPlanner, deposit
 from swarmnav.planners.colony_walk import ColonyWalk
+from swarmnav.planners.map_arc_cost import map_arc_cost
 from swarmnav.planners.max_min_trails import P_BEST, TrailLimits, trail_limits
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.swarm import SwarmState
@@ -111,5 +112,10 @@ class MaxMinColonyPlanner(GridColonyPlanner):
             data["limit_history"].append((limits.tau_min, limits.tau_max))
 
     def extra_stats(self, state: SwarmState, problem: Problem) -> dict[str, Any]:
-        limits: TrailLimits | None = state.data["limits"]
-        return {} if limits is None else {"tau_min": limits.tau_min, "tau_max": limits.tau_max}
+        """The trail limits, and the best tour's total arc cost priced on the map as IMMAS's is
+        (:mod:`planners.map_arc_cost`, for Hasan et al. (2023)'s cost comparison)."""
+        data = state.data
+        limits: TrailLimits | None = data["limits"]
+        goal = divmod(int(data["goal"]), problem.grid.occupied.shape[1])
+        extra = {"map_arc_cost": map_arc_cost(problem.grid.occupied, goal, data["graph"].cells(state.best_solution))}
+        return extra if limits is None else {**extra, "tau_min": limits.tau_min, "tau_max": limits.tau_max}

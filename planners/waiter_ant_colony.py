@@ -37,9 +37,8 @@ Deviations that remain (each also a row of the README's "Deviations from the pap
   its routes are 4-6 m.  Lengths compare only as ratios (to the straight line or to A*), never
   in centimetres.
 * **Nodes visited** (Table 2, Figs 8-9 and 13-14): the paper's M-ACO routes visit 9 of 10 and
-  13 of 15 nodes (goal 1), 7 of 10 and 14 of 15 (goal 2).  Ours visit fewer: over seeds 0-19
-  with the defaults, 2-10 of 10 (mean 5.2) and 5-11 of 15 (mean 7.6) beside table 2, 3-8 of 10
-  (mean 6.1) and 3-12 of 15 (mean 8.0) beside table 5 (``stats.extra["nodes_visited"]``).  Our
+  13 of 15 nodes (goal 1), 7 of 10 and 14 of 15 (goal 2).  Ours visit fewer
+  (``stats.extra["nodes_visited"]``; the counts measured: ``docs/papers.md``).  Our
   links are checked against the inflated obstacles, so an ant may leave the corridor's middle
   only by the links that stay clear; the paper's P0 rule (our reading above) and its node
   layout (its Fig. 4) are not given precisely enough to say which of the two makes its ants

@@ -1,7 +1,7 @@
 """The hostile-input sweep (issue 36): every CLI option and every declared field, tried with the worst values.
 
 Nothing here lists an option or a parameter by name: the CLI's options are found by walking the argparse
-tree :func:`swarmnav.sim.cli.main.build_parser` returns, the components' parameters from
+tree :func:`swarmnav.cli.main.build_parser` returns, the components' parameters from
 :func:`swarmnav.models.parameters.parameter_table` over the registries, and the scenario, study and suite
 fields by walking small valid documents.  An option or field added later is swept with no new case.
 

@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 import swarmnav
-from swarmnav.sim.cli.main import EXIT_EXPECTATION, main
+from swarmnav.cli.main import EXIT_EXPECTATION, main
 
 from plugin_dist import PLUGIN_STUDY, dist_info, example_plugin, python_path
 
@@ -23,7 +23,7 @@ WALL_CLOCK = {"wall_time_s", "replan_wall_s", "plan_time_s"}
 
 
 def _swarmnav(*args: str, env: dict[str, str] | None = None, cwd: Path | None = None):
-    return subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", *args], capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "swarmnav.cli", *args], capture_output=True, text=True,
                           env={**os.environ, **(env or {})}, cwd=cwd, timeout=600)
 
 
@@ -49,7 +49,7 @@ def test_a_folder_named_swarmnav_in_the_working_directory(tmp_path):
                           capture_output=True, text=True, timeout=60)
     assert done.stdout.strip() == "True", done.stderr
     # with the editable install's import hook alone the folder shadows the package: one line naming it, exit 2
-    hook_only = "import sys; sys.path = [p for p in sys.path if not p.endswith('/typing')]; import swarmnav.sim.cli.main"
+    hook_only = "import sys; sys.path = [p for p in sys.path if not p.endswith('/typing')]; import swarmnav.cli.main"
     done = subprocess.run([sys.executable, "-c", hook_only], cwd=tmp_path, capture_output=True, text=True, timeout=60)
     if "shadows" not in done.stderr and done.returncode == 0:
         pytest.skip("swarmnav is not an editable install here: nothing can shadow it")

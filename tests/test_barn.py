@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from swarmnav.sim.benchmarks import barn
-from swarmnav.sim.benchmarks.navigation import benchmark_navigation
-from swarmnav.sim.cli.main import main
+from swarmnav.benchmarks import barn
+from swarmnav.benchmarks.navigation import benchmark_navigation
+from swarmnav.cli.main import main
 
 DATA = Path(__file__).resolve().parents[2] / "shared/benchmarks/barn"
 needs_barn = pytest.mark.skipif(not (DATA / "worlds").is_dir() and not os.environ.get(barn.ENV_DIR),
@@ -75,8 +75,8 @@ def test_barn_options_are_checked(tmp_path, capsys):
 
 
 def test_barn_like_worlds_are_seeded_passable_and_barn_shaped():
-    from swarmnav.sim.benchmarks.barn_difficulty import c_space, field_grid
-    from swarmnav.sim.benchmarks.barn_like import FILLS, SMOOTHINGS, generate, parameters
+    from swarmnav.benchmarks.barn_difficulty import c_space, field_grid
+    from swarmnav.benchmarks.barn_like import FILLS, SMOOTHINGS, generate, parameters
     assert {parameters(s) for s in range(12)} == {(f, k) for f in FILLS for k in SMOOTHINGS}
     world, cells, _ = generate(7)
     again, cells_again, _ = generate(7)
@@ -86,7 +86,7 @@ def test_barn_like_worlds_are_seeded_passable_and_barn_shaped():
     assert not space[cells[:, 1], cells[:, 0]].any()      # the reference path runs over free C-space cells
     assert cells[0, 1] == 0 and cells[-1, 1] == 29 and np.abs(np.diff(cells, axis=0)).max() == 1
     assert all(c.radius_m == 0.075 for c in world.cylinders)
-    from swarmnav.sim.benchmarks.barn_like import draw_field, clear_passage, passable
+    from swarmnav.benchmarks.barn_like import draw_field, clear_passage, passable
     dense = draw_field(np.random.default_rng(0), 0.30, 2)        # BARN's densest pair: a passage is cut
     assert not passable(dense) and passable(clear_passage(dense)) and clear_passage(dense)[:, [0, -1]].all()
     assert {round(c.x_m, 3) for c in world.cylinders if c.y_m < 5} == {-4.425, -0.075} | {

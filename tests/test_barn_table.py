@@ -4,8 +4,8 @@ fails when either drifts from the other, and checks that the figures are the row
 import json
 from pathlib import Path
 
-from swarmnav.sim.benchmarks import barn_table
-from swarmnav.sim.benchmarks.barn_difficulty import success_against_difficulty
+from swarmnav.benchmarks import barn_table
+from swarmnav.benchmarks.barn_difficulty import success_against_difficulty
 
 README = Path(__file__).resolve().parent.parent / "docs" / "barn.md"  # the page that holds the block
 

@@ -14,9 +14,9 @@ from swarmnav.models.scenario import load_scenario, parse_scenario
 from swarmnav.planners.improved_max_min_ant_system import ImprovedMaxMinAntSystemPlanner
 from swarmnav.planners.problem import map_problem, scenario_problem
 from swarmnav.planners.registry import make_planner
-from swarmnav.sim.benchmarks import grid
-from swarmnav.sim.benchmarks.grid_quality import movingai_scenario_toml, pair_scenario_toml
-from swarmnav.sim.cli.commands import add_bench_grid_arguments
+from swarmnav.benchmarks import grid
+from swarmnav.benchmarks.grid_quality import movingai_scenario_toml, pair_scenario_toml
+from swarmnav.cli.commands import add_bench_grid_arguments
 
 
 def _instances(count: int):
@@ -82,7 +82,7 @@ def test_the_map_table_is_the_study_rows(tmp_path, capsys):
 
 
 def test_a_map_option_naming_a_scenario_without_a_map_is_one_line(capsys):
-    from swarmnav.sim.cli.main import main
+    from swarmnav.cli.main import main
 
     assert main(["bench", "grid", "--quick", "--maps", "gwo-scenario-1"]) == 2
     err = capsys.readouterr().err

@@ -11,7 +11,7 @@ import pytest
 from swarmnav.models import scenario_limits as limits
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import parse_scenario
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from probe_scenario import PROBE_SCENARIO
 
 
@@ -137,7 +137,7 @@ def test_the_memory_limit_holds_for_the_unbounded_cases_of_the_issue(tmp_path):
     zero_waypoints = ["run", "gwo-scenario-1", "--waypoints", "/dev/zero", "--no-log"]
     colony = ["plan", "immas-env1-scattered", "--planner", "aco", "--set", "max_steps=100000000"]
     script = ("import resource, sys\nresource.setrlimit(resource.RLIMIT_AS, (3_000_000_000, 3_000_000_000))\n"
-              "from swarmnav.sim.cli.main import main\nsys.exit(main(sys.argv[1:]))\n")
+              "from swarmnav.cli.main import main\nsys.exit(main(sys.argv[1:]))\n")
     for argv in (zero_waypoints, colony):
         done = subprocess.run([sys.executable, "-c", script, *argv], capture_output=True, text=True, timeout=60)
         assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, (argv, done.stderr)

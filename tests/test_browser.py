@@ -91,7 +91,7 @@ def browser():
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory) -> Path:
-    from swarmnav.sim.cli.main import main
+    from swarmnav.cli.main import main
     folder = tmp_path_factory.mktemp("study")
     (folder / "browser-check.toml").write_text(STUDY)
     assert main(["study", str(folder / "browser-check.toml"), "--out", str(folder / "out"), "--workers", "1",

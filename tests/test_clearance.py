@@ -7,7 +7,7 @@ import numpy as np
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
-from swarmnav.sim.runner import Simulation
+from swarmnav.sim.simulation import Simulation
 
 
 def test_the_probe_equals_the_smallest_gap_over_every_robot_collision_geom():

@@ -9,7 +9,7 @@ import pytest
 
 from probe_scenario import PROBE_SCENARIO
 
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 
 BASE = PROBE_SCENARIO.replace("time_limit_s = 30.0", "time_limit_s = 60.0")  # tests/probe_scenario.py
 
@@ -114,7 +114,7 @@ def test_unknown_bundled_name_and_planner_on_the_command_line_exit_2(capsys):
 
 def test_console_script_exits_2_without_traceback(tmp_path):
     bad = write(tmp_path, BASE.replace("radius_m = 0.5", "radius_m = 0"))
-    proc = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "plan", bad], capture_output=True, text=True)
+    proc = subprocess.run([sys.executable, "-m", "swarmnav.cli", "plan", bad], capture_output=True, text=True)
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr and "obstacles[0].radius_m" in proc.stderr
 

@@ -10,10 +10,10 @@ import os
 import subprocess
 import sys
 
-from swarmnav.sim.cli import main as cli
+from swarmnav.cli import main as cli
 
 HEAVY_PREFIXES = ("mujoco", "scipy", "dm_control", "dm_env", "gymnasium", "mcap", "foxglove", "matplotlib",
-                  "pyarrow", "swarmnav.sim.runner", "swarmnav.sim.episode", "swarmnav.sim.benchmarks.",
+                  "pyarrow", "swarmnav.sim.simulation", "swarmnav.sim.episode", "swarmnav.benchmarks.",
                   "swarmnav.controllers")
 # Of the planners package, the CLI needs the error types it maps to exit 3, and nothing else.
 LIGHT_PLANNER_MODULES = {"swarmnav.planners", "swarmnav.planners.errors"}
@@ -31,15 +31,15 @@ def _heavy(modules: list[str]) -> list[str]:
 
 
 def test_importing_the_cli_and_building_its_parser_loads_no_heavy_module():
-    modules = _modules_after("from swarmnav.sim.cli.main import build_parser\nbuild_parser()")
-    assert "swarmnav.sim.cli.main" in modules and "swarmnav.planners.errors" in modules
+    modules = _modules_after("from swarmnav.cli.main import build_parser\nbuild_parser()")
+    assert "swarmnav.cli.main" in modules and "swarmnav.planners.errors" in modules
     assert _heavy(modules) == []
 
 
 def test_the_check_sees_a_heavy_import():
     # The same check on a subcommand that did run: it names what that subcommand loaded.
-    modules = _modules_after("from swarmnav.sim.cli.main import build_parser\nbuild_parser()\n"
-                             "from swarmnav.sim.benchmarks import grid")
+    modules = _modules_after("from swarmnav.cli.main import build_parser\nbuild_parser()\n"
+                             "from swarmnav.benchmarks import grid")
     heavy = _heavy(modules)
     assert "scipy" in heavy and "swarmnav.planners.problem" in heavy
 
@@ -61,7 +61,7 @@ def test_the_registry_names_are_still_importable_from_the_package():
 def test_every_module_subcommand_has_its_options_and_runs_through_its_module():
     parser = cli.build_parser()
     args = parser.parse_args(["bench", "grid", "--quick"])
-    assert args.quick and args.func.__module__ == "swarmnav.sim.cli.commands"
+    assert args.quick and args.func.__module__ == "swarmnav.cli.commands"
     args = parser.parse_args(["replay", "run.mcap", "--verify"])
     assert args.verify and args.log == "run.mcap"
 
@@ -77,7 +77,7 @@ def test_bench_cli_prints_its_figures(capsys):
 def test_the_cli_runs_blas_on_one_thread_unless_the_environment_says_otherwise():
     """Set before NumPy loads (the planners' small matrices, multithreaded on a busy machine, ran up to 10x
     slower); a value the user exported wins."""
-    code = ("import os, sys; import swarmnav.sim.cli.main; assert 'numpy' not in sys.modules; import numpy; "
+    code = ("import os, sys; import swarmnav.cli.main; assert 'numpy' not in sys.modules; import numpy; "
             "print(os.environ['OPENBLAS_NUM_THREADS'], os.environ['OMP_NUM_THREADS'])")
     env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")}
     plain = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)

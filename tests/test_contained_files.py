@@ -10,7 +10,7 @@ import pytest
 
 from swarmnav.models.contained_files import loads_json, loads_toml, read_input_text
 from swarmnav.models.errors import ConfigError
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from probe_scenario import PROBE_SCENARIO
 
 DEEP = "[" * 5000 + "]" * 5000
@@ -146,7 +146,7 @@ def test_a_log_is_never_written_through_a_link(capsys, tmp_path, probe):
 def probe_log(tmp_path_factory) -> Path:
     from swarmnav.models.scenario import parse_scenario
     from swarmnav.sim.episode import EpisodeSpec, run_episode
-    from swarmnav.sim.log.writer import McapRecorder
+    from swarmnav.log.writer import McapRecorder
     path = tmp_path_factory.mktemp("log") / "probe.mcap"
     run_episode(EpisodeSpec(parse_scenario(PROBE_SCENARIO, "probe.toml")), [McapRecorder(path)], time_limit_s=0.2)
     return path
@@ -156,8 +156,8 @@ def tampered(source: Path, target: Path, scene=None, run: dict | None = None, dr
     """A copy of ``source`` with its scene.xml rewritten by ``scene`` and ``run`` metadata changed."""
     import json
     from mcap.writer import CompressionType, Writer
-    from swarmnav.sim.log.records import read_records
-    from swarmnav.sim.log.recover import _Copier
+    from swarmnav.log.records import read_records
+    from swarmnav.log.recover import _Copier
     with target.open("wb") as stream:
         writer = Writer(stream, compression=CompressionType.ZSTD)
         copier = _Copier(writer)

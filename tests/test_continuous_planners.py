@@ -210,8 +210,8 @@ def test_bench_planners_rows_agree_with_their_runs(tmp_path):
     and against the exact optimum computed here."""
     import pandas as pd
 
-    from swarmnav.sim.benchmarks import planners as bench_continuous
-    from swarmnav.sim.cli.commands import add_bench_planners_arguments
+    from swarmnav.benchmarks import planners as bench_continuous
+    from swarmnav.cli.commands import add_bench_planners_arguments
 
     parser = argparse.ArgumentParser()
     add_bench_planners_arguments(parser)
@@ -255,8 +255,8 @@ def test_bench_planners_random_fields_are_a_study_of_scenario_files(tmp_path):
     import pandas as pd
 
     from swarmnav.planners.random_fields import random_disc_field
-    from swarmnav.sim.benchmarks import planners as bench_continuous
-    from swarmnav.sim.cli.commands import add_bench_planners_arguments
+    from swarmnav.benchmarks import planners as bench_continuous
+    from swarmnav.cli.commands import add_bench_planners_arguments
 
     parser = argparse.ArgumentParser()
     add_bench_planners_arguments(parser)

@@ -14,8 +14,8 @@ from swarmnav.models.errors import ConfigError  # noqa: E402
 from swarmnav.models.obstacle_motion import LinearMotion  # noqa: E402
 from swarmnav.models.scenario import load_scenario  # noqa: E402
 from swarmnav.sim.episode import EpisodeSpec, run_episode  # noqa: E402
-from swarmnav.sim.log.reader import read_log  # noqa: E402
-from swarmnav.sim.log.writer import McapRecorder  # noqa: E402
+from swarmnav.log.reader import read_log  # noqa: E402
+from swarmnav.log.writer import McapRecorder  # noqa: E402
 from swarmnav.sim.scene import compile_scene  # noqa: E402
 from swarmnav.sim.stepper import EpisodeStepper  # noqa: E402
 

@@ -5,9 +5,9 @@ from pathlib import Path
 
 import pytest
 
-from swarmnav.sim.benchmarks import crowd_table
-from swarmnav.sim.benchmarks.crowd_table import PROTOCOL, RESULT, block, current_block
-from swarmnav.sim.benchmarks.navigation_table import read_rows
+from swarmnav.benchmarks import crowd_table
+from swarmnav.benchmarks.crowd_table import PROTOCOL, RESULT, block, current_block
+from swarmnav.benchmarks.navigation_table import read_rows
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -13,7 +13,7 @@ import pytest  # noqa: E402
 from swarmnav.models.crowd_agents import AgentMotion  # noqa: E402
 from swarmnav.models.scenario import parse_scenario  # noqa: E402
 from swarmnav.models.scenario_generator import GeneratorOptions, generate  # noqa: E402
-from swarmnav.sim.cli.main import main  # noqa: E402
+from swarmnav.cli.main import main  # noqa: E402
 from swarmnav.sim.crowd_stepping import crowd_metrics  # noqa: E402
 
 CENTRE = np.array([6.0, 6.0])
@@ -103,7 +103,7 @@ def test_bad_generator_options_are_one_line_and_exit_2(argv, message, capsys):
 def test_the_crowdnav_suite_reads_each_setting_apart_and_the_visible_one_without_a_yardstick(tmp_path):
     from swarmnav.controllers.oracle_search import NoClairvoyantYardstick, search
     from swarmnav.models.suites import load_suite
-    from swarmnav.sim.benchmarks.navigation import benchmark_navigation
+    from swarmnav.benchmarks.navigation import benchmark_navigation
     suite = load_suite("crowdnav")
     assert [len([s for s in suite.scenes if s.group == g]) for g in ("circle-invisible", "circle-visible")] == \
         [500, 500]
@@ -122,7 +122,7 @@ def test_the_crowdnav_suite_reads_each_setting_apart_and_the_visible_one_without
     # the blind follower meets the humans closer than the oracle does
     assert by[("follow", False)]["discomfort_frequency"] > by[("oracle", False)]["discomfort_frequency"]
     # The report counts the oracle's refused run on the visible scene nowhere: "no yardstick" instead.
-    from swarmnav.sim.study.report import write_report
+    from swarmnav.study.report import write_report
     text = write_report(tmp_path, tmp_path / "report.html").read_text(encoding="utf-8")
     assert "No yardstick: 1 runs of the clairvoyant oracle" in text
     assert "3 runs, " in text and "4 runs, " not in text

@@ -1,4 +1,4 @@
-"""Difficulty metrics (sim/difficulty.py) and `scenarios info`."""
+"""Difficulty metrics (sim/runtime/difficulty.py) and `scenarios info`."""
 
 import json
 
@@ -6,7 +6,7 @@ import pytest
 
 from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.scenario_generator import GeneratorOptions, generate
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from swarmnav.sim.difficulty import difficulty
 
 

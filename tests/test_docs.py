@@ -31,10 +31,10 @@ def test_the_site_builds_strict_with_every_page_of_the_nav(site):
 
 def test_the_api_reference_is_generated_from_the_docstrings(site):
     html = (site / "reference" / "api" / "index.html").read_text()
-    from swarmnav.sim.log.writer import McapRecorder
+    from swarmnav.log.writer import McapRecorder
     from swarmnav import RunOutcome
     for name in ("swarmnav.run", "swarmnav.results.RunOutcome", "swarmnav.planners.problem.Problem",
-                 "swarmnav.sim.log.writer.McapRecorder", "swarmnav.sim.env.task.EnvOptions"):
+                 "swarmnav.log.writer.McapRecorder", "swarmnav.env.task.EnvOptions"):
         assert f'id="{name}"' in html, name
     # A sentence of a docstring reaches the page (text, not just headings).
     for docstring in (McapRecorder.__doc__, RunOutcome.__doc__):

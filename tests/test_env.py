@@ -10,8 +10,8 @@ from dm_env import test_utils
 
 from swarmnav.models.scenario import Seeds, load_scenario, parse_scenario
 from swarmnav.models.world import Pose2D
-from swarmnav.sim.env import RewardWeights, make_environment
-from swarmnav.sim.env.task import same_model
+from swarmnav.env import RewardWeights, make_environment
+from swarmnav.env.task import same_model
 from swarmnav.sim.episode import EpisodeSpec, run_episode
 from swarmnav.sim.scene import compile_scene
 
@@ -277,7 +277,7 @@ def test_a_start_in_contact_ends_at_once_when_stopping_on_collision_and_its_cost
 
 
 def test_gymnasium_reset_reports_an_episode_over_at_its_start_and_the_first_step_terminates():
-    from swarmnav.sim.env import NavigateEnv
+    from swarmnav.env import NavigateEnv
     base = load_scenario("restaurant-table-5")
     env = NavigateEnv(dataclasses.replace(base, start=Pose2D(base.goal.x_m, base.goal.y_m, 0.0)))
     _, info = env.reset(seed=0)
@@ -293,7 +293,7 @@ def test_the_environments_final_metrics_are_run_jsons_for_the_same_wheel_command
     runs: the environment has no navigator to replan or trigger a safety filter.)"""
     import json
 
-    from swarmnav.sim.cli.main import main
+    from swarmnav.cli.main import main
     assert main(["run", name, "--navigator", "follow", "--json", "--no-log"]) == 0
     run = json.loads(capsys.readouterr().out)
     commands = run_episode(EpisodeSpec(load_scenario(name), navigator="follow")).result.wheel_command_rad_s

@@ -7,7 +7,7 @@ from swarmnav.controllers.observation_normaliser import ObservationNormaliser
 from swarmnav.controllers.policy_interface import FLAT_ORDER, flatten_observation
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.env import NavigateEnv
+from swarmnav.env import NavigateEnv
 from swarmnav.sim.episode import EpisodeSpec, run_episode
 from swarmnav.sim.scene import compile_scene, index_scene
 

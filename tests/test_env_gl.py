@@ -33,8 +33,8 @@ def test_making_and_stepping_an_environment_maps_no_gl_library(mujoco_gl):
     done = run_python("""
 import os
 import swarmnav
-import swarmnav.sim.env
-env = swarmnav.sim.env.NavigateEnv("gwo-scenario-2")
+import swarmnav.env
+env = swarmnav.env.NavigateEnv("gwo-scenario-2")
 env.reset(seed=1)
 for _ in range(5):
     env.step(env.action_space.sample())
@@ -48,8 +48,8 @@ print(mapped(), os.environ.get("MUJOCO_GL"))
 def test_render_makes_the_context_on_demand_and_exit_without_close_is_clean():
     done = run_python("""
 import os
-import swarmnav.sim.env
-env = swarmnav.sim.env.NavigateEnv("gwo-scenario-2", render_mode="rgb_array", width=64, height=48)
+import swarmnav.env
+env = swarmnav.env.NavigateEnv("gwo-scenario-2", render_mode="rgb_array", width=64, height=48)
 env.reset(seed=1)
 assert mapped() == [], mapped()
 frame = env.render()
@@ -61,15 +61,15 @@ print(frame.shape, frame.std() > 0, any("libEGL" in lib for lib in mapped()), os
 
 
 def test_triton_imports_beside_the_environment_and_after_a_render():
-    """Issue 25's 'done when': ``MUJOCO_GL=egl python -c "import swarmnav.sim.env, triton"`` exits 0; and triton
+    """Issue 25's 'done when': ``MUJOCO_GL=egl python -c "import swarmnav.env, triton"`` exits 0; and triton
     (which PyTorch imports when it is installed, e.g. on ``PPO.load``) imported after a render, as a policy loaded
     lazily under ``--video`` does, no longer dies with a segfault (exit -11 before the first context imported it)."""
     pytest.importorskip("triton")  # the test extra installs it on Linux
-    done = run_python("import swarmnav.sim.env, triton")
+    done = run_python("import swarmnav.env, triton")
     assert done.returncode == 0, (done.returncode, done.stderr)
     done = run_python("""
-import swarmnav.sim.env
-env = swarmnav.sim.env.NavigateEnv("gwo-scenario-2", render_mode="rgb_array", width=64, height=48)
+import swarmnav.env
+env = swarmnav.env.NavigateEnv("gwo-scenario-2", render_mode="rgb_array", width=64, height=48)
 env.reset(seed=1)
 first = env.render()
 import triton

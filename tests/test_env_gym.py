@@ -11,8 +11,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from swarmnav.models.scenario import Seeds, load_scenario
-from swarmnav.sim.env import ENV_ID, NavigateEnv
-from swarmnav.sim.log.reader import read_log
+from swarmnav.env import ENV_ID, NavigateEnv
+from swarmnav.log.reader import read_log
 
 
 @pytest.mark.parametrize("scenario, options", [
@@ -57,7 +57,7 @@ def test_spaces_are_float32_and_the_goal_and_velocity_bounds_come_from_the_arena
 
 def test_make_by_module_and_id_in_a_fresh_interpreter():
     code = ("import gymnasium, json, numpy as np\n"
-            f"env = gymnasium.make('swarmnav.sim.env:{ENV_ID}', scenario='restaurant-table-5', time_limit_s=1.0)\n"
+            f"env = gymnasium.make('swarmnav.env:{ENV_ID}', scenario='restaurant-table-5', time_limit_s=1.0)\n"
             "obs, info = env.reset(seed=0)\n"
             "done, n, ret = False, 0, 0.0\n"
             "while not done:\n"
@@ -133,7 +133,7 @@ def test_an_episode_records_to_mcap_like_a_run(tmp_path):
 
 
 def test_bench_env_quick_prints_the_three_rates_and_their_ratios_as_json():
-    out = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "bench", "env", "--quick", "--json"],
+    out = subprocess.run([sys.executable, "-m", "swarmnav.cli", "bench", "env", "--quick", "--json"],
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     figures = json.loads(out.stdout)
@@ -146,7 +146,7 @@ def test_bench_env_quick_prints_the_three_rates_and_their_ratios_as_json():
     assert figures["vector_steps_per_run"] * figures["vector_action_repeat"] <= figures["control_steps_per_run"]
     assert figures["env_vs_runner"] == pytest.approx(figures["env_steps_per_s"] / figures["runner_steps_per_s"],
                                                      rel=0.5)  # a median of ratios beside a ratio of medians
-    bad = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "bench", "env", "--repeats", "0"],
+    bad = subprocess.run([sys.executable, "-m", "swarmnav.cli", "bench", "env", "--repeats", "0"],
                          capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "--repeats" in bad.stderr and "Traceback" not in bad.stderr
 

@@ -6,7 +6,7 @@ import pytest
 from swarmnav.controllers.policy_interface import ActionError
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.env import NavigateEnv, RewardWeights, make_environment
+from swarmnav.env import NavigateEnv, RewardWeights, make_environment
 from swarmnav.sim.episode import EpisodeSpec, run_episode
 
 ONLY = dict(progress_per_m=0.0, goal_bonus=0.0, time_penalty_per_s=0.0)

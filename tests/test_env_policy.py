@@ -12,7 +12,7 @@ import pytest
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.env import make_environment
+from swarmnav.env import make_environment
 from swarmnav.sim.episode import EpisodeSpec, run_episode
 
 TESTS_DIR = str(Path(__file__).resolve().parent)  # holds reactive_policy.py, the bundled example policy
@@ -27,7 +27,7 @@ def policy_module(tmp_path, monkeypatch):
 
 
 def swarmnav(*args):
-    return subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", *args], capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "swarmnav.cli", *args], capture_output=True, text=True,
                           timeout=300)
 
 

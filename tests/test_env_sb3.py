@@ -115,7 +115,7 @@ def test_the_command_the_script_prints_runs_the_policy_with_a_video(trained, epi
     world.write_text(text)
     args = [str(world), *words[5:], "--world-seed", str(seeds.world), "--seed", str(seeds.planner), "--no-log",
             "--json", "--video", str(out / "run.mp4"), "--width", "160", "--height", "120", "--fps", "10"]
-    done = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "run", *args], capture_output=True, text=True,
+    done = subprocess.run([sys.executable, "-m", "swarmnav.cli", "run", *args], capture_output=True, text=True,
                           timeout=600, cwd=ROOT, env={**os.environ, **variables, "MUJOCO_GL": "egl"})
     assert done.returncode == 0, (done.returncode, done.stderr)
     assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr, done.stderr

@@ -12,7 +12,7 @@ import pytest
 from swarmnav.controllers.navigators import NAVIGATORS
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import Seeds, parse_scenario
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -111,7 +111,8 @@ def test_the_navigator_draws_from_its_own_stream(monkeypatch):
     run, and another navigator stream under the same seed leaves the plan but changes the replanned drive."""
     from swarmnav.sim import episode as episode_module
 
-    spec = EpisodeSpec(crossing_case(), "abc", navigator="replan", seed=3)
+    # A small colony (10 x 10): each replan is a whole ABC run, and the stream matters, not the colony's size.
+    spec = EpisodeSpec(crossing_case(), "abc", {"population": 10, "iterations": 10}, navigator="replan", seed=3)
     first = run_episode(spec)
     second = run_episode(spec)
     assert first.result.replans >= 1
@@ -252,7 +253,7 @@ def test_a_navigator_that_does_not_declare_what_it_uses_is_refused_at_registrati
 
 
 def test_only_the_composition_resolves_a_spec_or_builds_an_episode():
-    """sim/episode.py is the one place (compose, plan_episode, given_episode): the CLI, the API, studies,
+    """sim/runtime/episode.py is the one place (compose, plan_episode, given_episode): the CLI, the API, studies,
     given paths and the environment all go through it."""
     import pathlib
     import re

@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from swarmnav.sim.cli.main import main
-from swarmnav.sim.study import power
-from swarmnav.sim.study.claim_spec import Claim
-from swarmnav.sim.study.claims import CONTRADICTED, INCONCLUSIVE, REPRODUCES, UNDERPOWERED, claims_document, verdicts
-from swarmnav.sim.study.grid import count_cells, expand
-from swarmnav.sim.study.readme_table import RESULTS_DIR
-from swarmnav.sim.study.report_tables import merge_identical
-from swarmnav.sim.study.spec import load_study
+from swarmnav.cli.main import main
+from swarmnav.study import power
+from swarmnav.study.claim_spec import Claim
+from swarmnav.study.claims import CONTRADICTED, INCONCLUSIVE, REPRODUCES, UNDERPOWERED, claims_document, verdicts
+from swarmnav.study.grid import count_cells, expand
+from swarmnav.study.readme_table import RESULTS_DIR
+from swarmnav.study.report_tables import merge_identical
+from swarmnav.study.spec import load_study
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -121,7 +121,7 @@ def test_errored_arms_are_never_merged_as_identical_configurations():
 
 
 def test_the_ompl_log_marks_a_found_plan_solved_and_the_drive_separately():
-    from swarmnav.sim.study.ompl_log import PHYSICS_PROPERTIES, RUN_PROPERTIES, _run_values
+    from swarmnav.study.ompl_log import PHYSICS_PROPERTIES, RUN_PROPERTIES, _run_values
     row = {"outcome": "ok", "success": False, "plan_waypoints": "[[0, 0], [1, 1]]", "plan_time_s": 0.1,
            "plan_collision_free": True, "plan_length_m": 1.4142, "seed": 0, "reached": False, "collisions": 2}
     values = dict(zip([n for n, _ in RUN_PROPERTIES + PHYSICS_PROPERTIES], _run_values(row, None, True)))
@@ -131,7 +131,7 @@ def test_the_ompl_log_marks_a_found_plan_solved_and_the_drive_separately():
 
 
 def test_the_report_summary_counts_collisions_and_timeouts_as_not_successful(tmp_path, monkeypatch):
-    from swarmnav.sim.study import figures, report
+    from swarmnav.study import figures, report
     rows = [{"scenario": "s", "label": "a", "planner": "x", "navigator_label": "follow", "seed": i,
              "world_seed": None, "outcome": "ok", "success": i == 0, "mode": "physics", "collisions": i % 2,
              "plan_length_m": 1.0} for i in range(4)]
@@ -145,13 +145,13 @@ def test_the_report_summary_counts_collisions_and_timeouts_as_not_successful(tmp
 
 
 def test_equal_single_values_are_equal_not_inconclusive():
-    from swarmnav.sim.study.claims import EQUAL
+    from swarmnav.study.claims import EQUAL
     rows = _rows("A", [5.0] * 10, planner="immas") + _rows("B", [5.0] * 10, planner="immas")
     assert verdicts([_claim()], rows)[0]["verdict"] == EQUAL
 
 
 def test_a_resume_after_a_source_change_keeps_the_old_inputs_so_the_verdicts_read_stale(tmp_path, capsys):
-    from swarmnav.sim.study.execute import resumed_inputs
+    from swarmnav.study.execute import resumed_inputs
     (tmp_path / "runs.parquet").mkdir()
     old = {"study_file": {"path": "s.toml", "sha256": "a"}, "sources": {"planners/gwo.py": "1"},
            "scenarios": {"x.toml": "s"}, "versions": {"swarmnav": "0.1.0"}}

@@ -10,11 +10,11 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 from mcap.reader import make_reader  # noqa: E402
 
 from swarmnav.models.scenario import load_scenario  # noqa: E402
-from swarmnav.sim.cli.main import main  # noqa: E402
+from swarmnav.cli.main import main  # noqa: E402
 from swarmnav.sim.episode import EpisodeSpec, run_episode  # noqa: E402
-from swarmnav.sim.log.foxglove_layout import build_layout, shipped_layout  # noqa: E402
-from swarmnav.sim.log.reader import read_log  # noqa: E402
-from swarmnav.sim.log.writer import McapRecorder  # noqa: E402
+from swarmnav.log.foxglove_layout import build_layout, shipped_layout  # noqa: E402
+from swarmnav.log.reader import read_log  # noqa: E402
+from swarmnav.log.writer import McapRecorder  # noqa: E402
 
 
 def _panels(node):

@@ -6,8 +6,8 @@ from __future__ import annotations
 import json
 import shutil
 
-from swarmnav.sim.cli.main import main
-from swarmnav.sim.study.readme_table import RESULTS_DIR
+from swarmnav.cli.main import main
+from swarmnav.study.readme_table import RESULTS_DIR
 
 
 def test_check_fresh_passes_on_the_committed_results(capsys):

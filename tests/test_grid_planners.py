@@ -11,7 +11,7 @@ from swarmnav.models.scenario import list_scenarios, load_scenario, parse_scenar
 import json
 
 from swarmnav.planners.registry import PLANNERS, make_planner
-from swarmnav.sim.cli import main as cli
+from swarmnav.cli import main as cli
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.models.geometry import segment_box_distance, segment_box_distances
@@ -429,3 +429,29 @@ def test_cli_plans_a_map_scenario(capsys):
     assert cli.main(["plan", "immas-env2-rings", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["planner"] == "immas" and out["collision_free"] is True
+
+
+def test_dstar_lite_penalties_steer_the_path_and_their_repair_matches_a_fresh_search():
+    rng = np.random.default_rng(11)
+    occ = rng.random((24, 24)) < 0.15
+    start, goal = (0, 0), (23, 23)
+    occ[start] = occ[goal] = False
+    penalty = np.zeros(occ.shape)
+    penalty[:, 10:14] = 5.0  # a costly band every path must cross
+    planner = DStarLite(occ, start, goal, penalty=penalty)
+    cells = planner.plan()
+    assert planner.cost_cells > astar_cells(occ, start, goal)[1]  # the band costs more than its length
+    assert sum(10 <= c < 14 for _, c in cells) <= 6  # it is crossed as briefly as the cells allow
+    # New penalties after the robot moved: the incremental repair's cost equals a fresh search's.
+    robot = cells[4]
+    penalty2 = penalty.copy()
+    penalty2[:12, 10:14] = 0.0
+    planner.move_start(robot)
+    changed = planner.update_penalty(penalty2)
+    assert changed == 12 * 4
+    planner.plan()
+    fresh = DStarLite(occ, robot, goal, penalty=penalty2)
+    fresh.plan()
+    assert planner.cost_cells == pytest.approx(fresh.cost_cells)
+    with pytest.raises(ValueError, match="penalty"):
+        planner.update_penalty(-penalty2)

@@ -16,10 +16,10 @@ from swarmnav.models import scenario as scenario_module
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.grid_map import parse_map
 from swarmnav.models.scenario import load_scenario, parse_scenario
-from swarmnav.sim.cli import main as cli
+from swarmnav.cli import main as cli
 from probe_scenario import PROBE_SCENARIO
 
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from swarmnav.sim.scene import compile_scene
 
 BASE = PROBE_SCENARIO  # tests/probe_scenario.py

@@ -10,11 +10,11 @@ import pytest
 from mcap.writer import CompressionType, Writer
 
 from swarmnav.models.scenario import parse_scenario
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from swarmnav.sim.episode import EpisodeSpec, run_episode
-from swarmnav.sim.log.records import read_records
-from swarmnav.sim.log.recover import _Copier
-from swarmnav.sim.log.writer import McapRecorder
+from swarmnav.log.records import read_records
+from swarmnav.log.recover import _Copier
+from swarmnav.log.writer import McapRecorder
 from probe_scenario import PROBE_SCENARIO
 
 

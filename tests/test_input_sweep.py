@@ -16,7 +16,7 @@ import pytest
 import input_sweep as sweep_lib
 from input_sweep import (PARAMETER_VALUES, Sweep, cli_cases, cli_options, component_parameters, document_values,
                          leaves, no_new_processes, replaced, toml_text)
-from swarmnav.sim.cli import main as cli_main
+from swarmnav.cli import main as cli_main
 
 FAST_SCENARIO = """
 name = "sweep"
@@ -64,7 +64,7 @@ def files(tmp_path_factory) -> dict[str, str]:
     """The cheapest valid inputs, by the name of the positional or option that takes them."""
     from swarmnav.models.scenario import parse_scenario
     from swarmnav.sim.episode import EpisodeSpec, run_episode
-    from swarmnav.sim.log.writer import McapRecorder
+    from swarmnav.log.writer import McapRecorder
     folder = tmp_path_factory.mktemp("sweep")
     scenario = folder / "sweep.toml"
     scenario.write_text(FAST_SCENARIO)
@@ -92,6 +92,7 @@ def cheap_settings(files: dict[str, str]) -> dict[tuple[str, ...], list[str]]:
             ("bench", "planners"): ["--scenarios", s, "--seeds", "1", "--population", "4", "--iterations", "1",
                                     "--peer-runs", "0", "--fields", "0"],
             ("bench", "grid"): ["--runs", "1", "--swarm-sample", "1"],
+            ("bench", "sensed-map"): ["--scenario", s, "--only", "dstar_replan"],
             ("bench", "study"): ["--seeds", "1", "--iterations", "1", "--rounds", "1", "--no-ray"],
             ("study",): ["--workers", "1", "--out", str(Path(files["folder"]) / "study-out")],
             ("replay",): ["--verify"]}
@@ -170,7 +171,7 @@ def test_every_scenario_study_and_suite_field(files, tmp_path, capsys):
     from swarmnav.models.scenario import parse_scenario
     from swarmnav.models.suites import load_suite
     from swarmnav.sim.episode import EpisodeSpec, run_episode
-    from swarmnav.sim.study.spec import study_from_tables
+    from swarmnav.study.spec import study_from_tables
     sweep = Sweep(BUDGET_S)
     t0, cpu0 = time.perf_counter(), time.process_time()
     scenario_doc = tomllib.loads(FAST_SCENARIO)
@@ -254,7 +255,7 @@ def test_a_handful_in_their_own_process_under_a_3_gb_address_space(files, tmp_pa
     study.write_text(f'name = "huge"\nscenarios = ["{files["scenario"]}"]\n[[planners]]\nname = "gwo"\n'
                      f'params = {{ iterations = [{values}], population = [{values}] }}\n')
     script = ("import resource, sys\nresource.setrlimit(resource.RLIMIT_AS, (3_000_000_000, 3_000_000_000))\n"
-              "from swarmnav.sim.cli.main import main\nsys.exit(main(sys.argv[1:]))\n")
+              "from swarmnav.cli.main import main\nsys.exit(main(sys.argv[1:]))\n")
     cases = [["run", files["scenario"], "--waypoints", str(fifo), "--no-log"],
              ["plan", files["scenario"], "--set", "x=" + sweep_lib.DEEP],
              ["plan", str(discs)], ["study", str(study), "--out", str(tmp_path / "out")]]

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from probe_scenario import PROBE_SCENARIO
 
 
@@ -49,7 +49,7 @@ def test_an_output_is_never_a_fifo_or_a_device(capsys, tmp_path, argv):
 
 
 def test_bench_log_reports_a_failed_write_on_stderr_with_exit_2(capsys, monkeypatch):
-    from swarmnav.sim.benchmarks import log as bench_log
+    from swarmnav.benchmarks import log as bench_log
     monkeypatch.setattr(bench_log, "measure", lambda argv: {"s": 0.1, "cpu_s": 0.1, "peak_mb": 1.0, "exit": 2,
                                                             "error": "swarmnav: error: time_limit_s: too long"})
     code, err, out = outcome(capsys, ["bench", "log", "--duration", "10", "--no-video"])

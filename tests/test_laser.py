@@ -1,4 +1,4 @@
-"""The 2-D laser (sim/laser.py): a fan of beams from one origin cast with mj_multiRay, its angles as a
+"""The 2-D laser (sim/runtime/laser.py): a fan of beams from one origin cast with mj_multiRay, its angles as a
 LaserScan's, its readings the geometry's, and a replay of its log reading the same scan."""
 
 import math
@@ -13,8 +13,8 @@ from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.scenario_obstacles import Obstacle
 from swarmnav.sim.episode import EpisodeSpec, run_episode
 from swarmnav.sim.laser import LaserCaster
-from swarmnav.sim.log.reader import read_log
-from swarmnav.sim.log.writer import McapRecorder
+from swarmnav.log.reader import read_log
+from swarmnav.log.writer import McapRecorder
 from swarmnav.sim.scene import compile_scene
 from swarmnav.sim.stepper import reset_data
 
@@ -88,7 +88,7 @@ def test_bad_laser_fields_name_the_field(field, value, text):
                                          ('knowledge = { map = "unknown", map_cell_m = 0.0001 }',
                                           "knowledge.map_cell_m")])
 def test_bad_robot_laser_and_map_input_is_one_line_naming_the_field_exit_2(tmp_path, capsys, text, field):
-    from swarmnav.sim.cli.main import main
+    from swarmnav.cli.main import main
     body = LASER.format(model="jackal", count=12, fov=360.0, heading=0.0)
     key = text.split(" = ", 1)[0]
     body = "\n".join(line for line in body.splitlines() if not line.startswith(key + " ")) + "\n" + text + "\n"

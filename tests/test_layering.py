@@ -1,24 +1,51 @@
-"""Imports point one way: models <- planners <- controllers <- sim; no cycle; nothing below the CLI imports it
-and no runtime module imports a benchmark.
+"""The floors of the installed package: every import points down (or stays on its floor), no cycle, and every
+file is importable under exactly one name.
 
-Every import of every module is read with ``ast`` (imports inside functions
-included), so a lazy import that climbs a floor fails here too.
+The installed names come from ``pyproject.toml``'s ``package-dir`` (``sim/runtime`` is ``swarmnav.sim``,
+``sim/api`` is ``swarmnav`` itself, ...), and are checked against the installed package's own finder.  Every
+import of every module is read with ``ast`` (imports inside functions included), so a lazy import that climbs a
+floor fails here too.
 """
 
 import ast
+import functools
+import importlib.util
+import re
+import tomllib
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-LAYERS = ("models", "planners", "controllers", "sim")
-# What each layer may import from the project (itself included).
+PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["setuptools"]
+PACKAGE_DIRS: dict[str, str] = PYPROJECT["package-dir"]  # installed name -> its folder
+# The floors, from the bottom up: a module may import its own floor and the floors below, never one above.
+FLOORS: tuple[tuple[str, ...], ...] = (
+    ("swarmnav.models",),
+    ("swarmnav.planners",),
+    ("swarmnav.controllers",),
+    ("swarmnav.sim",),  # the physics runtime (sim/runtime/): scene, stepper, simulation, episode, sensing, ...
+    ("swarmnav.video",),  # what uses the runtime: rendering, the run log, studies and the dm_env task
+    ("swarmnav.log",),
+    ("swarmnav.study", "swarmnav.env"),
+    ("swarmnav.benchmarks",),
+    ("swarmnav",),  # the Python API (sim/api/: calls, results)
+    ("swarmnav.cli",),  # the command line, on top
+)
+LAYERS = ("models", "planners", "controllers", "sim")  # the repository's source folders
+# What each source folder may import from the project (itself included).
 ALLOWED = {layer: set(LAYERS[:i + 1]) for i, layer in enumerate(LAYERS)}
 SIM_ONLY = {"mujoco", "dm_control", "dm_env", "gymnasium", "foxglove", "mcap", "mcap_protobuf"}
 # Loading code by name outside sim/: only the policy navigator, which loads the user's
 # ``module:function`` policy (never project code) with pkgutil.resolve_name.
 CODE_LOADERS = {"importlib", "pkgutil"}
 USER_CODE_LOADER = ("controllers/navigators/policy.py", "pkgutil")
+
+
+def floor_of(module: str) -> int:
+    """The floor of an installed module: that of the longest package name it starts with."""
+    best = max((package for floor in FLOORS for package in floor if in_package(module, package)), key=len)
+    return next(index for index, floor in enumerate(FLOORS) if best in floor)
 
 
 def imported_modules(source: str, package: str) -> list[tuple[int, str]]:
@@ -71,8 +98,8 @@ def test_no_module_loads_project_code_by_string():
 
 
 def test_the_check_catches_an_import_inside_a_function():
-    source = "import numpy\n\ndef f():\n    from swarmnav.sim.runner import Simulation\n    return Simulation\n"
-    assert violations(source, "planners") == ["line 4: swarmnav.sim.runner (planners may import only "
+    source = "import numpy\n\ndef f():\n    from swarmnav.sim.simulation import Simulation\n    return Simulation\n"
+    assert violations(source, "planners") == ["line 4: swarmnav.sim.simulation (planners may import only "
                                               "['models', 'planners'])"]
     assert violations(source, "sim") == []
     assert violations("def g():\n    import mujoco\n", "controllers")
@@ -87,24 +114,44 @@ def test_no_grab_bag_utils_module():
     assert not list(ROOT.glob("*/utils.py"))
 
 
+def installed_names(path: Path) -> list[str]:
+    """Every name a project file is importable under: one per ``package-dir`` folder it sits in through a chain
+    of packages (folders with ``__init__.py``)."""
+    names = []
+    for package, folder in PACKAGE_DIRS.items():
+        base = ROOT / folder
+        if not path.is_relative_to(base):
+            continue
+        relative = path.relative_to(base)
+        folders = [base / Path(*relative.parts[:i]) for i in range(len(relative.parts))]
+        if all((f / "__init__.py").is_file() for f in folders):
+            parts = list(relative.with_suffix("").parts)
+            names.append(".".join([package, *(parts[:-1] if parts[-1] == "__init__" else parts)]))
+    return names
+
+
 def module_name(layer: str, path: Path) -> str:
-    """The installed name of a project file (``sim/api/`` is the top-level ``swarmnav`` package)."""
-    parts = list(path.relative_to(ROOT / layer).with_suffix("").parts)
-    if parts[-1] == "__init__":
-        parts = parts[:-1]
-    if layer == "sim" and parts[:1] == ["api"]:
-        return ".".join(["swarmnav", *parts[1:]])
-    return ".".join(["swarmnav", layer, *parts])
+    """The one installed name of a project file (``sim/runtime/`` is ``swarmnav.sim``, ``sim/api/`` the top-level
+    ``swarmnav`` package, ...; ``pyproject.toml``'s ``package-dir``)."""
+    names = installed_names(path)
+    assert len(names) == 1, f"{path.relative_to(ROOT)} is importable as {names}"
+    return names[0]
 
 
+@functools.cache
+def parsed(path: Path) -> ast.Module:
+    """A project file's syntax tree, parsed once per session (several checks read every file)."""
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
+@functools.cache
 def import_graph() -> dict[str, set[str]]:
     """Project module -> the project modules it imports, at any depth (imports inside functions included)."""
     files = {module_name(layer, path): (layer, path) for layer, path in project_modules()}
     graph: dict[str, set[str]] = {name: set() for name in files}
     for name, (layer, path) in files.items():
         package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
-        tree = ast.parse(path.read_text(encoding="utf-8"))
-        for node in ast.walk(tree):
+        for node in ast.walk(parsed(path)):
             targets: list[str] = []
             if isinstance(node, ast.Import):
                 targets = [alias.name for alias in node.names]
@@ -168,8 +215,8 @@ def test_the_cycle_check_finds_a_cycle():
     assert import_cycles({"a": {"b"}, "b": set()}) == []
 
 
-CLI = "swarmnav.sim.cli"  # sim/cli/: the parser and the commands
-BENCHMARKS = "swarmnav.sim.benchmarks"  # sim/benchmarks/: run by `swarmnav bench` only
+CLI = "swarmnav.cli"  # sim/cli/: the parser and the commands
+BENCHMARKS = "swarmnav.benchmarks"  # sim/benchmarks/: run by `swarmnav bench` only
 
 
 def in_package(module: str, package: str) -> bool:
@@ -181,6 +228,61 @@ def outside_importers(graph: dict[str, set[str]], package: str, allowed: tuple[s
     return sorted(name for name, targets in graph.items()
                   if not any(in_package(name, home) for home in (package, *allowed))
                   and any(in_package(target, package) for target in targets))
+
+
+def upward_imports(graph: dict[str, set[str]]) -> list[str]:
+    """``importer -> imported`` for every import from a lower floor to a higher one."""
+    return sorted(f"{name} -> {target}" for name, targets in graph.items() for target in targets
+                  if floor_of(target) > floor_of(name))
+
+
+def test_every_file_is_importable_under_exactly_one_name():
+    files = [path for layer, path in project_modules()]
+    assert len(files) > 200
+    assert {path.relative_to(ROOT).as_posix(): names for path in files
+            if len(names := installed_names(path)) != 1} == {}
+
+
+def test_every_package_folder_is_installed_and_found_by_its_name():
+    """Each folder with ``__init__.py`` is in ``packages`` (a wheel would leave it out otherwise), and the
+    installed package's finder resolves each name to that very folder."""
+    folders = sorted({path.parent for layer, path in project_modules() if path.name == "__init__.py"})
+    names = {module_name("", folder / "__init__.py"): folder for folder in folders}
+    assert sorted(set(names) - set(PYPROJECT["packages"])) == []
+    for name, folder in names.items():
+        spec = importlib.util.find_spec(name)
+        assert spec is not None and Path(spec.origin).resolve() == (folder / "__init__.py").resolve(), name
+    simulation = importlib.util.find_spec("swarmnav.sim.simulation")
+    assert Path(simulation.origin).resolve() == ROOT / "sim" / "runtime" / "simulation.py"
+
+
+def test_a_folder_of_one_floor_is_not_reachable_inside_another():
+    """No second name: the folders above the runtime are not packages of ``swarmnav.sim``, nor the API's."""
+    for package in ("api", "cli", "study", "log", "env", "video", "benchmarks", "runtime"):
+        assert importlib.util.find_spec(f"swarmnav.sim.{package}") is None, package
+    assert importlib.util.find_spec("swarmnav.api") is None and importlib.util.find_spec("swarmnav.runtime") is None
+
+
+def test_every_installed_package_has_a_floor():
+    assert sorted(name for name in PACKAGE_DIRS if not any(name in floor for floor in FLOORS)) == []
+
+
+def test_no_import_climbs_a_floor():
+    graph = import_graph()
+    assert sum(len(targets) for targets in graph.values()) > 500  # the check sees the imports
+    assert upward_imports(graph) == []
+
+
+def test_the_floor_check_finds_an_import_that_climbs():
+    graph = {"swarmnav.cli.main": {"swarmnav.calls", "swarmnav.sim.scene"},
+             "swarmnav.benchmarks.paper_defaults": {"swarmnav", "swarmnav.sim.episode"},
+             "swarmnav.sim.plot": {"swarmnav.log.reader"},
+             "swarmnav.study.cell": {"swarmnav.env.task", "swarmnav.log.writer"},
+             "swarmnav.results": {"swarmnav.sim.episode"}}
+    assert upward_imports(graph) == ["swarmnav.benchmarks.paper_defaults -> swarmnav",
+                                     "swarmnav.sim.plot -> swarmnav.log.reader"]
+    assert floor_of("swarmnav.calls") == floor_of("swarmnav") > floor_of("swarmnav.benchmarks.sim")
+    assert floor_of("swarmnav.simulation_like") == floor_of("swarmnav")  # a name that merely starts like a package
 
 
 def test_only_the_command_line_imports_the_command_line():
@@ -198,10 +300,43 @@ def test_no_runtime_module_imports_a_benchmark():
 
 
 def test_the_package_checks_find_an_importer():
-    graph = {"swarmnav.sim.cli.main": {"swarmnav.sim.runner", "swarmnav.sim.benchmarks.sim"},
-             "swarmnav.sim.runner": {"swarmnav.sim.cli.commands"},
-             "swarmnav.sim.client": {"swarmnav.sim.benchmarks"},  # a name that merely starts like the package
-             "swarmnav.sim.benchmarks.sim": {"swarmnav.sim.runner"}}
-    assert outside_importers(graph, CLI) == ["swarmnav.sim.runner"]
-    assert outside_importers(graph, BENCHMARKS, allowed=(CLI,)) == ["swarmnav.sim.client"]
-    assert outside_importers(graph, BENCHMARKS) == ["swarmnav.sim.cli.main", "swarmnav.sim.client"]
+    graph = {"swarmnav.cli.main": {"swarmnav.sim.simulation", "swarmnav.benchmarks.sim"},
+             "swarmnav.sim.simulation": {"swarmnav.cli.commands"},
+             "swarmnav.client": {"swarmnav.benchmarks"},  # a name that merely starts like the package
+             "swarmnav.benchmarks.sim": {"swarmnav.sim.simulation"}}
+    assert outside_importers(graph, CLI) == ["swarmnav.sim.simulation"]
+    assert outside_importers(graph, BENCHMARKS, allowed=(CLI,)) == ["swarmnav.client"]
+    assert outside_importers(graph, BENCHMARKS) == ["swarmnav.cli.main", "swarmnav.client"]
+
+
+def test_the_deprecated_runner_name_warns_and_is_the_same_class():
+    import sys
+    sys.modules.pop("swarmnav.sim.runner", None)
+    with pytest.warns(DeprecationWarning, match="swarmnav.sim.simulation"):
+        from swarmnav.sim.runner import Simulation
+    from swarmnav.sim.simulation import Simulation as Current
+    assert Simulation is Current
+
+
+def test_every_import_of_the_package_names_one_of_its_modules():
+    """``from swarmnav.X import ...`` names an installed module (or a compiled extension of pyproject.toml), and
+    ``from swarmnav.X import y`` a module of it or a name its ``__init__.py`` has: an old or second name
+    (``swarmnav.sim.api.calls``, ``from swarmnav.sim import plot``) fails here."""
+    modules = {module_name(layer, path): path for layer, path in project_modules()}
+    known = set(modules) | {extension["name"] for extension in PYPROJECT["ext-modules"]}
+    unknown = []
+    for layer, path in [*project_modules(), *(("tests", p) for p in sorted((ROOT / "tests").glob("*.py")))]:
+        for node in ast.walk(parsed(path)):
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+                names = [node.module]
+                if node.module in modules and modules[node.module].name == "__init__.py":
+                    package_text = modules[node.module].read_text(encoding="utf-8")
+                    names += [f"{node.module}.{alias.name}" for alias in node.names
+                              if not re.search(rf"\b{alias.name}\b", package_text)]
+            else:
+                continue
+            unknown += [f"{path.relative_to(ROOT)}:{node.lineno}: {name}" for name in names
+                        if name.split(".")[0] == "swarmnav" and name not in known and name != "swarmnav.sim.runner"]
+    assert unknown == []

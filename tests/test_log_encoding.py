@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from foxglove.messages import FrameTransform, LaserScan, Pose, PoseInFrame, Quaternion, Vector3
 
-from swarmnav.sim.log.encoding import StepEncoder, timestamp_field, varint
-from swarmnav.sim.log.messages import stamp
+from swarmnav.log.encoding import StepEncoder, timestamp_field, varint
+from swarmnav.log.messages import stamp
 
 SPECIAL = (0.0, -0.0, 1.0, -1.0, math.nan, math.inf, -math.inf, 5e-324, 1.7976931348623157e308, 0.1)
 
@@ -72,8 +72,8 @@ def test_obstacle_scene_update_is_the_sdk_encoding():
     and infinities among them) give the bytes of the SceneUpdate the SDK builds from obstacle_entity."""
     from foxglove.messages import SceneUpdate
 
-    from swarmnav.sim.log.encoding import SceneEncoder
-    from swarmnav.sim.log.messages import obstacle_entity, obstacle_template
+    from swarmnav.log.encoding import SceneEncoder
+    from swarmnav.log.messages import obstacle_entity, obstacle_template
     from swarmnav.sim.recording import ObstacleInfo
 
     rng = np.random.default_rng(9)

@@ -23,9 +23,9 @@ from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import Writer
 
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.cli.main import main
-from swarmnav.sim.log.writer import McapRecorder
-from swarmnav.sim.log.records import LogError, read_records
+from swarmnav.cli.main import main
+from swarmnav.log.writer import McapRecorder
+from swarmnav.log.records import LogError, read_records
 from swarmnav.sim.episode import EpisodeSpec, run_episode
 
 REPO = Path(__file__).resolve().parent.parent
@@ -204,7 +204,7 @@ def test_full_disk_is_one_line_with_the_path_and_exit_2(capsys):
     err = one_error_line(capsys)
     assert info.value.code == 2 and "/dev/full" in err and "device" in err
     # ... and a disk that fills under the log file is kept as the OSError naming it (the CLI's one line)
-    from swarmnav.sim.log.file import LogFile
+    from swarmnav.log.file import LogFile
     log = LogFile("/dev/full", overwrite=True)
     with pytest.raises(OSError) as full:
         log.write(b"x" * 4096)
@@ -216,7 +216,7 @@ FILE_SIZE_LIMITED_RUN = """
 import resource, signal, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG instead
 resource.setrlimit(resource.RLIMIT_FSIZE, (int(sys.argv[2]), int(sys.argv[2])))
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 sys.exit(main(["run", "gwo-scenario-2", "--out", sys.argv[1], "--seed", "0"]))
 """
 
@@ -391,9 +391,9 @@ def test_a_run_whose_encoder_dies_ends_with_one_line_and_a_finished_log(tmp_path
     """ffmpeg killed mid-run: the run stops at the next frame, exit 2, one line, the log closed."""
     import time
 
-    from swarmnav.sim.log.reader import read_log
+    from swarmnav.log.reader import read_log
     log, video = tmp_path / "run.mcap", tmp_path / "run.mp4"
-    process = subprocess.Popen([sys.executable, "-m", "swarmnav.sim.cli", "run", SCENARIO, "--out", str(log),
+    process = subprocess.Popen([sys.executable, "-m", "swarmnav.cli", "run", SCENARIO, "--out", str(log),
                                 "--video", str(video), "--width", "64", "--height", "48", "--fps", "30"],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120

@@ -19,8 +19,8 @@ rosbags = pytest.importorskip("rosbags")
 from rosbags.highlevel import AnyReader  # noqa: E402
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore  # noqa: E402
 
-from swarmnav.sim.log.format import ROS2_CHANNELS  # noqa: E402
-from swarmnav.sim.log.ros2_types import FIELDS, msgdef, schema_name  # noqa: E402
+from swarmnav.log.format import ROS2_CHANNELS  # noqa: E402
+from swarmnav.log.ros2_types import FIELDS, msgdef, schema_name  # noqa: E402
 
 HUMBLE = get_typestore(Stores.ROS2_HUMBLE)
 
@@ -76,7 +76,7 @@ def test_rosbags_decodes_every_message_as_the_standard_types(ros2_run, ros2_mess
     scan = messages["/scan"][0]
     assert len(scan.ranges) == 12 and scan.ranges.dtype == np.float32 and scan.header.frame_id == "base_scan"
     assert math.isclose(scan.angle_min + 11 * scan.angle_increment, scan.angle_max, abs_tol=1e-5)
-    from swarmnav.sim.log.summary import read_summary
+    from swarmnav.log.summary import read_summary
     obstacles = json.loads(read_summary(path).metadata["run"]["obstacles"])
     assert {len(m.markers) for m in messages["/obstacles"]} == {len(obstacles)}  # all of them, every step
     assert [m.ns for m in messages["/obstacles"][-1].markers] == [o["entity_id"] for o in obstacles]
@@ -97,7 +97,7 @@ def test_the_last_odometry_pose_is_the_runs_final_pose_at_the_goal(ros2_run, ros
 
 
 def test_log_info_plot_and_verify_read_the_ros2_log(ros2_run, tmp_path, capsys):
-    from swarmnav.sim.cli.main import main
+    from swarmnav.cli.main import main
     path, outcome = ros2_run
     assert main(["log", "info", str(path)]) == 0
     text = capsys.readouterr().out
@@ -111,8 +111,8 @@ def test_log_info_plot_and_verify_read_the_ros2_log(ros2_run, tmp_path, capsys):
 def test_an_odometry_estimate_goes_to_odom_and_map_to_odom_carries_its_error(tmp_path):
     """With ``StepFrame.odometry`` (the drifting estimate a run with odometry hands over), /odom is the
     estimate and map -> odom -> base_link is still the true pose, which the reader recovers."""
-    from swarmnav.sim.log.reader import read_log
-    from swarmnav.sim.log.writer import McapRecorder
+    from swarmnav.log.reader import read_log
+    from swarmnav.log.writer import McapRecorder
     from swarmnav.sim.recording import RunContext, StepFrame
     mjcf = '<mujoco><worldbody><body><geom name="chassis" size="0.2 0.05"/></body></worldbody></mujoco>'
     context = RunContext("s", "", "p", {}, 0, mjcf, 0.1, 0.01, np.linspace(-1, 1, 3), 1.0, 0.2, 0.1, ())
@@ -138,8 +138,8 @@ def test_an_odometry_run_logs_the_estimate_on_odom_and_the_true_pose_through_map
     """knowledge.pose = "odometry": /odom is the dead-reckoned pose (it drifts), map -> odom -> base_link the truth."""
     from swarmnav.models.scenario import load_scenario
     from swarmnav.sim.episode import EpisodeSpec, run_episode
-    from swarmnav.sim.log.reader import read_log
-    from swarmnav.sim.log.writer import McapRecorder
+    from swarmnav.log.reader import read_log
+    from swarmnav.log.writer import McapRecorder
     scenario = load_scenario("gwo-scenario-1").with_knowledge(pose_source="odometry")
     result = run_episode(EpisodeSpec(scenario), [McapRecorder(tmp_path / "odo.mcap", log_format="ros2")],
                          time_limit_s=4.0).result
@@ -160,7 +160,7 @@ def test_with_the_map_unknown_map_is_the_sensed_grid_as_nav_msgs_occupancy_grid(
     from mcap_protobuf.decoder import DecoderFactory
     from swarmnav.models.scenario import load_scenario
     from swarmnav.sim.episode import EpisodeSpec, run_episode
-    from swarmnav.sim.log.writer import McapRecorder
+    from swarmnav.log.writer import McapRecorder
     scenario = load_scenario("gwo-scenario-1").with_knowledge("unknown")
     for log_format in ("ros2", "swarmnav"):
         run_episode(EpisodeSpec(scenario, navigator="replan"),
@@ -179,8 +179,8 @@ def test_with_the_map_unknown_map_is_the_sensed_grid_as_nav_msgs_occupancy_grid(
 
 def test_bad_log_format_is_refused_by_run_study_and_env(capsys):
     from swarmnav.models.errors import ConfigError
-    from swarmnav.sim.cli.main import main
-    from swarmnav.sim.env.task import EnvOptions
+    from swarmnav.cli.main import main
+    from swarmnav.env.task import EnvOptions
     for argv in (["run", "gwo-scenario-2", "--log-format", "rosbag"], ["study", "x", "--logs", "--log-format", "bag"]):
         with pytest.raises(SystemExit) as exit_info:
             main(argv)
@@ -191,9 +191,9 @@ def test_bad_log_format_is_refused_by_run_study_and_env(capsys):
 
 
 def test_study_logs_and_the_env_recorder_write_the_ros2_profile_and_replay_renders_it(tmp_path):
-    from swarmnav.sim.cli.main import main
-    from swarmnav.sim.env.gym_adapter import NavigateEnv
-    from swarmnav.sim.log.summary import read_summary
+    from swarmnav.cli.main import main
+    from swarmnav.env.gym_adapter import NavigateEnv
+    from swarmnav.log.summary import read_summary
     study = tmp_path / "logged.toml"
     study.write_text('name = "logged"\nscenarios = ["restaurant-table-2"]\nmode = "physics"\ntime_limit_s = 1.0\n'
                      'seeds = [0]\n[[planners]]\nname = "astar"\n')
@@ -219,8 +219,8 @@ def test_study_logs_and_the_env_recorder_write_the_ros2_profile_and_replay_rende
 
 
 def test_a_cut_ros2_log_is_read_and_recovered_as_ros2(ros2_run, tmp_path):
-    from swarmnav.sim.cli.main import main
-    from swarmnav.sim.log.reader import read_log
+    from swarmnav.cli.main import main
+    from swarmnav.log.reader import read_log
     path, outcome = ros2_run
     cut = tmp_path / "cut.mcap"
     cut.write_bytes(path.read_bytes()[: path.stat().st_size // 2])

@@ -4,8 +4,8 @@ import math
 
 import numpy as np
 
-from swarmnav.sim.log.format import dumps, scan_from_ranges, scan_list_from_ranges
-from swarmnav.sim.log.messages import controller_json, wheels_json
+from swarmnav.log.format import dumps, scan_from_ranges, scan_list_from_ranges
+from swarmnav.log.messages import controller_json, wheels_json
 
 
 def test_the_scan_list_is_scan_from_ranges_bit_for_bit():

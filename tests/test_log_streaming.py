@@ -15,10 +15,10 @@ from mcap.reader import make_reader
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.episode import EpisodeSpec, run_episode
-from swarmnav.sim.log.columns import Rows
-from swarmnav.sim.log.summary import from_records, read_summary
-from swarmnav.sim.log.writer import McapRecorder
-from swarmnav.sim.log.records import read_records
+from swarmnav.log.columns import Rows
+from swarmnav.log.summary import from_records, read_summary
+from swarmnav.log.writer import McapRecorder
+from swarmnav.log.records import read_records
 
 
 @pytest.fixture(scope="module")
@@ -65,7 +65,7 @@ def test_bench_log_measures_every_reader_of_the_log_it_writes():
     import subprocess
     import sys
 
-    out = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "bench", "log", "--duration", "2",
+    out = subprocess.run([sys.executable, "-m", "swarmnav.cli", "bench", "log", "--duration", "2",
                           "--no-video", "--json"], capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr
     figures = json.loads(out.stdout)

@@ -21,12 +21,12 @@ from mcap.reader import make_reader  # noqa: E402
 from mcap_protobuf.decoder import DecoderFactory  # noqa: E402
 
 from swarmnav.models.scenario import load_scenario  # noqa: E402
-from swarmnav.sim.cli.main import main  # noqa: E402
+from swarmnav.cli.main import main  # noqa: E402
 from swarmnav.sim.episode import EpisodeSpec, run_episode  # noqa: E402
-from swarmnav.sim.log.format import TOPICS  # noqa: E402
-from swarmnav.sim.log.reader import read_log  # noqa: E402
-from swarmnav.sim.log.writer import McapRecorder  # noqa: E402
-from swarmnav.sim.log.records import read_records  # noqa: E402
+from swarmnav.log.format import TOPICS  # noqa: E402
+from swarmnav.log.reader import read_log  # noqa: E402
+from swarmnav.log.writer import McapRecorder  # noqa: E402
+from swarmnav.log.records import read_records  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 SCENARIO = "gwo-scenario-2"  # moving obstacles and collisions: every channel has traffic
@@ -147,7 +147,7 @@ def test_same_seed_gives_identical_message_bytes(tmp_path):
 CRASHING_RUN = """
 import os, signal, sys
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.log.writer import McapRecorder
+from swarmnav.log.writer import McapRecorder
 from swarmnav.sim.episode import EpisodeSpec, run_episode
 
 class Crash(McapRecorder):
@@ -191,7 +191,7 @@ def test_sigkill_leaves_a_file_that_log_recover_completes(tmp_path, full_run, ca
 
 
 def test_replay_video_has_expected_frames_and_is_not_blank(tmp_path, full_run):
-    from swarmnav.sim.video.render import expected_frames
+    from swarmnav.video.render import expected_frames
     from video_files import read_video_frames, video_info
 
     path, _ = full_run
@@ -246,7 +246,7 @@ def test_plot_svg_names_everything_it_draws(tmp_path, full_run):
 def test_plot_title_wraps_so_it_is_never_clipped(full_run):
     import dataclasses
 
-    from swarmnav.sim.plot import TITLE_CHARS, figure_title
+    from swarmnav.log.plot import TITLE_CHARS, figure_title
 
     log = read_log(full_run[0])
     long_name = "a-scenario-with-a-very-long-name-" * 4
@@ -257,7 +257,7 @@ def test_plot_title_wraps_so_it_is_never_clipped(full_run):
 
 
 def test_plot_marks_time_along_moving_tracks_and_the_trajectory():
-    from swarmnav.sim.plot import _mark_step_s, decimated
+    from swarmnav.log.plot import _mark_step_s, decimated
 
     assert [_mark_step_s(d) for d in (4.0, 72.4, 3000.0)] == [0.5, 10.0, 300.0]
     picked = decimated(1_000_000, 4000)
@@ -367,7 +367,7 @@ def test_step_json_is_the_same_text_as_sorted_json_dumps():
     json.dumps(sort_keys=True), including edge values and non-finite ones."""
     import json
 
-    from swarmnav.sim.log.messages import controller_json, wheels_json
+    from swarmnav.log.messages import controller_json, wheels_json
 
     rng = np.random.default_rng(7)
     edge = [0.0, -0.0, 1e-300, -1e300, 5e-324, 0.1, 1 / 3, math.pi, 12.5, math.nan, math.inf, -math.inf]
@@ -437,7 +437,7 @@ def test_metadata_values_are_plain_strings_and_read_back_typed(full_run):
 @pytest.mark.parametrize("value", ["goal_reached", "true", "12", "null", '"quoted"', "", "a b", 3, 2.5, None,
                                    True, [1, 2], {"k": "v"}])
 def test_metadata_text_round_trips_every_value(value):
-    from swarmnav.sim.log.format import metadata_text, metadata_value
+    from swarmnav.log.format import metadata_text, metadata_value
 
     text = metadata_text(value)
     assert metadata_value(text) == value and type(metadata_value(text)) is type(value)
@@ -448,9 +448,9 @@ def test_metadata_text_round_trips_every_value(value):
 def test_events_of_older_logs_in_json_still_read():
     from mcap.records import Channel, Schema
 
-    from swarmnav.sim.log.format import LEGACY_EVENT_SCHEMA, dumps
-    from swarmnav.sim.log.reader import event_decoder
-    from swarmnav.sim.log.records import RawLog
+    from swarmnav.log.format import LEGACY_EVENT_SCHEMA, dumps
+    from swarmnav.log.reader import event_decoder
+    from swarmnav.log.records import RawLog
 
     raw = RawLog(path=Path("old.mcap"), schemas={1: Schema(id=1, name="swarmnav.Event", encoding="jsonschema",
                                                           data=dumps(LEGACY_EVENT_SCHEMA).encode())})

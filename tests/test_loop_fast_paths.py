@@ -16,7 +16,7 @@ import pytest
 from swarmnav.models.scenario import load_scenario
 from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
 from swarmnav.sim.episode import EpisodeSpec, run_episode
-from swarmnav.sim.runner import Simulation
+from swarmnav.sim.simulation import Simulation
 from swarmnav.sim.sensing import ranges_from_sensors
 
 
@@ -239,7 +239,7 @@ def test_skipping_the_sensing_model_for_a_navigator_that_never_reads_it_changes_
 
 
 def test_bench_sim_figures_are_rates_of_the_same_run_and_name_their_targets():
-    from swarmnav.sim.benchmarks.sim import benchmark_sim
+    from swarmnav.benchmarks.sim import benchmark_sim
 
     figures = benchmark_sim("dense-field-30", duration_s=1.0, repeats=1)
     assert figures["ratio"] == pytest.approx(figures["closed_loop_steps_per_s"] / figures["bare_steps_per_s"])

@@ -16,7 +16,7 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.scenario_generator import GeneratorOptions, generate
 from swarmnav.models.world import Pose2D
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode, static_problem
 
 ONLINE = ("replan", "dstar_replan", "dwa", "velocity_obstacle")
@@ -115,7 +115,7 @@ def test_safety_filter_stops_the_robot_before_an_obstacle_that_drives_straight_a
 
 @pytest.mark.parametrize("navigator", ["replan", "dstar_replan"])
 def test_same_scenario_seeds_and_navigator_give_the_same_trajectory_and_log_bytes(tmp_path, navigator):
-    from swarmnav.sim.log.writer import McapRecorder
+    from swarmnav.log.writer import McapRecorder
     scenario = parse_scenario(short_case("crossing"))
     logs, poses = [], []
     for k in range(2):
@@ -196,7 +196,7 @@ def navigator_messages(path):
 def test_navigator_channel_draws_what_the_detector_reported_beside_the_true_obstacles(tmp_path):
     """With the exact ``detector`` model the believed centres are the true ones at every logged step;
     the update after the last sensed step only deletes; ``follow`` (which ignores sensing) writes none."""
-    from swarmnav.sim.log.writer import McapRecorder
+    from swarmnav.log.writer import McapRecorder
     scenario = parse_scenario(short_case("head_on", "detector"))
     logs = {}
     for nav in ("dwa", "follow"):
@@ -220,7 +220,7 @@ def test_navigator_channel_draws_what_the_detector_reported_beside_the_true_obst
 
 @pytest.mark.parametrize("navigator", ["replan", "dwa"])
 def test_replay_verify_reproduces_a_navigator_run_bit_for_bit(tmp_path, navigator, capsys):
-    from swarmnav.sim.log.writer import McapRecorder
+    from swarmnav.log.writer import McapRecorder
     log = tmp_path / f"{navigator}.mcap"
     run_episode(EpisodeSpec(parse_scenario(short_case("crossing")), navigator=navigator), [McapRecorder(log)])
     assert navigator_messages(log)["/navigator"]  # the run sensed the obstacle and logged its belief

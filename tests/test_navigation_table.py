@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from swarmnav.sim.benchmarks import navigation_table
-from swarmnav.sim.benchmarks.navigation_table import RESULT, RESULTS, block, current_block, read_rows, replace_block
+from swarmnav.benchmarks import navigation_table
+from swarmnav.benchmarks.navigation_table import RESULT, RESULTS, block, current_block, read_rows, replace_block
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -30,7 +30,7 @@ def test_the_headline_table_is_the_one_generated_from_the_committed_dyn300_resul
 
 
 def test_the_committed_dyn_result_runs_every_bundled_dyn_scene_for_every_default_navigator():
-    from swarmnav.sim.benchmarks.navigation import default_navigators
+    from swarmnav.benchmarks.navigation import default_navigators
     rows = read_rows(RESULTS[1])
     assert [r["navigator"] for r in rows] == [n for n in default_navigators() if n != "oracle"] + ["oracle"]
     bundled = len(list((REPO / "models" / "scenarios").glob("dyn-*.toml")))
@@ -38,7 +38,7 @@ def test_the_committed_dyn_result_runs_every_bundled_dyn_scene_for_every_default
 
 
 def test_the_committed_result_is_a_dyn300_run_of_every_default_navigator_beside_the_oracle():
-    from swarmnav.sim.benchmarks.navigation import default_navigators
+    from swarmnav.benchmarks.navigation import default_navigators
     rows = read_rows(RESULT)
     names = [r["navigator"] for r in rows if not r.get("arm_of")]     # arms: rows of their own labels beside
     assert names == [n for n in default_navigators() if n != "oracle"] + ["oracle"]
@@ -69,8 +69,8 @@ def test_the_table_follows_the_rows_and_a_bad_file_is_named(tmp_path, capsys):
 
 
 def test_per_group_writes_that_many_scenes_of_each_group_and_needs_a_generated_suite(tmp_path, capsys):
-    from swarmnav.sim.benchmarks.navigation import write_suite
-    from swarmnav.sim.cli.main import main
+    from swarmnav.benchmarks.navigation import write_suite
+    from swarmnav.cli.main import main
     paths, suite = write_suite("dyn300", False, None, str(tmp_path), per_group=3)
     groups = list(dict.fromkeys(s.group for s in suite.scenes))
     names = [Path(p).stem for p in paths]
@@ -81,7 +81,7 @@ def test_per_group_writes_that_many_scenes_of_each_group_and_needs_a_generated_s
 
 
 def test_the_summary_under_a_table_is_computed_from_its_rows():
-    from swarmnav.sim.benchmarks.navigation_table import summary_lines, table_lines
+    from swarmnav.benchmarks.navigation_table import summary_lines, table_lines
     rows = [dict(r, sensor_model="detector") for r in read_rows(RESULT)]
     by_name = {r["navigator"]: r for r in rows}
     arm = dict(by_name["iaco_local"], navigator="iaco_local+evade", arm_of="iaco_local",
@@ -115,7 +115,7 @@ def test_the_committed_rangefinder_result_is_all_300_scenes_with_the_rangefinder
 
 
 def test_the_speed_sentence_follows_the_run_figures():
-    from swarmnav.sim.benchmarks.navigation_table import summary_lines
+    from swarmnav.benchmarks.navigation_table import summary_lines
     rows = [dict(r) for r in read_rows(RESULT)]
     speed = next(line for line in summary_lines(rows) if line.startswith("Speed"))
     slowest = min((r for r in rows if r.get("realtime_factor_cpu") is not None), key=lambda r: r["realtime_factor_cpu"])

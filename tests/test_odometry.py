@@ -11,7 +11,7 @@ from swarmnav.controllers.odometry import WheelOdometry
 from swarmnav.models.scenario import load_scenario
 from swarmnav.models.world import Pose2D
 from swarmnav.sim.episode import EpisodeSpec, run_episode
-from swarmnav.sim.log.writer import McapRecorder
+from swarmnav.log.writer import McapRecorder
 
 
 def test_equal_wheel_speeds_drive_straight_and_opposite_ones_turn_in_place():

@@ -4,7 +4,7 @@ it fails when either drifts from the other, or when a committed row is no longer
 import json
 
 from swarmnav.models.robots import ROBOTS
-from swarmnav.sim.benchmarks import odometry
+from swarmnav.benchmarks import odometry
 
 PAGE = odometry.PAGE
 

@@ -15,8 +15,8 @@ import pytest
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.planners.problem import scenario_problem
-from swarmnav.sim.cli import main as cli
-from swarmnav.sim.study.rows import PROGRESS, RUNS, read_table
+from swarmnav.cli import main as cli
+from swarmnav.study.rows import PROGRESS, RUNS, read_table
 
 STUDY = """
 name = "ompl export"

@@ -17,7 +17,7 @@ from swarmnav.planners.errors import NoPathFound, PlanningError
 from swarmnav.planners.problem import scenario_problem
 from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.planners.sampling_ompl import OMPL_PLANNERS
-from swarmnav.sim.cli import main as cli
+from swarmnav.cli import main as cli
 
 NAMES = [cls.name for cls in OMPL_PLANNERS]
 BUDGET = {"max_evaluations": 2000, "round_evaluations": 100}
@@ -58,7 +58,7 @@ def test_the_four_planners_are_registered():
 
 
 def test_importing_the_registry_does_not_import_ompl():
-    code = "import sys, swarmnav.planners.registry, swarmnav.sim.cli.main; print('ompl' in sys.modules)"
+    code = "import sys, swarmnav.planners.registry, swarmnav.cli.main; print('ompl' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"
 
@@ -86,7 +86,7 @@ def test_same_seed_same_path_after_other_plans_and_in_another_process(name):
     again = make_planner(name, BUDGET).plan(problem, np.random.default_rng(7))
     assert first.same_as(again)
     assert not np.array_equal(first.waypoints, other.waypoints)
-    args = [sys.executable, "-m", "swarmnav.sim.cli", "plan", "gwo-scenario-1", "--planner", name, "--seed", "7",
+    args = [sys.executable, "-m", "swarmnav.cli", "plan", "gwo-scenario-1", "--planner", name, "--seed", "7",
             "--json"] + [f"--set={k}={v}" for k, v in BUDGET.items()]
     fresh = json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)
     # the CLI plans with default_rng(--seed), in a process where OMPL has planned nothing before
@@ -128,7 +128,7 @@ def test_a_time_budget_stops_the_search():
 def test_plan_through_the_cli_prints_only_swarmnav_output():
     """``swarmnav plan SCENARIO --planner rrt_star --json``: OMPL's console and nanobind's exit-time
     messages stay out of stdout and stderr."""
-    proc = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "plan", "restaurant-table-5", "--planner",
+    proc = subprocess.run([sys.executable, "-m", "swarmnav.cli", "plan", "restaurant-table-5", "--planner",
                            "rrt_star", "--json", "--set", "max_evaluations=1500"], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr == ""

@@ -240,7 +240,7 @@ def test_paper_navigation_rows_are_study_rows_with_the_walks_events(tmp_path):
     its move events, and every contender's run is a row of the kept study folder."""
     import pandas as pd
 
-    from swarmnav.sim.benchmarks.paper_navigation import benchmark_paper_navigation
+    from swarmnav.benchmarks.paper_navigation import benchmark_paper_navigation
 
     rows = benchmark_paper_navigation(1, ("immas-dynamic-10x10",), str(tmp_path))
     runs = pd.read_parquet(tmp_path / "runs.parquet")

@@ -15,7 +15,7 @@ from swarmnav.models.scenario import list_scenarios, load_scenario
 from swarmnav.planners.registry import PLANNERS, make_planner, register
 from swarmnav.planners.errors import BudgetExceeded, NoPathFound, PlanningError
 from swarmnav.planners.problem import Planner, scenario_problem
-from swarmnav.sim.cli import main as cli
+from swarmnav.cli import main as cli
 
 SCENARIOS = list_scenarios()
 

@@ -14,10 +14,10 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from swarmnav.sim.cli.main import main
-from swarmnav.sim.study.claim_spec import Claim
-from swarmnav.sim.study.claims import CONTRADICTED, INCONCLUSIVE, REPRODUCES, a12, verdicts
-from swarmnav.sim.study.spec import list_studies, load_study
+from swarmnav.cli.main import main
+from swarmnav.study.claim_spec import Claim
+from swarmnav.study.claims import CONTRADICTED, INCONCLUSIVE, REPRODUCES, a12, verdicts
+from swarmnav.study.spec import list_studies, load_study
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -187,14 +187,14 @@ def test_figures_fit_the_page_and_tables_exist_as_csv_and_latex(shorter, tmp_pat
 
 
 def test_numbers_have_a_consistent_number_of_significant_digits():
-    from swarmnav.sim.study.tables import number, p_value
+    from swarmnav.study.tables import number, p_value
     assert [number(x) for x in (14.355, 14.2269, 1.885e-05, 0.0001571, 20966.3, 3, 0.0)] == \
         ["14.36", "14.23", "0.00001885", "0.0001571", "20966", "3", "0"]
     assert [p_value(p) for p in (0.36, 0.0123, 1.2e-17)] == ["0.36", "0.012", "1.2e-17"]
 
 
 def test_anytime_targets_count_every_run_and_the_quartiles_count_unstarted_runs_as_worst():
-    from swarmnav.sim.study.anytime import History, first_reached, fixed_target, quartiles
+    from swarmnav.study.anytime import History, first_reached, fixed_target, quartiles
     runs = [History(np.array([20.0, 11.0, 10.2]), np.array([10.0, 20.0, 40.0]), np.array([0.1, 0.2, 0.4]), False),
             History(np.array([30.0, 15.0]), np.array([10.0, 20.0]), np.array([0.1, 0.2]), False)]
     assert first_reached(runs[0].evaluations, runs[0].cost, 11.0) == 20.0
@@ -218,7 +218,7 @@ def test_progress_rows_carry_the_planners_wall_times(shorter):
 
 
 def test_identical_configurations_are_shown_once():
-    from swarmnav.sim.study.report_tables import merge_identical
+    from swarmnav.study.report_tables import merge_identical
     def rows(navigator, length):
         return [{"label": "gwo", "navigator_label": navigator, "seed": s, "world_seed": None, "outcome": "ok",
                  "plan_waypoints": "[[0, 0], [1, 1]]", "plan_length_m": length, "plan_time_s": s * 0.1 + len(navigator)}
@@ -229,7 +229,7 @@ def test_identical_configurations_are_shown_once():
 
 
 def test_the_readme_claims_table_is_the_one_generated_from_the_committed_verdicts(capsys):
-    from swarmnav.sim.study.readme_table import RESULTS_DIR, current_block
+    from swarmnav.study.readme_table import RESULTS_DIR, current_block
     committed = sorted(RESULTS_DIR.glob("*/claims.json"))
     assert main(["report", "--readme-table", str(RESULTS_DIR)]) == 0
     generated = capsys.readouterr().out.strip()
@@ -289,7 +289,7 @@ def test_physics_paths_show_the_driven_trajectory_from_logs_and_say_so_without(t
 
 
 def test_identical_lengths_up_to_rounding_have_no_spread_in_the_paper_table():
-    from swarmnav.sim.study.statistics import paper_table
+    from swarmnav.study.statistics import paper_table
     rows = [{"outcome": "ok", "success": True, "plan_length_m": x} for x in (31.7, 31.700000000000003, 31.7)]
     header, [line] = paper_table({"a": rows})
     assert line[header.index("mean - best (m)")] == 0.0 and line[header.index("std (m)")] == 0.0

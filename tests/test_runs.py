@@ -113,7 +113,7 @@ def test_the_episode_stepper_is_driven_by_anyone_and_refuses_steps_outside_its_e
     from swarmnav.controllers.controller import ControlCommand
     from swarmnav.controllers.kinematics import WheelSpeeds
     from swarmnav.sim.recording import RecorderGroup
-    from swarmnav.sim.runner import Simulation
+    from swarmnav.sim.simulation import Simulation
 
     simulation = Simulation(load_scenario("gwo-scenario-2"))
     stepper = simulation.stepper(time_limit_s=1.0)
@@ -140,7 +140,7 @@ def test_the_episode_stepper_is_driven_by_anyone_and_refuses_steps_outside_its_e
 def test_an_overridden_time_limit_between_control_periods_is_refused_by_the_stepper():
     """The stepper runs whole control periods: a limit that is not one is a ConfigError, never cut short."""
     from swarmnav.models.errors import ConfigError
-    from swarmnav.sim.runner import Simulation
+    from swarmnav.sim.simulation import Simulation
 
     simulation = Simulation(load_scenario("gwo-scenario-2"))
     with pytest.raises(ConfigError, match=r"0.051 s is not a whole number of control periods.*after 0.04 s"):

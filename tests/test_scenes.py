@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from swarmnav.models.scenario import list_scenarios, load_scenario
-from swarmnav.sim.runner import Simulation
+from swarmnav.sim.simulation import Simulation
 from swarmnav.sim.sensing import ranges_from_sensors
 from swarmnav.sim.scene import compile_scene
 

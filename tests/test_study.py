@@ -16,10 +16,10 @@ from scipy import stats
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.planners.errors import PlanningError
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
-from swarmnav.sim.study.grid import expand
-from swarmnav.sim.study.spec import list_studies, load_study
+from swarmnav.study.grid import expand
+from swarmnav.study.spec import list_studies, load_study
 
 TINY = """
 name = "tiny"
@@ -49,6 +49,15 @@ def tiny(tmp_path_factory):
     path = write(base, TINY.format(time_limit_s=TINY_TIME_LIMIT_S))
     assert main(["study", str(path), "--out", str(base / "out"), "--workers", "2", "--json"]) == 0
     return path, base / "out"
+
+
+@pytest.fixture(scope="module")
+def tiny_report(tiny, tmp_path_factory):
+    """The tiny study's report, written once for the tests that read it: (HTML path, Markdown text)."""
+    _, out = tiny
+    html = tmp_path_factory.mktemp("tiny-report") / "r.html"
+    assert main(["report", str(out), "--out", str(html)]) == 0
+    return html, html.with_suffix(".md").read_text()
 
 
 def test_tiny_study_rows_equal_the_same_episodes(tiny):
@@ -92,7 +101,7 @@ def test_resume_after_a_kill_runs_each_cell_once(tmp_path):
     path = write(tmp_path, 'name = "resume"\nscenarios = ["gwo-scenario-1"]\nseeds = 40\n'
                            '[[planners]]\nname = "gwo"\nparams = { population = 20, iterations = 40 }\n')
     out = tmp_path / "out"
-    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out), "--workers", "1",
+    command = [sys.executable, "-m", "swarmnav.cli", "study", str(path), "--out", str(out), "--workers", "1",
                "--json"]
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
@@ -139,7 +148,7 @@ def _markdown_table(text: str, first_header: str) -> list[list[str]]:
     return out
 
 
-def test_the_report_is_in_the_study_order_whatever_order_the_rows_finished_in(tiny, tmp_path):
+def test_the_report_is_in_the_study_order_whatever_order_the_rows_finished_in(tiny, tiny_report, tmp_path):
     """The same rows give the same report: written from the rows reversed, the Markdown is identical, and the
     scenarios and planners appear in the study file's order."""
     import shutil
@@ -154,22 +163,18 @@ def test_the_report_is_in_the_study_order_whatever_order_the_rows_finished_in(ti
     shutil.copy(out / "study.json", copy / "study.json")
     table = pq.read_table(out / "runs.parquet")
     pq.write_table(table.take(pa.array(range(table.num_rows - 1, -1, -1))), copy / "runs.parquet" / "part-0.parquet")
-    texts = []
-    for folder in (out, copy):
-        html = tmp_path / folder.name / "r.html"
-        assert main(["report", str(folder), "--out", str(html)]) == 0
-        texts.append(html.with_suffix(".md").read_text())
+    html = tmp_path / "copy-report" / "r.html"
+    assert main(["report", str(copy), "--out", str(html)]) == 0
+    texts = [tiny_report[1], html.with_suffix(".md").read_text()]
     assert texts[0] == texts[1]
     assert texts[0].index("## Scenario gwo-scenario-1") < texts[0].index("## Scenario restaurant-table-2")
     counts = texts[0].split("## Scenario gwo-scenario-1")[1]
     assert counts.index("| astar |") < counts.index("| gwo |")
 
 
-def test_report_tables_and_wilcoxon_agree_with_the_rows(tiny, tmp_path):
+def test_report_tables_and_wilcoxon_agree_with_the_rows(tiny, tiny_report):
     _, out = tiny
-    html = tmp_path / "r.html"
-    assert main(["report", str(out), "--out", str(html)]) == 0
-    text = (tmp_path / "r.md").read_text()
+    html, text = tiny_report
     assert "data:image/svg+xml;base64," in html.read_text() and "src='http" not in html.read_text()
     rows = pd.read_parquet(out / "runs.parquet")
     checked = 0
@@ -256,7 +261,7 @@ def test_studies_lists_every_bundled_study(capsys):
 
 
 def test_paper_values_are_flagged_where_impossible():
-    from swarmnav.sim.study.statistics import impossible
+    from swarmnav.study.statistics import impossible
     rows = [{"planner": "gwo", "outcome": "ok", "plan_length_m": 14.3, "straight_line_m": 14.142},
             {"planner": "optimal", "outcome": "ok", "plan_length_m": 14.2, "straight_line_m": 14.142}]
     assert "straight line" in impossible("plan_length_m", 14.0, rows)
@@ -317,7 +322,7 @@ def test_logs_keep_one_mcap_per_run_that_replays(tmp_path):
 
 
 def test_paired_seeds_run_the_kth_seed_with_the_kth_world_seed(tmp_path):
-    from swarmnav.sim.study.spec import parse_study
+    from swarmnav.study.spec import parse_study
     text = 'scenarios = ["gwo-scenario-2"]\nseeds = [3, 4, 5]\nworld_seeds = [7, 8, 9]\n{}[[planners]]\nname = "astar"\n'
     paired = expand(parse_study(text.format("paired_seeds = true\n")))
     crossed = expand(parse_study(text.format("")))
@@ -350,7 +355,7 @@ def test_the_progress_bar_appears_only_on_a_terminal(tmp_path, capsys):
     path = write(tmp_path, PLAN_ONLY)
     assert main(["study", str(path), "--workers", "1", "--out", str(tmp_path / "piped")]) == 0
     assert capsys.readouterr().err == ""  # stderr is not a terminal here
-    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--workers", "1"]
+    command = [sys.executable, "-m", "swarmnav.cli", "study", str(path), "--workers", "1"]
     leader, follower = pty.openpty()
     try:
         on_terminal = subprocess.run(command + ["--out", str(tmp_path / "tty")], stdout=subprocess.PIPE,
@@ -374,8 +379,8 @@ def test_the_progress_bar_appears_only_on_a_terminal(tmp_path, capsys):
 
 def test_off_the_main_thread_the_wall_limit_is_checked_after_the_run():
     import threading
-    from swarmnav.sim.study.cell import run_cell
-    from swarmnav.sim.study.spec import parse_study
+    from swarmnav.study.cell import run_cell
+    from swarmnav.study.spec import parse_study
     cell = expand(parse_study(PLAN_ONLY.replace("seeds = 2\n", "seeds = 1\nwall_limit_s = 0.0001\n")))[0]
     result = {}
     thread = threading.Thread(target=lambda: result.update(row=run_cell(cell)[0]))
@@ -400,7 +405,7 @@ def test_an_unreachable_ray_address_is_one_line_naming_the_option(tmp_path):
     import socket
 
     from swarmnav.models.errors import ConfigError
-    from swarmnav.sim.study.ray_engine import check_reachable
+    from swarmnav.study.ray_engine import check_reachable
 
     with socket.socket() as listener:  # a port that surely refuses: bound, never listening
         listener.bind(("127.0.0.1", 0))
@@ -422,8 +427,8 @@ ABC_PLAN_ONLY = ('name = "abc-progress"\nscenarios = ["restaurant-table-2"]\nsee
 def test_progress_rows_are_the_planners_own_evaluation_history():
     """A study's progress rows for a cell equal the history the planner records for the same seed, and
     ABC's evaluations per iteration differ (scouts), so they are no even spread."""
-    from swarmnav.sim.study.cell import run_cell
-    from swarmnav.sim.study.spec import parse_study
+    from swarmnav.study.cell import run_cell
+    from swarmnav.study.spec import parse_study
     for cell in expand(parse_study(ABC_PLAN_ONLY)):
         row, progress = run_cell(cell)
         assert row["outcome"] == "ok", row.get("error")
@@ -440,8 +445,8 @@ def test_a_planner_without_an_evaluation_history_gets_an_even_spread_marked_esti
     import dataclasses
 
     from swarmnav.planners.problem import Path as PlannedPath
-    from swarmnav.sim.study.cell import _progress_rows
-    from swarmnav.sim.study.spec import parse_study
+    from swarmnav.study.cell import _progress_rows
+    from swarmnav.study.spec import parse_study
     cell = expand(parse_study(ABC_PLAN_ONLY))[0]
     episode = plan_episode(EpisodeSpec(load_scenario(cell.scenario), cell.planner, cell.planner_params,
                                        seed=cell.seed))
@@ -455,7 +460,7 @@ def test_a_planner_without_an_evaluation_history_gets_an_even_spread_marked_esti
 
 
 def test_the_convergence_curve_by_evaluations_is_the_recorded_step_function():
-    from swarmnav.sim.study.anytime import on_grid
+    from swarmnav.study.anytime import on_grid
     costs = on_grid(np.array([20, 61, 101, 150]), np.array([9.0, 7.0, 7.0, 4.0]),
                     np.array([0, 19, 20, 60, 61, 149, 150, 400]))
     assert np.isnan(costs[:2]).all()  # nothing was scored before the first population

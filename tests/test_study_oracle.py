@@ -14,10 +14,10 @@ import pytest
 
 from swarmnav.models.scenario_generator import GeneratorOptions, generate
 from swarmnav.sim import palette
-from swarmnav.sim.cli.main import main
-from swarmnav.sim.study.against_oracle import binned_success
-from swarmnav.sim.study.rows import RUN_SCHEMA, RUNS, load_runs, part_name
-from swarmnav.sim.study.yardstick import FILE, Yardstick
+from swarmnav.cli.main import main
+from swarmnav.study.against_oracle import binned_success
+from swarmnav.study.rows import RUN_SCHEMA, RUNS, load_runs, part_name
+from swarmnav.study.yardstick import FILE, Yardstick
 
 # Two scenes the oracle solves and one it cannot: the same kind of crossing with too little time to arrive.
 SCENES = {"cross": ("crossing", 1, {"obstacles": 2}), "headon": ("head_on", 2, {"obstacles": 1}),

@@ -55,7 +55,7 @@ def test_run_study_at_a_scripts_top_level_stops_at_once_with_one_line(tmp_path):
 def test_a_planner_registered_only_in_the_driver_ends_the_study_without_error_rows(tmp_path):
     done = _script(tmp_path, """
         import swarmnav
-        from swarmnav.sim.study.cell import ComponentMissing
+        from swarmnav.study.cell import ComponentMissing
 
         if __name__ == "__main__":
             from swarmnav.planners.straight import StraightPlanner

@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 
 from swarmnav.models.errors import ConfigError
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 
 pytest.importorskip("ray", reason="the ray extra is not installed (pip install 'swarmnav[ray]')")
 
@@ -89,7 +89,7 @@ def test_a_physics_study_on_two_nodes_keeps_every_log_under_out(cluster, tmp_pat
     path = tmp_path / "study.toml"
     path.write_text(STUDY)
     out = tmp_path / "out"
-    done = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out),
+    done = subprocess.run([sys.executable, "-m", "swarmnav.cli", "study", str(path), "--out", str(out),
                            "--engine", "ray", "--address", address, "--logs", "--json"],
                           env=ENVIRONMENT, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
@@ -105,8 +105,8 @@ def test_a_physics_study_on_two_nodes_keeps_every_log_under_out(cluster, tmp_pat
 
 
 def test_a_node_with_other_versions_fails_the_study_naming_it():
-    from swarmnav.sim.study.cell import _versions_json
-    from swarmnav.sim.study.ray_engine import _check_versions
+    from swarmnav.study.cell import _versions_json
+    from swarmnav.study.ray_engine import _check_versions
     driver = _versions_json()
     other = json.loads(driver)
     other["swarmnav"] = "0.0.1"

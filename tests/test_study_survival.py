@@ -14,11 +14,11 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from swarmnav.sim.cli.main import main
-from swarmnav.sim.study.execute import run_study
-from swarmnav.sim.study.grid import expand
-from swarmnav.sim.study.rows import RUNS, RowWriter, compact, read_table
-from swarmnav.sim.study.spec import Component, load_study, parse_study
+from swarmnav.cli.main import main
+from swarmnav.study.execute import run_study
+from swarmnav.study.grid import expand
+from swarmnav.study.rows import RUNS, RowWriter, compact, read_table
+from swarmnav.study.spec import Component, load_study, parse_study
 
 TESTS_DIR = str(Path(__file__).parent)
 PHYSICS = ('name = "{name}"\nscenarios = ["gwo-scenario-1", "restaurant-table-2"]\nmode = "physics"\n'
@@ -67,7 +67,7 @@ def test_a_worker_killed_from_outside_is_one_error_row_and_the_study_finishes(tm
     path = tmp_path / "study.toml"
     path.write_text(PHYSICS.format(name="killed", limit=3.0, seeds=4))
     out = tmp_path / "out"
-    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out), "--workers", "2"]
+    command = [sys.executable, "-m", "swarmnav.cli", "study", str(path), "--out", str(out), "--workers", "2"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
     while not parts(out) and time.monotonic() < deadline:  # a first row: the workers are running cells
@@ -89,7 +89,7 @@ def test_a_second_study_into_a_folder_in_use_exits_2_naming_it_and_the_holder(tm
     path = tmp_path / "study.toml"
     path.write_text(PHYSICS.format(name="locked", limit=2.0, seeds=3))
     out = tmp_path / "out"
-    command = [sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out), "--workers", "1",
+    command = [sys.executable, "-m", "swarmnav.cli", "study", str(path), "--out", str(out), "--workers", "1",
                "--json"]
     first = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60
@@ -112,7 +112,7 @@ def test_the_lock_of_a_killed_study_is_released(tmp_path):
     path = tmp_path / "study.toml"
     path.write_text(PHYSICS.format(name="killed-holder", limit=2.0, seeds=3))
     out = tmp_path / "out"
-    holder = subprocess.Popen([sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out),
+    holder = subprocess.Popen([sys.executable, "-m", "swarmnav.cli", "study", str(path), "--out", str(out),
                                "--workers", "1"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
     while not (out / ".lock").exists() or not (out / ".lock").read_text().strip():
@@ -200,7 +200,7 @@ def test_compaction_keeps_each_cell_once_the_last_written(tmp_path):
 def test_cliffs_delta_counts_every_pair_with_ties():
     import numpy as np
 
-    from swarmnav.sim.study.statistics import cliffs_delta
+    from swarmnav.study.statistics import cliffs_delta
     rng = np.random.default_rng(7)
     for n, m in ((1, 1), (5, 9), (40, 33)):
         a, b = rng.integers(0, 6, n).astype(float), rng.integers(0, 6, m).astype(float)  # many ties
@@ -213,7 +213,7 @@ def test_a_batch_sent_to_a_worker_that_just_died_stays_queued_for_the_next_worke
     worker's queue, where the death handling finds it, instead of ending the study with BrokenPipeError."""
     import multiprocessing
 
-    from swarmnav.sim.study.engines import _LocalWorker
+    from swarmnav.study.engines import _LocalWorker
     study = parse_study(PHYSICS.format(name="late", limit=2.0, seeds=1))
     cells = list(expand(study))[:2]
     worker = _LocalWorker(multiprocessing.get_context("spawn"), None)

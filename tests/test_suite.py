@@ -6,7 +6,7 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.scenario_generator import GeneratorOptions, generate
 from swarmnav.models.suites import load_suite, stratified_sample
-from swarmnav.sim.benchmarks.navigation import ORACLE, benchmark_navigation
+from swarmnav.benchmarks.navigation import ORACLE, benchmark_navigation
 
 
 def test_dyn300_has_300_distinct_scenes_each_with_a_shipped_verdict_in_order_of_difficulty():
@@ -69,7 +69,7 @@ def test_bench_rows_read_each_run_against_the_oracle_verdict(tmp_path):
         assert row["realtime_factor_cpu"] > 0                   # simulated over the runs' own CPU time
     search = oracle["oracle_search"]                            # the speed lines' figures: timed, not asserted
     assert search["scenes"] == 1 and search["max_s"] == search["median_s"] > 0 and search["max_cpu_s"] > 0
-    from swarmnav.sim.benchmarks.navigation_speed import speed_lines
+    from swarmnav.benchmarks.navigation_speed import speed_lines
     lines = speed_lines(rows, search, None)
     assert lines[0].startswith("oracle search: median") and "1 scenes" in lines[0]
     assert any(line.startswith("real-time factor: follow") for line in lines)
@@ -77,7 +77,7 @@ def test_bench_rows_read_each_run_against_the_oracle_verdict(tmp_path):
 
 
 def test_the_mppi_speed_line_times_an_optimisation_at_every_control_step():
-    from swarmnav.sim.benchmarks.navigation_speed import mppi_step_cost
+    from swarmnav.benchmarks.navigation_speed import mppi_step_cost
     cost = mppi_step_cost(("dyn-crossing-3",), sim_s=1.0)
     assert (cost["samples"], cost["horizon_steps"]) == (1000, 30)
     assert cost["steps"] == 50 or cost["steps"] == 51            # 1 s at 50 Hz, every step timed
@@ -89,7 +89,7 @@ def test_arms_are_rows_under_their_own_labels_and_extend_a_kept_benchmark(tmp_pa
     with the same (default) parameters under another label drives the same runs; a later run into the same
     folder with one more arm runs only that arm's cells (the study resumes)."""
     import pyarrow.parquet as pq
-    from swarmnav.sim.benchmarks.navigation import parse_arm
+    from swarmnav.benchmarks.navigation import parse_arm
     path = tmp_path / "short.toml"
     path.write_text(generate("crossing", 5, GeneratorOptions(obstacles=2, arena_m=5.0, sensor_model="detector")))
     out = tmp_path / "out"
@@ -118,7 +118,7 @@ def test_arms_are_rows_under_their_own_labels_and_extend_a_kept_benchmark(tmp_pa
     ("a:velocity_obstacle:margin_m=[1,2]", "--arm a: navigator.params.margin_m: expected a number"),
 ])
 def test_bad_arms_are_one_line_and_exit_2(arm, message, capsys):
-    from swarmnav.sim.cli.main import main
+    from swarmnav.cli.main import main
     assert main(["bench", "navigation", "--quick", "--navigator", "follow", "--arm", arm]) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
@@ -141,14 +141,14 @@ def test_a_seed_offset_gives_held_out_scenes_of_the_same_groups():
 
 
 def test_a_seed_offset_without_a_generated_suite_is_one_line_and_exit_2(capsys):
-    from swarmnav.sim.cli.main import main
+    from swarmnav.cli.main import main
     assert main(["bench", "navigation", "--quick", "--seed-offset", "5"]) == 2
     err = capsys.readouterr().err.strip()
     assert "--seed-offset" in err and len(err.splitlines()) == 1
 
 
 def test_an_arms_settings_split_at_keys_only():
-    from swarmnav.sim.benchmarks.navigation import parse_arm
+    from swarmnav.benchmarks.navigation import parse_arm
     arm = parse_arm("drive:immas_stepwise:evade=true, lookahead_cells=6,predict_s=1")
     assert arm.params == {"evade": True, "lookahead_cells": 6, "predict_s": 1}
     assert parse_arm("plain:follow:").params == {}
@@ -157,7 +157,7 @@ def test_an_arms_settings_split_at_keys_only():
 def test_bench_navigation_map_and_pose_reach_every_run_and_row(tmp_path, capsys):
     import json
 
-    from swarmnav.sim.cli.main import main
+    from swarmnav.cli.main import main
     path = tmp_path / "short.toml"
     text = generate("crossing", 5, GeneratorOptions(obstacles=2, arena_m=5.0))
     path.write_text(text.replace("time_limit_s = 65", "time_limit_s = 4"))

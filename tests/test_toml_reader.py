@@ -21,8 +21,8 @@ from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.suites import load_suite
 from swarmnav.models.toml_table import TomlTable, parse_toml, within
 from swarmnav.planners.registry import make_planner
-from swarmnav.sim.cli.main import main
-from swarmnav.sim.study.spec import parse_study
+from swarmnav.cli.main import main
+from swarmnav.study.spec import parse_study
 
 SCENARIO = {
     "name": "reader", "seed": 1, "time_limit_s": 30.0,

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from swarmnav.models.scenario import parse_scenario
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 from swarmnav.sim.episode import EpisodeSpec, run_episode
-from swarmnav.sim.log.records import LogError, read_records
-from swarmnav.sim.log.writer import McapRecorder
+from swarmnav.log.records import LogError, read_records
+from swarmnav.log.writer import McapRecorder
 from probe_scenario import PROBE_SCENARIO
 
 

@@ -45,7 +45,7 @@ def marker(tmp_path, monkeypatch):
 
 
 def swarmnav(*args):
-    return subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", *args], capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "swarmnav.cli", *args], capture_output=True, text=True,
                           timeout=300)
 
 

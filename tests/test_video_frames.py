@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 from swarmnav.models.scenario import load_scenario  # noqa: E402
-from swarmnav.sim.video.caption import FrameCaption, run_title  # noqa: E402
+from swarmnav.video.caption import FrameCaption, run_title  # noqa: E402
 from swarmnav.sim.scene import compile_scene  # noqa: E402
 
 WIDTH, HEIGHT = 320, 240
@@ -22,7 +22,7 @@ WIDTH, HEIGHT = 320, 240
 def _frame(camera: str, xy_m=(5.0, 5.0), yaw_rad: float = 0.0, scenario: str = "gwo-scenario-2") -> np.ndarray:
     import mujoco
 
-    from swarmnav.sim.video.render import ScenePoser, SceneRenderer
+    from swarmnav.video.render import ScenePoser, SceneRenderer
 
     loaded = load_scenario(scenario)
     model = mujoco.MjModel.from_xml_string(compile_scene(loaded).xml)
@@ -72,7 +72,7 @@ def test_obstacles_take_the_shared_palette():
     import mujoco
 
     from swarmnav.sim import palette
-    from swarmnav.sim.video.render import paint_obstacles
+    from swarmnav.video.render import paint_obstacles
 
     model = mujoco.MjModel.from_xml_string(compile_scene(load_scenario("gwo-scenario-2")).xml)
     paint_obstacles(model)

@@ -16,7 +16,7 @@ import pytest
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.world_scenario import ImportSettings, import_world
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 
 BARN = Path(os.environ.get("SWARMNAV_BARN_DIR", Path(__file__).resolve().parents[2] / "shared/benchmarks/barn"))
 needs_barn = pytest.mark.skipif(not (BARN / "worlds").is_dir(), reason="the BARN data (../shared) is not here")

@@ -57,6 +57,15 @@ path, which hugs the marked cells, leads along or ahead of it; when the robot st
 path (the controller turns on the spot), the obstacle runs into it.  A grid of swept cells without time cannot
 say "step aside now"; the evasion does.  ``evade = false`` gives the earlier behaviour.
 
+**A box chassis** (ours; all off by default, :mod:`controllers.footprint`): ``footprint = "box"`` blocks
+the cells by the robot's inscribed circle instead of its circumscribed one (a Jackal's 0.215 m instead of
+0.333 m, which closes BARN's 0.75 m passages), and checks every turn on the spot against the box (backing off,
+or turning the other way, when a corner would hit); ``cost_weight`` > 0 adds D* Lite cell penalties
+``cost_weight`` x (1 - d / ``cost_reach_m``)^2 near blocked cells, so that paths keep to the middle of
+passages (and string pulling never cuts nearer the obstacles than the cells); ``max_decel_m_s2`` > 0 caps the
+forward speed to stop before the path's next sharp turn and before the nearest mapped obstacle in the
+chassis' corridor ahead.  BARN's configuration: ``footprint=box, cost_weight=10, max_decel_m_s2=2`` (docs/barn.md).
+
 ``cell_m`` = 0 uses the scenario's ``sim.cell_m`` (a map scenario's own cells
 always).  The optional safety filter (``safety_filter``) is the same layer's.
 Planning wall time (``replan_wall_s``) counts the D* Lite repairs only.
@@ -76,6 +85,8 @@ from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.replan import keep_outside
 from swarmnav.controllers.prediction import swept_discs
+from swarmnav.controllers.footprint import (block_radius_m, braked, cell_penalty, chassis_box_m, chassis_extent_m,
+                                            free_ahead_m, guarded_turn, no_costlier)
 from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario_limits import MAX_GRID_CELLS
@@ -99,6 +110,11 @@ class DStarReplanNavigator:
         improvement_m: a new path replaces a still-free one only when shorter by more than this.
         update_period_s: the sweeps are marked (and D* Lite repaired) at most this often.
         planner: the planner of every path followed: ``"dstar_lite"`` (the only one; see the module docstring).
+        footprint: ``"circle"`` (cells blocked by the robot radius) or ``"box"`` (by the chassis' inscribed
+            circle, turns on the spot checked against the box).
+        cost_weight: D* Lite's penalty on cells beside blocked ones (0: none).
+        cost_reach_m: how far from a blocked cell the penalty reaches.
+        max_decel_m_s2: the braking the forward speed is capped by (0: no cap).
     """
 
     name: ClassVar[str] = "dstar_replan"
@@ -113,10 +129,15 @@ class DStarReplanNavigator:
     improvement_m: float = param(0.5, within(0, 1e6))
     update_period_s: float = param(0.2, within(0, 1e6))
     planner: str = param("dstar_lite", choices=("dstar_lite",))  # it repairs D* Lite's own paths
+    footprint: str = param("circle", choices=("circle", "box"))
+    cost_weight: float = param(0.0, within(0, 1000))
+    cost_reach_m: float = param(0.3, above(0, 100))
+    max_decel_m_s2: float = param(0.0, within(0, 1000))
 
     def reset(self, setup: NavigationSetup) -> None:
         known = setup.map_problem
         self.known = known
+        self.block_m = known.inflation_m if self.footprint == "circle" else block_radius_m(setup) + known.clearance_m
         self.setup = setup
         self.map_revision = setup.map_revision
         self.controller = setup.controller
@@ -129,17 +150,22 @@ class DStarReplanNavigator:
                 raise ConfigError("navigator.params.cell_m" if self.cell_m else "sim.cell_m",
                                   f"{cell_m:g} m cells over the {known.bounds.width_m:g} x {known.bounds.height_m:g} m "
                                   f"arena are {cells:.3g} grid cells, at most {MAX_GRID_CELLS:,} (MAX_GRID_CELLS)")
-            self.grid = rasterise(known.bounds, known.obstacles, known.boxes, known.inflation_m, cell_m)
+            self.grid = rasterise(known.bounds, known.obstacles, known.boxes, self.block_m, cell_m)
         self.static = np.asarray(self.grid.occupied, dtype=bool)
         self.current = self.static.copy()
-        self.inflation_m = known.inflation_m + self.margin_m
+        self.inflation_m = self.block_m + self.margin_m
         # Sweeps are kept this far from the robot and the goal, so their cells stay free.
         self.room_m = self.inflation_m + 1.5 * self.grid.cell_m
         self.goal_xy = (setup.goal.x_m, setup.goal.y_m)
         self.goal_cell = self.grid.cell_of(*self.goal_xy)
         start = self._free_cell_near(setup.problem.start.x_m, setup.problem.start.y_m)
-        self.dstar = DStarLite(self.static, start if start != NO_CELL else self.goal_cell, self.goal_cell)
+        self.penalty = cell_penalty(self.current, self.grid.cell_m, self.cost_weight, self.cost_reach_m)
+        self.dstar = DStarLite(self.static, start if start != NO_CELL else self.goal_cell, self.goal_cell,
+                               penalty=self.penalty)
         self.cells: list[Cell] = []
+        self.waypoints: list[tuple[float, float]] = []
+        self.front_m, self.half_width_m = chassis_extent_m(setup)
+        self.box_m, self.turn_sign = chassis_box_m(setup), 0.0
         self.at = 0  # index of the robot's cell in self.cells
         self.adopted = False  # a path has been adopted at least once
         self.blocked_spell = False
@@ -180,6 +206,12 @@ class DStarReplanNavigator:
                     events.append(("replan", {"reason": reason, "tracks": [d.track_id for d in observation.detections],
                                               "length_m": round(new_path.stats.length_m, 6)}))
         command = self.controller.command(pose, observation.twist)
+        if self.max_decel_m_s2 > 0:
+            ahead_m = free_ahead_m(self.known, pose, self.front_m, self.half_width_m)
+            command = braked(command, pose, self.controller, self.waypoints, self.max_decel_m_s2, ahead_m)
+        if self.footprint == "box":
+            command, self.turn_sign = guarded_turn(command, pose, self.controller, self.known, self.box_m,
+                                                   self.turn_sign)
         return self._finish(observation, command, events, new_path)
 
     # -- cells ---------------------------------------------------------------
@@ -199,6 +231,9 @@ class DStarReplanNavigator:
             return False
         self.current = occupied
         self.dstar.update_cells({(int(r), int(c)): bool(occupied[r, c]) for r, c in flips})
+        if self.cost_weight > 0:
+            self.penalty = cell_penalty(occupied, self.grid.cell_m, self.cost_weight, self.cost_reach_m)
+            self.dstar.update_penalty(self.penalty)
         return True
 
     def _map_cells(self) -> np.ndarray:
@@ -207,7 +242,7 @@ class DStarReplanNavigator:
         if self.setup.map_revision != self.map_revision:
             self.map_revision = self.setup.map_revision
             known = self.known = self.setup.map_problem
-            cells = rasterise(known.bounds, known.obstacles, known.boxes, known.inflation_m, self.grid.cell_m).occupied
+            cells = rasterise(known.bounds, known.obstacles, known.boxes, self.block_m, self.grid.cell_m).occupied
             if cells.shape == self.static.shape:
                 self.static = cells
         return self.static
@@ -260,7 +295,7 @@ class DStarReplanNavigator:
         if self.setup.world_map is not None and any(self.static[r, c] for r, c in rest):
             return "blocked on the sensed map"
         # Blocked: a sweep grown by the bare inflation (without margin_m) covers a cell still to come.
-        marks = self._rasterise(self.known.inflation_m)
+        marks = self._rasterise(self.block_m)
         if marks is not None and any(marks[r, c] for r, c in rest):
             return "sensed obstacle on the path"
         if _cells_length(rest) - _cells_length(cells) > self.improvement_m / self.grid.cell_m:
@@ -274,6 +309,7 @@ class DStarReplanNavigator:
         middle = self.grid.centres_m(np.array(corners[1:-1])).reshape(-1, 2)
         waypoints = np.vstack([[pose.x_m, pose.y_m], middle, [self.goal_xy]])
         path = Path.from_waypoints(waypoints, 0.0)
+        self.waypoints = [(float(x), float(y)) for x, y in waypoints]
         self.controller.reset(path)
         return path
 
@@ -287,21 +323,23 @@ class DStarReplanNavigator:
         while anchor < len(cells) - 1:
             nxt = anchor + 1
             while nxt + 1 < len(cells) and grid_line_of_sight(free, cells[anchor], cells[nxt + 1]) \
-                    and self._clear_of_map(centres[anchor], centres[nxt + 1]):
+                    and self._clear_of_map(centres[anchor], centres[nxt + 1]) \
+                    and no_costlier(self.penalty, self.grid, centres[anchor], centres[nxt + 1], cells[anchor:nxt + 2]):
                 nxt += 1
             out.append(cells[nxt])
             anchor = nxt
         return out
 
     def _clear_of_map(self, a_m: np.ndarray, b_m: np.ndarray) -> bool:
-        """Whether the segment keeps the inflation (robot radius + clearance) from every known disc and box."""
+        """Whether the segment keeps the blocking inflation (robot radius, or the inscribed radius with
+        ``footprint = "box"``, + clearance) from every known disc and box."""
         a, b = a_m.reshape(1, 2), b_m.reshape(1, 2)
         known = self.known
         if len(known.disc_centres_m) and np.any(segment_disc_distances(a, b, known.disc_centres_m)[0]
-                                               < known.disc_radii_m + known.inflation_m - 1e-9):
+                                               < known.disc_radii_m + self.block_m - 1e-9):
             return False
         boxes = known.box_array_m
-        return not (len(boxes) and np.any(segment_box_distances(a, b, boxes)[0] < known.inflation_m - 1e-9))
+        return not (len(boxes) and np.any(segment_box_distances(a, b, boxes)[0] < self.block_m - 1e-9))
 
     def _stop(self, events: list, why: str) -> ControlCommand:
         if not self.blocked_spell:

@@ -3,7 +3,7 @@
 ``--navigator policy --navigator-set policy=mypkg.agent:act`` calls ``act`` with
 the observation dict the environment gives (:mod:`controllers.policy_interface`)
 every control step and turns its (2,) action into wheel speeds the same way, so
-a policy trained in ``swarmnav.sim.env`` runs here unchanged.
+a policy trained in ``swarmnav.env`` runs here unchanged.
 
 Loading the callable: ``pkgutil.resolve_name`` (the standard library's
 ``module:attribute`` resolver) imports the user's module.  This is the one place

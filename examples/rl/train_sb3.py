@@ -30,7 +30,7 @@ from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
 
 from swarmnav.controllers.observation_normaliser import ObservationNormaliser
-from swarmnav.sim.env import NavigateEnv, RewardWeights
+from swarmnav.env import NavigateEnv, RewardWeights
 
 REWARD = RewardWeights(collision_penalty=1.0, smoothness=0.05)
 

@@ -9,7 +9,8 @@ For example:
 
 Importing ``swarmnav`` is light: MuJoCo, SciPy and the planners load on first use.  The names below are
 the public surface; everything else is reachable through ``swarmnav.models``, ``swarmnav.planners``,
-``swarmnav.controllers`` and ``swarmnav.sim``.
+``swarmnav.controllers``, ``swarmnav.sim`` (the physics runtime) and what stands on it: ``swarmnav.video``,
+``swarmnav.log``, ``swarmnav.study``, ``swarmnav.env``.
 """
 
 from __future__ import annotations

@@ -19,7 +19,7 @@ if TYPE_CHECKING:
 
     from swarmnav.models.scenario import Scenario
     from swarmnav.sim.episode import EpisodeSpec
-    from swarmnav.sim.study.spec import Study
+    from swarmnav.study.spec import Study
 
 ComponentClass = TypeVar("ComponentClass", bound=type)
 
@@ -157,7 +157,7 @@ def run_spec(spec: Any, *, waypoints: "Sequence[Sequence[float]] | np.ndarray | 
     recorders: list[Any] = []
     log_path = None
     if log:
-        from swarmnav.sim.log.writer import McapRecorder, default_log_path
+        from swarmnav.log.writer import McapRecorder, default_log_path
         log_path = FilePath(log) if log is not True else default_log_path(
             planned.spec.scenario.name, planned.spec.planner, planned.spec.seed, time.strftime("%Y%m%d-%H%M%S"))
         if log_path.is_dir():
@@ -169,7 +169,7 @@ def run_spec(spec: Any, *, waypoints: "Sequence[Sequence[float]] | np.ndarray | 
         raise ConfigError("--live", "needs the log (drop --no-log)")
     if video:
         from swarmnav.sim.defaults import DEFAULT_FPS
-        from swarmnav.sim.video.render import VideoRecorder
+        from swarmnav.video.render import VideoRecorder
         recorders.append(VideoRecorder(str(video), camera=camera, width=width, height=height,
                                        fps=DEFAULT_FPS if fps is None else fps))
     episode = run_episode(planned, recorders, stop_on_collision=stop_on_collision)
@@ -184,8 +184,8 @@ def run_study(file_or_spec: str | os.PathLike[str] | Mapping[str, Any] | Study,
     (default ``studies/<name>``); a folder that holds some of its rows resumes.  Returns the summary that
     ``swarmnav study --json`` prints."""
     from swarmnav.sim.plugins import load_plugins
-    from swarmnav.sim.study.execute import run_study as execute
-    from swarmnav.sim.study.spec import Study, load_study, study_from_tables
+    from swarmnav.study.execute import run_study as execute
+    from swarmnav.study.spec import Study, load_study, study_from_tables
     load_plugins()
     if isinstance(file_or_spec, Study):
         study = file_or_spec

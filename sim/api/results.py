@@ -54,7 +54,7 @@ class PlanResult:
 
 class RunOutcome(PlanResult):
     """A driven episode: ``outcome`` (``goal_reached``, ``collision``, ``timeout``, ``left_arena``), ``reached``,
-    ``success`` (reached with no collision, inside the arena), ``result`` (the full :class:`swarmnav.sim.runner.RunResult` with its arrays),
+    ``success`` (reached with no collision, inside the arena), ``result`` (the full :class:`swarmnav.sim.simulation.RunResult` with its arrays),
     ``log`` and ``video`` paths; ``to_dict()`` is what ``swarmnav run --json`` prints."""
 
     def __init__(self, episode: Episode, log: str | None = None, video: str | None = None):

@@ -32,6 +32,7 @@ mean over every run (failures count 0), beside ``success_rate``, ``collision_rat
 
 from __future__ import annotations
 
+import functools
 import os
 from dataclasses import dataclass
 from pathlib import Path as FilePath
@@ -165,14 +166,22 @@ class BarnRun:
 
 def world_source(world: int, generated: bool, barn: str | None = None):
     """A world's obstacles (:class:`models.gazebo_world.GazeboWorld`) and reference path cells: BARN's world
-    ``world`` from the data, or the BARN-like world of seed ``world`` (:mod:`sim.benchmarks.barn_like`)."""
+    ``world`` from the data, or the BARN-like world of seed ``world`` (:mod:`swarmnav.benchmarks.barn_like`).
+    Each is read (or generated) once per process (the suite's files and its difficulty metrics share it)."""
+    return _world_source(world, generated, None if generated else str(barn_dir(barn)))
+
+
+@functools.lru_cache(maxsize=None)
+def _world_source(world: int, generated: bool, folder: str | None):
     if generated:
-        from swarmnav.sim.benchmarks.barn_like import generate
+        from swarmnav.benchmarks.barn_like import generate
         parsed, cells, _ = generate(world)
-        return parsed, cells
-    from swarmnav.models.gazebo_world import read_world
-    folder = barn_dir(barn)
-    return read_world(folder / "worlds" / f"world_{world}.world.gz"), reference_cells(folder, world)
+    else:
+        from swarmnav.models.gazebo_world import read_world
+        parsed = read_world(FilePath(folder) / "worlds" / f"world_{world}.world.gz")
+        cells = reference_cells(FilePath(folder), world)
+    cells.setflags(write=False)
+    return parsed, cells
 
 
 MAX_GENERATED_SEED = 10**6
@@ -276,14 +285,17 @@ def write_barn_suite(folder: str, quick: bool, worlds: tuple[int, ...] | None = 
 
 
 def add_scores(table: list[dict[str, Any]], rows: list[dict[str, Any]], meta: dict[str, BarnRun], setup: str,
-               with_difficulty: bool = False, barn: str | None = None) -> None:
-    """BARN's columns on the benchmark's rows: ``barn_score`` (mean over the rows' runs), ``barn_setup``; a
+               with_difficulty: bool = False, barn: str | None = None,
+               params: dict[str, dict[str, Any]] | None = None) -> None:
+    """BARN's columns on the benchmark's rows: ``barn_score`` (mean over the rows' runs), ``barn_setup``,
+    ``navigator_params`` (the parameters the row's navigator was given, ``params`` by row label: a BARN
+    configuration such as ``dstar_replan``'s ``footprint=box``; {} for its defaults); a
     per-scenario row (one run) also gets ``world``, ``run``, ``reference_length_m``, ``optimal_time_s``,
     ``time_s`` (AT: the run's simulated time) and, ``with_difficulty``, the world's metrics
-    (:mod:`sim.benchmarks.barn_difficulty`) as ``difficulty``."""
+    (:mod:`swarmnav.benchmarks.barn_difficulty`) as ``difficulty``."""
     difficulty = None
     if with_difficulty:
-        from swarmnav.sim.benchmarks.barn_difficulty import world_metrics
+        from swarmnav.benchmarks.barn_difficulty import world_metrics
         difficulty = {}
         for world, generated in sorted({(m.world, m.generated) for m in meta.values()}):
             parsed, cells = world_source(world, generated, barn)
@@ -307,6 +319,7 @@ def add_scores(table: list[dict[str, Any]], rows: list[dict[str, Any]], meta: di
         # the plan against the reference path (a yardstick): its length over the reference's, collision-free plans
         row["mean_plan_over_reference"] = sum(planned) / len(planned) if planned else None
         row["barn_setup"] = setup
+        row["navigator_params"] = dict((params or {}).get(label, {}))
         if row["scenario"] is not None:
             run = meta[row["scenario"]]
             row.update(world=run.world, run=run.run, reference_length_m=run.reference_length_m,

@@ -2,7 +2,7 @@
 navigation --suite barn --by-scenario --json`` results (``models/suites/results/barn*.json``) beside the
 published figures.
 
-``python -m swarmnav.sim.benchmarks.barn_table [--readme FILE]`` prints the block (or replaces it between its
+``python -m swarmnav.benchmarks.barn_table [--readme FILE]`` prints the block (or replaces it between its
 markers in FILE: ``docs/barn.md``); ``make readme-table`` runs it; ``tests/test_barn_table.py`` fails when the
 page drifts from the JSON.  Every figure in the block is read from a result file or is a published one cited
 beside it.
@@ -21,7 +21,8 @@ from swarmnav.models.errors import ConfigError
 RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results"
 RESULTS = (RESULTS_DIR / "barn-test50.json", RESULTS_DIR / "barn-test10-dwa-vo.json", RESULTS_DIR / "barn.json",
            RESULTS_DIR / "barn-like.json", RESULTS_DIR / "barn-jackal-test10.json",
-           RESULTS_DIR / "barn-protocol-test10.json", RESULTS_DIR / "barn-protocol-test10-more.json")
+           RESULTS_DIR / "barn-protocol-test10.json", RESULTS_DIR / "barn-protocol-test10-more.json",
+           RESULTS_DIR / "barn-protocol-test50.json")
 TEST_50, ALL_300, FRESH = RESULTS[0], RESULTS[2], RESULTS[3]  # compared: BARN-like worlds against BARN's
 BEGIN = "<!-- barn-table: generated from models/suites/results/barn*.json by `make readme-table`; do not edit by hand -->"
 END = "<!-- end of barn-table -->"
@@ -64,6 +65,8 @@ def result_lines(path: FilePath, rows: list[dict[str, Any]]) -> list[str]:
              "|---|---:|---:|---:|---:|---:|---:|"]
     for r in overall:
         name = f"{r['navigator']} (clairvoyant yardstick)" if r["navigator"] == ORACLE else r["navigator"]
+        if r.get("navigator_params"):
+            name += " (" + ", ".join(f"{k}={v}" for k, v in r["navigator_params"].items()) + ")"
         lines.append(f"| {name} | {r['runs']} | {r['success_rate']:.3f} | {r['collision_rate']:.3f} | "
                      f"{r['timeout_rate']:.3f} | {_f(r['barn_score'], '.4f')} | {_f(r['mean_time_to_goal_s'], '.2f')} |")
     contenders = [r for r in overall if r["navigator"] != ORACLE]
@@ -86,7 +89,7 @@ def published_lines() -> list[str]:
 
 def difficulty_lines(rows: list[dict[str, Any]]) -> list[str]:
     """Success against BARN's difficulty metrics, per navigator, from the per-run rows."""
-    from swarmnav.sim.benchmarks.barn_difficulty import METRICS, success_against_difficulty
+    from swarmnav.benchmarks.barn_difficulty import METRICS, success_against_difficulty
     per_run = [r for r in rows if r.get("scenario") is not None and r.get("difficulty")]
     names = [n for n in dict.fromkeys(r["navigator"] for r in per_run)]
     if not per_run:
@@ -103,12 +106,17 @@ def difficulty_lines(rows: list[dict[str, Any]]) -> list[str]:
 
 
 def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
-    """The BARN-like worlds' figures against BARN's (the 300 when committed, else the 50 test worlds), navigator
-    by navigator, same setup only (issue 34's check: within 0.05)."""
-    against = next((p for p in (ALL_300, TEST_50) if p in results and p.is_file()), None)
-    if against is None or FRESH not in results or not FRESH.is_file():
+    """The BARN-like worlds' figures against BARN's (the 300 when committed in the same setup, else the 50 test
+    worlds), navigator by navigator, same setup only (issue 34's check: within 0.05)."""
+    if FRESH not in results or not FRESH.is_file():
         return []
-    base_rows, fresh_rows = read_result(against), read_result(FRESH)
+    fresh_rows = read_result(FRESH)
+    setups = {r["barn_setup"] for r in fresh_rows}
+    against = next((p for p in (ALL_300, TEST_50) if p in results and p.is_file()
+                    and setups & {r["barn_setup"] for r in read_result(p)}), None)  # the same setup only
+    if against is None:
+        return []
+    base_rows = read_result(against)
     base = {r["navigator"]: r for r in base_rows if r.get("scenario") is None}
     fresh = {r["navigator"]: r for r in fresh_rows if r.get("scenario") is None}
     lines = []
@@ -122,7 +130,7 @@ def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
                      f"{b['success_rate']:.3f} ({ds:+.3f}), score {f['barn_score']:.4f} vs {b['barn_score']:.4f} "
                      f"({dsc:+.4f}): {'within' if abs(ds) <= 0.05 and abs(dsc) <= 0.05 else 'NOT within'} 0.05.")
     if lines:
-        from swarmnav.sim.benchmarks.barn_difficulty import METRICS
+        from swarmnav.benchmarks.barn_difficulty import METRICS
 
         def means(rows: list[dict[str, Any]]) -> dict[str, float]:
             worlds = {r["world"]: r["difficulty"] for r in rows if r.get("scenario") is not None and r.get("difficulty")}
@@ -161,7 +169,7 @@ def current_block(text: str) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m swarmnav.sim.benchmarks.barn_table",
+    parser = argparse.ArgumentParser(prog="python -m swarmnav.benchmarks.barn_table",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("--readme", help="replace the block between the markers in this file")
     args = parser.parse_args(argv)

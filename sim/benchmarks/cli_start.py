@@ -17,7 +17,7 @@ import sys
 import time
 from pathlib import Path
 
-from swarmnav.sim.benchmarks.figures import print_figures
+from swarmnav.benchmarks.figures import print_figures
 
 TARGET_SCENARIOS_S = 0.3
 
@@ -25,7 +25,7 @@ TARGET_SCENARIOS_S = 0.3
 def _command() -> list[str]:
     """The console script beside this interpreter, else the module (the same ``main``)."""
     script = Path(sys.executable).parent / "swarmnav"
-    return [str(script)] if script.exists() else [sys.executable, "-m", "swarmnav.sim.cli"]
+    return [str(script)] if script.exists() else [sys.executable, "-m", "swarmnav.cli"]
 
 
 def _wall_s(argv: list[str]) -> float:

@@ -1,6 +1,6 @@
 """The README's CrowdNav table, generated from the committed ``bench navigation --suite crowdnav --json`` result.
 
-``python -m swarmnav.sim.benchmarks.crowd_table [RESULT.json] [--protocol FULL.json] [--readme FILE]`` prints (or,
+``python -m swarmnav.benchmarks.crowd_table [RESULT.json] [--protocol FULL.json] [--readme FILE]`` prints (or,
 with ``--readme``, writes between its markers) the full protocol's tables when there is one
 (``crowdnav-500.json``: 500 cases per setting), then every navigator's on a sample of the cases; per table one
 table per setting (the robot invisible to the humans, then visible), our rows
@@ -17,7 +17,7 @@ from pathlib import Path as FilePath
 from typing import Any
 
 from swarmnav.models.errors import ConfigError
-from swarmnav.sim.benchmarks.navigation_table import RESULTS_DIR, read_rows
+from swarmnav.benchmarks.navigation_table import RESULTS_DIR, read_rows
 
 RESULT = RESULTS_DIR / "crowdnav.json"  # every navigator on a sample of the cases
 PROTOCOL = RESULTS_DIR / "crowdnav-500.json"  # CrowdNav's full protocol (500 cases per setting), where it was run
@@ -161,7 +161,7 @@ def current_block(text: str) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m swarmnav.sim.benchmarks.crowd_table",
+    parser = argparse.ArgumentParser(prog="python -m swarmnav.benchmarks.crowd_table",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("result", nargs="?", default=str(RESULT), help="a `bench navigation --suite crowdnav --json`")
     parser.add_argument("--protocol", default=str(PROTOCOL) if PROTOCOL.is_file() else None,

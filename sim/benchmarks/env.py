@@ -37,10 +37,10 @@ import time
 import mujoco
 import numpy as np
 
-from swarmnav.sim.benchmarks.figures import print_figures
+from swarmnav.benchmarks.figures import print_figures
 from swarmnav.sim.episode import EpisodeSpec, plan_episode, run_episode
 from swarmnav.sim.defaults import BENCH_ENV_QUICK, SINGLE_THREAD_ENVIRONMENT
-from swarmnav.sim.runner import Simulation
+from swarmnav.sim.simulation import Simulation
 
 VECTOR_ACTION_REPEAT = 5  # control periods per vectorised environment step (about 1 ms of work in the worker)
 
@@ -83,7 +83,7 @@ def _vector_steps_per_s(scenario_name: str, workers: int, steps: int) -> float:
 
     import gymnasium
 
-    from swarmnav.sim.env import NavigateEnv
+    from swarmnav.env import NavigateEnv
     with _single_thread_environment():
         vector = gymnasium.vector.AsyncVectorEnv(
             [functools.partial(NavigateEnv, scenario_name, action_repeat=VECTOR_ACTION_REPEAT)] * workers,
@@ -129,7 +129,7 @@ def _bare_control_steps_per_s(simulation: Simulation, control_steps: int) -> flo
 def benchmark_env(scenario_name: str = "dense-field-30", duration_s: float = 20.0,
                   repeats: int = 3) -> dict[str, float | int | str]:
     """Median control steps per second of the three, and the environment's ratios to the other two."""
-    from swarmnav.sim.env import NavigateEnv  # dm_control and Gymnasium load only for this benchmark
+    from swarmnav.env import NavigateEnv  # dm_control and Gymnasium load only for this benchmark
     env = NavigateEnv(scenario_name)
     replay_env = NavigateEnv(scenario_name, action="wheels")
     planned = plan_episode(EpisodeSpec(env.task.scenario))

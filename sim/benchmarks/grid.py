@@ -2,7 +2,7 @@
 
 Prints (or, with ``--json``, emits one object with):
 
-* ``rows`` (from the quality studies of :mod:`swarmnav.sim.benchmarks.grid_quality`, kept in
+* ``rows`` (from the quality studies of :mod:`swarmnav.benchmarks.grid_quality`, kept in
   ``--out``): per map and planner, ``runs``, ``feasible_runs``, ``median_length_m`` (the executed path,
   shortcut on, as each planner returns it), ``astar_length_m`` (A*'s, the same way),
   ``ratio_to_astar``, ``mean_plan_time_s``; also the raw (cell path) lengths and
@@ -32,7 +32,7 @@ import numpy as np
 
 from swarmnav.models.scenario import load_scenario
 from swarmnav.planners.problem import scenario_problem
-from swarmnav.sim.benchmarks.grid_quality import (GRID_PLANNERS, map_scenarios, maps_study, movingai_study,
+from swarmnav.benchmarks.grid_quality import (GRID_PLANNERS, map_scenarios, maps_study, movingai_study,
                                                   restaurant_study)
 
 #: Issue 14's targets (astar < 3 ms, iaco < 0.3 s on the worst bundled map), and the earlier ones.
@@ -172,7 +172,7 @@ def bench_movingai_peer(per_map: int = 20) -> dict[str, Any]:
 
 
 def quality_rows(args: argparse.Namespace, limit: int | None, out_dir: FilePath):
-    """The map, restaurant and Moving AI quality studies (:mod:`swarmnav.sim.benchmarks.grid_quality`)."""
+    """The map, restaurant and Moving AI quality studies (:mod:`swarmnav.benchmarks.grid_quality`)."""
     rows = maps_study(args, out_dir) + restaurant_study(args.runs, out_dir)
     return rows, movingai_study(args.swarm_sample, limit, out_dir)
 

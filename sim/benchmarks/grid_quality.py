@@ -1,7 +1,7 @@
 """The quality tables of ``swarmnav bench grid``, run as studies.
 
 Three plan-only studies, built in code and run by the study machinery
-(:mod:`swarmnav.sim.study`, the one episode function, the same Parquet rows as
+(:mod:`swarmnav.study`, the one episode function, the same Parquet rows as
 ``swarmnav study``), into ``OUT/maps``, ``OUT/restaurant`` and ``OUT/movingai``:
 
 * ``bench-grid-maps``: every grid planner on the bundled 50 x 50 map scenarios, ``runs``
@@ -33,8 +33,8 @@ from scipy import ndimage
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import list_scenarios, load_scenario
 from swarmnav.planners.problem import scenario_problem
-from swarmnav.sim.benchmarks.planner_quality import arms, run_time_s
-from swarmnav.sim.study.execute import run_study_tables
+from swarmnav.benchmarks.planner_quality import arms, run_time_s
+from swarmnav.study.execute import run_study_tables
 
 GRID_PLANNERS = ("astar", "dijkstra", "theta_star", "dstar_lite", "immas", "iaco")
 MOVINGAI_PLANNERS = ("immas", "iaco")

@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from swarmnav.sim.benchmarks.figures import print_figures
+from swarmnav.benchmarks.figures import print_figures
 
 STUCK_SCENARIO = """
 name = "bench-log-stuck"
@@ -94,7 +94,7 @@ def measure(argv: list[str]) -> dict[str, Any]:
 
 def benchmark_log(duration_s: float, video: bool = True) -> dict[str, Any]:
     """Write a ``duration_s`` run log, then time every reader of it (one process each)."""
-    swarmnav = [sys.executable, "-m", "swarmnav.sim.cli"]
+    swarmnav = [sys.executable, "-m", "swarmnav.cli"]
     python = [sys.executable, "-c"]
     figures: dict[str, Any] = {"simulated_s": duration_s}
     with tempfile.TemporaryDirectory() as tmp:

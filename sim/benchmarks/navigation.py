@@ -30,7 +30,7 @@ N`` one of N per group;
 shipped verdicts (``dyn300-verdicts.json``) disagree with this run's oracle, ``verdict_mismatches`` says how
 often (the oracle row).
 
-**Speed** (:mod:`sim.benchmarks.navigation_speed`; figures printed after the table, never asserted):
+**Speed** (:mod:`swarmnav.benchmarks.navigation_speed`; figures printed after the table, never asserted):
 ``realtime_factor_cpu`` (simulated time over the runs' own CPU time, ``run_cpu_s``); the oracle row's
 ``oracle_search`` (its search timed on every scene run: median and max, wall and CPU); the ``mppi`` row's
 ``mppi_every_step`` (its control step at 1,000 x 30 optimising every step); each with the load average.
@@ -51,7 +51,7 @@ from swarmnav.models.scenario import list_scenarios, load_scenario
 
 SUITE_PREFIX = "dyn-"
 ORACLE = "oracle"  # the clairvoyant yardstick, run beside every contender
-# A generated suite's per-scenario rows carry these shipped difficulty metrics (sim/difficulty.py).
+# A generated suite's per-scenario rows carry these shipped difficulty metrics (sim/runtime/difficulty.py).
 DIFFICULTY_KEYS = ("difficulty_rank", "static_density", "dispersion", "survivability", "dynamic_traversability",
                    "t_star_ratio")
 
@@ -199,14 +199,14 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     ``suite`` (e.g. ``dyn300``) runs a generated suite instead of ``scenarios``; ``arms``: more rows, each a
     navigator under its own label with its own parameters (the rows are keyed by label); ``engine="ray"``:
     the runs on Ray (a local instance of ``workers`` CPUs, or the cluster at ``address``); ``suite="barn"``: the
-    BARN worlds (:mod:`sim.benchmarks.barn`; ``barn``: its ``worlds``, ``runs`` and ``dir``), with its score;
+    BARN worlds (:mod:`swarmnav.benchmarks.barn`; ``barn``: its ``worlds``, ``runs`` and ``dir``), with its score;
     ``knowledge``: the study axes ``maps`` / ``poses`` (``--map`` / ``--pose``), every row says its values."""
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-navigation-") as folder:
             return benchmark_navigation(seeds, navigators, scenarios, progress, navigator_params, by_scenario,
                                         folder, suite, quick, sensor_model, workers, speed, per_group, arms,
                                         engine, address, seed_offset, barn, knowledge)
-    from swarmnav.sim.study.execute import run_study_tables
+    from swarmnav.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
     contenders = [n for n in (navigators or default_navigators(navigator_params)) if not is_clairvoyant(n)]
@@ -214,7 +214,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     shipped: dict[str, dict[str, Any]] = {}
     barn_meta = None
     if suite in ("barn", "barn-like"):
-        from swarmnav.sim.benchmarks import barn as barn_suite
+        from swarmnav.benchmarks import barn as barn_suite
         names, barn_meta, barn_setup = barn_suite.write_barn_suite(out_dir, quick, (barn or {}).get("worlds"),
                                                                    (barn or {}).get("runs"), (barn or {}).get("dir"),
                                                                    generated=suite == "barn-like",
@@ -239,7 +239,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     runs = {label: [r for r in rows if r["navigator_label"] == label] for label in labels}
     settings = {a.label: {"arm_of": a.navigator, "arm_params": a.params} for a in arms}
     sensing = "+".join(sorted({load_scenario(name).sensor_model for name in names}))
-    from swarmnav.sim.benchmarks.crowd_rows import crowd_rows, robot_visible
+    from swarmnav.benchmarks.crowd_rows import crowd_rows, robot_visible
     visible = robot_visible(names)
     if visible:  # scenes among agents: one table per setting (CrowdNav's invisible and visible robot)
         table = crowd_rows(runs, visible, verdicts, shipped, sensing, settings, _row, ORACLE)
@@ -249,7 +249,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     if speed:
         _add_speed(table, rows)
         if visible:  # the agents' own cost (navigation_speed.crowd_step_cost), on the oracle's row
-            from swarmnav.sim.benchmarks.navigation_speed import crowd_step_cost
+            from swarmnav.benchmarks.navigation_speed import crowd_step_cost
             next(r for r in table if r["navigator"] == ORACLE)["crowd_step"] = crowd_step_cost()
     if by_scenario:
         for name in dict.fromkeys(r["scenario"] for r in rows):
@@ -261,14 +261,15 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     for row in table:  # what the runs were given (the oracle keeps the true map: controllers.world_map)
         row.update(given)
     if barn_meta is not None:
-        barn_suite.add_scores(table, rows, barn_meta, barn_setup, by_scenario, (barn or {}).get("dir"))
+        barn_suite.add_scores(table, rows, barn_meta, barn_setup, by_scenario, (barn or {}).get("dir"),
+                              {**navigator_params, **{a.label: a.params for a in arms}})
     return table
 
 
 def _add_speed(table: list[dict[str, Any]], rows: list[dict[str, Any]]) -> None:
     """The oracle's search times on every scene run (its row's ``oracle_search``) and MPPI's cost per control
-    step optimising every step (its row's ``mppi_every_step``): :mod:`sim.benchmarks.navigation_speed`."""
-    from swarmnav.sim.benchmarks.navigation_speed import mppi_step_cost, oracle_search_times
+    step optimising every step (its row's ``mppi_every_step``): :mod:`swarmnav.benchmarks.navigation_speed`."""
+    from swarmnav.benchmarks.navigation_speed import mppi_step_cost, oracle_search_times
     scenes = list(dict.fromkeys((r["scenario_ref"], r["world_seed"]) for r in rows if r["navigator"] == ORACLE))
     for row in table:
         if row["navigator"] == ORACLE:
@@ -343,7 +344,7 @@ def run(args: argparse.Namespace) -> int:
     if args.suite == "papers":
         if getattr(args, "engine", "local") == "ray":
             raise ConfigError("--engine", "ray applies to the dyn and dyn300 suites (papers runs in this process)")
-        from swarmnav.sim.benchmarks.paper_navigation import (PAPER_SUITE, benchmark_paper_navigation,
+        from swarmnav.benchmarks.paper_navigation import (PAPER_SUITE, benchmark_paper_navigation,
                                                               print_table)
         paper_rows = benchmark_paper_navigation(args.seeds, tuple(args.scenario or PAPER_SUITE), args.out,
                                                 knowledge_axes(args))
@@ -378,7 +379,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     overall = [r for r in rows if r["scenario"] is None]
     if any("robot_visible" in r for r in overall):  # among agents: CrowdNav's two settings apart
-        from swarmnav.sim.benchmarks.crowd_rows import print_crowd_lines
+        from swarmnav.benchmarks.crowd_rows import print_crowd_lines
         for seen in (False, True):
             part = [r for r in overall if r.get("robot_visible") is seen]
             if part:
@@ -389,13 +390,13 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print_table(overall, "")
     if suite in ("barn", "barn-like"):
-        from swarmnav.sim.benchmarks.barn import print_scores
+        from swarmnav.benchmarks.barn import print_scores
         print_scores(overall)
     if args.by_scenario:
         for name in dict.fromkeys(r["scenario"] for r in rows if r["scenario"] is not None):
             print()
             _print_table([r for r in rows if r["scenario"] == name], name)
-    from swarmnav.sim.benchmarks.navigation_speed import speed_lines
+    from swarmnav.benchmarks.navigation_speed import speed_lines
     print()
     oracle = next((r.get("oracle_search") for r in overall if r["navigator"] == ORACLE), None)
     mppi = next((r.get("mppi_every_step") for r in overall if r["navigator"] == "mppi"), None)
@@ -403,7 +404,7 @@ def run(args: argparse.Namespace) -> int:
         print(line)
     crowd = next((r["crowd_step"] for r in overall if r.get("crowd_step")), None)
     if crowd:
-        from swarmnav.sim.benchmarks.navigation_speed import crowd_line
+        from swarmnav.benchmarks.navigation_speed import crowd_line
         print(crowd_line(crowd))
     return 0
 
@@ -421,7 +422,7 @@ def _barn_options(args: argparse.Namespace, suite: str | None) -> dict[str, Any]
     for option in ("sensor_model", "per_group", "seed_offset"):
         if getattr(args, option, None):
             raise ConfigError(f"--{option.replace('_', '-')}", "applies to --suite dyn300 only")
-    from swarmnav.sim.benchmarks.barn import barn_dir, parse_planner, parse_worlds
+    from swarmnav.benchmarks.barn import barn_dir, parse_planner, parse_worlds
     if suite == "barn":
         barn_dir(given["dir"])  # no data: one line before anything runs
     return {"dir": given["dir"], "runs": given["runs"], "worlds": parse_worlds(given["worlds"], suite == "barn-like"),

@@ -1,6 +1,6 @@
 """The README's navigation tables, generated from committed ``bench navigation --json`` results.
 
-``python -m swarmnav.sim.benchmarks.navigation_table [RESULT.json] [--readme FILE]`` prints the table (one row
+``python -m swarmnav.benchmarks.navigation_table [RESULT.json] [--readme FILE]`` prints the table (one row
 per navigator and the oracle's, from the overall rows of the JSON that ``swarmnav bench navigation [--suite
 dyn300] --json`` printed); with ``--readme FILE`` it replaces the lines between the markers that name that
 result (:func:`begin_marker`, :data:`END`) in FILE instead.  The committed results are :data:`RESULTS`
@@ -160,7 +160,7 @@ def replace_block(text: str, new_block: str, source: str, result: FilePath = RES
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m swarmnav.sim.benchmarks.navigation_table",
+    parser = argparse.ArgumentParser(prog="python -m swarmnav.benchmarks.navigation_table",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("result", nargs="?", default=str(RESULT), help="a `bench navigation --json` result")
     parser.add_argument("--readme", help="replace the table between the markers in this file")

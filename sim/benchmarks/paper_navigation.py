@@ -66,7 +66,7 @@ def benchmark_paper_navigation(seeds: int = 1, scenarios: tuple[str, ...] = PAPE
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="swarmnav-bench-paper-navigation-") as folder:
             return benchmark_paper_navigation(seeds, scenarios, folder, knowledge)
-    from swarmnav.sim.study.execute import run_study_tables
+    from swarmnav.study.execute import run_study_tables
 
     rows = []
     for name in scenarios:

@@ -1,6 +1,6 @@
 """The quality tables of ``swarmnav bench planners``, run as studies.
 
-Two studies, built in code and run by the study machinery (:mod:`swarmnav.sim.study`:
+Two studies, built in code and run by the study machinery (:mod:`swarmnav.study`:
 the same cells, the one episode function, the same Parquet rows as ``swarmnav study``):
 
 * ``bench-planners`` on the bundled scenarios: every planner in every mode (labels

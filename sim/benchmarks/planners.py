@@ -1,7 +1,7 @@
 """``swarmnav bench planners``: the continuous planners and OMPL's sampling planners against
 the exact optimum, the papers' reported lengths, and mealpy on the same objective.
 
-Quality (:mod:`swarmnav.sim.benchmarks.planner_quality`): a plan-only study on the
+Quality (:mod:`swarmnav.benchmarks.planner_quality`): a plan-only study on the
 scenarios (every planner in every mode of ``--modes``, default ``paper robust``: the
 paper's algorithm as written and the robust options of :mod:`planners.continuous`, side
 by side; OMPL's RRT*, Informed RRT*, BIT* and PRM* of ``--sampling``, mode ``ompl``, each
@@ -48,7 +48,7 @@ from swarmnav.planners.registry import make_planner
 from swarmnav.planners.path_cost import PathObjective
 from swarmnav.planners.problem import Problem
 from swarmnav.planners.problem import scenario_problem
-from swarmnav.sim.benchmarks.planner_quality import SAMPLING_MODE, field_summary, scenario_rows, study_tables
+from swarmnav.benchmarks.planner_quality import SAMPLING_MODE, field_summary, scenario_rows, study_tables
 from swarmnav.sim.defaults import BENCH_PLANNERS_SCENARIOS
 
 SOURCE = "swarmnav bench planners"  # what an error in the options' study names
@@ -179,7 +179,7 @@ def _median(values: list[float]) -> float | None:
 def quality_rows(args: argparse.Namespace, out_dir: FilePath) -> tuple[list[dict], list[dict], list[str]]:
     """Run the two quality studies into ``out_dir``; return the scenario rows, the field summary, notes."""
     from swarmnav.models.disc_fields import disc_field_name, disc_field_toml
-    from swarmnav.sim.study.execute import run_study_tables
+    from swarmnav.study.execute import run_study_tables
 
     runs = run_study_tables(
         study_tables("bench-planners", args.scenarios, args.planners, args.modes, args.seeds, args.population,

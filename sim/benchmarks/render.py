@@ -13,12 +13,12 @@ import math
 import os
 import time
 
-# Imported at the top on purpose: sim.video.render sets MUJOCO_GL=egl, which must happen before
+# Imported at the top on purpose: swarmnav.video.render sets MUJOCO_GL=egl, which must happen before
 # anything imports mujoco, and the CLI imports this module before the runner's.
-from swarmnav.sim.benchmarks.figures import print_figures
+from swarmnav.benchmarks.figures import print_figures
 from swarmnav.sim.defaults import BENCH_RENDER_QUICK_FRAMES
-from swarmnav.sim.video.caption import FrameCaption, run_title
-from swarmnav.sim.video.render import ScenePoser, SceneRenderer, check_video_size
+from swarmnav.video.caption import FrameCaption, run_title
+from swarmnav.video.render import ScenePoser, SceneRenderer, check_video_size
 
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402

@@ -21,12 +21,12 @@ from pathlib import Path as FilePath
 
 import mujoco
 
-from swarmnav.sim.benchmarks.figures import print_figures
+from swarmnav.benchmarks.figures import print_figures
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import MAX_CONTROL_STEPS, load_scenario
 from swarmnav.sim.defaults import BENCH_SIM_QUICK
 from swarmnav.sim.episode import Episode, EpisodeSpec, plan_episode, run_episode
-from swarmnav.sim.runner import Simulation
+from swarmnav.sim.simulation import Simulation
 
 # The closed loop's targets on a quiet machine: its rate against bare mj_step, without and with the MCAP log.
 TARGET_RATIO, TARGET_LOGGING_RATIO = 0.92, 0.80
@@ -62,7 +62,7 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
     collision and clearance checks, no logging; the logging row adds the MCAP
     recorder.  ``duration_s`` must be shorter than the run to the goal so that
     every measurement covers the same simulated time.  ``sensing``: also the laser, sensed-map and Jackal
-    lines of :mod:`sim.benchmarks.sensing`.
+    lines of :mod:`swarmnav.benchmarks.sensing`.
     """
     scenario = load_scenario(scenario_name)
     if not duration_s * scenario.sim.control_hz <= MAX_CONTROL_STEPS:
@@ -75,7 +75,7 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
     recorder_cls = None
     if with_logging:
         try:
-            from swarmnav.sim.log.writer import McapRecorder
+            from swarmnav.log.writer import McapRecorder
             recorder_cls = McapRecorder
         except ImportError:
             recorder_cls = None
@@ -111,7 +111,7 @@ def benchmark_sim(scenario_name: str = "dense-field-30", duration_s: float = 20.
         figures["logging_ratio"] = statistics.median(logging_ratios)
         figures["target_logging_ratio"] = TARGET_LOGGING_RATIO
     if sensing:
-        from swarmnav.sim.benchmarks.sensing import sensing_figures
+        from swarmnav.benchmarks.sensing import sensing_figures
         figures.update(sensing_figures(duration_s, repeats))
     return figures
 

@@ -73,7 +73,7 @@ def run_scale(args: argparse.Namespace) -> int:
                 path = Path(folder) / f"scale-{seeds}.toml"
                 path.write_text(SCALE_STUDY.format(seeds=seeds), encoding="utf-8")
                 out = Path(folder) / f"out-{engine}-{seeds}"
-                done = subprocess.run([sys.executable, "-m", "swarmnav.sim.cli", "study", str(path), "--out", str(out),
+                done = subprocess.run([sys.executable, "-m", "swarmnav.cli", "study", str(path), "--out", str(out),
                                        "--engine", engine, "--workers", "2", "--json"],
                                       capture_output=True, text=True)
                 if done.returncode != 0:
@@ -120,11 +120,11 @@ def run(args: argparse.Namespace) -> int:
         return run_scale(args)
     from swarmnav.models.scenario import load_scenario
     from swarmnav.sim.episode import EpisodeSpec, plan_episode
-    from swarmnav.sim.study.cell import run_cell
-    from swarmnav.sim.study.engines import run_local
-    from swarmnav.sim.study.ray_engine import run_ray, start_ray
-    from swarmnav.sim.study.grid import expand
-    from swarmnav.sim.study.spec import parse_study
+    from swarmnav.study.cell import run_cell
+    from swarmnav.study.engines import run_local
+    from swarmnav.study.ray_engine import run_ray, start_ray
+    from swarmnav.study.grid import expand
+    from swarmnav.study.spec import parse_study
     study = parse_study(BENCH_STUDY.format(seeds=args.seeds, iterations=args.iterations))
     cells = expand(study)
     out: dict = {"cells": len(cells)}

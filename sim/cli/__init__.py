@@ -1,6 +1,6 @@
 """The ``swarmnav`` command line: the parser and the commands.
 
-:mod:`.main` is the entry point (``swarmnav``, ``python -m swarmnav.sim.cli``): the parser, the exit codes and
+:mod:`.main` is the entry point (``swarmnav``, ``python -m swarmnav.cli``): the parser, the exit codes and
 the commands that drive an episode (``plan``, ``run``, ``scenarios``, ``planners``, ``navigators``).
 :mod:`.commands` holds the options of the subcommands implemented in modules below the CLI (``bench``,
 ``replay``, ``plot``, ``log``, ``foxglove-layout``, ``study``), each imported only when its subcommand runs;

@@ -1,7 +1,7 @@
-"""``python -m swarmnav.sim.cli``: the ``swarmnav`` command."""
+"""``python -m swarmnav.cli``: the ``swarmnav`` command."""
 
 import sys
 
-from swarmnav.sim.cli.main import main
+from swarmnav.cli.main import main
 
 sys.exit(main())

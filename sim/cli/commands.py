@@ -20,7 +20,7 @@ from swarmnav.sim.defaults import (  # noqa: F401  (re-exported: the CLI's own d
 from swarmnav.models.scenario_limits import (MAX_BENCH_DURATION_S, MAX_BENCH_FRAMES, MAX_BENCH_REPEATS, MAX_BENCH_RUNS,
                                              MAX_BENCH_SEEDS, MAX_STUDY_RUNS, MAX_WORKERS)
 from swarmnav.sim.options import add_trust_code_argument  # noqa: F401
-from swarmnav.sim.cli import study as study_cli
+from swarmnav.cli import study as study_cli
 
 # The counts and durations of the benchmarks, each with its stated maximum (models/scenario_limits.py).
 DURATION = options.float_in(0.0, MAX_BENCH_DURATION_S)
@@ -43,7 +43,7 @@ def add_bench_sim_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_sim(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import sim
+    from swarmnav.benchmarks import sim
     return sim.run(args)
 
 
@@ -78,7 +78,7 @@ def add_bench_planners_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_planners(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import planners
+    from swarmnav.benchmarks import planners
     return planners.run(args)
 
 
@@ -97,7 +97,7 @@ def add_bench_grid_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_grid(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import grid
+    from swarmnav.benchmarks import grid
     return grid.run(args)
 
 
@@ -115,7 +115,7 @@ def add_bench_render_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_render(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import render
+    from swarmnav.benchmarks import render
     return render.run(args)
 
 
@@ -129,7 +129,7 @@ def add_bench_env_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_env(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import env
+    from swarmnav.benchmarks import env
     return env.run(args)
 
 
@@ -196,7 +196,7 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_navigation(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import navigation
+    from swarmnav.benchmarks import navigation
     if args.quick and args.suite not in ("dyn300", "barn", "barn-like"):
         args.seeds, args.scenario = 1, args.scenario or list(BENCH_NAVIGATION_QUICK_SCENARIOS)
     return navigation.run(args)
@@ -221,7 +221,7 @@ def add_bench_study_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_study(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import study
+    from swarmnav.benchmarks import study
     if args.quick:
         (args.seeds, args.iterations), args.no_ray, args.rounds = BENCH_STUDY_QUICK, True, 1
     return study.run(args)
@@ -234,7 +234,7 @@ def add_bench_cli_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_cli(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import cli_start
+    from swarmnav.benchmarks import cli_start
     return cli_start.run(args)
 
 
@@ -247,7 +247,7 @@ def add_bench_log_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_log(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import log
+    from swarmnav.benchmarks import log
     return log.run(args)
 
 
@@ -259,8 +259,22 @@ def add_bench_odometry_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_odometry(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import odometry
+    from swarmnav.benchmarks import odometry
     return odometry.run(args)
+
+
+def add_bench_sensed_map_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenario", action="append", metavar="NAME",
+                        help="a scenario instead of dense-field-30 and gwo-scenario-1 (repeatable)")
+    parser.add_argument("--only", metavar="NAME", help="only the runs of this navigator or planner")
+    parser.add_argument("--json", action="store_true", help="one JSON object per run")
+    parser.add_argument("--write", action="store_true",
+                        help="also write models/suites/results/sensed_map.json and docs/sensing.md's table from it")
+
+
+def run_bench_sensed_map(args: argparse.Namespace) -> int:
+    from swarmnav.benchmarks import sensed_map
+    return sensed_map.run(args)
 
 
 def add_bench_defaults_arguments(parser: argparse.ArgumentParser) -> None:
@@ -271,7 +285,7 @@ def add_bench_defaults_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_bench_defaults(args: argparse.Namespace) -> int:
-    from swarmnav.sim.benchmarks import paper_defaults
+    from swarmnav.benchmarks import paper_defaults
     return paper_defaults.run(args)
 
 
@@ -281,7 +295,7 @@ def add_log_info_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_log_info(args: argparse.Namespace) -> int:
-    from swarmnav.sim.cli import log as log_commands
+    from swarmnav.cli import log as log_commands
     return log_commands.run_info(args)
 
 
@@ -291,7 +305,7 @@ def add_log_recover_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_log_recover(args: argparse.Namespace) -> int:
-    from swarmnav.sim.cli import log as log_commands
+    from swarmnav.cli import log as log_commands
     return log_commands.run_recover(args)
 
 
@@ -315,7 +329,7 @@ def add_replay_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_replay(args: argparse.Namespace) -> int:
-    from swarmnav.sim.log import replay
+    from swarmnav.log import replay
     return replay.run(args)
 
 
@@ -326,7 +340,7 @@ def add_plot_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_plot(args: argparse.Namespace) -> int:
-    from swarmnav.sim import plot
+    from swarmnav.log import plot
     return plot.run(args)
 
 
@@ -338,7 +352,7 @@ def add_foxglove_layout_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_foxglove_layout(args: argparse.Namespace) -> int:
-    from swarmnav.sim.log import foxglove_layout
+    from swarmnav.log import foxglove_layout
     return foxglove_layout.run(args)
 
 
@@ -363,6 +377,8 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
      "each paper's planners at their defaults on its scenarios: collision-free plans over N seeds"),
     (("bench", "odometry"), add_bench_odometry_arguments, run_bench_odometry,
      "wheel odometry's pose error against distance driven, per robot, clean and in hard contact"),
+    (("bench", "sensed-map"), add_bench_sensed_map_arguments, run_bench_sensed_map,
+     "every planning navigator with the map known and unknown on dense-field-30 and gwo-scenario-1"),
     (("log", "info"), add_log_info_arguments, run_log_info, "what a log holds"),
     (("log", "recover"), add_log_recover_arguments, run_log_recover, "rewrite a truncated log as a complete one"),
     (("replay",), add_replay_arguments, run_replay, "re-render or re-simulate a log"),

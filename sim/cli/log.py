@@ -2,7 +2,7 @@
 
 ``info`` prints the scenario, planner, navigator, seed, duration, outcome and every channel
 with its message count and schema, from the file's summary section
-(:mod:`sim.log.summary`: a log of any length answers at once).  A file without
+(:mod:`swarmnav.log.summary`: a log of any length answers at once).  A file without
 footer (a killed run) is read as ``plot`` reads it: what was recovered, with a
 warning line that says how much and advises ``log recover``, exit 0.  ``recover``
 turns it into a complete, indexed file holding every message up to the writer's
@@ -16,9 +16,9 @@ import json
 import math
 import sys
 
-from swarmnav.sim.log.reader import outcome_text, truncation_advice
-from swarmnav.sim.log.recover import recover_log
-from swarmnav.sim.log.summary import LogSummary, read_summary
+from swarmnav.log.reader import outcome_text, truncation_advice
+from swarmnav.log.recover import recover_log
+from swarmnav.log.summary import LogSummary, read_summary
 
 
 def describe(log: LogSummary) -> list[str]:

@@ -21,17 +21,17 @@ import tomllib
 from pathlib import Path as FilePath
 from typing import Any, Callable
 
-# Building the parser imports only light modules (sim.cli.commands): each subcommand imports
+# Building the parser imports only light modules (swarmnav.cli.commands): each subcommand imports
 # what it needs (MuJoCo, SciPy, the planners, the log formats) when it runs.
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import PlanningError
 from swarmnav.sim import options
-from swarmnav.sim.cli import stop_signal
+from swarmnav.cli import stop_signal
 from swarmnav.sim.options import parse_settings
 from swarmnav.sim.defaults import LOG_FORMATS
-from swarmnav.sim.cli.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
+from swarmnav.cli.commands import DEFAULT_FPS, MODULE_COMMANDS, SINGLE_THREAD_ENVIRONMENT, add_trust_code_argument
 
-# As sim.video.render does, before any subcommand imports mujoco (which reads it once, on import).
+# As swarmnav.video.render does, before any subcommand imports mujoco (which reads it once, on import).
 os.environ.setdefault("MUJOCO_GL", "egl")
 for _name, _value in SINGLE_THREAD_ENVIRONMENT.items():  # before any subcommand imports NumPy
     os.environ.setdefault(_name, _value)
@@ -113,7 +113,7 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
 
 
 def cmd_scenario_info(args: argparse.Namespace) -> int:
-    """``scenarios info SCENARIO``: its difficulty metrics and the clairvoyant oracle's verdict (sim/difficulty.py)."""
+    """``scenarios info SCENARIO``: its difficulty metrics and the clairvoyant oracle's verdict (sim/runtime/difficulty.py)."""
     from swarmnav.models.scenario import load_scenario
     from swarmnav.sim.difficulty import difficulty
     scenario = load_scenario(args.scenario)
@@ -154,7 +154,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     from swarmnav.models.scenario_generator import GeneratorOptions, generate
     options = GeneratorOptions(**{f.name: getattr(args, f.name) for f in fields(GeneratorOptions)
                                   if getattr(args, f.name, None) is not None})
-    from swarmnav.sim.api.calls import check_components
+    from swarmnav.calls import check_components
     text = generate(args.kind, args.seed, options)
     try:  # it must load back, its planner and navigator too
         check_components(parse_scenario(text, args.out or "<generated>"))
@@ -211,7 +211,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from swarmnav.calls import run_spec
     options.check_output_file(args.json_out, "--json-out")
     if args.video:
-        from swarmnav.sim.video.render import check_video_size
+        from swarmnav.video.render import check_video_size
         check_video_size(args.width, args.height, args.fps)  # before the plan: bad options fail at once
     scenario = _load(args)  # the file's own errors name the file, never an option
     try:
@@ -297,7 +297,7 @@ def build_parser() -> argparse.ArgumentParser:
     info.add_argument("scenario", metavar="SCENARIO", help="a bundled name or a .toml path")
     info.add_argument("--world-seed", type=options.seed, help="seed of the random obstacle motions (default: the scenario's)")
     info.add_argument("--json", action="store_true", help="print one JSON object")
-    from swarmnav.sim.cli import world_import
+    from swarmnav.cli import world_import
     imp = scenario_commands.add_parser("import", help="a Gazebo world's static cylinders and boxes as a scenario file")
     world_import.add_arguments(imp)
     imp.set_defaults(scenario_run=world_import.run)

@@ -58,7 +58,7 @@ def _first_stop(exc: BaseException) -> BaseException:
     """The Ctrl-C or SIGTERM that stopped the study: a native library may turn the CLI's ``SystemExit(143)``
     into one of its own on the way out (Ray's ``wait`` raises ``SystemExit(1)`` when a signal interrupts it),
     so the signal the CLI's handler recorded wins."""
-    from swarmnav.sim.cli import stop_signal
+    from swarmnav.cli import stop_signal
     if isinstance(exc, SystemExit) and stop_signal.received is not None:
         return SystemExit(128 + stop_signal.received)
     return exc
@@ -66,7 +66,7 @@ def _first_stop(exc: BaseException) -> BaseException:
 
 def run_study(args: argparse.Namespace) -> int:
     from swarmnav.models.errors import ConfigError
-    from swarmnav.sim.study.spec import load_study
+    from swarmnav.study.spec import load_study
     if args.workers is not None and args.workers < 1:
         raise ConfigError("--workers", f"must be at least 1, got {args.workers}")
     most = WORKERS_PER_CORE * (os.cpu_count() or 1)
@@ -92,7 +92,7 @@ def run_study(args: argparse.Namespace) -> int:
         if not study.claims:
             raise ConfigError("--claims-only", f"study {study.name!r} has no [[claims]]")
         study = study.claims_only()
-    from swarmnav.sim.study.execute import run_study as execute
+    from swarmnav.study.execute import run_study as execute
     out = args.out or str(FilePath("studies") / study.name)
     try:
         summary = execute(study, out, engine=args.engine, workers=args.workers, address=args.address,
@@ -122,8 +122,8 @@ def _ci_checks(args: argparse.Namespace, study: str, out: str) -> int:
     """``--junit`` and ``--min-success`` over every row of the folder (this run's and earlier ones')."""
     if not args.junit and args.min_success is None:
         return 0
-    from swarmnav.sim.study.junit import success_shortfalls, write_junit
-    from swarmnav.sim.study.rows import read_table
+    from swarmnav.study.junit import success_shortfalls, write_junit
+    from swarmnav.study.rows import read_table
     rows = read_table(out).to_pylist()
     if args.junit:
         write_junit(study, rows, args.junit)
@@ -142,8 +142,8 @@ def add_studies_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run_studies(args: argparse.Namespace) -> int:
-    from swarmnav.sim.study.grid import count_cells
-    from swarmnav.sim.study.spec import list_studies, load_study
+    from swarmnav.study.grid import count_cells
+    from swarmnav.study.spec import list_studies, load_study
     rows = []
     for name in list_studies():
         study = load_study(name)
@@ -179,7 +179,7 @@ def add_report_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _readme_table(args: argparse.Namespace) -> int:
-    from swarmnav.sim.study.readme_table import block, read_documents, replace_block
+    from swarmnav.study.readme_table import block, read_documents, replace_block
     text = block(read_documents(args.readme_table))
     if args.readme:
         path = FilePath(args.readme)
@@ -191,7 +191,7 @@ def _readme_table(args: argparse.Namespace) -> int:
 
 
 def _check_fresh(args: argparse.Namespace) -> int:
-    from swarmnav.sim.study.provenance import check_fresh
+    from swarmnav.study.provenance import check_fresh
     lines, stale, notes = check_fresh(args.check_fresh)
     if args.names:
         print(" ".join(stale))
@@ -217,7 +217,7 @@ def run_report(args: argparse.Namespace) -> int:
         raise ConfigError("--readme", "needs --readme-table")
     if args.dir is None:
         raise ConfigError("dir", "is required (a study's output directory), unless --readme-table")
-    from swarmnav.sim.study.report import write_report
+    from swarmnav.study.report import write_report
     directory = FilePath(args.dir)
     if not (directory / "runs.parquet").is_dir():
         raise ConfigError("dir", "holds no runs.parquet (run `swarmnav study` first)", str(directory))
@@ -229,7 +229,7 @@ def run_report(args: argparse.Namespace) -> int:
     else:
         print(f"report: {html_path}  markdown: {markdown_path}  claims: {claims_path}")
     if args.ompl_log:
-        from swarmnav.sim.study.ompl_log import write_ompl_logs
+        from swarmnav.study.ompl_log import write_ompl_logs
         logs = write_ompl_logs(directory, args.ompl_log)
         print(f"OMPL logs: {len(logs)} in {args.ompl_log}  (ompl_benchmark_statistics {args.ompl_log}/*.log -d bench.db)",
               file=sys.stderr if args.json else sys.stdout)

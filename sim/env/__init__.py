@@ -3,8 +3,8 @@
 Importing this package registers ``swarmnav/Navigate-v0`` with Gymnasium.
 """
 
-from swarmnav.sim.env.gym_adapter import ENV_ID, NavigateEnv
-from swarmnav.sim.env.reward import RewardWeights
-from swarmnav.sim.env.task import EnvOptions, NavigationTask, make_environment
+from swarmnav.env.gym_adapter import ENV_ID, NavigateEnv
+from swarmnav.env.reward import RewardWeights
+from swarmnav.env.task import EnvOptions, NavigationTask, make_environment
 
 __all__ = ["ENV_ID", "EnvOptions", "NavigateEnv", "NavigationTask", "RewardWeights", "make_environment"]

@@ -1,15 +1,15 @@
 """A Gymnasium adapter over the dm_control task: ``swarmnav/Navigate-v0``.
 
-Importing :mod:`swarmnav.sim.env` registers the id, so in a fresh interpreter::
+Importing :mod:`swarmnav.env` registers the id, so in a fresh interpreter::
 
-    env = gymnasium.make("swarmnav.sim.env:swarmnav/Navigate-v0", scenario="gwo-scenario-2")
+    env = gymnasium.make("swarmnav.env:swarmnav/Navigate-v0", scenario="gwo-scenario-2")
 
 (Gymnasium 1.x imports the module before the colon; it does not load plugin
 entry points.)  ``reset(seed=..., options={"scenario": ..., "planner_seed": ..., "world_seed": ...})``:
 ``seed`` seeds ``np_random`` and derives the episode's two seeds
 (:meth:`models.scenario.Seeds.derived`: ``SeedSequence(seed).spawn(2)``, the path
 planner's from the first child, the obstacles' random walks from the second), so
-another ``seed`` gives another world; with ``scenarios=`` (:mod:`sim.env.worlds`) the
+another ``seed`` gives another world; with ``scenarios=`` (:mod:`swarmnav.env.worlds`) the
 seed (or, without one, a draw from ``np_random``) also draws the episode's scenario,
 so every reset is a new world; ``planner_seed`` and ``world_seed`` in
 ``options`` override the derived ones.  ``reset()`` with no seed after a seeded
@@ -36,8 +36,8 @@ from gymnasium import spaces
 from swarmnav.controllers.policy_interface import FLAT_ORDER, flatten_observation
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.seeds import Seeds
-from swarmnav.sim.env.worlds import draw_rng, merged_layout, scenario_source
-from swarmnav.sim.env.task import EnvOptions, NavigationTask, make_environment
+from swarmnav.env.worlds import draw_rng, merged_layout, scenario_source
+from swarmnav.env.task import EnvOptions, NavigationTask, make_environment
 
 ENV_ID = "swarmnav/Navigate-v0"
 RESET_OPTIONS = ("scenario", "planner_seed", "world_seed")
@@ -58,7 +58,7 @@ class NavigateEnv(gymnasium.Env):
         scenario: a bundled scenario name, a path, or a Scenario.
         flatten: observations as one float32 vector in the documented flat order
             (:func:`controllers.policy_interface.flatten_observation`), the ``policy`` navigator's ``flatten``.
-        scenarios: a new world per episode (:mod:`sim.env.worlds`): a list of scenarios or a generator
+        scenarios: a new world per episode (:mod:`swarmnav.env.worlds`): a list of scenarios or a generator
             specification; ``scenario`` is then not used.
         render_mode: None or ``"rgb_array"``.
         width, height, camera: the rendered frames.
@@ -148,7 +148,7 @@ class NavigateEnv(gymnasium.Env):
     def render(self):
         if self.render_mode != "rgb_array":
             return None
-        from swarmnav.sim.video.render import SceneRenderer
+        from swarmnav.video.render import SceneRenderer
         stepper = self.task.stepper
         if self._renderer is None:
             width, height, camera = self._size

@@ -56,9 +56,9 @@ from swarmnav.models.seeds import Seeds
 from swarmnav.sim.episode import EpisodeSpec, plan_episode
 from swarmnav.sim.plugins import load_plugins
 from swarmnav.sim.control_period import control_periods
-from swarmnav.sim.env.observations import action_spec, observation_specs
-from swarmnav.sim.env.reward import RewardWeights
-from swarmnav.sim.runner import Simulation
+from swarmnav.env.observations import action_spec, observation_specs
+from swarmnav.env.reward import RewardWeights
+from swarmnav.sim.simulation import Simulation
 from swarmnav.sim.scene import compile_scene, index_scene
 from swarmnav.sim.stepper import EpisodeStepper
 
@@ -313,7 +313,7 @@ class NavigationTask(control.Task):
     def _open_recorder(self):
         if self.options.record_to is None:
             return None
-        from swarmnav.sim.log.writer import McapRecorder
+        from swarmnav.log.writer import McapRecorder
         return McapRecorder(FilePath(self.options.record_to.replace("{episode}", str(self.episode))), overwrite=True,
                             log_format=self.options.record_format)
 
@@ -329,7 +329,7 @@ def make_environment(scenario: Scenario | str, options: EnvOptions | None = None
     """The dm_env environment of a scenario (a name, a path or a :class:`Scenario`).
 
     ``kwargs`` are :class:`EnvOptions` fields when ``options`` is not given; ``layout`` fixes the
-    observation's entries and bounds (:mod:`sim.env.worlds`: the same spaces across scenarios), else the
+    observation's entries and bounds (:mod:`swarmnav.env.worlds`: the same spaces across scenarios), else the
     scenario's own.  Installed plugins' scenarios and planners are known here (:mod:`swarmnav.sim.plugins`).
     """
     load_plugins()

@@ -159,7 +159,7 @@ class SceneEncoder:
     Args:
         static_entities: the encoded static ``SceneEntity`` messages, in order.
         frame_id: the moving entities' frame.
-        moving: per moving obstacle, its entity id and :func:`sim.log.messages.obstacle_template`.
+        moving: per moving obstacle, its entity id and :func:`swarmnav.log.messages.obstacle_template`.
     """
 
     def __init__(self, static_entities: list[bytes], frame_id: str,

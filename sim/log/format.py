@@ -1,7 +1,7 @@
 """The run log's format: channels, schemas, names, time stamps and the scan convention.
 
-Shared by the writer (:mod:`sim.log.writer`) and the readers (:mod:`sim.log.records`,
-:mod:`sim.log.reader`), so both sides agree on one table.
+Shared by the writer (:mod:`swarmnav.log.writer`) and the readers (:mod:`swarmnav.log.records`,
+:mod:`swarmnav.log.reader`), so both sides agree on one table.
 
 Channels (Foxglove well-known protobuf schemas unless said otherwise):
 
@@ -44,7 +44,7 @@ Channels (Foxglove well-known protobuf schemas unless said otherwise):
 ======================  ===============================================================
 
 Profile ``ros2`` (``--log-format ros2``): CDR messages with ``ros2msg`` schemas of the standard
-ROS 2 types (:mod:`sim.log.ros2_types`), frames after REP 105 (``map`` -> ``odom`` ->
+ROS 2 types (:mod:`swarmnav.log.ros2_types`), frames after REP 105 (``map`` -> ``odom`` ->
 ``base_link``; ``base_scan`` the rangefinders' plane) and units after REP 103:
 
 ======================  ===============================================================

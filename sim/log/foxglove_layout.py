@@ -22,7 +22,7 @@ from importlib import resources
 from pathlib import Path
 
 from swarmnav.sim import palette
-from swarmnav.sim.log.format import (
+from swarmnav.log.format import (
     EVENTS_TOPIC,
     MAP_TOPIC,
     NAVIGATOR_TOPIC,
@@ -88,7 +88,7 @@ def build_layout(log_format: str = "swarmnav") -> str:
 
 def shipped_layout(log_format: str = "swarmnav") -> str:
     """The layout file of the installed package for logs of ``log_format``."""
-    return resources.files("swarmnav.sim.log").joinpath(LAYOUT_FILES[log_format]).read_text()
+    return resources.files("swarmnav.log").joinpath(LAYOUT_FILES[log_format]).read_text()
 
 
 def run(args: argparse.Namespace) -> int:

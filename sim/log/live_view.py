@@ -1,7 +1,7 @@
 """A loopback WebSocket server that shows a run in Foxglove while it happens.
 
 The server is a sink of the same ``foxglove.Context`` as the MCAP file (see
-:class:`sim.log.writer.McapRecorder`), so a viewer sees exactly the messages the
+:class:`swarmnav.log.writer.McapRecorder`), so a viewer sees exactly the messages the
 log gets.  It binds its port when it is created: a busy port is an error before
 any file is opened, so a failed ``--live`` leaves nothing behind.
 """

@@ -3,7 +3,7 @@
 One ``int8`` field ``occupancy`` per cell, as ROS' ``nav_msgs/OccupancyGrid`` holds it: the occupancy
 probability in percent (0..100), -1 where the laser never saw; rows grow with y, columns with x, the
 grid's corner at the arena's origin in the ``world`` frame.  Written at a low rate by the runner
-(``sim.runner.MAP_LOG_PERIOD_S``).
+(``sim.simulation.MAP_LOG_PERIOD_S``).
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ from foxglove.channels import GridChannel
 from foxglove.messages import Grid, PackedElementField, PackedElementFieldNumericType, Pose, Quaternion, Vector2, \
     Vector3
 
-from swarmnav.sim.log.format import MAP_TOPIC, WORLD_FRAME
-from swarmnav.sim.log.messages import stamp
+from swarmnav.log.format import MAP_TOPIC, WORLD_FRAME
+from swarmnav.log.messages import stamp
 
 
 def occupancy_percent(log_odds: np.ndarray) -> np.ndarray:

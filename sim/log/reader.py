@@ -1,8 +1,8 @@
 """Reading run logs back: a run log decoded into NumPy arrays.
 
-Only this module, :mod:`sim.log.records` and the writer know MCAP.  Everything
+Only this module, :mod:`swarmnav.log.records` and the writer know MCAP.  Everything
 else (replay, plot, ``log info``) gets a :class:`RunLog` of NumPy arrays.  The
-records are read by :func:`sim.log.records.read_records`, which survives a file
+records are read by :func:`swarmnav.log.records.read_records`, which survives a file
 cut off anywhere, and streamed into arrays as they are read (:class:`_Decoder`),
 so memory follows the arrays, not the file.  ``plot``, ``log info`` and ``replay``
 read a truncated file as far as it goes, with a warning line
@@ -22,7 +22,7 @@ from google.protobuf.message import DecodeError
 from mcap_protobuf.decoder import DecoderFactory
 from mcap_ros2.decoder import DecoderFactory as Ros2DecoderFactory
 
-from swarmnav.sim.log.format import (
+from swarmnav.log.format import (
     CHANNELS,
     EVENTS_TOPIC,
     LEGACY_CHANNELS,
@@ -35,10 +35,10 @@ from swarmnav.sim.log.format import (
     events_topic,
     metadata_value,
 )
-from swarmnav.sim.log.columns import Rows
-from swarmnav.sim.log.records import LogError, RawLog, RawLogView, read_records
-from swarmnav.sim.log.ros2_reader import Ros2Rows
-from swarmnav.sim.log.run_metadata import checked_run_metadata
+from swarmnav.log.columns import Rows
+from swarmnav.log.records import LogError, RawLog, RawLogView, read_records
+from swarmnav.log.ros2_reader import Ros2Rows
+from swarmnav.log.run_metadata import checked_run_metadata
 
 
 # -- decoding into arrays ------------------------------------------------------
@@ -108,7 +108,7 @@ def _decoder_for(raw: RawLog, channel: Channel, protobuf: DecoderFactory) -> Cal
 def event_decoder(raw: RawLog, channel: Channel,
                   protobuf: DecoderFactory | None = None) -> Callable[[bytes], tuple[str, dict[str, Any]]]:
     """Bytes of an ``/events`` message to (kind, details): a ``foxglove.Log`` whose message is
-    :func:`sim.log.format.event_text`, or the JSON ``swarmnav.Event`` of older logs."""
+    :func:`swarmnav.log.format.event_text`, or the JSON ``swarmnav.Event`` of older logs."""
     decode = _decoder_for(raw, channel, protobuf or DecoderFactory())
     if channel.message_encoding == "json":
         def legacy(data: bytes) -> tuple[str, dict[str, Any]]:
@@ -151,7 +151,7 @@ def check_channels(raw: RawLog) -> None:
 
 
 class _Decoder:
-    """Turns each message, as it is read, into rows of numbers (:class:`sim.log.columns.Rows`).
+    """Turns each message, as it is read, into rows of numbers (:class:`swarmnav.log.columns.Rows`).
 
     Nothing decoded is kept as a message object: memory is the numbers of the
     arrays a :class:`RunLog` holds, for a log of any length.

@@ -98,8 +98,8 @@ class RawLog:
 
 
 class RawLogView:
-    """What a log read either way (:class:`~swarmnav.sim.log.reader.RunLog`, the streamed
-    :class:`~swarmnav.sim.log.summary.LogSummary`) says from its :class:`RawLog` alone."""
+    """What a log read either way (:class:`~swarmnav.log.reader.RunLog`, the streamed
+    :class:`~swarmnav.log.summary.LogSummary`) says from its :class:`RawLog` alone."""
 
     raw: RawLog
     metadata: dict[str, dict[str, str]]  # the run's metadata (a field of RunLog, read from ``raw`` by LogSummary)

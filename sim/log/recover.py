@@ -10,7 +10,7 @@ from mcap.writer import CompressionType, Writer
 
 from swarmnav.models.contained_files import check_output_target
 from swarmnav.models.errors import ConfigError
-from swarmnav.sim.log.records import RawLog, read_records
+from swarmnav.log.records import RawLog, read_records
 
 
 def recover_log(source: str | Path, target: str | Path) -> RawLog:

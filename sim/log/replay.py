@@ -2,19 +2,19 @@
 
 ``--video out.mp4`` rebuilds the scene from the MJCF attached to the log, poses
 the robot (free joint) and the moving obstacles (mocap bodies) from the log frame
-by frame, and renders offscreen (see :mod:`sim.video.render`) through the same
-:class:`sim.video.render.VideoRecorder` that ``swarmnav run --video`` uses.
+by frame, and renders offscreen (see :mod:`swarmnav.video.render`) through the same
+:class:`swarmnav.video.render.VideoRecorder` that ``swarmnav run --video`` uses.
 
 ``--verify`` re-simulates from what the log holds (scenario TOML, planner name and
 parameters, seed, and the attached MJCF, not today's model files) and compares
 every logged pose and range scan with the re-simulated one (the comparison and
-its verdict are :mod:`sim.log.verify_report`).  On the same machine and versions we
+its verdict are :mod:`swarmnav.log.verify_report`).  On the same machine and versions we
 expect bitwise equality; otherwise the largest deviation is reported and where it
 first appeared.  A log that ends early (killed, interrupted, recovered, or a file
 without its footer, read as far as it goes with a warning line) passes when every
 step it holds is equal: "prefix bitwise equal, the log ends at t = ...".
 
-Both stream the log (:func:`sim.log.reader.read_log`): memory is the arrays of
+Both stream the log (:func:`swarmnav.log.reader.read_log`): memory is the arrays of
 numbers the comparison or the frames need, not the log's messages.
 """
 
@@ -30,13 +30,13 @@ import numpy as np
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim.defaults import DEFAULT_FPS
-from swarmnav.sim.log.format import ranges_from_scan
-from swarmnav.sim.log.reader import RunLog, read_log, truncation_advice
-from swarmnav.sim.log.records import LogError
-from swarmnav.sim.log.scene_guard import compile_log_scene
+from swarmnav.log.format import ranges_from_scan
+from swarmnav.log.reader import RunLog, read_log, truncation_advice
+from swarmnav.log.records import LogError
+from swarmnav.log.scene_guard import compile_log_scene
 from swarmnav.models.contained_files import loads_json
 from swarmnav.sim.recording import ObstacleInfo, RunContext, StepFrame
-from swarmnav.sim.log.verify_report import TrajectoryCapture, VerifyReport, compare_with_log
+from swarmnav.log.verify_report import TrajectoryCapture, VerifyReport, compare_with_log
 
 
 EXIT_DIFFERENT = 4  # replay --verify: the re-simulation differs from the log
@@ -55,7 +55,7 @@ def _params(log: RunLog, record: str) -> dict:
 
 def context_from_log(log: RunLog) -> RunContext:
     """The :class:`RunContext` a log was written with (as far as a renderer needs it); its scene is checked
-    and compiled once here (:func:`sim.log.scene_guard.compile_log_scene`), so a scene from elsewhere that
+    and compiled once here (:func:`swarmnav.log.scene_guard.compile_log_scene`), so a scene from elsewhere that
     reaches beyond itself is refused before anything renders or re-simulates."""
     compile_log_scene(log.mjcf_xml, str(log.raw.path))
     planner = log.metadata.get("planner", {})
@@ -134,7 +134,7 @@ def frames_from_log(log: RunLog) -> Iterator[StepFrame]:
 def render_log(log: RunLog, video_path: str | Path, *, camera: str = "top", width: int = 640,
                height: int = 480, fps: float = DEFAULT_FPS, trail: bool = True) -> dict[str, float]:
     """Render a log to MP4; returns frame count, video and render seconds."""
-    from swarmnav.sim.video.render import VideoRecorder  # EGL only when a video is asked for
+    from swarmnav.video.render import VideoRecorder  # EGL only when a video is asked for
 
     recorder = VideoRecorder(video_path, camera=camera, width=width, height=height, fps=fps, trail=trail)
     recorder.start(context_from_log(log))
@@ -230,7 +230,7 @@ def run(args: argparse.Namespace) -> int:
     if (args.navigator_set or args.trust_code) and not args.verify:
         raise ConfigError("--navigator-set" if args.navigator_set else "--trust-code", "needs --verify")
     if args.video:
-        from swarmnav.sim.video.render import check_video_size
+        from swarmnav.video.render import check_video_size
         check_video_size(args.width, args.height, args.fps)
     log = read_log(args.log, allow_truncated=True)  # as plot and log info: what was recovered, with a warning
     if not log.complete:

@@ -1,6 +1,6 @@
-"""Decoded messages of a ``ros2`` log into the rows a :class:`sim.log.reader.RunLog` is made of.
+"""Decoded messages of a ``ros2`` log into the rows a :class:`swarmnav.log.reader.RunLog` is made of.
 
-The reader (:mod:`sim.log.reader`) decodes each CDR message with ``mcap-ros2-support``'s
+The reader (:mod:`swarmnav.log.reader`) decodes each CDR message with ``mcap-ros2-support``'s
 decoder and hands it here with its topic; :class:`Ros2Rows` appends the numbers to the
 same rows the ``swarmnav`` profile's messages fill, so everything after the reader
 (``plot``, ``replay``, ``log info``) reads both profiles alike.
@@ -19,8 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from swarmnav.sim.log.columns import Rows
-from swarmnav.sim.log.format import BASE_FRAME, MAP_FRAME, ODOM_FRAME, ROS2_EVENTS_TOPIC
+from swarmnav.log.columns import Rows
+from swarmnav.log.format import BASE_FRAME, MAP_FRAME, ODOM_FRAME, ROS2_EVENTS_TOPIC
 
 
 def _multiply(a: tuple, b: tuple) -> tuple[float, float, float, float]:
@@ -72,7 +72,7 @@ class Ros2Rows:
                     continue
                 last[0] = t
                 track.append((t, marker.pose.position.x, marker.pose.position.y))
-        elif topic == ROS2_EVENTS_TOPIC:  # decoded by sim.log.reader.event_decoder: (kind, details)
+        elif topic == ROS2_EVENTS_TOPIC:  # decoded by swarmnav.log.reader.event_decoder: (kind, details)
             kind, details = d
             rows.events.append((t, kind, details))
 

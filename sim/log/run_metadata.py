@@ -14,7 +14,7 @@ from swarmnav.models.contained_files import loads_json
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import MAP_KNOWLEDGE, POSE_SOURCES
 from swarmnav.models.scenario_limits import MAX_MOVING_OBSTACLES, MAX_SENSORS, MAX_STATIC_OBSTACLES
-from swarmnav.sim.log.records import LogError
+from swarmnav.log.records import LogError
 
 MAX_SEED = 2**63 - 1
 

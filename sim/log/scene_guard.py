@@ -20,7 +20,7 @@ import xml.etree.ElementTree as ElementTree
 
 from swarmnav.models.scenario_limits import (MAX_INPUT_FILE_BYTES, MAX_MOVING_OBSTACLES, MAX_NESTING_DEPTH,
                                              MAX_STATIC_OBSTACLES)
-from swarmnav.sim.log.records import LogError
+from swarmnav.log.records import LogError
 
 MAX_SCENE_PIXELS_SIDE = 8_192  # a texture's or an offscreen buffer's side (video frames are at most 4,096)
 MAX_SCENE_ELEMENTS = 4 * (MAX_STATIC_OBSTACLES + MAX_MOVING_OBSTACLES) + 1_000  # bodies, geoms, sensors...

@@ -9,7 +9,7 @@ A damaged chunk inside a file whose summary is intact is therefore not noticed
 here; ``plot``, ``replay`` and ``log recover``, which read every message, report it.
 
 A file without a usable summary (cut off by a killed run, or written without one)
-is walked record by record instead (:func:`sim.log.records.read_records`),
+is walked record by record instead (:func:`swarmnav.log.records.read_records`),
 decoding only its ``/events`` messages: what was recovered, with the file marked
 incomplete so the caller can warn.
 """
@@ -24,15 +24,15 @@ from typing import Any
 from mcap.reader import SeekingReader
 from mcap.records import Message
 
-from swarmnav.sim.log.format import events_topic, metadata_value
-from swarmnav.sim.log.reader import check_channels, check_has_steps, event_decoder
-from swarmnav.sim.log.records import LogError, RawLog, RawLogView, open_regular, read_records
-from swarmnav.sim.log.run_metadata import checked_run_metadata
+from swarmnav.log.format import events_topic, metadata_value
+from swarmnav.log.reader import check_channels, check_has_steps, event_decoder
+from swarmnav.log.records import LogError, RawLog, RawLogView, open_regular, read_records
+from swarmnav.log.run_metadata import checked_run_metadata
 
 
 @dataclass
 class LogSummary(RawLogView):
-    """The facts ``log info`` prints (the attributes :func:`sim.cli.log.describe` reads)."""
+    """The facts ``log info`` prints (the attributes :func:`swarmnav.cli.log.describe` reads)."""
 
     raw: RawLog  # schemas, channels, metadata, counts; no messages
     events: list[tuple[float, str, dict[str, Any]]]

@@ -1,9 +1,9 @@
 """The channels of a log of profile ``swarmnav``: Foxglove's protobuf schemas and JSON.
 
-What :class:`sim.log.writer.McapRecorder` writes on each channel when ``log_format`` is
-``swarmnav`` (the default); the table of channels is in :mod:`sim.log.format`.  The
-per-step protobuf messages are encoded by :mod:`sim.log.encoding`, the rest built by
-:mod:`sim.log.messages`.
+What :class:`swarmnav.log.writer.McapRecorder` writes on each channel when ``log_format`` is
+``swarmnav`` (the default); the table of channels is in :mod:`swarmnav.log.format`.  The
+per-step protobuf messages are encoded by :mod:`swarmnav.log.encoding`, the rest built by
+:mod:`swarmnav.log.messages`.
 """
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ import numpy as np
 from foxglove.channels import LogChannel, PoseInFrameChannel, PosesInFrameChannel, SceneUpdateChannel
 from foxglove.messages import FrameTransform, LaserScan, Pose, PoseInFrame, PosesInFrame, SceneUpdate, Vector3
 
-from swarmnav.sim.log.encoding import SceneEncoder, StepEncoder, timestamp_field
-from swarmnav.sim.log.map_channel import MapChannel
-from swarmnav.sim.log.format import (
+from swarmnav.log.encoding import SceneEncoder, StepEncoder, timestamp_field
+from swarmnav.log.map_channel import MapChannel
+from swarmnav.log.format import (
     BASE_FRAME,
     CONTROLLER_SCHEMA,
     EVENTS_TOPIC,
@@ -29,8 +29,9 @@ from swarmnav.sim.log.format import (
     WORLD_FRAME,
     scan_list_from_ranges,
 )
-from swarmnav.sim.log.messages import (
+from swarmnav.log.messages import (
     belief_update,
+    chassis_box_m,
     chassis_radius_m,
     controller_json,
     event_log,
@@ -65,7 +66,7 @@ class SwarmnavChannels:
     def open(self, fox: foxglove.Context, context: RunContext) -> None:
         """Make the channels (before the run's metadata is written)."""
         self._fox = fox
-        # The per-step protobuf channels take bytes from a StepEncoder (sim.log.encoding): the SDK's
+        # The per-step protobuf channels take bytes from a StepEncoder (swarmnav.log.encoding): the SDK's
         # schemas and encoding, without building its message objects every step.
         self._tf, self._pose = (
             foxglove.Channel(topic, schema=message.get_schema(), message_encoding="protobuf", context=fox)
@@ -96,7 +97,8 @@ class SwarmnavChannels:
         self._scene = SceneEncoder(static_entities, WORLD_FRAME,
                                    [(o.entity_id, obstacle_template(o)) for o in self._moving_infos])
         self._obstacles.base.log(self._scene_update(0, None), 0, None)
-        self._scene_message = scene_update(context.arena_size_m, chassis_radius_m(context.mjcf_xml))
+        self._scene_message = scene_update(context.arena_size_m, chassis_radius_m(context.mjcf_xml),
+                                           chassis_box_m(context.mjcf_xml))
         self._scene_channel.log(self._scene_message, log_time=0)
         return 2
 
@@ -155,7 +157,7 @@ class SwarmnavChannels:
         return 1
 
     def occupancy(self, t_ns: int, grid: Any) -> int:
-        """``/map``: the sensed map (:mod:`sim.log.map_channel`; the channel made at the first)."""
+        """``/map``: the sensed map (:mod:`swarmnav.log.map_channel`; the channel made at the first)."""
         if self._map is None:
             self._map = MapChannel(self._fox)
         self._map.log(t_ns, grid)

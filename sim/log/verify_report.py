@@ -2,7 +2,7 @@
 
 :class:`TrajectoryCapture` records what the re-simulation did; :func:`compare_with_log`
 compares it step by step with the log: every pose (position and quaternion), every
-range scan (in the log's own convention, :func:`sim.log.format.scan_from_ranges`),
+range scan (in the log's own convention, :func:`swarmnav.log.format.scan_from_ranges`),
 the time stamps and the planned path.  All must be bitwise equal to pass.
 
 A log that stops before its run did (killed, interrupted, recovered from a cut
@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarmnav.sim.log.columns import Rows
-from swarmnav.sim.log.format import ROS2_PROFILE, scan_from_ranges
-from swarmnav.sim.log.reader import RunLog, outcome_text
+from swarmnav.log.columns import Rows
+from swarmnav.log.format import ROS2_PROFILE, scan_from_ranges
+from swarmnav.log.reader import RunLog, outcome_text
 from swarmnav.sim.recording import RunContext, StepFrame
 
 # Outcomes of a run that reached its natural end; any other log stops early.
@@ -90,7 +90,7 @@ class VerifyReport:
 
 class TrajectoryCapture:
     """A Recorder that keeps the time, base pose and ranges of every step, as rows of numbers
-    (:class:`sim.log.columns.Rows`: a long run costs its numbers, not an object per step)."""
+    (:class:`swarmnav.log.columns.Rows`: a long run costs its numbers, not an object per step)."""
 
     def __init__(self) -> None:
         self._poses = Rows(8)  # t, x, y, z, qw, qx, qy, qz

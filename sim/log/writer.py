@@ -2,12 +2,12 @@
 
 One :class:`McapRecorder` per run.  It owns one ``foxglove.Context``; the MCAP
 file and, with ``live=True``, a loopback WebSocket server for Foxglove
-(:mod:`sim.log.live_view`) are both sinks of that context, so they see exactly the
-same messages.  The channels, time stamps and names are in :mod:`sim.log.format`.
+(:mod:`swarmnav.log.live_view`) are both sinks of that context, so they see exactly the
+same messages.  The channels, time stamps and names are in :mod:`swarmnav.log.format`.
 
 ``log_format`` picks the channels, the file's one seam between formats: ``swarmnav``
-(:class:`sim.log.swarmnav_channels.SwarmnavChannels`, Foxglove's protobuf schemas, the
-default) or ``ros2`` (:class:`sim.log.ros2_channels.Ros2Channels`, CDR messages of the
+(:class:`swarmnav.log.swarmnav_channels.SwarmnavChannels`, Foxglove's protobuf schemas, the
+default) or ``ros2`` (:class:`swarmnav.log.ros2_channels.Ros2Channels`, CDR messages of the
 standard ROS 2 types, MCAP profile ``ros2``).  Everything else here (the file, the
 metadata, the attachment, flushing, the live view, pacing) is the same for both.
 
@@ -15,12 +15,12 @@ Metadata records: ``scenario`` (name, TOML text), ``planner`` and ``navigator`` 
 ``run`` (seed, world seed, time steps, sensor layout, obstacles), ``versions`` and, from
 ``finish``, ``outcome`` (the runner's summary).  Values are plain text where they are
 strings (Foxglove shows ``goal_reached``, not ``"goal_reached"``) and JSON where they are
-numbers, booleans, lists or objects (:func:`sim.log.format.metadata_text`).  Attachment:
+numbers, booleans, lists or objects (:func:`swarmnav.log.format.metadata_text`).  Attachment:
 ``scene.xml``, the compiled MJCF.  Everything needed to re-simulate is in the file.
 
 The writer is the foxglove SDK with ``disable_seeking=True``, so the file is
 written strictly front to back and a killed process never leaves a
-half-rewritten chunk header behind.  It writes into a :class:`sim.log.file.LogFile`,
+half-rewritten chunk header behind.  It writes into a :class:`swarmnav.log.file.LogFile`,
 so a failure to open or to write (a full disk) is an ``OSError`` naming the file.
 ``flush`` closes the current chunk; we flush at least once per simulated second
 (``flush_interval_s``), so a SIGKILL loses at most that much and ``swarmnav log
@@ -37,9 +37,9 @@ import foxglove
 import numpy as np
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
-from swarmnav.sim.log.live_view import DEFAULT_LIVE_HOST, DEFAULT_LIVE_PORT, LiveServer
-from swarmnav.sim.log.file import LogFile
-from swarmnav.sim.log.format import (
+from swarmnav.log.live_view import DEFAULT_LIVE_HOST, DEFAULT_LIVE_PORT, LiveServer
+from swarmnav.log.file import LogFile
+from swarmnav.log.format import (
     LOG_FORMATS,
     MJCF_ATTACHMENT,
     TOPICS,
@@ -49,13 +49,13 @@ from swarmnav.sim.log.format import (
     time_ns,
     writer_versions,
 )
-from swarmnav.sim.log.messages import run_metadata
-from swarmnav.sim.log.pacing import RealTimePacer
-from swarmnav.sim.log.ros2_channels import Ros2Channels
-from swarmnav.sim.log.swarmnav_channels import SwarmnavChannels
+from swarmnav.log.messages import run_metadata
+from swarmnav.log.pacing import RealTimePacer
+from swarmnav.log.ros2_channels import Ros2Channels
+from swarmnav.log.swarmnav_channels import SwarmnavChannels
 from swarmnav.sim.recording import RunContext, StepFrame
 
-# TOPICS and default_log_path live in sim.log.format; re-exported for existing callers.
+# TOPICS and default_log_path live in swarmnav.log.format; re-exported for existing callers.
 __all__ = ["McapRecorder", "TOPICS", "default_log_path"]
 
 ZSTD_LEVEL = 1  # chunk compression level (see start)
@@ -90,11 +90,11 @@ class McapRecorder:
             port 0 picks a free one, see :attr:`live_port_bound`).
         live_speed: with ``live``, hold the run to this multiple of real time so a
             viewer can follow it (``None`` or 0: as fast as it goes), through a
-            :class:`sim.log.pacing.RealTimePacer`.
+            :class:`swarmnav.log.pacing.RealTimePacer`.
         on_live: called with the server's URL once it listens (the caller prints it;
             the recorder never prints).
         overwrite: replace an existing file instead of refusing.
-        log_format: ``swarmnav`` or ``ros2`` (:data:`sim.log.format.LOG_FORMATS`).
+        log_format: ``swarmnav`` or ``ros2`` (:data:`swarmnav.log.format.LOG_FORMATS`).
 
     Errors: ``start`` raises ``ConfigError`` for a live port it cannot serve
     (before the file exists) and ``OSError`` (with the file name) when the file

@@ -4,5 +4,5 @@
 through the one episode function, ``engines`` runs many (local processes or Ray),
 ``rows`` writes and reads the Parquet tables, ``statistics`` and ``report`` turn the
 rows into tables, tests and plots.  The ``study``, ``studies`` and ``report``
-subcommands are in :mod:`sim.cli.study`.
+subcommands are in :mod:`swarmnav.cli.study`.
 """

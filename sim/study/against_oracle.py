@@ -1,7 +1,7 @@
 """The report's navigation section: each navigator against the clairvoyant oracle, over a study's dynamic scenes.
 
 Read from the rows alone (their ``oracle_verdict``, ``time_score`` and difficulty columns, added when the study
-ran: :mod:`sim.study.yardstick`).  Per navigator (per arm where a scenario has several planners): every run in
+ran: :mod:`swarmnav.study.yardstick`).  Per navigator (per arm where a scenario has several planners): every run in
 ``success`` and ``SPL`` (failures count, as everywhere in the report); the oracle-solvable runs alone in the
 share solved and the mean time score (BARN's, Perille et al. 2020), so a scene the oracle calls unsolvable, or
 could not decide, never counts against a navigator.  The figure sets each navigator's success on the
@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from swarmnav.sim.study.statistics import arm
-from swarmnav.sim.study.tables import Table
+from swarmnav.study.statistics import arm
+from swarmnav.study.tables import Table
 
 FIGURE_METRIC = "dynamic_traversability"
 FIGURE_BINS = 5
@@ -112,7 +112,7 @@ def success_figure(runs: list[dict[str, Any]], metric: str = FIGURE_METRIC):
     None when no row has the metric."""
     import matplotlib.pyplot as plt
     from swarmnav.sim import palette
-    from swarmnav.sim.study.figures import MAX_WIDTH_IN
+    from swarmnav.study.figures import MAX_WIDTH_IN
     found = binned_success(runs, metric)
     if found is None:
         return None

@@ -32,7 +32,7 @@ from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.swarm import Budget
 from swarmnav.sim.plugins import load_plugins
 from swarmnav.sim.episode import EpisodeSpec, compose, json_safe, plan_episode, resolved_params, run_episode
-from swarmnav.sim.study.grid import Cell
+from swarmnav.study.grid import Cell
 from swarmnav.sim.trajectory_metrics import bends, count_turns
 from swarmnav.sim.versions import software_versions
 
@@ -41,6 +41,7 @@ EXTRA_COLUMNS = {"raw_length_m": "plan_raw_length_m",  # the tour before shortcu
                  "gates_raised": "plan_gates_raised",  # IMMAS (Hasan et al. 2023), GateRaiseState
                  "tunnels_closed": "plan_tunnels_closed",  # IMMAS, Algorithm 2 (tight tunnels)
                  "total_arc_cost": "plan_arc_cost",  # IMMAS, the arc cost of its tour
+                 "map_arc_cost": "plan_map_arc_cost",  # IMMAS and MMAS: the tour's arc cost on the map as given
                  "moves": "plan_moves",  # grid planners: cell moves of the raw tour (IMMAS's Table 1 iterations)
                  "mean_cell_clearance_m": "plan_cell_clearance_m",  # grid planners: mean obstacle distance of the cells
                  "nodes_visited": "plan_nodes_visited"}  # M-ACO (Habib et al. 2021): random nodes on the route
@@ -185,7 +186,7 @@ def run_cell(cell: Cell, logs_dir: str | None = None,
                 tally = EventTally()
                 recorders = [tally]
                 if logs_dir is not None:
-                    from swarmnav.sim.log.writer import McapRecorder
+                    from swarmnav.log.writer import McapRecorder
                     log_path = FilePath(logs_dir) / f"{cell.config_hash}.mcap"
                     recorders.append(McapRecorder(log_path, overwrite=True, log_format=log_format))
                     row["log"] = str(log_path)

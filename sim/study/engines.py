@@ -1,7 +1,7 @@
 """Engines that run study cells: separate local processes, or Ray tasks (``ray_engine``), or, for the
 benchmarks, this process.
 
-Every engine calls the same :func:`swarmnav.sim.study.cell.run_cell` and yields
+Every engine calls the same :func:`swarmnav.study.cell.run_cell` and yields
 each cell's ``(row, progress)`` as it finishes (in finishing order).  Workers run
 with one thread for NumPy's BLAS and OpenMP and ``MUJOCO_GL`` set (no rendering
 happens in workers), set in the environment the workers start with, so it holds
@@ -34,8 +34,8 @@ from multiprocessing.connection import wait as wait_any
 from typing import Any, Iterable, Iterator
 
 from swarmnav.sim.defaults import SINGLE_THREAD_ENVIRONMENT
-from swarmnav.sim.study.cell import ComponentMissing, _versions_json, base_row, run_cell
-from swarmnav.sim.study.grid import Cell
+from swarmnav.study.cell import ComponentMissing, _versions_json, base_row, run_cell
+from swarmnav.study.grid import Cell
 
 PARENT_POLL_S = 0.5
 BATCH_TARGET_S = 0.25  # a batch of short cells takes about this long on a worker

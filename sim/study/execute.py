@@ -22,13 +22,13 @@ from typing import Any, Iterator, TextIO
 from swarmnav.models.contained_files import check_no_link, folder as contained_folder, loads_json, replace_file
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import load_scenario
-from swarmnav.sim.study.engines import run_inline, run_local
-from swarmnav.sim.study.grid import Cell, count_cells, iter_cells
-from swarmnav.sim.study.lock import FolderLock
-from swarmnav.sim.study.main_guard import check_main_guard
-from swarmnav.sim.study.rows import RowWriter, compact, done_hashes, read_table
-from swarmnav.sim.study.spec import Study, study_from_tables
-from swarmnav.sim.study.yardstick import Yardstick
+from swarmnav.study.engines import run_inline, run_local
+from swarmnav.study.grid import Cell, count_cells, iter_cells
+from swarmnav.study.lock import FolderLock
+from swarmnav.study.main_guard import check_main_guard
+from swarmnav.study.rows import RowWriter, compact, done_hashes, read_table
+from swarmnav.study.spec import Study, study_from_tables
+from swarmnav.study.yardstick import Yardstick
 
 METADATA = "study.json"
 
@@ -48,7 +48,7 @@ def scenario_geometry(ref: str, world_seed: int | None = None) -> dict[str, Any]
 
 def _scenario_entry(ref: str, world_seed: int | None, study: Study) -> dict[str, Any]:
     """The geometry of one scenario and what the report's anytime and path figures need of it."""
-    from swarmnav.sim.study.scenario_facts import scenario_facts
+    from swarmnav.study.scenario_facts import scenario_facts
     scenario = load_scenario(ref)
     if world_seed is not None:
         scenario = scenario.with_world_seed(world_seed)
@@ -56,7 +56,7 @@ def _scenario_entry(ref: str, world_seed: int | None, study: Study) -> dict[str,
 
 
 def study_metadata(study: Study) -> dict[str, Any]:
-    from swarmnav.sim.study.provenance import study_inputs
+    from swarmnav.study.provenance import study_inputs
     world_seed = study.world_seeds[0]
     return {"inputs": study_inputs(study), "claims": [c.as_dict() for c in study.claims], "name": study.name, "description": study.description, "source": study.source, "mode": study.mode,
             "reference": study.reference, "planners": [p.label for p in study.planners],
@@ -91,7 +91,7 @@ def resumed_inputs(old: dict[str, Any] | None, new: dict[str, Any], out_dir: Fil
     scenarios or a swarmnav version that have changed since; then the old record stays (with today's study
     file, whose claims and comments decide no row, and the files of newly used components added), so that
     ``report --check-fresh`` calls the mixed rows stale, and a warning says to start the folder afresh."""
-    from swarmnav.sim.study.provenance import stale_inputs
+    from swarmnav.study.provenance import stale_inputs
     if not old or not (out_dir / "runs.parquet").exists():
         return new
     changes = [c for c in stale_inputs(old, new)[0] if not c.startswith("study file")
@@ -148,7 +148,7 @@ def run_study(study: Study, out_dir: str | os.PathLike, *, engine: str = "local"
     if engine == "local":
         check_main_guard()  # a script's unguarded top level: each spawned worker would run it again
     if engine == "ray" and address:
-        from swarmnav.sim.study.ray_engine import check_reachable
+        from swarmnav.study.ray_engine import check_reachable
         check_reachable(address)  # before anything is written
     with FolderLock(out_dir):
         return _run_locked(study, out_dir, engine, workers, address, logs, show_progress, retry_errors)
@@ -163,7 +163,7 @@ def _run_locked(study: Study, out_dir: FilePath, engine: str, workers: int | Non
     log_format = logs if isinstance(logs, str) else "swarmnav"
     nodes: set[str] = set()
     if engine == "ray":
-        from swarmnav.sim.study.ray_engine import run_ray
+        from swarmnav.study.ray_engine import run_ray
         results: Iterator = run_ray(todo, address, None if address else workers, logs_dir, nodes, log_format)
     elif engine == "inline":
         results = run_inline(todo, logs_dir, log_format)

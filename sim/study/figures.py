@@ -21,8 +21,8 @@ from matplotlib.collections import LineCollection, PatchCollection  # noqa: E402
 from matplotlib.ticker import NullFormatter  # noqa: E402
 
 from swarmnav.sim import palette  # noqa: E402
-from swarmnav.sim.study import anytime  # noqa: E402
-from swarmnav.sim.study.statistics import OUTCOME_CLASSES, outcome_class, values  # noqa: E402
+from swarmnav.study import anytime  # noqa: E402
+from swarmnav.study.statistics import OUTCOME_CLASSES, outcome_class, values  # noqa: E402
 
 PNG_DPI = 200
 MAX_WIDTH_IN = 10.0

@@ -15,7 +15,7 @@ from pathlib import Path as FilePath
 from typing import Any, Iterator
 
 from swarmnav.models.scenario import resolve_scenario_path
-from swarmnav.sim.study.spec import Component, Study
+from swarmnav.study.spec import Component, Study
 
 
 @dataclass(frozen=True)

@@ -43,8 +43,8 @@ from typing import Any
 import numpy as np
 
 from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
-from swarmnav.sim.study.report import ordered_runs
-from swarmnav.sim.study.rows import PROGRESS, RUNS, read_table
+from swarmnav.study.report import ordered_runs
+from swarmnav.study.rows import PROGRESS, RUNS, read_table
 
 RUN_PROPERTIES = (("time", "REAL"), ("solved", "BOOLEAN"), ("correct solution", "BOOLEAN"),
                   ("solution length", "REAL"), ("solution segments", "INTEGER"), ("solution clearance", "REAL"),

@@ -119,7 +119,7 @@ def component_files(study) -> list[FilePath]:
     ``--claims-only``: those of the arms its claims compare)."""
     from swarmnav.controllers.navigators import NAVIGATORS
     from swarmnav.planners.registry import PLANNERS
-    from swarmnav.sim.study.claim_spec import arm_labels
+    from swarmnav.study.claim_spec import arm_labels
     wanted = None if study.claim_arms is None else {label for _, label, _ in study.claim_arms}
     planners = [p for p in study.planners if wanted is None or set(arm_labels([p])) & wanted]
     files = [_class_file(PLANNERS[p.name]) for p in planners if p.name in PLANNERS]
@@ -202,8 +202,8 @@ def check_fresh(paths: list[str]) -> tuple[list[str], list[str], list[str]]:
     """Every ``claims.json`` under ``paths`` (as ``--readme-table`` reads them) against today's inputs of its
     study: (one line per stale study naming its claims and what changed, the stale studies' names, notes)."""
     from swarmnav.models.errors import ConfigError
-    from swarmnav.sim.study.readme_table import read_documents
-    from swarmnav.sim.study.spec import load_study
+    from swarmnav.study.readme_table import read_documents
+    from swarmnav.study.spec import load_study
     lines, stale, notes = [], [], []
     for document in read_documents(paths):
         name = document.get("study", "?")

@@ -34,9 +34,9 @@ from typing import Any, Iterable, Iterator
 from swarmnav.models.contained_files import check_no_link, folder as contained_folder, open_in_folder
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim.plugins import distributions
-from swarmnav.sim.study.cell import ComponentMissing, _versions_json, run_cell
-from swarmnav.sim.study.engines import BATCHES_IN_FLIGHT, BatchSizer, Result, died_row, worker_environment
-from swarmnav.sim.study.grid import Cell
+from swarmnav.study.cell import ComponentMissing, _versions_json, run_cell
+from swarmnav.study.engines import BATCHES_IN_FLIGHT, BatchSizer, Result, died_row, worker_environment
+from swarmnav.study.grid import Cell
 
 RAY_AUTH_LOGGER = "ray._private.authentication.authentication_token_setup"
 TRIES = 1  # Ray's max_retries = 0: one try per task

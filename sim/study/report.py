@@ -18,14 +18,14 @@ import re
 from pathlib import Path as FilePath
 from typing import Any
 
-from swarmnav.sim.study import against_oracle, anytime, figures
-from swarmnav.sim.study.claim_spec import Claim
-from swarmnav.sim.study.claims import claims_document
-from swarmnav.sim.study.report_tables import (claims_table, count_table, merge_identical, paper_values_table,
+from swarmnav.study import against_oracle, anytime, figures
+from swarmnav.study.claim_spec import Claim
+from swarmnav.study.claims import claims_document
+from swarmnav.study.report_tables import (claims_table, count_table, merge_identical, paper_values_table,
                                               statistics_section, summary_tables)
-from swarmnav.sim.study.rows import load_progress_rows, load_runs
-from swarmnav.sim.study.statistics import by_scenario, paper_table
-from swarmnav.sim.study.tables import Table
+from swarmnav.study.rows import load_progress_rows, load_runs
+from swarmnav.study.statistics import by_scenario, paper_table
+from swarmnav.study.tables import Table
 
 CLAIMS_FILE = "claims.json"
 STYLE = ("body{font-family:sans-serif;max-width:1200px;margin:auto;padding:0 12px}"
@@ -139,8 +139,8 @@ def ordered_runs(runs: list[dict[str, Any]], meta: dict[str, Any]) -> list[dict[
 def _driven(arms: dict[str, list[dict[str, Any]]]) -> tuple[dict[str, tuple], str]:
     """The driven trajectory and collision points of each arm's path-figure run, read from its MCAP log
     (kept by ``swarmnav study --logs``); and a sentence saying where there were none."""
-    from swarmnav.sim.log.reader import read_log
-    from swarmnav.sim.plot import collision_points_m
+    from swarmnav.log.reader import read_log
+    from swarmnav.log.plot import collision_points_m
     out, missing = {}, []
     for name, rows in arms.items():
         ok = sorted((r for r in rows if r.get("plan_waypoints")), key=lambda r: (r["seed"], str(r["world_seed"])))

@@ -1,4 +1,4 @@
-"""The report's tables of one scenario (and of the claims), as :class:`~swarmnav.sim.study.tables.Table`:
+"""The report's tables of one scenario (and of the claims), as :class:`~swarmnav.study.tables.Table`:
 wide tables, one row per arm (planner, with its navigator when not plain follow), metrics as columns with
 their units."""
 
@@ -7,16 +7,16 @@ from __future__ import annotations
 import json
 from typing import Any
 
-from swarmnav.sim.study.statistics import (OUTCOME_CLASSES, arm_counts, compare, compare_success, friedman,
+from swarmnav.study.statistics import (OUTCOME_CLASSES, arm_counts, compare, compare_success, friedman,
                                            impossible, summarise, values)
-from swarmnav.sim.study.tables import Pair, Table
+from swarmnav.study.tables import Pair, Table
 
 # (column, header with unit) of the wide summary tables, in this order where the runs have them.
 METRICS = (("plan_length_m", "plan length (m)"), ("plan_time_s", "plan time (s)"),
            ("plan_evaluations", "evaluations"), ("plan_iterations", "iterations"),
            ("plan_convergence_iteration", "convergence iteration"), ("plan_bends", "bends"),
            ("plan_raw_length_m", "raw length (m)"), ("plan_gates_raised", "gates"),
-           ("plan_tunnels_closed", "tunnels"), ("plan_arc_cost", "arc cost"),
+           ("plan_tunnels_closed", "tunnels"), ("plan_arc_cost", "arc cost"), ("plan_map_arc_cost", "map arc cost"),
            ("path_length_m", "driven length (m)"), ("sim_time_s", "simulated time (s)"),
            ("min_clearance_m", "min clearance (m)"), ("collisions", "collisions"))
 UNITS = dict(METRICS)
@@ -114,7 +114,7 @@ def statistics_section(scenario: str, arms: dict[str, list[dict[str, Any]]], ref
     if any(r.get("plan_length_m") is not None for r in scenario_rows):
         result = friedman(arms, "plan_length_m")
         if result is not None and result["blocks"] >= 2:
-            from swarmnav.sim.study.tables import number, p_value
+            from swarmnav.study.tables import number, p_value
             out.append(f"Friedman test of the plan length across all {len(arms)} planners on {result['blocks']} "
                        f"seeds every planner completed: chi² = {number(result['statistic'])}, "
                        f"p = {p_value(result['p'])}, Kendall's W = {number(result['kendall_w'], 3)}.")

@@ -50,7 +50,7 @@ RUN_SCHEMA = pa.schema([
     ("plan_evaluations", pa.int64()), ("plan_collision_free", pa.bool_()), ("plan_waypoints", pa.string()),
     ("plan_bends", pa.int64()), ("plan_convergence_iteration", pa.int64()), ("plan_extra", pa.string()),
     ("plan_raw_length_m", pa.float64()), ("plan_gates_raised", pa.int64()), ("plan_tunnels_closed", pa.int64()),
-    ("plan_arc_cost", pa.float64()), ("plan_moves", pa.int64()), ("plan_cell_clearance_m", pa.float64()),
+    ("plan_arc_cost", pa.float64()), ("plan_map_arc_cost", pa.float64()), ("plan_moves", pa.int64()), ("plan_cell_clearance_m", pa.float64()),
     ("plan_nodes_visited", pa.int64()),
     ("reached", pa.bool_()), ("run_outcome", pa.string()), ("collisions", pa.int64()),
     ("first_collision_s", pa.float64()), ("sim_time_s", pa.float64()), ("wall_time_s", pa.float64()),

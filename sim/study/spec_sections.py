@@ -1,4 +1,4 @@
-"""The sections of a study file (:mod:`swarmnav.sim.study.spec` has the schema), each read with the one TOML
+"""The sections of a study file (:mod:`swarmnav.study.spec` has the schema), each read with the one TOML
 reader (:mod:`swarmnav.models.toml_table`): every problem is one ConfigError naming the file and the field
 (``planners[1].params.alpha``)."""
 

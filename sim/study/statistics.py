@@ -270,7 +270,8 @@ PAPER_COLUMNS = (("best length (m)", "plan_length_m", "best"), ("mean length (m)
                  ("convergence iteration", "plan_convergence_iteration", "mean"),
                  ("bends", "plan_bends", "mean"), ("plan time (s)", "plan_time_s", "mean"),
                  ("gates", "plan_gates_raised", "mean"), ("tunnels", "plan_tunnels_closed", "mean"),
-                 ("arc cost", "plan_arc_cost", "mean"), ("iterations", "plan_iterations", "mean"))
+                 ("arc cost", "plan_arc_cost", "mean"), ("map arc cost", "plan_map_arc_cost", "mean"),
+                 ("iterations", "plan_iterations", "mean"))
 
 
 def paper_table(arms: dict[str, list[dict[str, Any]]]) -> tuple[list[str], list[list[float | int | None]]]:

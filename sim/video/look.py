@@ -3,7 +3,7 @@
 Everything here changes only what is drawn (a free camera, geom colours, light
 intensities, decor geoms computed for the scene), never what a simulation reads,
 so logs and physics do not depend on it and an older log's MJCF renders alike.
-Used by :class:`sim.video.render.SceneRenderer`.
+Used by :class:`swarmnav.video.render.SceneRenderer`.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Offscreen rendering of a run with EGL, and MP4 output (:mod:`sim.video.file`).
+"""Offscreen rendering of a run with EGL, and MP4 output (:mod:`swarmnav.video.file`).
 
 The GL context is made when a :class:`SceneRenderer` is, by :func:`sim.gl_backend.new_renderer`
 (EGL unless the user chose another backend), so rendering works on headless,
@@ -10,7 +10,7 @@ robot's ``chase`` camera, or ``follow`` (straight down on the robot, about
 size in any arena); obstacles in the shared palette (:mod:`sim.palette`); a
 visual-only ground past the floor's edge (decor boxes, not in the model: no
 black background in the chase view, and logs and physics are untouched); a title
-bar and the simulation time (:mod:`sim.video.caption`).
+bar and the simulation time (:mod:`swarmnav.video.caption`).
 
 Speed: shadows, reflections and multisampling are switched off, which takes a
 640x480 frame from ~267 ms to ~20 ms on the reference machine, and the floor is
@@ -39,8 +39,8 @@ import numpy as np  # noqa: E402
 
 from swarmnav.models.errors import ConfigError  # noqa: E402
 from swarmnav.sim import palette  # noqa: E402
-from swarmnav.sim.video.caption import FrameCaption, run_title  # noqa: E402
-from swarmnav.sim.video.look import (  # noqa: E402
+from swarmnav.video.caption import FrameCaption, run_title  # noqa: E402
+from swarmnav.video.look import (  # noqa: E402
     FOLLOW_VIEW_M,
     follow_camera,
     ground_boxes,
@@ -50,7 +50,7 @@ from swarmnav.sim.video.look import (  # noqa: E402
 from swarmnav.sim.defaults import MAX_FPS, MIN_FPS  # noqa: E402
 from swarmnav.sim.gl_backend import new_renderer  # noqa: E402
 from swarmnav.sim.recording import RunContext, StepFrame  # noqa: E402
-from swarmnav.sim.video.file import VideoWriter  # noqa: E402
+from swarmnav.video.file import VideoWriter  # noqa: E402
 
 CAMERAS = ("top", "chase", "follow")
 GROUND_RGBA = np.array([0.78, 0.79, 0.8, 1.0], dtype=np.float32)
@@ -294,7 +294,7 @@ class VideoRecorder:
             centred on the robot, :data:`FOLLOW_VIEW_M` high).
         trail: also draw the driven trajectory so far.
         caption: draw the title bar (scenario, planner + navigator, seeds) and the
-            simulation time on every frame (:class:`sim.video.caption.FrameCaption`).
+            simulation time on every frame (:class:`swarmnav.video.caption.FrameCaption`).
     """
 
     def __init__(

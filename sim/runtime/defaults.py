@@ -12,7 +12,7 @@ from __future__ import annotations
 # robust GWO plan on a 40-disc field 0.03-0.37 s instead of 0.033 s.  A value already set in the environment wins.
 SINGLE_THREAD_ENVIRONMENT = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
                              "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
-LOG_FORMATS = ("swarmnav", "ros2")  # --log-format of run and study --logs; each is its MCAP profile (sim.log.format)
+LOG_FORMATS = ("swarmnav", "ros2")  # --log-format of run and study --logs; each is its MCAP profile (swarmnav.log.format)
 DEFAULT_FPS = 30.0  # frames per simulated second of a video (run --video, replay --video)
 MIN_FPS, MAX_FPS = 0.1, 240.0  # --fps bounds: each simulated second is MAX_FPS frames at most
 MIN_DPI, MAX_DPI = 10, 600  # plot: 600 dpi is 4800 x 6300 pixels (about 120 MB of RGBA)

@@ -3,8 +3,8 @@
 :class:`EpisodeStepper` owns an episode on a compiled scene: the ``MjData``, the
 obstacle motion, sensing, the contact check, the recorders' ``start`` and
 ``finish``, the reference length L* and the metrics.  Whoever chooses the wheel
-commands drives it: a navigator (:meth:`sim.runner.Simulation.run`) or a policy
-(the dm_control task of :mod:`sim.env.task`)::
+commands drives it: a navigator (:meth:`sim.simulation.Simulation.run`) or a policy
+(the dm_control task of :mod:`swarmnav.env.task`)::
 
     observation = stepper.reset()
     while not stepper.outcome:

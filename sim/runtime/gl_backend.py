@@ -29,7 +29,7 @@ that loads PyTorch lazily, on its first action after ``--video`` made its contex
 
 ``dm_control``'s own renderer (``Physics.render``) stays disabled in a process
 that imported it through swarmnav: the environment renders with
-:class:`sim.video.render.SceneRenderer`, never with ``Physics.render``.  A user who
+:class:`swarmnav.video.render.SceneRenderer`, never with ``Physics.render``.  A user who
 imported ``mujoco`` or ``dm_control`` before swarmnav keeps what they loaded.
 """
 

@@ -1,4 +1,6 @@
-"""The simulation layer: the only one that imports MuJoCo (with no GL library loaded; see :mod:`sim.gl_backend`).
+"""The physics runtime (``sim/runtime/``, installed as ``swarmnav.sim``): the floor that steps MuJoCo (with no GL
+library loaded; see :mod:`swarmnav.sim.gl_backend`).  Video, logs, studies, the environment, benchmarks, the API
+and the CLI stand on it (``pyproject.toml``'s ``package-dir``).
 
 A folder named ``swarmnav`` on the import path ahead of the installed package (a clone of the repository in the
 working directory, with an editable install whose folders Python finds by an import hook) makes ``swarmnav`` a

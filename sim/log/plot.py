@@ -23,7 +23,7 @@ import numpy as np
 from swarmnav.models.errors import ConfigError
 from swarmnav.sim import palette
 from swarmnav.sim.defaults import MAX_DPI, MIN_DPI
-from swarmnav.sim.log.reader import RunLog, outcome_text, read_log, truncation_advice
+from swarmnav.log.reader import RunLog, outcome_text, read_log, truncation_advice
 
 MAX_SCANS = 400
 MAX_TRACK_POINTS = 4000  # a track is decimated to this many points, about the figure's resolution

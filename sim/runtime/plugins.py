@@ -21,7 +21,7 @@ plugin's) is one warning line on stderr naming the distribution, and is skipped;
 
 Every place that looks a component up by name loads the plugins first (:func:`load_plugins`): the command line,
 the API's calls, a study's validation, each study cell in a local worker or a Ray task
-(:func:`swarmnav.sim.study.cell.run_cell`) and the environment.  A process scans the entry points again when
+(:func:`swarmnav.study.cell.run_cell`) and the environment.  A process scans the entry points again when
 its ``sys.path`` changed since the last scan (a script that put a plugin's folder on it), loading only the
 entries it has not seen.
 """
