@@ -77,8 +77,9 @@ CROWD_TARGET_US = 50.0
 REALTIME_TARGET = 30.0
 
 
-def summary_lines(part: list[dict[str, Any]], seen: bool) -> list[str]:
-    """The targets of one setting, computed from its rows (never written by hand)."""
+def summary_lines(part: list[dict[str, Any]], seen: bool, every: bool = True) -> list[str]:
+    """The targets of one setting, computed from its rows (never written by hand); ``every``: the rows hold every
+    navigator, so the every-online-navigator lines apply."""
     from swarmnav.controllers.navigators import NAVIGATORS
     contenders = [r for r in part if r["navigator"] != ORACLE]
     if not contenders:
@@ -89,13 +90,17 @@ def summary_lines(part: list[dict[str, Any]], seen: bool) -> list[str]:
              f"{best['success_rate']:.3f} of its {best['runs']} runs with discomfort "
              f"{best['discomfort_frequency']:.4f} (target ≥ {BEST_TARGET:.2f} with discomfort < "
              f"{DISCOMFORT_TARGET:.2f}: {'met' if met else 'not met'})."]
-    online = [r for r in contenders if not r.get("arm_of")
+    if not every:
+        lines.append("Every online navigator ≥ 0.90: see the sample below (the full protocol ran "
+                     + ", ".join(f"`{r['navigator']}`" for r in contenders) + " only).")
+    online = [] if not every else [r for r in contenders if not r.get("arm_of")
               and getattr(NAVIGATORS.get(r["navigator"]), "uses_detections", True)]
     below = [r for r in online if r["success_rate"] < ONLINE_TARGET]
-    lines.append(f"Every online navigator at its defaults ≥ {ONLINE_TARGET:.2f}: " + (
-        "met." if not below else "not met: " + ", ".join(f"`{r['navigator']}` {r['success_rate']:.3f}"
-                                                         for r in below) + "."))
-    if any(r.get("arm_of") for r in contenders):  # each navigator at its best configuration of the rows
+    if every:
+        lines.append(f"Every online navigator at its defaults ≥ {ONLINE_TARGET:.2f}: " + (
+            "met." if not below else "not met: " + ", ".join(f"`{r['navigator']}` {r['success_rate']:.3f}"
+                                                             for r in below) + "."))
+    if every and any(r.get("arm_of") for r in contenders):  # each navigator at its best configuration of the rows
         best_of: dict[str, dict[str, Any]] = {}
         for r in contenders:
             base = r.get("arm_of") or r["navigator"]
@@ -137,7 +142,7 @@ def block(rows: list[dict[str, Any]], protocol: list[dict[str, Any]] | None = No
         for seen in (False, True):
             part = [r for r in protocol if r.get("robot_visible") is seen]
             if part:
-                out += table_lines(part, seen) + [""] + summary_lines(part, seen) + [""]
+                out += table_lines(part, seen) + [""] + summary_lines(part, seen, every=False) + [""]
         out += [f"**Every navigator** on {_cases(rows)} of the 500 test cases per setting "
                 f"(`{RESULT.relative_to(RESULTS_DIR.parents[2]).as_posix()}`).", ""]
     for seen in (False, True):
