@@ -44,8 +44,10 @@ demo: $(STAMP)
 	@$(BIN)/swarmnav plot logs/demo.mcap -o logs/demo.png > /dev/null
 	@echo "plot: logs/demo.png   (inspect the log: swarmnav log info logs/demo.mcap; open it in Foxglove)"
 
+# the suite on TEST_WORKERS processes, each taking whole files (module fixtures stay in one process)
+TEST_WORKERS ?= 2
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile
 
 # The documentation site (mkdocs.yml, docs/): built with --strict into site/, then served on
 # http://127.0.0.1:$(DOCS_PORT) (rebuilt as pages change; Ctrl-C stops it).

@@ -127,6 +127,14 @@ class NavigationSetup:
         return self.known_problem if self.known_problem is not None else self.problem
 
     @property
+    def plan_problem(self) -> Problem:
+        """The map as the planners see it: :attr:`map_problem`, or with the map unknown the sensed map's
+        cells grown into the space not seen free behind them (:meth:`~controllers.world_map.SensedMap.planning_problem`)."""
+        if self.world_map is not None:
+            return self.world_map.planning_problem()
+        return self.map_problem
+
+    @property
     def map_revision(self) -> int:
         """Grows whenever :attr:`map_problem` changes (always 0 with the map known)."""
         return self.world_map.revision if self.world_map is not None else 0

@@ -3,7 +3,7 @@ including it with floor, light and camera, as MuJoCo Menagerie lays out its mode
 swarmnav needs to know of each without reading MuJoCo.
 
 A scenario picks one with ``robot = { model = "jackal" }``; its other ``robot`` fields override the entry's
-defaults (the planning radius, the top speed).  Every robot file follows the same names, which ``sim/scene.py``
+defaults (the planning radius, the top speed).  Every robot file follows the same names, which ``sim/runtime/scene.py``
 reads: a ``base_link`` body with the free joint ``base_free``, the collision footprint ``chassis``, the wheel
 bodies ``left_wheel`` / ``right_wheel`` (their tyres ``left_wheel_tyre`` / ..., hinges ``left_wheel_hinge`` /
 ..., speed sensors ``left_wheel_speed`` / ...), the actuators ``left_wheel_motor`` / ``right_wheel_motor``
@@ -42,6 +42,10 @@ class RobotModel:
         ring_sensors: rangefinders sit on the chassis rim, each pointing outward (the papers' 12-ray ring);
             else all beams start at the laser's site (``range_site_00``), as a scanning laser's do.
         default_range_m: the default ``sensors.range_m`` (the robot's usual laser).
+        max_angular_rad_s: the published turn-rate limit, the PTP controller's ``max_angular_rad_s`` (None:
+            the controller's default, 1.2 rad/s).
+        ptp_limits: the PTP controller's drift and corner limits for this robot (``max_drift_m``,
+            ``max_deceleration_m_s2``: :mod:`controllers.point_to_point`); None: off, the paper's controller.
         sources: where every figure of the robot file comes from (also in the file's header comment).
     """
 
@@ -53,6 +57,8 @@ class RobotModel:
     ring_sensors: bool
     default_range_m: float
     sources: str
+    max_angular_rad_s: float | None = None
+    ptp_limits: tuple[float, float] | None = None
 
     @property
     def scene_xml(self) -> FilePath:
@@ -72,6 +78,8 @@ class RobotModel:
 
 
 ROBOTS: dict[str, RobotModel] = {}
+#: The real platforms' PTP limits: 0.05 m of drift (the default planning clearance), braking at 2.0 m/s^2.
+PTP_LIMITS = (0.05, 2.0)
 
 
 def _register(robot: RobotModel) -> None:
@@ -89,13 +97,17 @@ _register(RobotModel(
     round_chassis=False, max_speed_m_s=2.0, ring_sensors=False, default_range_m=10.0,
     sources="MuJoCo Menagerie clearpath_jackal/jackal.xml (masses, inertia, wheel radius 0.095 m, "
             "track 0.37559 m, wheelbase 0.262 m, +-26 rad/s); Clearpath Robotics Jackal specifications "
-            "(508 x 430 x 250 mm, 2.0 m/s, skid-steer)"))
+            "(508 x 430 x 250 mm, 2.0 m/s, skid-steer); Clearpath jackal_control config/control.yaml "
+            "(wheel_separation_multiplier 1.5, angular max_velocity 4.0 rad/s); the effective track "
+            "(track_multiplier 1.95) calibrated on the model by spins on the spot (robot.xml)",
+    max_angular_rad_s=4.0, ptp_limits=PTP_LIMITS))
 _register(RobotModel(
     name="turtlebot3_burger", folder=MODELS_DIR / "turtlebot3_burger", footprint_m=(-0.102, -0.089, 0.038, 0.089),
     round_chassis=False, max_speed_m_s=0.22, ring_sensors=False, default_range_m=3.5,
     sources="ROBOTIS e-Manual TurtleBot3 specifications (138 x 178 x 192 mm, 0.22 m/s, 2.84 rad/s); ROBOTIS "
             "turtlebot3 burger.yaml (wheel radius 0.033 m, separation 0.160 m) and turtlebot3_burger.urdf "
-            "(base box, wheel, caster and LDS positions)"))
+            "(base box, wheel, caster and LDS positions)",
+    max_angular_rad_s=2.84, ptp_limits=PTP_LIMITS))
 
 
 def robot_model(name: str) -> RobotModel:

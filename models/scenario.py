@@ -94,11 +94,13 @@ class Scenario:
     # [knowledge]: what the robot is given.  map "known" (the static obstacles, in advance) or "unknown"
     # (mapped online from the laser at map_cell_m, controllers.world_map); pose "truth" (the simulator's)
     # or "odometry" (integrated wheel speeds, with encoder_noise: the relative standard deviation of each
-    # measured wheel speed, drawn from the world seed's streams).
+    # measured wheel speed, drawn from the world seed's streams); unknown_cost: with the map unknown, the extra
+    # weight of a move through a never-seen cell for the grid searches (0: unknown cells are free).
     map_knowledge: str = "known"
     pose_source: str = "truth"
     map_cell_m: float = 0.05
     encoder_noise: float = 0.0
+    unknown_cost: float = 0.0
     # with_knowledge gave map or pose (--map / --pose, a study axis): the run logs them, so a replay has them.
     knowledge_overridden: bool = False
 
@@ -227,6 +229,7 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
     pose_source = knowledge.string("pose", "truth", choices=POSE_SOURCES)
     map_cell_m = knowledge.number("map_cell_m", 0.05, bounds=within(MIN_LENGTH_M))
     encoder_noise = knowledge.number("encoder_noise", 0.0, bounds=within(0.0, 1.0))
+    unknown_cost = knowledge.number("unknown_cost", 0.0, bounds=within(0.0, 1000.0))
     knowledge.close()
     if map_knowledge == "unknown":
         check_grid_size(width_m, height_m, map_cell_m, "knowledge.map_cell_m", source, MAX_MAP_CELLS)
@@ -262,7 +265,8 @@ def parse_scenario(text: str, source: str = "<string>", trust_code: bool = False
         sim=sim, cell_m=cell_m, source_text=text, source_path=source, boxes=boxes, world_seed=seed,
         map_grid=map_grid, map_pairs=section.pairs if section is not None else (), sensor_model=sensor_model,
         trust_code=bool(trust_code), robot_model=robot_model, sensor_fov_deg=sensor_fov_deg,
-        map_knowledge=map_knowledge, pose_source=pose_source, map_cell_m=map_cell_m, encoder_noise=encoder_noise)
+        map_knowledge=map_knowledge, pose_source=pose_source, map_cell_m=map_cell_m, encoder_noise=encoder_noise,
+        unknown_cost=unknown_cost)
     _check_endpoints(scenario, source)
     return scenario
 

@@ -55,7 +55,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import param, within
 from swarmnav.planners.continuous import ContinuousPlanner
 from swarmnav.planners.exact_check import ContinuousState
 from swarmnav.planners.path_cost import inverse_fitness
@@ -113,14 +113,13 @@ class BeeColonyPlanner(ContinuousPlanner):
     """
 
     name: ClassVar[str] = "abc"
-    parameter_ranges: ClassVar[dict[str, Range]] = {"limit": within(0, 1e9), "mcn": within(1, 1_000_000)}  # models.parameters: checked on build
 
     population: int = 100
     iterations: int = 1000
-    limit: float = 5.0
+    limit: float = param(5.0, within(0, 1e9))
     scouts: str = "worst"
     adaptive_limit: bool = False
-    mcn: int = 100
+    mcn: int = param(100, within(1, 1_000_000))
 
     def __post_init__(self) -> None:
         super().__post_init__()

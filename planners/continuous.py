@@ -99,7 +99,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import BudgetExceeded, NoPathFound, check_parameters
 from swarmnav.planners.exact_check import ContinuousState, ExactCheckStage
@@ -164,43 +164,34 @@ class ContinuousPlanner(ExactCheckStage):
     """
 
     supports: ClassVar[frozenset[str]] = frozenset({"discs"})
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        # population x samples: at most MAX_POPULATION_SAMPLES, checked with both known (__post_init__)
-        "population": within(4, 1e9), "iterations": within(0, 1_000_000), "max_evaluations": within(0, 1e9),
-        "via_points": within(1, 1000), "samples": within(2, 1e9), "length_weight": within(0, 1e6),
-        "smoothness_weight": within(0, 1e6), "penalty_weight": above(0, 1e12), "penalty_margin_m": within(0, 100),
-        "waypoint_spacing_m": within(0.001, 100), "repair_rounds": within(0, 100_000),
-        "guess_fraction": within(0, 1), "guess_spread_m": within(0, 100), "guess_cell_m": within(0.01, 100),
-        "polish_rounds": within(0, 100_000), "polish_step_m": above(0, 100), "via_point_growth": within(0, 10),
-        "guess_margin_m": within(0, 100), "fit_push_rounds": within(0, 100_000),
-        "stall_evaluations": within(0, 1e9), "stall_tolerance": within(0, 1)}  # models.parameters: checked on build
 
-    population: int = 50
-    iterations: int = 100
-    max_evaluations: int | None = None
-    via_points: int | None = None
-    samples: int = 100
+    # population x samples: at most MAX_POPULATION_SAMPLES, checked with both known (__post_init__)
+    population: int = param(50, within(4, 1e9))
+    iterations: int = param(100, within(0, 1_000_000))
+    max_evaluations: int | None = param(None, within(0, 1e9))
+    via_points: int | None = param(None, within(1, 1000))
+    samples: int = param(100, within(2, 1e9))
     encoding: str = "spline"
-    length_weight: float = 1.0
-    smoothness_weight: float = 0.0
-    penalty_weight: float | None = None
-    penalty_margin_m: float | None = None
+    length_weight: float = param(1.0, within(0, 1e6))
+    smoothness_weight: float = param(0.0, within(0, 1e6))
+    penalty_weight: float | None = param(None, above(0, 1e12))
+    penalty_margin_m: float | None = param(None, within(0, 100))
     bounds_penalty: bool | None = None
     population_fallback: bool | None = None
-    waypoint_spacing_m: float = 0.05
-    repair_rounds: int | None = None
+    waypoint_spacing_m: float = param(0.05, within(0.001, 100))
+    repair_rounds: int | None = param(None, within(0, 100_000))
     mode: str = "paper"
-    guess_fraction: float | None = None
-    guess_spread_m: float = 0.2
-    guess_cell_m: float | None = None
-    polish_rounds: int | None = None
-    polish_step_m: float = 0.05
-    via_point_growth: int | None = None
+    guess_fraction: float | None = param(None, within(0, 1))
+    guess_spread_m: float = param(0.2, within(0, 100))
+    guess_cell_m: float | None = param(None, within(0.01, 100))
+    polish_rounds: int | None = param(None, within(0, 100_000))
+    polish_step_m: float = param(0.05, above(0, 100))
+    via_point_growth: int | None = param(None, within(0, 10))
     guess: str | None = None
-    guess_margin_m: float | None = None
-    fit_push_rounds: int | None = None
-    stall_evaluations: int | None = None
-    stall_tolerance: float = 1e-4
+    guess_margin_m: float | None = param(None, within(0, 100))
+    fit_push_rounds: int | None = param(None, within(0, 100_000))
+    stall_evaluations: int | None = param(None, within(0, 1e9))
+    stall_tolerance: float = param(1e-4, within(0, 1))
     gap_margins: bool | None = None
 
     def __post_init__(self) -> None:

@@ -19,7 +19,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import param, within
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners._grid_search import astar
@@ -27,6 +27,7 @@ from swarmnav.planners.grid_graph import (ADJACENCY, DIRECTIONS, INF, SQRT2, STE
                                           check_cells, count_bends, grid_endpoints, grid_problem, moves_by_mask)
 from swarmnav.planners.grid_shortcut import exact_shortcut
 from swarmnav.planners.problem import Path, Problem, check_endpoints
+from swarmnav.planners.unknown_cost import cell_weights, cost_shortcut, weighted_cells
 
 
 def _octile_to(goal: Cell, shape: tuple[int, int]) -> list[float]:
@@ -153,9 +154,9 @@ class GridPlanner:
     """
 
     name: ClassVar[str] = ""
-    parameter_ranges: ClassVar[dict[str, Range]] = {"cell_m": within(1e-6, 100)}  # models.parameters: checked on build
+    honours_unknown_cost: ClassVar[bool] = False  # astar and dijkstra: Problem.unknown_cost (planners.unknown_cost)
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
-    cell_m: float | None = None
+    cell_m: float | None = param(None, within(1e-6, 100))
     shortcut: bool = True
 
     def __post_init__(self) -> None:
@@ -172,9 +173,18 @@ class GridPlanner:
         problem = grid_problem(problem, self.cell_m)
         grid = problem.grid
         start, goal = grid_endpoints(problem, grid)
-        cells, cost_cells, expansions, extra = self.search(problem, grid, start, goal)
+        weighted = self.honours_unknown_cost and problem.unknown_cells is not None and problem.unknown_cost > 0.0
+        if weighted:  # costly unknown cells (planners.unknown_cost): a weighted Dijkstra, a cost-aware shortcut
+            weights = cell_weights(problem, grid)
+            cells, cost_cells, expansions = weighted_cells(grid.occupied, weights, start, goal)
+            extra = {"unknown_cost": problem.unknown_cost}
+        else:
+            cells, cost_cells, expansions, extra = self.search(problem, grid, start, goal)
         raw = cells_to_waypoints(problem, grid, cells)
-        waypoints = exact_shortcut(problem, raw) if self.shortcut else raw
+        if weighted:
+            waypoints = cost_shortcut(problem, grid, weights, raw) if self.shortcut else raw
+        else:
+            waypoints = exact_shortcut(problem, raw) if self.shortcut else raw
         stats = {"raw_cells": [list(c) for c in cells], "raw_length_m": cost_cells * grid.cell_m,
                  "bends": count_bends(cells)}
         stats.update(extra)
@@ -193,6 +203,7 @@ class AStarPlanner(GridPlanner):
     """
 
     name: ClassVar[str] = "astar"
+    honours_unknown_cost: ClassVar[bool] = True
 
     def search(self, problem, grid, start, goal):
         cells, cost, expansions = astar_cells(grid.occupied, start, goal)
@@ -204,6 +215,7 @@ class DijkstraPlanner(GridPlanner):
     """Grid Dijkstra over the same 8-connected graph as A* (the uninformed baseline)."""
 
     name: ClassVar[str] = "dijkstra"
+    honours_unknown_cost: ClassVar[bool] = True
 
     def search(self, problem, grid, start, goal):
         cells, cost, expansions = dijkstra_cells(grid.occupied, start, goal)

@@ -91,7 +91,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.planners.ant_colony import roulette
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.grid_graph import (DIRECTIONS, Cell, cell_clearance_m, cells_to_waypoints, count_bends,
@@ -138,25 +138,21 @@ class ImprovedMaxMinAntSystemPlanner(SwarmPlanner):
     """
 
     name: ClassVar[str] = "immas"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "alpha": within(0, 100), "beta": within(0, 100), "rho": above(0, 1), "clean_weight": within(0, 1e6),
-        "diagonal_factor": within(1, 10), "iterations": within(0, 10_000_000), "cell_m": within(1e-6, 100),
-        "max_evaluations": within(0, 1e9), "p_best": above(0, 1)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs", "boxes"})
-    alpha: float = 3.0
-    beta: float = 1.0
-    rho: float = 0.98
-    clean_weight: float = 0.5
-    diagonal_factor: float = 1.4
+    alpha: float = param(3.0, within(0, 100))
+    beta: float = param(1.0, within(0, 100))
+    rho: float = param(0.98, above(0, 1))
+    clean_weight: float = param(0.5, within(0, 1e6))
+    diagonal_factor: float = param(1.4, within(1, 10))
     close_gates_and_tunnels: bool = True
     propagation: str = "mmas"
     evaporation_doubling: bool = False
-    p_best: float = P_BEST
+    p_best: float = param(P_BEST, above(0, 1))
     selection: str = "best"
-    iterations: int = 0
-    cell_m: float | None = None
+    iterations: int = param(0, within(0, 10_000_000))
+    cell_m: float | None = param(None, within(1e-6, 100))
     shortcut: bool = True
-    max_evaluations: int | None = None
+    max_evaluations: int | None = param(None, within(0, 1e9))
 
     def __post_init__(self) -> None:
         check_parameters(self, (

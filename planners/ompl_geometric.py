@@ -42,7 +42,7 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import Range, above, param, within
 from swarmnav.planners.errors import check_parameters
 from swarmnav.planners.sampling_ompl import OmplPlanner, PRMStarPlanner, _path_waypoints, solve_in_rounds
 
@@ -94,9 +94,8 @@ class RRTPlanner(_FirstSolutionPlanner):
 
     name: ClassVar[str] = "rrt"
     ompl_class: ClassVar[str] = "RRT"
-    range_m: float = 0.0
-    goal_bias: float = 0.05
-    parameter_ranges: ClassVar[dict[str, Range]] = {"range_m": RANGE_M, "goal_bias": within(0, 1)}
+    range_m: float = param(0.0, RANGE_M)
+    goal_bias: float = param(0.05, within(0, 1))
 
     def check_own_parameters(self) -> None:
         _check_range(self, self.range_m)
@@ -118,8 +117,7 @@ class RRTConnectPlanner(_FirstSolutionPlanner):
 
     name: ClassVar[str] = "rrt_connect"
     ompl_class: ClassVar[str] = "RRTConnect"
-    range_m: float = 0.0
-    parameter_ranges: ClassVar[dict[str, Range]] = {"range_m": RANGE_M}
+    range_m: float = param(0.0, RANGE_M)
 
     def check_own_parameters(self) -> None:
         _check_range(self, self.range_m)
@@ -141,11 +139,9 @@ class LBKPIECE1Planner(_FirstSolutionPlanner):
 
     name: ClassVar[str] = "lbkpiece1"
     ompl_class: ClassVar[str] = "LBKPIECE1"
-    range_m: float = 0.0
-    border_fraction: float = 0.9
+    range_m: float = param(0.0, RANGE_M)
+    border_fraction: float = param(0.9, within(MIN_BORDER_FRACTION, 1))
     # OMPL refuses a border fraction below machine epsilon (a RuntimeError): 0.001 is the stated floor
-    parameter_ranges: ClassVar[dict[str, Range]] = {"range_m": RANGE_M,
-                                                    "border_fraction": within(MIN_BORDER_FRACTION, 1)}
 
     def check_own_parameters(self) -> None:
         _check_range(self, self.range_m)
@@ -176,8 +172,7 @@ class KPIECE1Planner(LBKPIECE1Planner):
 
     name: ClassVar[str] = "kpiece1"
     ompl_class: ClassVar[str] = "KPIECE1"
-    goal_bias: float = 0.05
-    parameter_ranges: ClassVar[dict[str, Range]] = {"goal_bias": within(0, 1)}
+    goal_bias: float = param(0.05, within(0, 1))
 
     def check_own_parameters(self) -> None:
         super().check_own_parameters()
@@ -199,8 +194,7 @@ class AORRTCPlanner(_FirstSolutionPlanner):
 
     name: ClassVar[str] = "aorrtc"
     ompl_class: ClassVar[str] = "AORRTC"
-    range_m: float = 0.0
-    parameter_ranges: ClassVar[dict[str, Range]] = {"range_m": RANGE_M}
+    range_m: float = param(0.0, RANGE_M)
 
     def check_own_parameters(self) -> None:
         _check_range(self, self.range_m)
@@ -222,10 +216,8 @@ class FMTStarPlanner(_FirstSolutionPlanner):
 
     name: ClassVar[str] = "fmt_star"
     ompl_class: ClassVar[str] = "FMT"
-    num_samples: int = 1000
-    radius_multiplier: float = 1.1
-    parameter_ranges: ClassVar[dict[str, Range]] = {"num_samples": within(1, 1_000_000),
-                                                    "radius_multiplier": above(0, 1e3)}
+    num_samples: int = param(1000, within(1, 1_000_000))
+    radius_multiplier: float = param(1.1, above(0, 1e3))
 
     def check_own_parameters(self) -> None:
         check_parameters(self, (
@@ -257,8 +249,7 @@ class PRMPlanner(PRMStarPlanner):
 
     name: ClassVar[str] = "prm"
     ompl_class: ClassVar[str] = "PRM"
-    max_nearest_neighbors: int = 10
-    parameter_ranges: ClassVar[dict[str, Range]] = {"max_nearest_neighbors": within(1, 10_000)}
+    max_nearest_neighbors: int = param(10, within(1, 10_000))
 
     def check_own_parameters(self) -> None:
         check_parameters(self, (("max_nearest_neighbors", self.max_nearest_neighbors >= 1, "must be at least 1"),))

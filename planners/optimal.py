@@ -34,7 +34,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import param, within
 from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
@@ -78,10 +78,9 @@ class OptimalPlanner:
     """
 
     name: ClassVar[str] = "optimal"
-    parameter_ranges: ClassVar[dict[str, Range]] = {"arc_bulge_m": within(1e-6, 1)}  # models.parameters: checked on build
     supports: ClassVar[frozenset[str]] = frozenset({"discs"})
 
-    arc_bulge_m: float = 1e-5
+    arc_bulge_m: float = param(1e-5, within(1e-6, 1))
 
     def __post_init__(self) -> None:
         if not self.arc_bulge_m > 0:

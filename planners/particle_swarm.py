@@ -21,7 +21,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.planners.continuous import ContinuousPlanner
 from swarmnav.planners.exact_check import ContinuousState
 from swarmnav.models.errors import ConfigError
@@ -43,15 +43,12 @@ class ParticleSwarmPlanner(ContinuousPlanner):
     """
 
     name: ClassVar[str] = "pso"
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "inertia": within(-10, 10), "cognitive": within(0, 10), "social": within(0, 10),
-        "velocity_limit": above(0, 100)}  # models.parameters: checked on build
 
-    inertia: float = 0.7298
-    cognitive: float = 1.49618
-    social: float = 1.49618
+    inertia: float = param(0.7298, within(-10, 10))
+    cognitive: float = param(1.49618, within(0, 10))
+    social: float = param(1.49618, within(0, 10))
     topology: str = "global"
-    velocity_limit: float = 0.2
+    velocity_limit: float = param(0.2, above(0, 100))
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -34,6 +34,10 @@ class Problem:
         clearance_m: extra safety margin a planner keeps beyond the robot radius.
         boxes: axis-aligned box footprints (from grid maps), not inflated.
         cell_m: resolution of :attr:`grid`.
+        unknown_cells: with the map unknown, the never-seen cells of the sensed map (``occupied`` = unknown);
+            None otherwise.
+        unknown_cost: the extra weight of a move through an unknown cell, read by the grid searches ``astar``
+            and ``dijkstra`` only (:mod:`planners.unknown_cost`); 0: unknown cells are free.
     """
 
     start: Pose2D
@@ -45,6 +49,8 @@ class Problem:
     boxes: tuple[Box, ...] = ()
     cell_m: float = 0.05
     grid_override: OccupancyGrid | None = field(default=None, repr=False)
+    unknown_cells: OccupancyGrid | None = field(default=None, repr=False)
+    unknown_cost: float = 0.0
 
     @property
     def inflation_m(self) -> float:

@@ -44,6 +44,15 @@ Library", IEEE Robotics & Automation Magazine 19(4)), through its Python binding
   start-goal route on the roadmap (Dijkstra on its ``PlannerData``, edge cost the segment
   length) is the best cost.  That is the algorithm of the paper; OMPL's extra expansion
   step (random bounces from weakly connected milestones) is not run.
+* **Attempts.** ``attempts`` (default 1) runs the planner that many times, each from its own seed drawn
+  from ``rng`` in turn, and returns the shortest path: MoveIt's ``num_planning_attempts`` ("the shortest
+  solution will be reported"), for the feasible planners that stop at their first solution, whose length is
+  a draw.  The attempts share the budget: each runs on the collision checks and the time the earlier ones
+  left, and ``stats.evaluations`` counts them all (so it never exceeds ``max_evaluations``).  The chosen
+  attempt's histories are its own, its checks offset by the attempts before it; ``extra["attempt_lengths_m"]``
+  lists every attempt's length (``inf``: none found) when ``attempts`` > 1.  With 1 (the default) a plan is
+  the single run above, bit for bit.  An optimizing planner spends the whole budget in its first attempt, so
+  the later ones get none.
 * **Console.** OMPL's log level is set to ``LOG_NONE`` once, at the first import (which
   happens on the first plan, so the CLI does not pay for it elsewhere).
 
@@ -61,7 +70,7 @@ from typing import Callable, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import Range, above, within
+from swarmnav.models.parameters import above, param, within
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.ompl_checks import CollisionChecks, motion_validator_type, ompl_modules
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
@@ -89,6 +98,7 @@ class OmplPlanner:
         max_evaluations: the budget in collision checks (0 or None: none, then ``time_s`` is needed).
         time_s: wall-clock limit in seconds (0 or None: none).
         round_evaluations: collision checks per recorded round of the best-cost history.
+        attempts: plans made in turn on the one budget, the shortest returned (module docstring).
     """
 
     name: ClassVar[str]
@@ -96,13 +106,11 @@ class OmplPlanner:
     #: The OMPL class (in ``ompl.geometric``) this planner runs.
     ompl_class: ClassVar[str]
 
-    max_evaluations: int | None = 5000
-    time_s: float | None = None
-    round_evaluations: int = 100
+    max_evaluations: int | None = param(5000, within(0, 100_000_000))
+    time_s: float | None = param(None, within(0, 86_400))
+    round_evaluations: int = param(100, within(1, 100_000_000))
+    attempts: int = param(1, within(1, 100))
     # models.parameters checks these on build: collision checks are a few microseconds each, so 10^8 is minutes.
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "max_evaluations": within(0, 100_000_000), "time_s": within(0, 86_400),
-        "round_evaluations": within(1, 100_000_000)}
 
     def with_budget(self, budget) -> "OmplPlanner":
         """A copy that runs to a study's budget: ``evaluations`` as collision checks (this planner's own unit
@@ -138,11 +146,31 @@ class OmplPlanner:
         t0 = time.perf_counter()
         check_supported(self, problem)
         check_endpoints(problem)
-        seed = int(rng.integers(1, 2**31 - 1))
+        limit = self.max_evaluations or math.inf
+        best: Path | None = None
+        made, lengths = 0, []
         with _OMPL_LOCK:
-            return self._run(problem, seed, t0)
+            for _ in range(self.attempts):
+                if made >= limit:
+                    break
+                seed = int(rng.integers(1, 2**31 - 1))
+                path, checks = self._run(problem, seed, t0, limit - made)
+                if path is not None and (best is None or path.stats.length_m < best.stats.length_m):
+                    best = dataclasses.replace(path, stats=dataclasses.replace(
+                        path.stats, evaluation_history=tuple(made + c for c in path.stats.evaluation_history)))
+                lengths.append(path.stats.length_m if path is not None else math.inf)
+                made += checks
+        if best is None:
+            raise NoPathFound(f"{self.name}: no path within the budget of "
+                              f"{self._budget_text()} ({made} collision checks made)")
+        if self.attempts == 1:
+            return best
+        return dataclasses.replace(best, stats=dataclasses.replace(
+            best.stats, evaluations=made, plan_time_s=time.perf_counter() - t0,
+            extra={**best.stats.extra, "attempt_lengths_m": lengths}))
 
-    def _run(self, problem: Problem, seed: int, t0: float) -> Path:
+    def _run(self, problem: Problem, seed: int, t0: float, max_checks: float) -> tuple[Path | None, int]:
+        """One attempt on ``max_checks`` collision checks: its path (None: none found) and the checks it made."""
         ob, og, ou = ompl_modules()
         ou.RNG.setSeed(seed)
         space = ob.RealVectorStateSpace(2)
@@ -152,8 +180,7 @@ class OmplPlanner:
         bounds.high = [b.x_max_m, b.y_max_m]
         space.setBounds(bounds)
         si = ob.SpaceInformation(space)
-        checks = CollisionChecks(problem, self.max_evaluations or math.inf,
-                                  t0 + self.time_s if self.time_s else math.inf)
+        checks = CollisionChecks(problem, max_checks, t0 + self.time_s if self.time_s else math.inf)
         si.setStateValidityChecker(checks.state_valid)
         validator = motion_validator_type()(si, checks)
         si.setMotionValidator(validator)
@@ -175,8 +202,7 @@ class OmplPlanner:
             validator.checks = None  # no cycle left between the validator and the run
             del planner, pdef, validator, si
         if waypoints is None:
-            raise NoPathFound(f"{self.name}: no path within the budget of "
-                              f"{self._budget_text()} ({checks.made} collision checks made)")
+            return None, checks.made
         waypoints[0], waypoints[-1] = problem.start.xy, problem.goal.xy
         if not problem.is_collision_free(waypoints):  # the validity checks make this unreachable
             raise NoPathFound(f"{self.name}: OMPL returned a path the exact check refuses")
@@ -186,7 +212,7 @@ class OmplPlanner:
             cost_history=tuple(progress.costs), evaluation_history=tuple(progress.checks),
             extra={"ompl_planner": self.ompl_class, "ompl_seed": seed, "ompl_iterations": iterations,
                    "refused_checks": checks.refused,
-                   "convergence_iteration": improved[-1] if improved else 0})
+                   "convergence_iteration": improved[-1] if improved else 0}), checks.made
 
     def _budget_text(self) -> str:
         parts = ([f"{self.max_evaluations} collision checks"] if self.max_evaluations else []) + (
@@ -249,11 +275,9 @@ class RRTStarPlanner(_TreePlanner):
     name: ClassVar[str] = "rrt_star"
     ompl_class: ClassVar[str] = "RRTstar"
 
-    range_m: float = 0.0
-    goal_bias: float = 0.05
-    rewire_factor: float = 1.1
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "range_m": within(0, 1e6), "goal_bias": within(0, 1), "rewire_factor": above(0, 1e3)}
+    range_m: float = param(0.0, within(0, 1e6))
+    goal_bias: float = param(0.05, within(0, 1))
+    rewire_factor: float = param(1.1, above(0, 1e3))
 
     def check_own_parameters(self) -> None:
         check_parameters(self, (
@@ -295,10 +319,8 @@ class BITStarPlanner(_TreePlanner):
     name: ClassVar[str] = "bit_star"
     ompl_class: ClassVar[str] = "BITstar"
 
-    samples_per_batch: int = 100
-    rewire_factor: float = 1.1
-    parameter_ranges: ClassVar[dict[str, Range]] = {
-        "samples_per_batch": within(1, 1_000_000), "rewire_factor": above(0, 1e3)}
+    samples_per_batch: int = param(100, within(1, 1_000_000))
+    rewire_factor: float = param(1.1, above(0, 1e3))
 
     def check_own_parameters(self) -> None:
         check_parameters(self, (

@@ -18,6 +18,7 @@ from swarmnav.planners.max_min_trails import check_limits, trail_limits
 from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.cli.main import main
 from swarmnav.sim.episode import scenario_problem
+from swarmnav.study.claim_spec import AGGREGATE, claim_scenarios
 from swarmnav.study.grid import expand
 from swarmnav.study.rows import RUN_SCHEMA
 from swarmnav.study.spec import STUDY_DIR, load_study
@@ -202,8 +203,10 @@ def test_claims_name_the_studys_arms_scenarios_and_columns(name):
     assert len(ids) == len(set(ids))
     for claim in study.claims:
         assert claim.planner in labels and set(claim.than) <= labels, claim.id
-        assert claim.scenario in scenarios and claim.metric in columns, claim.id
-        assert claim.better in ("lower", "higher") and claim.test in ("rank_sum", "signed_rank", "fisher")
+        matched = claim_scenarios(claim, sorted(scenarios))      # an aggregate claim's glob: two or more
+        assert set(matched) <= scenarios and len(matched) >= (2 if claim.test == AGGREGATE else 1), claim.id
+        assert claim.metric in columns, claim.id
+        assert claim.better in ("lower", "higher") and claim.test in ("rank_sum", "signed_rank", "fisher", AGGREGATE)
 
 
 def test_the_ant_papers_studies_hold_at_least_seven_claims():

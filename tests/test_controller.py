@@ -57,6 +57,25 @@ def test_controller_switches_waypoints_and_slows_down_before_the_last():
     assert far.linear_m_s == pytest.approx(0.2) and 0.0 < near.linear_m_s < far.linear_m_s
 
 
+def test_drift_and_corner_limits_slow_a_fast_robot_and_are_off_for_the_papers_controller():
+    """controllers/point_to_point.py: at 2 m/s, a 20 degree heading error is driven at the speed whose sideways
+    drift stays within max_drift_m, and a right-angle corner 0.5 m ahead is approached at the braking speed; the
+    paper's controller (limits off, the disc robot's) drives cos(e) x 2 m/s in both cases."""
+    fast = dict(max_speed_m_s=2.0, max_angular_rad_s=4.0)
+    limited = PointToPointController(GEOMETRY, max_drift_m=0.05, max_deceleration_m_s2=2.0, **fast)
+    paper = PointToPointController(GEOMETRY, **fast)
+    e = math.radians(20.0)
+    for c in (limited, paper):
+        c.reset(Path.from_waypoints(np.array([[0.0, 0.0], [5.0, 0.0]]), 0.0))
+    rate = min(limited.heading_gain * e, 4.0)
+    assert limited.command(Pose2D(0.0, 0.0, e)).linear_m_s == pytest.approx(0.05 * rate / e ** 2)
+    assert paper.command(Pose2D(0.0, 0.0, e)).linear_m_s == pytest.approx(2.0 * math.cos(e))
+    for c in (limited, paper):
+        c.reset(Path.from_waypoints(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]), 0.0))
+    assert limited.command(Pose2D(0.5, 0.0, 0.0)).linear_m_s == pytest.approx(math.sqrt(2.0 * 2.0 * 0.5))
+    assert paper.command(Pose2D(0.5, 0.0, 0.0)).linear_m_s == pytest.approx(2.0)
+
+
 def test_the_goal_checker_alone_decides_arrival():
     goal = GoalChecker(1.0, 1.0, 0.1)
     assert goal.reached(Pose2D(1.0, 0.95)) and goal.reached(Pose2D(1.07, 1.07))

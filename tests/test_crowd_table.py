@@ -6,21 +6,24 @@ from pathlib import Path
 import pytest
 
 from swarmnav.benchmarks import crowd_table
-from swarmnav.benchmarks.crowd_table import RESULT, block, current_block
+from swarmnav.benchmarks.crowd_table import PROTOCOL, RESULT, block, current_block
 from swarmnav.benchmarks.navigation_table import read_rows
 
 REPO = Path(__file__).resolve().parents[1]
 
 
 def test_the_readme_crowdnav_table_is_the_one_generated_from_the_committed_result(capsys):
-    assert crowd_table.main([str(RESULT)]) == 0
+    assert crowd_table.main([str(RESULT)] + (["--protocol", str(PROTOCOL)] if PROTOCOL.is_file() else [])) == 0
     generated = capsys.readouterr().out.strip()
     assert current_block((REPO / "docs" / "crowds.md").read_text()) == generated, \
         "run `make readme-table` (docs/crowds.md and models/suites/results/crowdnav.json differ)"
 
 
-def test_the_committed_result_has_both_settings_and_no_oracle_where_the_humans_see_the_robot():
-    rows = read_rows(RESULT)
+@pytest.mark.parametrize("path", [RESULT, PROTOCOL])
+def test_the_committed_result_has_both_settings_and_no_oracle_where_the_humans_see_the_robot(path):
+    if not path.is_file():
+        pytest.skip(f"{path.name} not committed")
+    rows = read_rows(path)
     invisible = [r for r in rows if r["robot_visible"] is False]
     visible = [r for r in rows if r["robot_visible"] is True]
     assert {r["navigator"] for r in invisible} - {"oracle"} == {r["navigator"] for r in visible}
@@ -46,3 +49,13 @@ def test_every_published_method_has_a_line_found_or_not(seen, methods):
     lines = crowd_table.table_lines([], seen)
     for m in methods:
         assert any(line.startswith(f"| {m}, Chen et al. (2019)") for line in lines)
+
+
+def test_the_protocol_comes_first_with_the_published_figures_and_the_sample_after_without_them():
+    rows = read_rows(RESULT)
+    protocol = [dict(r, runs=500) for r in rows if r["navigator"] in ("oracle", "follow")]
+    text = block(rows, protocol)
+    assert text.index("**CrowdNav's protocol**: 500 test cases") < text.index("**Every navigator** on")
+    assert text.count("| SARL, Chen et al. (2019)") == 2  # once per setting
+    assert text.rindex("| SARL, Chen et al. (2019)") < text.index("**Every navigator** on")
+    assert block(rows).count("| SARL, Chen et al. (2019)") == 2  # no protocol file: beside the sample

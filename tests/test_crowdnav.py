@@ -121,3 +121,8 @@ def test_the_crowdnav_suite_reads_each_setting_apart_and_the_visible_one_without
         assert r["runs"] == 1 and 0.0 <= r["discomfort_frequency"] <= 1.0
     # the blind follower meets the humans closer than the oracle does
     assert by[("follow", False)]["discomfort_frequency"] > by[("oracle", False)]["discomfort_frequency"]
+    # The report counts the oracle's refused run on the visible scene nowhere: "no yardstick" instead.
+    from swarmnav.study.report import write_report
+    text = write_report(tmp_path, tmp_path / "report.html").read_text(encoding="utf-8")
+    assert "No yardstick: 1 runs of the clairvoyant oracle" in text
+    assert "3 runs, " in text and "4 runs, " not in text

@@ -111,7 +111,8 @@ def test_the_navigator_draws_from_its_own_stream(monkeypatch):
     run, and another navigator stream under the same seed leaves the plan but changes the replanned drive."""
     from swarmnav.sim import episode as episode_module
 
-    spec = EpisodeSpec(crossing_case(), "abc", navigator="replan", seed=3)
+    # A small colony (10 x 10): each replan is a whole ABC run, and the stream matters, not the colony's size.
+    spec = EpisodeSpec(crossing_case(), "abc", {"population": 10, "iterations": 10}, navigator="replan", seed=3)
     first = run_episode(spec)
     second = run_episode(spec)
     assert first.result.replans >= 1

@@ -92,6 +92,7 @@ def cheap_settings(files: dict[str, str]) -> dict[tuple[str, ...], list[str]]:
             ("bench", "planners"): ["--scenarios", s, "--seeds", "1", "--population", "4", "--iterations", "1",
                                     "--peer-runs", "0", "--fields", "0"],
             ("bench", "grid"): ["--runs", "1", "--swarm-sample", "1"],
+            ("bench", "sensed-map"): ["--scenario", s, "--only", "dstar_replan"],
             ("bench", "study"): ["--seeds", "1", "--iterations", "1", "--rounds", "1", "--no-ray"],
             ("study",): ["--workers", "1", "--out", str(Path(files["folder"]) / "study-out")],
             ("replay",): ["--verify"]}

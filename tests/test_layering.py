@@ -8,6 +8,7 @@ floor fails here too.
 """
 
 import ast
+import functools
 import importlib.util
 import re
 import tomllib
@@ -137,14 +138,20 @@ def module_name(layer: str, path: Path) -> str:
     return names[0]
 
 
+@functools.cache
+def parsed(path: Path) -> ast.Module:
+    """A project file's syntax tree, parsed once per session (several checks read every file)."""
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
+@functools.cache
 def import_graph() -> dict[str, set[str]]:
     """Project module -> the project modules it imports, at any depth (imports inside functions included)."""
     files = {module_name(layer, path): (layer, path) for layer, path in project_modules()}
     graph: dict[str, set[str]] = {name: set() for name in files}
     for name, (layer, path) in files.items():
         package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
-        tree = ast.parse(path.read_text(encoding="utf-8"))
-        for node in ast.walk(tree):
+        for node in ast.walk(parsed(path)):
             targets: list[str] = []
             if isinstance(node, ast.Import):
                 targets = [alias.name for alias in node.names]
@@ -319,7 +326,7 @@ def test_every_import_of_the_package_names_one_of_its_modules():
     known = set(modules) | {extension["name"] for extension in PYPROJECT["ext-modules"]}
     unknown = []
     for layer, path in [*project_modules(), *(("tests", p) for p in sorted((ROOT / "tests").glob("*.py")))]:
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in ast.walk(parsed(path)):
             if isinstance(node, ast.Import):
                 names = [alias.name for alias in node.names]
             elif isinstance(node, ast.ImportFrom) and not node.level and node.module:

@@ -191,11 +191,13 @@ def test_one_declaration_per_parameter_gives_the_reader_its_checks_and_the_listi
     assert rows["evade"]["default"] is False and rows["evade_trigger_s"]["range"] == "[0, 600]"
     assert {row["name"]: row["default"] for row in navigator_table("replan")}["evade"] is True
     assert set(numeric_parameters(SafetyLayer)) <= set(parameter_ranges(SafetyLayer))
-    # No navigator keeps a second declaration or a checking helper of its own.
-    folder = pathlib.Path(__file__).resolve().parents[1] / "controllers" / "navigators"
-    for path in folder.glob("*.py"):
+    # No navigator keeps a second declaration or a checking helper of its own, and no planner declares its
+    # ranges in the older class-level dict: every parameter is one param(default, range|choices) field.
+    root = pathlib.Path(__file__).resolve().parents[1]
+    for path in (root / "controllers" / "navigators").glob("*.py"):
         text = path.read_text()
         assert "parameter_ranges" not in text and "def check_" not in text, path.name
+    assert [path.name for path in (root / "planners").glob("*.py") if "parameter_ranges" in path.read_text()] == []
 
 
 def test_a_value_out_of_range_names_the_field_and_the_range():

@@ -98,3 +98,36 @@ def test_a_run_with_map_and_pose_given_on_the_command_line_replays(tmp_path):
     run = read_log(str(out)).metadata["run"]
     assert json.loads(run["map_knowledge"]) == "unknown" and json.loads(run["pose_source"]) == "odometry"
     assert main(["replay", str(out), "--verify"]) == 0
+
+
+def test_grown_discs_cover_each_sensed_cell_reach_behind_it_and_never_over_a_cell_seen_free():
+    """The planners' view of the sensed map (controllers.world_map.grown_discs): a cylinder scanned from one
+    side is mapped as a rim of cells; each is presented as a disc that covers it, larger than the cell where
+    the unseen space behind it leaves room, and none covers the centre of a cell seen free or driven over."""
+    from swarmnav.controllers.world_map import GROWN_MAX_M, grown_discs
+    grid = LogOddsGrid(Rect(0.0, 0.0, 4.0, 4.0), 0.05)
+    angles = np.linspace(-0.6, 0.6, 61)
+    # A cylinder of radius 0.3 m at (2.5, 2.0), seen from (1.0, 2.0): each beam's range to its surface.
+    d = np.array([1.5 * math.cos(a) - math.sqrt(max(0.09 - (1.5 * math.sin(a)) ** 2, 0.0))
+                  if abs(1.5 * math.sin(a)) < 0.3 else math.inf for a in angles])
+    for _ in range(3):
+        grid.integrate(1.0, 2.0, 0.0, d, angles)
+    occupied = grid.occupied
+    seen_free = grid.log_odds < 0.0
+    driven = np.zeros_like(occupied)
+    driven[38:42, 18:22] = True
+    centres, radii = grown_discs(occupied, seen_free, driven, grid.cell_m, grid.origin_m)
+    cells = (np.argwhere(occupied)[:, ::-1] + 0.5) * grid.cell_m
+    assert len(centres) == len(cells) >= 5
+    half_diagonal = grid.cell_m * math.sqrt(0.5)
+    # Each disc covers its cell (the cell's far corner included).
+    assert np.all(np.hypot(*(centres - cells).T) + half_diagonal <= radii + 1e-9)
+    # The rim's middle is grown into the unseen shadow behind it (away from the laser), up to the stated largest
+    # radius; its ends, with the space seen free beside them, stay near their cells' size.
+    grown = radii > half_diagonal
+    assert grown.sum() >= len(radii) / 3 and radii.max() >= 0.15 and radii.max() <= GROWN_MAX_M + 1e-12
+    assert np.all(centres[grown, 0] >= cells[grown, 0]) and np.any(centres[grown, 0] > cells[grown, 0] + 0.05)
+    # No disc reaches the centre of a cell seen free (or driven over).
+    free_centres = (np.argwhere((seen_free | driven) & ~occupied)[:, ::-1] + 0.5) * grid.cell_m
+    gaps = np.hypot(*(free_centres[:, None, :] - centres[None]).transpose(2, 0, 1)) - radii[None]
+    assert gaps[:, radii > half_diagonal].min() >= -1e-9

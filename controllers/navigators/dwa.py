@@ -41,7 +41,13 @@ Where we differ or the paper is silent (our choices):
   robot's frame, at reset; each step takes the block of lattice pairs inside
   the dynamic window (on an axis where the window holds no lattice value, the
   value nearest the measured one) and moves the obstacles into the robot's
-  frame instead of the arcs into the world's.
+  frame instead of the arcs into the world's.  The speed lattice is made fine
+  enough for the window: at least ``ceil(2 v_max / (accel_m_s2 window_s)) + 1``
+  speeds (at most 50, ``v_samples``' bound), so that the window (+-0.125 m/s at the defaults) always holds two or
+  more of them (a bug fix: at 1 m/s the 7 default speeds were 0.167 m/s apart,
+  the window from standing held 0 alone and the robot never moved; at or
+  below 0.75 m/s, dyn300's 0.2 m/s included, the lattice is the 7 speeds as
+  before).
 """
 
 from __future__ import annotations
@@ -61,6 +67,9 @@ from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationSt
 from swarmnav.models.world import wrap_angle_rad
 
 
+CLEARANCES = ("distance", "time")
+
+
 @dataclass
 class DynamicWindowNavigator:
     """Fox, Burgard & Thrun (1997) with the global path as guidance and moving obstacles predicted.
@@ -70,7 +79,8 @@ class DynamicWindowNavigator:
         accel_m_s2, angular_accel_rad_s2: the acceleration limits of the window.
         window_s: the time over which the window is open (the paper's cycle, 0.25 s).
         max_angular_rad_s: turn-rate limit.
-        v_samples, omega_samples: the velocity lattice over [0, v_max] x [-omega_max, omega_max].
+        v_samples, omega_samples: the velocity lattice over [0, v_max] x [-omega_max, omega_max] (the speeds
+            at least as many as keep two in the window: see the module's note on sampling).
         horizon_s, sim_step_s: how far and how finely arcs are simulated.
         dist_cap_m: ``dist`` beyond this counts as free.
         margin_m: extra distance kept beyond the robot radius.
@@ -79,6 +89,12 @@ class DynamicWindowNavigator:
             the known map (:meth:`controllers.guidance.PathCarrot.keep_in_sight`; ours, on by default: on
             dyn300's door scenes the carrot behind a wall held the robot still against it; false: the plain
             lookahead point).  The bundled dyn-* scenes have no static obstacle: there it changes nothing.
+        clearance: how an arc that meets an obstacle within the horizon is scored and admitted:
+            "distance" (default; the paper's dist) the length driven before contact, ``v t_contact``; "time"
+            (named option, ours) ``v_max t_contact``, the time before contact at top speed: a standing robot
+            then scores 0 only if nothing comes at it.  With "distance" stopping is always admissible and
+            scores as well as any arc that meets an obstacle at once, so among people who do not see the robot
+            it stood in their way and was walked into (CrowdNav's circle crossing, robot invisible).
     """
 
     name: ClassVar[str] = "dwa"
@@ -103,6 +119,7 @@ class DynamicWindowNavigator:
     margin_m: float = param(0.05, within(0, 100))
     lookahead_m: float = param(1.0, above(0, 1000))
     carrot_in_sight: bool = True
+    clearance: str = param("distance", choices=CLEARANCES)
 
     def __post_init__(self) -> None:
         if self.horizon_s < self.sim_step_s:  # no rollout step at all
@@ -116,7 +133,10 @@ class DynamicWindowNavigator:
         self.times = np.arange(1, int(round(self.horizon_s / self.sim_step_s)) + 1) * self.sim_step_s  # (T,)
         self.reach = self.max_speed * self.horizon_s + 1.0
         # The lattice V_s and its arcs in the robot's frame (start at the origin facing +x).
-        self.speeds = np.linspace(0.0, self.max_speed, self.v_samples) if self.v_samples > 1 \
+        dv = self.accel_m_s2 * self.window_s
+        n_speeds = max(self.v_samples, min(math.ceil(2.0 * self.max_speed / dv - 1e-9) + 1, 50)) \
+            if self.v_samples > 1 else 1                                                    # 50: v_samples' bound
+        self.speeds = np.linspace(0.0, self.max_speed, n_speeds) if n_speeds > 1 \
             else np.array([self.max_speed])                                                 # (V,)
         self.turns = np.linspace(-self.max_angular_rad_s, self.max_angular_rad_s, self.omega_samples) \
             if self.omega_samples > 1 else np.zeros(1)                                      # (W,)
@@ -150,7 +170,8 @@ class DynamicWindowNavigator:
             hit = gap < 0.0
             first = np.where(hit.any(axis=1), hit.argmax(axis=1), n_t)
             t_free = np.where(first > 0, self.times[np.maximum(first - 1, 0)], 0.0)
-            dist = np.where(first == n_t, self.dist_cap_m, np.minimum(v * t_free, self.dist_cap_m))  # before contact
+            driven = self.max_speed * t_free if self.clearance == "time" else v * t_free
+            dist = np.where(first == n_t, self.dist_cap_m, np.minimum(driven, self.dist_cap_m))  # before contact
             admissible = (v <= np.sqrt(2.0 * dist * self.accel_m_s2) + 1e-9) & \
                          (w_abs <= np.sqrt(2.0 * dist * self.angular_accel_rad_s2) + 1e-9)
         # The three terms of G, each normalised to [0, 1]; the carrot in the robot's frame.

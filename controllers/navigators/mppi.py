@@ -76,6 +76,13 @@ class MppiNavigator:
             the known map (:meth:`controllers.guidance.PathCarrot.keep_in_sight`; ours, on by default: on
             dyn300's door scenes the carrot behind a wall held the robot still against it; false: the plain
             lookahead point).  The bundled dyn-* scenes have no static obstacle: there it changes nothing.
+        reference_speed_m_s: the top speed ``linear_std_m_s`` and ``lookahead_m`` are given for; the robot's top
+            speed over it scales both (named option, ours); 0 (default): both as given, whatever the top speed.
+            Why: the control cost gamma u Sigma^-1 eps weighs a speed u by u / sigma_v, and the carrot
+            ``lookahead_m`` ahead caps the speed at about lookahead / horizon (1 m in 3 s), so the defaults,
+            set for dyn300's 0.2 m/s, held a 1 m/s robot near 0.29 m/s (CrowdNav's circle crossing: 6.5 m in
+            25 s, timeouts); scaled (0.2: sigma_v 0.5 m/s, carrot 5 m at 1 m/s) it drives near its top speed.
+            At a top speed equal to it nothing changes.
     """
 
     name: ClassVar[str] = "mppi"
@@ -105,6 +112,7 @@ class MppiNavigator:
     noise_bank: int = param(8, within(1, 16))
     optimise_period_s: float = param(0.1, within(0, 10))
     carrot_in_sight: bool = True
+    reference_speed_m_s: float = param(0.0, within(0, 100))
 
     def __post_init__(self) -> None:
         # Each field's own range is declared with it (param); what no single field can say:
@@ -113,12 +121,14 @@ class MppiNavigator:
                                                           f"got {self.samples * self.horizon_steps:,}")
 
     def reset(self, setup: NavigationSetup) -> None:
+        scale = setup.max_speed_m_s / self.reference_speed_m_s if self.reference_speed_m_s > 0 else 1.0
+        scale = min(scale, 1000.0)  # a tiny reference speed: sigma_v and the carrot stay finite
         (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(
-            setup, self.margin_m, self.lookahead_m, self.carrot_in_sight)
+            setup, self.margin_m, self.lookahead_m * scale, self.carrot_in_sight)
         self.rng = setup.rng
         self.optimised_at_s = -1.0
         self.nominal = np.zeros((self.horizon_steps, 2), dtype=np.float32)
-        self.std = np.array([self.linear_std_m_s, self.angular_std_rad_s], dtype=np.float32)
+        self.std = np.array([self.linear_std_m_s * scale, self.angular_std_rad_s], dtype=np.float32)
         self.lo = np.array([0.0, -self.max_angular_rad_s], dtype=np.float32)
         self.hi = np.array([self.max_speed, self.max_angular_rad_s], dtype=np.float32)
         if self.noise_bank > 0:

@@ -188,7 +188,8 @@ class ReplanNavigator:
     def _replan(self, observation: Observation, reason: str, events: list) -> Path | None:
         t = observation.time_s
         self.next_replan_s = t + self.cooldown_s
-        problem = sensed_problem(self.known, observation.pose, swept_discs(observation.detections, self.horizon_s))
+        problem = sensed_problem(self.setup.plan_problem, observation.pose,
+                                 swept_discs(observation.detections, self.horizon_s))
         wall0 = time.perf_counter()
         goal = self.setup.goal
         on_goal = [d.track_id for d in observation.detections

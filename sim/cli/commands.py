@@ -263,6 +263,20 @@ def run_bench_odometry(args: argparse.Namespace) -> int:
     return odometry.run(args)
 
 
+def add_bench_sensed_map_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenario", action="append", metavar="NAME",
+                        help="a scenario instead of dense-field-30 and gwo-scenario-1 (repeatable)")
+    parser.add_argument("--only", metavar="NAME", help="only the runs of this navigator or planner")
+    parser.add_argument("--json", action="store_true", help="one JSON object per run")
+    parser.add_argument("--write", action="store_true",
+                        help="also write models/suites/results/sensed_map.json and docs/sensing.md's table from it")
+
+
+def run_bench_sensed_map(args: argparse.Namespace) -> int:
+    from swarmnav.benchmarks import sensed_map
+    return sensed_map.run(args)
+
+
 def add_bench_defaults_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seeds", type=options.positive_int, default=10, help="seeds 0..N-1 per case (default 10)")
     parser.add_argument("--planners", nargs="+", metavar="NAME", help="only these planners (default: every paper's)")
@@ -363,6 +377,8 @@ MODULE_COMMANDS: list[tuple[tuple[str, ...], Adder, Runner, str]] = [
      "each paper's planners at their defaults on its scenarios: collision-free plans over N seeds"),
     (("bench", "odometry"), add_bench_odometry_arguments, run_bench_odometry,
      "wheel odometry's pose error against distance driven, per robot, clean and in hard contact"),
+    (("bench", "sensed-map"), add_bench_sensed_map_arguments, run_bench_sensed_map,
+     "every planning navigator with the map known and unknown on dense-field-30 and gwo-scenario-1"),
     (("log", "info"), add_log_info_arguments, run_log_info, "what a log holds"),
     (("log", "recover"), add_log_recover_arguments, run_log_recover, "rewrite a truncated log as a complete one"),
     (("replay",), add_replay_arguments, run_replay, "re-render or re-simulate a log"),

@@ -64,6 +64,9 @@ class ScenarioSource(Protocol):
         """The merged layout, widened where the envelope's scenarios fall short of what a draw can give."""
 
 
+REDRAWS = 50  # draws of one episode's world before its options are called unfit
+
+
 def draw_rng(episode_seed: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(int(episode_seed)).spawn(DRAW_CHILD + 1)[DRAW_CHILD])
 
@@ -128,8 +131,15 @@ class GeneratorSpec:
                 drawn[key] = int(rng.integers(int(low), int(high) + 1))
             else:
                 drawn[key] = float(rng.uniform(low, high))
-        seed = int(rng.integers(2**31))
-        return parse_scenario(generate(kind, seed, self.options(kind, drawn)), f"generated {kind} {seed}")
+        # the radii are drawn too, so a count that fits the envelope's draw may not fit this one's: such a
+        # draw is redrawn from the same stream (a bounded number of times), so a reset never fails on it
+        for _ in range(REDRAWS):
+            seed = int(rng.integers(2**31))
+            try:
+                return parse_scenario(generate(kind, seed, self.options(kind, drawn)), f"generated {kind} {seed}")
+            except ConfigError as exc:
+                last = exc
+        raise ConfigError(FIELD, f"no {kind} scenario fits {drawn} in {REDRAWS} draws: {last}")
 
     def envelope(self) -> list[Scenario]:
         upper = {key: high for key, (_, high) in self.ranges.items()}

@@ -182,8 +182,22 @@ def chassis_radius_m(mjcf_xml: str) -> float:
     raise ValueError("the scene has no chassis geom with a size")
 
 
-def scene_update(arena_size_m: tuple[float, float], robot_radius_m: float) -> SceneUpdate:
-    """``/scene`` at t = 0: the arena's outline in ``world`` and the robot's footprint in ``base_link``.
+def chassis_box_m(mjcf_xml: str) -> tuple[float, float, float, float] | None:
+    """The plan view of a box ``chassis`` geom of the run's MJCF, (centre x, centre y, half length, half width)
+    in the base frame; None for a cylinder chassis (the disc robot) or none."""
+    for geom in ElementTree.fromstring(mjcf_xml).iter("geom"):
+        if geom.get("name") == "chassis" and geom.get("size") and geom.get("type") == "box":
+            size = [float(v) for v in geom.get("size").split()]
+            x, y = ([float(v) for v in geom.get("pos", "0 0 0").split()] + [0.0, 0.0])[:2]
+            return x, y, size[0], size[1]
+    return None
+
+
+def scene_update(arena_size_m: tuple[float, float], robot_radius_m: float,
+                 box_m: tuple[float, float, float, float] | None = None) -> SceneUpdate:
+    """``/scene`` at t = 0: the arena's outline in ``world`` and the robot's footprint in ``base_link``: a disc
+    of ``robot_radius_m``, or the box ``box_m`` (:func:`chassis_box_m`) of a box robot; the heading arrow's
+    size follows ``robot_radius_m``.
 
     The footprint is ``frame_locked``: Foxglove moves it with ``base_link`` as ``/tf`` goes, so
     it is sent once and never expires (no lifetime).
@@ -194,12 +208,19 @@ def scene_update(arena_size_m: tuple[float, float], robot_radius_m: float) -> Sc
     arena = SceneEntity(timestamp=stamp(0), frame_id=WORLD_FRAME, id=ARENA_ENTITY, lines=[LinePrimitive(
         type=LinePrimitiveLineType.LineLoop, thickness=0.04, points=corners, color=_colour(palette.ARENA))])
     r = float(robot_radius_m)
+    if box_m is None:
+        shape = {"cylinders": [CylinderPrimitive(pose=Pose(position=Vector3(x=0.0, y=0.0, z=_FOOTPRINT_Z_M),
+                                                           orientation=Quaternion(w=1.0)),
+                                                 size=Vector3(x=2 * r, y=2 * r, z=_FOOTPRINT_HEIGHT_M),
+                                                 bottom_scale=1.0, top_scale=1.0, color=_colour(palette.ROBOT, 0.6))]}
+    else:
+        cx, cy, hx, hy = (float(v) for v in box_m)
+        shape = {"cubes": [CubePrimitive(pose=Pose(position=Vector3(x=cx, y=cy, z=_FOOTPRINT_Z_M),
+                                                   orientation=Quaternion(w=1.0)),
+                                         size=Vector3(x=2 * hx, y=2 * hy, z=_FOOTPRINT_HEIGHT_M),
+                                         color=_colour(palette.ROBOT, 0.6))]}
     footprint = SceneEntity(
-        timestamp=stamp(0), frame_id=BASE_FRAME, id=FOOTPRINT_ENTITY, frame_locked=True,
-        cylinders=[CylinderPrimitive(pose=Pose(position=Vector3(x=0.0, y=0.0, z=_FOOTPRINT_Z_M),
-                                               orientation=Quaternion(w=1.0)),
-                                     size=Vector3(x=2 * r, y=2 * r, z=_FOOTPRINT_HEIGHT_M), bottom_scale=1.0,
-                                     top_scale=1.0, color=_colour(palette.ROBOT, 0.6))],
+        timestamp=stamp(0), frame_id=BASE_FRAME, id=FOOTPRINT_ENTITY, frame_locked=True, **shape,
         arrows=[ArrowPrimitive(pose=Pose(position=Vector3(x=0.0, y=0.0, z=2 * _FOOTPRINT_Z_M),
                                          orientation=Quaternion(w=1.0)),
                                shaft_length=0.7 * r, shaft_diameter=0.15 * r, head_length=0.3 * r,

@@ -31,7 +31,7 @@ from swarmnav.log.format import (
     event_text,
 )
 from swarmnav.log.map_channel import occupancy_percent
-from swarmnav.log.messages import chassis_radius_m, event_severity
+from swarmnav.log.messages import chassis_box_m, chassis_radius_m, event_severity
 from swarmnav.log.ros2_types import (
     LOG_ERROR,
     LOG_INFO,
@@ -108,8 +108,10 @@ def obstacle_marker(info: ObstacleInfo, x_m: float, y_m: float, t_ns: int) -> di
             "color": _colour(palette.MOVING_OBSTACLE if info.moving else palette.OBSTACLE)}
 
 
-def scene_markers(arena_size_m: tuple[float, float], robot_radius_m: float) -> list[dict[str, Any]]:
-    """``/scene``: the arena's outline in ``map``, the footprint and heading arrow in ``base_link``."""
+def scene_markers(arena_size_m: tuple[float, float], robot_radius_m: float,
+                  box_m: tuple[float, float, float, float] | None = None) -> list[dict[str, Any]]:
+    """``/scene``: the arena's outline in ``map``, the footprint (a disc, or a box robot's box ``box_m``:
+    :func:`swarmnav.log.messages.chassis_box_m`) and heading arrow in ``base_link``."""
     w, h = (float(v) for v in arena_size_m)
     r = float(robot_radius_m)
     outline = [{"x": x, "y": y, "z": 0.002} for x, y in ((0.0, 0.0), (w, 0.0), (w, h), (0.0, h), (0.0, 0.0))]
@@ -120,7 +122,11 @@ def scene_markers(arena_size_m: tuple[float, float], robot_radius_m: float) -> l
          "color": _colour(palette.ARENA), "points": outline},
         {**base, "ns": "robot_footprint", "type": MARKER_CYLINDER,
          "pose": {"position": {"x": 0.0, "y": 0.0, "z": 0.005}, "orientation": _IDENTITY},
-         "scale": {"x": 2 * r, "y": 2 * r, "z": 0.01}, "color": _colour(palette.ROBOT, 0.6)},
+         "scale": {"x": 2 * r, "y": 2 * r, "z": 0.01}, "color": _colour(palette.ROBOT, 0.6)} if box_m is None else
+        {**base, "ns": "robot_footprint", "type": MARKER_CUBE,
+         "pose": {"position": {"x": float(box_m[0]), "y": float(box_m[1]), "z": 0.005}, "orientation": _IDENTITY},
+         "scale": {"x": 2 * float(box_m[2]), "y": 2 * float(box_m[3]), "z": 0.01},
+         "color": _colour(palette.ROBOT, 0.6)},
         {**base, "ns": "robot_heading", "type": MARKER_ARROW,
          "pose": {"position": {"x": 0.0, "y": 0.0, "z": 0.01}, "orientation": _IDENTITY},
          "scale": {"x": r, "y": 0.15 * r, "z": 0.35 * r}, "color": _colour(palette.DRIVEN)},
@@ -221,7 +227,8 @@ class Ros2Channels:
                                   (0.0, 0.0, 0.0, 1.0))]
         self._static_map_odom = transform(0, MAP_FRAME, ODOM_FRAME, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
         self._static_written = False
-        self._scene = {"markers": scene_markers(context.arena_size_m, chassis_radius_m(context.mjcf_xml))}
+        self._scene = {"markers": scene_markers(context.arena_size_m, chassis_radius_m(context.mjcf_xml),
+                                                chassis_box_m(context.mjcf_xml))}
         self._log("/obstacles", self._obstacle_array(0, None), 0)
         self._log("/scene", self._scene, 0)
         return 2

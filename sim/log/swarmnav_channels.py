@@ -31,6 +31,7 @@ from swarmnav.log.format import (
 )
 from swarmnav.log.messages import (
     belief_update,
+    chassis_box_m,
     chassis_radius_m,
     controller_json,
     event_log,
@@ -96,7 +97,8 @@ class SwarmnavChannels:
         self._scene = SceneEncoder(static_entities, WORLD_FRAME,
                                    [(o.entity_id, obstacle_template(o)) for o in self._moving_infos])
         self._obstacles.base.log(self._scene_update(0, None), 0, None)
-        self._scene_message = scene_update(context.arena_size_m, chassis_radius_m(context.mjcf_xml))
+        self._scene_message = scene_update(context.arena_size_m, chassis_radius_m(context.mjcf_xml),
+                                           chassis_box_m(context.mjcf_xml))
         self._scene_channel.log(self._scene_message, log_time=0)
         return 2
 

@@ -246,6 +246,18 @@ def given_episode(spec: EpisodeSpec | Composition, waypoints: np.ndarray, source
     return parts.episode(problem, path)
 
 
+def point_to_point(drive, scenario: Scenario) -> PointToPointController:
+    """The run's PTP controller: the model's drive geometry, the scenario's top speed, the robot's published
+    turn-rate limit and its drift and corner limits (``models.robots``; the controller's defaults when it has
+    none: the disc robot's, the paper's)."""
+    from swarmnav.models.robots import robot_model
+    robot = robot_model(scenario.robot_model)
+    extra = {} if robot.max_angular_rad_s is None else {"max_angular_rad_s": robot.max_angular_rad_s}
+    if robot.ptp_limits is not None:
+        extra["max_drift_m"], extra["max_deceleration_m_s2"] = robot.ptp_limits
+    return PointToPointController(drive, max_speed_m_s=scenario.max_speed_m_s, **extra)
+
+
 def unknown_map_problem(scenario: Scenario) -> Problem:
     """What the robot knows at t = 0 with the map unknown: the arena, its start and goal, no obstacle."""
     return scenario_problem(replace(scenario, obstacles=(), boxes=(), map_grid=None))
@@ -283,13 +295,14 @@ def run_episode(episode: Episode | EpisodeSpec, recorders: Sequence[Recorder] = 
         raise ValueError("this episode was planned without a navigator (plan_episode(drive=False)): nothing to run")
     unknown = scenario.map_knowledge == "unknown"
     known_problem = static_problem(scenario) if not unknown else planned.problem
-    world_map = SensedMap(planned.problem, scenario.bounds, scenario.map_cell_m) if unknown else None
+    world_map = SensedMap(planned.problem, scenario.bounds, scenario.map_cell_m,
+                          unknown_cost=scenario.unknown_cost) if unknown else None
     setup = NavigationSetup(
         path=planned.path, problem=planned.problem,
         # With the map unknown every navigator that plans replans its (guidance) path on the sensed map.
         planner=planned.planner if navigator.uses_planner or unknown else None,
         rng=np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(NAVIGATOR_STREAM,))),
-        controller=PointToPointController(simulation.scene.drive, max_speed_m_s=scenario.max_speed_m_s),
+        controller=point_to_point(simulation.scene.drive, scenario),
         goal=simulation.goal_checker(), control_dt_s=simulation.control_dt_s,
         max_speed_m_s=scenario.max_speed_m_s, known_problem=known_problem,
         scenario=scenario, world_map=world_map)

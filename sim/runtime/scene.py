@@ -240,6 +240,10 @@ def compile_scene(scenario: Scenario) -> CompiledScene:
     return index_scene(model, xml)
 
 
+def _has_numeric(model: mujoco.MjModel, name: str) -> bool:
+    return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, name) >= 0
+
+
 def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
     """Look up the runner's indices in a compiled swarmnav scene (also for replaying a log's MJCF)."""
     def gid(name: str) -> int:
@@ -249,7 +253,10 @@ def index_scene(model: mujoco.MjModel, xml: str) -> CompiledScene:
     left = model.joint("left_wheel_hinge")
     right = model.joint("right_wheel_hinge")
     wheel_radius = float(model.geom("left_wheel_tyre").size[0])
-    track = float(np.linalg.norm(model.body("left_wheel").pos - model.body("right_wheel").pos))
+    # A skid-steer's effective track: the wheel separation times the robot file's track_multiplier, if any
+    # (Clearpath's wheel_separation_multiplier: the commands and the odometry both use it).
+    multiplier = model.numeric("track_multiplier").data[0] if _has_numeric(model, "track_multiplier") else 1.0
+    track = float(np.linalg.norm(model.body("left_wheel").pos - model.body("right_wheel").pos)) * float(multiplier)
     max_wheel = float(min(abs(model.actuator("left_wheel_motor").ctrlrange).min(),
                           abs(model.actuator("right_wheel_motor").ctrlrange).min()))
     drive = DriveGeometry(wheel_radius_m=wheel_radius, track_m=track, max_wheel_speed_rad_s=max_wheel)

@@ -13,6 +13,12 @@
     than = ["abc"]                         # one or more labels it is claimed better than (each pair must hold)
     navigator = "follow"                   # optional: only rows of this navigator label
     test = "rank_sum"                      # "rank_sum" | "signed_rank" (paired by seeds) | "fisher" (success)
+                                           # | "signed_rank_scenarios" (an average over scenarios, below)
+
+An **aggregate** claim (a paper's average over many start/goal pairs, e.g. Hasan et al. 2023's 30 pairs) takes
+``test = "signed_rank_scenarios"`` and a ``scenario`` that is a glob over the study's scenario names (``"*"``,
+``"immas-env*"``) matching two or more: each side's mean over its completed runs of each scenario, paired by
+scenario, Wilcoxon signed-rank over the scenarios (:mod:`swarmnav.study.claims`).
 
 :func:`read_claims` validates them against the study (its scenarios, its planner and navigator labels, the
 row columns); every problem is one :class:`ConfigError` naming the file and the field.  The verdicts are
@@ -21,6 +27,7 @@ row columns); every problem is one :class:`ConfigError` naming the file and the 
 
 from __future__ import annotations
 
+import fnmatch
 import re
 from dataclasses import dataclass
 from pathlib import Path as FilePath
@@ -28,7 +35,8 @@ from typing import Any
 
 from swarmnav.models.toml_table import REQUIRED, TomlTable, check_array, check_string, fail
 
-TESTS = ("rank_sum", "signed_rank", "fisher")
+TESTS = ("rank_sum", "signed_rank", "fisher", "signed_rank_scenarios")
+AGGREGATE = "signed_rank_scenarios"  # the test of a claim over scenarios (``scenario`` is a glob)
 BETTER = ("lower", "higher")
 SUCCESS = "success"
 KEYS = {"id", "statement", "source", "scenario", "metric", "better", "planner", "than", "navigator", "test"}
@@ -40,7 +48,7 @@ class Claim:
     id: str
     statement: str
     source: str
-    scenario: str  # the scenario's name (file stem)
+    scenario: str  # the scenario's name (file stem); an aggregate claim's glob over the names
     metric: str
     better: str
     planner: str
@@ -92,7 +100,8 @@ def read_claims(top: TomlTable, scenarios: tuple[str, ...], planners, navigators
             entry.fail("id", f"{claim_id!r} is used by an earlier claim")
         statement = entry.string("statement", non_empty=True)
         origin = entry.string("source", non_empty=True)
-        scenario = _one_of(entry, "scenario", names, "a scenario of the study")
+        test = _one_of(entry, "test", TESTS, "a test")
+        scenario = _scenario(entry, names, test)
         metric = entry.string("metric", non_empty=True)
         if metric != SUCCESS and metric not in columns:
             entry.fail("metric", f"{metric!r} is neither 'success' nor a numeric row column "
@@ -101,12 +110,30 @@ def read_claims(top: TomlTable, scenarios: tuple[str, ...], planners, navigators
         planner = _one_of(entry, "planner", planner_labels, "a planner label of the study")
         than = _than(entry, planner, planner_labels)
         navigator = _one_of(entry, "navigator", navigator_labels, "a navigator label of the study", None)
-        test = _one_of(entry, "test", TESTS, "a test")
         if (test == "fisher") != (metric == SUCCESS):
             entry.fail("test", f"{test!r} does not test {metric!r} (success rates take 'fisher'; "
                                "a numeric metric 'rank_sum' or 'signed_rank')")
         out.append(Claim(claim_id, statement, origin, scenario, metric, better, planner, than, test, navigator))
     return tuple(out)
+
+
+def claim_scenarios(claim: Claim, names) -> list[str]:
+    """The scenario names a claim compares on: its one scenario, or those its glob matches (aggregate)."""
+    if claim.test != AGGREGATE:
+        return [claim.scenario]
+    return [name for name in names if fnmatch.fnmatchcase(name, claim.scenario)]
+
+
+def _scenario(entry: TomlTable, names: list[str], test: str) -> str:
+    """``scenario``: one of the study's scenarios; for an aggregate claim a glob matching two or more."""
+    if test != AGGREGATE:
+        return _one_of(entry, "scenario", names, "a scenario of the study")
+    pattern = entry.string("scenario", REQUIRED, non_empty=True)
+    matched = [name for name in names if fnmatch.fnmatchcase(name, pattern)]
+    if len(matched) < 2:
+        entry.fail("scenario", f"{pattern!r} matches {len(matched)} of the study's scenarios; an aggregate claim "
+                               f"({AGGREGATE}) needs a glob matching two or more")
+    return pattern
 
 
 def _one_of(entry: TomlTable, key: str, allowed, what: str, default: Any = REQUIRED) -> str | None:

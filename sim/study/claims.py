@@ -7,7 +7,12 @@ Each claim compares its planner with every label of ``than`` on its scenario (an
 * ``signed_rank``: the Wilcoxon signed-rank test (``scipy.stats.wilcoxon``, two-sided) over the runs of the
   two sides that share (seed, world seed), both completed;
 * ``fisher``: Fisher's exact test (``scipy.stats.fisher_exact``, two-sided) of successes and failures over
-  every row (a run with no path, an error or a timeout is a failure).
+  every row (a run with no path, an error or a timeout is a failure);
+* ``signed_rank_scenarios`` (an aggregate claim, a paper's average over many scenarios): each side's mean of
+  the metric over its completed runs of each scenario the claim's glob matches, paired by scenario, and the
+  Wilcoxon signed-rank test over those scenarios; its n is the number of scenarios both sides completed, the
+  difference the mean over them of (claimed minus other), and ``relative`` that mean over the other side's
+  mean over them (a paper's "+9.99 %").
 
 Failed rows count: for ``success`` they are failures; for a numeric metric they are left out of its test, and
 each pair states n per side (runs tested / runs).  The p-values of every pair of every claim of the study are
@@ -36,7 +41,7 @@ import numpy as np
 from scipy import stats
 
 from swarmnav.study import power
-from swarmnav.study.claim_spec import SUCCESS, Claim
+from swarmnav.study.claim_spec import AGGREGATE, SUCCESS, Claim, claim_scenarios
 from swarmnav.study.statistics import holm, ranksum_p
 
 ALPHA = 0.05
@@ -58,8 +63,24 @@ def a12(better: np.ndarray, worse: np.ndarray) -> float:
 
 
 def _side(rows: Iterable[dict[str, Any]], claim: Claim, label: str) -> list[dict[str, Any]]:
-    return [r for r in rows if r["scenario"] == claim.scenario and r["label"] == label
+    rows = list(rows)
+    scenarios = set(claim_scenarios(claim, sorted({r["scenario"] for r in rows})))
+    return [r for r in rows if r["scenario"] in scenarios and r["label"] == label
             and (claim.navigator is None or (r.get("navigator_label") or "follow") == claim.navigator)]
+
+
+def _scenario_means(a_rows: list[dict[str, Any]], b_rows: list[dict[str, Any]],
+                    metric: str) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Each side's mean of ``metric`` over its completed runs of each scenario both sides completed."""
+    def means(rows):
+        by: dict[str, list[float]] = {}
+        for r in rows:
+            if r.get("outcome") == "ok" and r.get(metric) is not None:
+                by.setdefault(r["scenario"], []).append(float(r[metric]))
+        return {k: float(np.mean(v)) for k, v in by.items()}
+    a, b = means(a_rows), means(b_rows)
+    keys = sorted(set(a) & set(b))
+    return np.array([a[k] for k in keys]), np.array([b[k] for k in keys]), keys
 
 
 def _values(rows: list[dict[str, Any]], metric: str) -> np.ndarray:
@@ -98,6 +119,8 @@ def pair_result(claim: Claim, rows: list[dict[str, Any]], other: str) -> dict[st
     mine, theirs = _side(rows, claim, claim.planner), _side(rows, claim, other)
     sign = 1.0 if claim.better == "higher" else -1.0  # orient so that larger is better
     raw_a, raw_b = _values(mine, claim.metric), _values(theirs, claim.metric)
+    if claim.test == AGGREGATE:
+        return _aggregate_pair(claim, mine, theirs, other, sign)
     single = [claim.metric != SUCCESS and single_valued(side) and values.size > 0
               for side, values in ((mine, raw_a), (theirs, raw_b))]
     if single[0]:
@@ -151,8 +174,28 @@ def pair_result(claim: Claim, rows: list[dict[str, Any]], other: str) -> dict[st
     return pair
 
 
+def _aggregate_pair(claim: Claim, mine: list[dict[str, Any]], theirs: list[dict[str, Any]], other: str,
+                    sign: float) -> dict[str, Any]:
+    """An aggregate claim's pair (``signed_rank_scenarios``): per-scenario means, paired by scenario."""
+    raw_a, raw_b, scenarios = _scenario_means(mine, theirs, claim.metric)
+    a, b = sign * raw_a, sign * raw_b
+    d = a - b
+    p, direction = float("nan"), 0
+    if np.any(d != 0):
+        p = float(stats.wilcoxon(a, b).pvalue)
+        nonzero = d[d != 0]
+        ranks = stats.rankdata(np.abs(nonzero))
+        direction = int(np.sign(ranks[nonzero > 0].sum() - ranks[nonzero < 0].sum()))
+    difference, low, high = power.difference_interval(raw_a, raw_b, True)
+    base = float(np.mean(raw_b)) if raw_b.size else math.nan
+    return {"than": other, "n": [int(a.size), int(b.size)], "runs": [len(mine), len(theirs)], "a12": a12(a, b),
+            "test": AGGREGATE, "single_valued": [False, False], "pairs": int(a.size), "scenarios": scenarios,
+            "p": p, "direction": direction, "difference": difference, "interval": [low, high],
+            "relative": difference / base if base else math.nan}
+
+
 def _tested_sizes(pair: dict[str, Any]) -> tuple[int, int]:
-    if pair["test"] == "signed_rank":
+    if pair["test"] in ("signed_rank", AGGREGATE):
         return pair.get("pairs", 0), pair.get("pairs", 0)
     return pair["n"][0], pair["n"][1]
 
@@ -194,6 +237,8 @@ def verdicts(claims: Iterable[Claim], rows: list[dict[str, Any]], alpha: float =
         weakest = min(pairs, key=lambda p: (p["a12"] if not math.isnan(p["a12"]) else -1.0))
         claim["n"] = _tested_sizes(weakest)
         claim["difference"], claim["interval"] = weakest["difference"], weakest["interval"]
+        if "relative" in weakest:
+            claim["relative"] = weakest["relative"]
     return out
 
 

@@ -49,8 +49,8 @@ def smallest_p(test: str, n_a: int, n_b: int) -> float:
         return 1.0
     if test == "rank_sum":
         return float(stats.ranksums(np.arange(n_a), np.arange(n_a, n_a + n_b)).pvalue)
-    if test in ("signed_rank", "one_sample"):
-        n = min(n_a, n_b) if test == "signed_rank" else max(n_a, n_b)
+    if test in ("signed_rank", "signed_rank_scenarios", "one_sample"):
+        n = max(n_a, n_b) if test == "one_sample" else min(n_a, n_b)
         return float(stats.wilcoxon(np.arange(1.0, n + 1.0)).pvalue) if n >= 1 else 1.0
     if test == "fisher":
         return float(stats.fisher_exact([[n_a, 0], [0, n_b]]).pvalue)
@@ -58,7 +58,11 @@ def smallest_p(test: str, n_a: int, n_b: int) -> float:
 
 
 def seeds_needed(test: str, pairs_in_study: int, alpha: float) -> int:
-    """The seed rule (module docstring): runs per side for ``test`` among ``pairs_in_study`` Holm-corrected pairs."""
+    """The seed rule (module docstring): runs per side for ``test`` among ``pairs_in_study`` Holm-corrected pairs.
+    An aggregate claim (``signed_rank_scenarios``) samples scenarios, not seeds: it needs :data:`MIN_SEEDS` seeds
+    per scenario, and its pair is underpowered when its scenarios are too few (:func:`can_reach`)."""
+    if test == "signed_rank_scenarios":
+        return MIN_SEEDS
     threshold = alpha / max(1, pairs_in_study)
     n = 1
     while n < MAX_SEEDS and smallest_p(test, n, n) >= threshold:

@@ -45,6 +45,8 @@ def _n(c: dict[str, Any]) -> str:
     n = c.get("n")
     if not n:
         return "–"
+    if c.get("test") == "signed_rank_scenarios":
+        return f"{n[0]} scenarios (paired means)"
     return f"{n[0]} / {n[1]}" + (" (single values)" if c.get("single_values") else "")
 
 
@@ -52,9 +54,10 @@ def _difference(c: dict[str, Any]) -> str:
     interval = c.get("interval") or [None, None]
     if c.get("difference") is None:
         return "–"
+    relative = f" ({100 * c['relative']:+.1f} %)" if c.get("relative") is not None else ""
     if interval[0] is None or interval[0] == interval[1]:
-        return number(c["difference"], 3)
-    return f"{number(c['difference'], 3)} [{number(interval[0], 3)}, {number(interval[1], 3)}]"
+        return number(c["difference"], 3) + relative
+    return f"{number(c['difference'], 3)} [{number(interval[0], 3)}, {number(interval[1], 3)}]" + relative
 
 
 def table_lines(documents: list[dict[str, Any]]) -> list[str]:

@@ -36,6 +36,12 @@ STYLE = ("body{font-family:sans-serif;max-width:1200px;margin:auto;padding:0 12p
          "td.t{text-align:left;white-space:normal;min-width:8em}")
 
 
+def no_yardstick(row: dict[str, Any]) -> bool:
+    """The oracle's refused run on a scene whose agents react to the robot (its verdict ``none``): no yardstick
+    there, so a report counts it nowhere (neither a run nor a failure)."""
+    return row.get("navigator") == "oracle" and row.get("oracle_verdict") == "none"
+
+
 def load_rows(directory: FilePath) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """The run rows (only the columns a report reads; each cell once) and the progress rows of a results folder,
     as dicts."""
@@ -175,6 +181,8 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
     meta_path = directory / "study.json"
     meta = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
     runs = ordered_runs(runs, meta)
+    refused = [r for r in runs if no_yardstick(r)]
+    runs = [r for r in runs if not no_yardstick(r)]
     title = f"Study {meta.get('name', directory.name)}"
     markdown_path = html_path.with_suffix(".md")
     html_path.parent.mkdir(parents=True, exist_ok=True)
@@ -188,6 +196,10 @@ def write_report(directory: str | FilePath, html_path: str | FilePath) -> FilePa
                   f"simulated time; counted, never dropped). Mode: {meta.get('mode', '?')}. Statistics compare each planner against the "
                   f"reference planner {meta.get('reference', '?')!r}. Numbers to 4 significant digits, "
                   "p-values to 2.")
+    if refused:
+        doc.paragraph(f"No yardstick: {len(refused)} runs of the clairvoyant oracle on scenes whose agents react to "
+                      "the robot (sees_robot), where no clairvoyant yardstick exists; the oracle refuses them, and "
+                      "they are left out of every total and table above and below.")
     claims = [Claim.from_dict(c) for c in meta.get("claims", [])]
     document = claims_document(meta.get("name", directory.name), claims, runs, meta.get("inputs"))
     (html_path.parent / CLAIMS_FILE).write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")

@@ -70,7 +70,7 @@ from swarmnav.models.toml_table import POSITIVE, TomlTable, above, parse_toml, r
 from swarmnav.planners.registry import make_planner
 from swarmnav.planners.swarm import Budget
 from swarmnav.sim.plugins import load_plugins
-from swarmnav.study.claim_spec import Claim, read_claims
+from swarmnav.study.claim_spec import Claim, claim_scenarios, read_claims
 from swarmnav.study.spec_sections import (MAX_SEED, MAX_SEEDS, Component, PaperValue, check_time_limit,  # noqa: F401
                                               read_budget, read_clearance, read_components, read_knowledge, read_paper,
                                               read_scenarios, read_seeds, refuse_scenario_code)
@@ -125,7 +125,9 @@ class Study:
         """The study restricted to the arms its claims compare (each claim's planner and ``than`` labels on its
         scenario, with its navigator when it names one): the rows the verdicts need and no more.  Its cells
         are the full study's cells (the same hashes), so a later full run into the same folder resumes."""
-        arms = frozenset((c.scenario, label, c.navigator) for c in self.claims for label in (c.planner, *c.than))
+        names = [FilePath(s).stem for s in self.scenarios]
+        arms = frozenset((scenario, label, c.navigator) for c in self.claims for scenario in claim_scenarios(c, names)
+                         for label in (c.planner, *c.than))
         return replace(self, claim_arms=arms)
 
     def wants(self, scenario: str, planner_label: str, navigator_label: str) -> bool:
