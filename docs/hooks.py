@@ -8,6 +8,7 @@ is git-ignored), the folder mkdocs.yml's python handler searches.
 
 from __future__ import annotations
 
+import os
 import tomllib
 from pathlib import Path
 
@@ -22,11 +23,14 @@ SUBPACKAGES = {name.split(".", 1)[1]: folder for name, folder in tomllib.loads(
 
 
 def _link(link: Path, target: Path) -> None:
+    """``link`` -> ``target``, replaced atomically: two builds at once (the test suite's workers) never see it
+    missing or trip over each other's link."""
     if link.is_symlink() and link.resolve() == target.resolve():
         return
-    if link.is_symlink() or link.exists():
-        link.unlink()
-    link.symlink_to(target, target_is_directory=target.is_dir())
+    fresh = link.with_name(f".{link.name}.{os.getpid()}")
+    fresh.unlink(missing_ok=True)
+    fresh.symlink_to(target, target_is_directory=target.is_dir())
+    os.replace(fresh, link)
 
 
 @event_priority(100)  # before mkdocstrings' on_config, which keeps only search paths that exist
