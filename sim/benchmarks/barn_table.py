@@ -22,8 +22,10 @@ RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "r
 RESULTS = (RESULTS_DIR / "barn-test50.json", RESULTS_DIR / "barn-test10-dwa-vo.json", RESULTS_DIR / "barn.json",
            RESULTS_DIR / "barn-like.json", RESULTS_DIR / "barn-jackal-test10.json",
            RESULTS_DIR / "barn-protocol-test10.json", RESULTS_DIR / "barn-protocol-test10-more.json",
-           RESULTS_DIR / "barn-protocol-test50.json")
-TEST_50, ALL_300, FRESH = RESULTS[0], RESULTS[2], RESULTS[3]  # compared: BARN-like worlds against BARN's
+           RESULTS_DIR / "barn-protocol-test50.json", RESULTS_DIR / "barn-like-protocol.json")
+# compared: each BARN-like result (fresh worlds) against BARN's in its own setup (the 300 first, then 50 test worlds)
+BARN_300, BARN_50 = (RESULTS[2],), (RESULTS[0], RESULTS[7])
+FRESH = (RESULTS[3], RESULTS[8])
 BEGIN = "<!-- barn-table: generated from models/suites/results/barn*.json by `make readme-table`; do not edit by hand -->"
 END = "<!-- end of barn-table -->"
 ORACLE = "oracle"
@@ -106,26 +108,36 @@ def difficulty_lines(rows: list[dict[str, Any]]) -> list[str]:
 
 
 def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
-    """The BARN-like worlds' figures against BARN's (the 300 when committed in the same setup, else the 50 test
-    worlds), navigator by navigator, same setup only (issue 34's check: within 0.05)."""
-    if FRESH not in results or not FRESH.is_file():
-        return []
-    fresh_rows = read_result(FRESH)
+    """Each BARN-like result's figures (fresh worlds) against BARN's in the same setup (the 300 when committed,
+    else the 50 test worlds), navigator by navigator with the same parameters (issue 34's check: within 0.05)."""
+    lines: list[str] = []
+    for fresh_path in FRESH:
+        if fresh_path in results and fresh_path.is_file():
+            lines += _fresh_against_barn(fresh_path, results)
+    return lines
+
+
+def _key(row: dict[str, Any]) -> tuple[str, str]:
+    return row["navigator"], json.dumps(row.get("navigator_params") or {}, sort_keys=True)
+
+
+def _fresh_against_barn(fresh_path: FilePath, results: tuple[FilePath, ...]) -> list[str]:
+    fresh_rows = read_result(fresh_path)
     setups = {r["barn_setup"] for r in fresh_rows}
-    against = next((p for p in (ALL_300, TEST_50) if p in results and p.is_file()
+    against = next((p for p in BARN_300 + BARN_50 if p in results and p.is_file()
                     and setups & {r["barn_setup"] for r in read_result(p)}), None)  # the same setup only
     if against is None:
         return []
     base_rows = read_result(against)
-    base = {r["navigator"]: r for r in base_rows if r.get("scenario") is None}
-    fresh = {r["navigator"]: r for r in fresh_rows if r.get("scenario") is None}
+    base = {_key(r): r for r in base_rows if r.get("scenario") is None}
+    fresh = {_key(r): r for r in fresh_rows if r.get("scenario") is None}
     lines = []
-    for name in [n for n in fresh if n in base]:
-        b, f = base[name], fresh[name]
+    for key in [k for k in fresh if k in base]:
+        b, f = base[key], fresh[key]
         ds, dsc = f["success_rate"] - b["success_rate"], (f["barn_score"] or 0.0) - (b["barn_score"] or 0.0)
         if f["barn_setup"] != b["barn_setup"]:
             continue
-        lines.append(f"BARN-like worlds (`{FRESH.name}`) against BARN's (`{against.name}`), `{name}`: success "
+        lines.append(f"BARN-like worlds (`{fresh_path.name}`) against BARN's (`{against.name}`), `{key[0]}`: success "
                      f"{f['success_rate']:.3f} vs "
                      f"{b['success_rate']:.3f} ({ds:+.3f}), score {f['barn_score']:.4f} vs {b['barn_score']:.4f} "
                      f"({dsc:+.4f}): {'within' if abs(ds) <= 0.05 and abs(dsc) <= 0.05 else 'NOT within'} 0.05.")
