@@ -95,9 +95,10 @@ class MppiNavigator:
     samples: int = param(1000, within(1, 20_000))
     horizon_steps: int = param(30, within(1, 100))
     model_dt_s: float = param(0.1, above(0, 10))
-    linear_std_m_s: float = param(0.1, above(0, 100))
-    angular_std_rad_s: float = param(0.6, above(0, 100))
-    temperature: float = param(0.3, above(0, 1e6))
+    # float32 rollouts: sigma and lambda at least 1e-6 (a smaller one underflows sigma^-1 or -1/lambda to inf)
+    linear_std_m_s: float = param(0.1, within(1e-6, 100))
+    angular_std_rad_s: float = param(0.6, within(1e-6, 100))
+    temperature: float = param(0.3, within(1e-6, 1e6))
     control_cost: float = param(0.015, within(0, 1e6))
     margin_m: float = param(0.05, within(0, 100))
     repulsion_m: float = param(0.2, within(0, 100))
@@ -186,7 +187,7 @@ class MppiNavigator:
         if gap is not None:
             hit = np.logical_or.accumulate(gap < 0.0, axis=1)            # after a collision the rollout stays collided
             cost += np.float32(self.collision_cost / px.shape[1]) * np.count_nonzero(hit, axis=1)
-            if self.repulsion_m > 0:
+            if np.float32(self.repulsion_m) > 0:                           # below float32's range: off, as 0
                 near = np.clip((self.repulsion_m - gap) / np.float32(self.repulsion_m), 0.0, 1.0)
                 cost += np.float32(self.repulsion_weight) * np.mean(near * near, axis=1)
         to_goal = math.hypot(self.goal[0] - pose.x_m, self.goal[1] - pose.y_m)
