@@ -90,8 +90,18 @@ class Sweep:
             timers.append(timer)
             timer.start()
 
+        deferred = [0]
+
         def stop(_signal, frame):
-            while frame is not None:  # never inside an import: a half-imported module would stay broken
+            # Never inside an import (a half-imported module would stay broken), and, for up to 2 s, never inside a
+            # library's own Python code: an exception raised mid-draw left matplotlib's state broken for the next
+            # invocation in this process ("Invalid affine transformation matrix" on a report that runs fine alone).
+            inner = frame.f_code.co_filename if frame is not None else ""
+            if "site-packages" in inner and deferred[0] < 40:
+                deferred[0] += 1
+                arm(0.05)
+                return
+            while frame is not None:
                 if "importlib" in frame.f_code.co_filename:
                     arm(0.05)
                     return
