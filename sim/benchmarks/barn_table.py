@@ -17,6 +17,7 @@ from pathlib import Path as FilePath
 from typing import Any
 
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.marked_block import MarkedBlock
 
 RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results"
 RESULTS = (RESULTS_DIR / "barn-test50.json", RESULTS_DIR / "barn-test10-dwa-vo.json", RESULTS_DIR / "barn.json",
@@ -166,18 +167,8 @@ def block(results: tuple[FilePath, ...] = RESULTS) -> str:
     return "\n".join(lines)
 
 
-def replace_block(text: str, new_block: str, source: str) -> str:
-    start = text.find(BEGIN)
-    end = text.find(END, start) if start >= 0 else -1
-    if start < 0 or end < start:
-        raise ConfigError("--readme", "has no barn-table markers", source)
-    return text[:start] + new_block + text[end + len(END):]
-
-
-def current_block(text: str) -> str | None:
-    start = text.find(BEGIN)
-    end = text.find(END, start) if start >= 0 else -1
-    return None if start < 0 or end < start else text[start:end + len(END)]
+MARKERS = MarkedBlock(BEGIN, END, "barn-table markers")
+replace_block, current_block = MARKERS.replace, MARKERS.current
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -17,6 +17,7 @@ from pathlib import Path as FilePath
 from typing import Any
 
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.marked_block import MarkedBlock
 from swarmnav.benchmarks.navigation_table import RESULTS_DIR, read_rows
 
 RESULT = RESULTS_DIR / "crowdnav.json"  # every navigator on a sample of the cases
@@ -154,10 +155,8 @@ def block(rows: list[dict[str, Any]], protocol: list[dict[str, Any]] | None = No
     return "\n".join(out)
 
 
-def current_block(text: str) -> str | None:
-    start = text.find(BEGIN)
-    end = text.find(END, start) if start >= 0 else -1
-    return None if start < 0 or end < 0 else text[start:end + len(END)]
+MARKERS = MarkedBlock(BEGIN, END, "crowdnav-table markers")
+current_block = MARKERS.current
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -179,11 +178,8 @@ def main(argv: list[str] | None = None) -> int:
         generated = block(rows, protocol)
         if args.readme:
             path = FilePath(args.readme)
-            text = path.read_text(encoding="utf-8")
-            old = current_block(text)
-            if old is None:
-                raise ConfigError("--readme", "has no crowdnav-table markers", args.readme)
-            path.write_text(text.replace(old, generated), encoding="utf-8")
+            path.write_text(MARKERS.replace(path.read_text(encoding="utf-8"), generated, args.readme),
+                            encoding="utf-8")
         else:
             print(generated)
     except ConfigError as exc:

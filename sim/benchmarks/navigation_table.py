@@ -19,6 +19,7 @@ from pathlib import Path as FilePath
 from typing import Any
 
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.marked_block import MarkedBlock
 
 END = "<!-- end of navigation-table -->"
 RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "results"
@@ -141,22 +142,17 @@ def block(rows: list[dict[str, Any]], result: FilePath = RESULT) -> str:
                      + ["", END])
 
 
-def _span(text: str, result: FilePath) -> tuple[int, int]:
-    start = text.find(begin_marker(result))
-    end = text.find(END, start) if start >= 0 else -1
-    return start, end
+def markers(result: FilePath = RESULT) -> MarkedBlock:
+    """The block of ``result``'s table in a page."""
+    return MarkedBlock(begin_marker(result), END, f"navigation-table markers for {FilePath(result).name}")
 
 
 def current_block(text: str, result: FilePath = RESULT) -> str | None:
-    start, end = _span(text, result)
-    return None if start < 0 or end < start else text[start:end + len(END)]
+    return markers(result).current(text)
 
 
 def replace_block(text: str, new_block: str, source: str, result: FilePath = RESULT) -> str:
-    start, end = _span(text, result)
-    if start < 0 or end < start:
-        raise ConfigError("--readme", f"has no navigation-table markers for {FilePath(result).name}", source)
-    return text[:start] + new_block + text[end + len(END):]
+    return markers(result).replace(text, new_block, source)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -20,6 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from swarmnav.models.marked_block import MarkedBlock
+
 RESULTS = Path(__file__).resolve().parents[2] / "models" / "suites" / "results" / "odometry.json"
 PAGE = Path(__file__).resolve().parents[2] / "docs" / "sensing.md"  # the page that holds the table
 BEGIN = "<!-- odometry-table: generated from models/suites/results/odometry.json by `swarmnav bench odometry --write`; do not edit by hand -->"
@@ -90,20 +92,14 @@ def block(rows: list[dict[str, Any]] | None = None) -> str:
     return f"{BEGIN}\n{table(rows)}\n{END}"
 
 
-def current_block(page: str) -> str:
-    """The page's block as it stands (markers included; empty when absent)."""
-    start, end = page.find(BEGIN), page.find(END)
-    return page[start:end + len(END)] if start >= 0 and end > start else ""
+MARKERS = MarkedBlock(BEGIN, END, "odometry-table markers")
+current_block = MARKERS.current
 
 
 def write(rows: list[dict[str, Any]], page: Path) -> None:
     """Commit-ready output: ``rows`` as :data:`RESULTS` and the page's block regenerated from them."""
     RESULTS.write_text(json.dumps(rows, indent=1) + "\n", encoding="utf-8")
-    text = page.read_text(encoding="utf-8")
-    old = current_block(text)
-    if not old:
-        raise ValueError(f"{page}: no odometry-table markers")
-    page.write_text(text.replace(old, block(rows)), encoding="utf-8")
+    page.write_text(MARKERS.replace(page.read_text(encoding="utf-8"), block(rows), str(page)), encoding="utf-8")
 
 
 def run(args) -> int:

@@ -22,6 +22,8 @@ import json
 from pathlib import Path
 from typing import Any
 
+from swarmnav.models.marked_block import MarkedBlock
+
 RESULTS = Path(__file__).resolve().parents[2] / "models" / "suites" / "results" / "sensed_map.json"
 PAGE = Path(__file__).resolve().parents[2] / "docs" / "sensing.md"
 BEGIN = ("<!-- sensed-map-table: generated from models/suites/results/sensed_map.json by "
@@ -111,21 +113,15 @@ def block(rows: list[dict[str, Any]] | None = None) -> str:
     return f"{BEGIN}\n{table(rows)}\n{END}"
 
 
-def current_block(page: str) -> str:
-    """The page's block as it stands (markers included; empty when absent)."""
-    start, end = page.find(BEGIN), page.find(END)
-    return page[start:end + len(END)] if start >= 0 and end > start else ""
+MARKERS = MarkedBlock(BEGIN, END, "sensed-map-table markers")
+current_block = MARKERS.current
 
 
 def write(rows: list[dict[str, Any]], page: Path) -> None:
     """``rows`` as :data:`RESULTS` (the wall times dropped: they are not deterministic) and the page's block."""
     kept = [{k: v for k, v in r.items() if k != "wall_s"} for r in rows]
     RESULTS.write_text(json.dumps(kept, indent=1) + "\n", encoding="utf-8")
-    text = page.read_text(encoding="utf-8")
-    old = current_block(text)
-    if not old:
-        raise ValueError(f"{page}: no sensed-map-table markers")
-    page.write_text(text.replace(old, block(kept)), encoding="utf-8")
+    page.write_text(MARKERS.replace(page.read_text(encoding="utf-8"), block(kept), str(page)), encoding="utf-8")
 
 
 def run(args) -> int:
