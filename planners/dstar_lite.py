@@ -204,11 +204,7 @@ class DStarLite:
             if self.free[r][c] == (not occupied):
                 continue
             self.free[r][c] = not occupied
-            for dr in (-1, 0, 1):
-                for dc in (-1, 0, 1):
-                    nr, nc = r + dr, c + dc
-                    if 0 <= nr < self.rows and 0 <= nc < self.cols:
-                        touched.add(nr * self.cols + nc)
+            self._add_block(touched, r, c)
         self._repair(touched)
 
     def update_penalty(self, penalty: np.ndarray) -> int:
@@ -220,14 +216,17 @@ class DStarLite:
         changed = np.flatnonzero(np.asarray(new) != np.asarray(old))
         touched: set[int] = set()
         for v in changed.tolist():
-            r, c = divmod(v, self.cols)
-            for dr in (-1, 0, 1):
-                for dc in (-1, 0, 1):
-                    nr, nc = r + dr, c + dc
-                    if 0 <= nr < self.rows and 0 <= nc < self.cols:
-                        touched.add(nr * self.cols + nc)
+            self._add_block(touched, *divmod(v, self.cols))
         self._repair(touched)
         return len(changed)
+
+    def _add_block(self, touched: set[int], r: int, c: int) -> None:
+        """Cell (r, c) and its in-grid 8 neighbours into ``touched``: the vertices whose moves it changes."""
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                nr, nc = r + dr, c + dc
+                if 0 <= nr < self.rows and 0 <= nc < self.cols:
+                    touched.add(nr * self.cols + nc)
 
     def _checked_penalty(self, penalty: np.ndarray) -> list[float]:
         pen = np.asarray(penalty, dtype=float)
