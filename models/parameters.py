@@ -84,6 +84,21 @@ def parameter_choices(cls: type) -> dict[str, tuple[str, ...]]:
     return _declared(cls, _CHOICES)
 
 
+def check_declared(component: Any, kind: str) -> None:
+    """``component``'s values held to its class's declared ranges and choices, for a component made directly
+    in Python (:func:`build_component` checks a table before building); a ConfigError names
+    ``<kind>.params.<key>`` as the reader's does."""
+    cls = type(component)
+    for key, bounds in parameter_ranges(cls).items():
+        value = getattr(component, key)
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and not bounds.holds(value):
+            raise ConfigError(f"{kind}.params.{key}", f"{bounds.requirement()}, got {value!r}")
+    for key, allowed in parameter_choices(cls).items():
+        value = getattr(component, key)
+        if value is not None and value not in allowed:
+            raise ConfigError(f"{kind}.params.{key}", f"must be one of {', '.join(allowed)}, got {value!r}")
+
+
 def _shown_default(f: dataclasses.Field) -> Any:
     if f.default is not dataclasses.MISSING:
         return f.default

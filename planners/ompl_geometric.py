@@ -43,7 +43,6 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from swarmnav.models.parameters import Range, above, param, within
-from swarmnav.planners.errors import check_parameters
 from swarmnav.planners.sampling_ompl import OmplPlanner, PRMStarPlanner, _path_waypoints, solve_in_rounds
 
 MIN_BORDER_FRACTION = 1e-3  # KPIECE's share of border expansions: OMPL throws below machine epsilon
@@ -75,16 +74,19 @@ class _FirstSolutionPlanner(OmplPlanner):
         return _path_waypoints(pdef.getSolutionPath()), len(progress.costs) - 1
 
 
-def _check_range(planner: OmplPlanner, range_m: float) -> None:
-    check_parameters(planner, (("range_m", math.isfinite(range_m) and range_m >= 0, "must be a finite length >= 0"),))
+@dataclass
+class _RangedPlanner(_FirstSolutionPlanner):
+    """A first-solution planner with OMPL's ``range`` (the longest motion added at once; 0: OMPL's default)."""
 
+    range_m: float = param(0.0, RANGE_M)
 
-def _check_fraction(planner: OmplPlanner, name: str, value: float) -> None:
-    check_parameters(planner, ((name, 0.0 <= value <= 1.0, "must lie in [0, 1]"),))
+    def configure(self, planner) -> None:
+        if self.range_m:
+            planner.setRange(self.range_m)
 
 
 @dataclass
-class RRTPlanner(_FirstSolutionPlanner):
+class RRTPlanner(_RangedPlanner):
     """``rrt``: OMPL's RRT (LaValle 1998), stops at its first solution.
 
     Attributes:
@@ -94,21 +96,15 @@ class RRTPlanner(_FirstSolutionPlanner):
 
     name: ClassVar[str] = "rrt"
     ompl_class: ClassVar[str] = "RRT"
-    range_m: float = param(0.0, RANGE_M)
     goal_bias: float = param(0.05, within(0, 1))
 
-    def check_own_parameters(self) -> None:
-        _check_range(self, self.range_m)
-        _check_fraction(self, "goal_bias", self.goal_bias)
-
     def configure(self, planner) -> None:
-        if self.range_m:
-            planner.setRange(self.range_m)
+        super().configure(planner)
         planner.setGoalBias(self.goal_bias)
 
 
 @dataclass
-class RRTConnectPlanner(_FirstSolutionPlanner):
+class RRTConnectPlanner(_RangedPlanner):
     """``rrt_connect``: OMPL's RRT-Connect (Kuffner and LaValle 2000), two trees, stops at its first solution.
 
     Attributes:
@@ -117,18 +113,10 @@ class RRTConnectPlanner(_FirstSolutionPlanner):
 
     name: ClassVar[str] = "rrt_connect"
     ompl_class: ClassVar[str] = "RRTConnect"
-    range_m: float = param(0.0, RANGE_M)
-
-    def check_own_parameters(self) -> None:
-        _check_range(self, self.range_m)
-
-    def configure(self, planner) -> None:
-        if self.range_m:
-            planner.setRange(self.range_m)
 
 
 @dataclass
-class LBKPIECE1Planner(_FirstSolutionPlanner):
+class LBKPIECE1Planner(_RangedPlanner):
     """``lbkpiece1``: OMPL's Lazy Bi-directional KPIECE (Sucan and Kavraki 2009), one level of discretization,
     motions checked lazily; stops at its first solution.
 
@@ -139,18 +127,11 @@ class LBKPIECE1Planner(_FirstSolutionPlanner):
 
     name: ClassVar[str] = "lbkpiece1"
     ompl_class: ClassVar[str] = "LBKPIECE1"
-    range_m: float = param(0.0, RANGE_M)
     border_fraction: float = param(0.9, within(MIN_BORDER_FRACTION, 1))
     # OMPL refuses a border fraction below machine epsilon (a RuntimeError): 0.001 is the stated floor
 
-    def check_own_parameters(self) -> None:
-        _check_range(self, self.range_m)
-        check_parameters(self, (("border_fraction", MIN_BORDER_FRACTION <= self.border_fraction <= 1.0,
-                                 f"must lie in [{MIN_BORDER_FRACTION:g}, 1]"),))
-
     def configure(self, planner) -> None:
-        if self.range_m:
-            planner.setRange(self.range_m)
+        super().configure(planner)
         planner.setBorderFraction(self.border_fraction)
 
 
@@ -174,17 +155,13 @@ class KPIECE1Planner(LBKPIECE1Planner):
     ompl_class: ClassVar[str] = "KPIECE1"
     goal_bias: float = param(0.05, within(0, 1))
 
-    def check_own_parameters(self) -> None:
-        super().check_own_parameters()
-        _check_fraction(self, "goal_bias", self.goal_bias)
-
     def configure(self, planner) -> None:
         super().configure(planner)
         planner.setGoalBias(self.goal_bias)
 
 
 @dataclass
-class AORRTCPlanner(_FirstSolutionPlanner):
+class AORRTCPlanner(_RangedPlanner):
     """``aorrtc``: OMPL's AORRTC (Wilson et al. 2025), asymptotically optimal RRT-Connect: bidirectional
     searches in a shrinking informed set; improves until the budget is spent.
 
@@ -194,14 +171,6 @@ class AORRTCPlanner(_FirstSolutionPlanner):
 
     name: ClassVar[str] = "aorrtc"
     ompl_class: ClassVar[str] = "AORRTC"
-    range_m: float = param(0.0, RANGE_M)
-
-    def check_own_parameters(self) -> None:
-        _check_range(self, self.range_m)
-
-    def configure(self, planner) -> None:
-        if self.range_m:
-            planner.setRange(self.range_m)
 
 
 @dataclass
@@ -218,12 +187,6 @@ class FMTStarPlanner(_FirstSolutionPlanner):
     ompl_class: ClassVar[str] = "FMT"
     num_samples: int = param(1000, within(1, 1_000_000))
     radius_multiplier: float = param(1.1, above(0, 1e3))
-
-    def check_own_parameters(self) -> None:
-        check_parameters(self, (
-            ("num_samples", self.num_samples >= 1, "must be at least 1"),
-            ("radius_multiplier", math.isfinite(self.radius_multiplier) and self.radius_multiplier > 0,
-             "must be a finite number > 0")))
 
     def configure(self, planner) -> None:
         planner.setNumSamples(self.num_samples)
@@ -250,9 +213,6 @@ class PRMPlanner(PRMStarPlanner):
     name: ClassVar[str] = "prm"
     ompl_class: ClassVar[str] = "PRM"
     max_nearest_neighbors: int = param(10, within(1, 10_000))
-
-    def check_own_parameters(self) -> None:
-        check_parameters(self, (("max_nearest_neighbors", self.max_nearest_neighbors >= 1, "must be at least 1"),))
 
     def configure(self, planner) -> None:
         planner.setMaxNearestNeighbors(self.max_nearest_neighbors)

@@ -70,7 +70,7 @@ from typing import Callable, ClassVar
 
 import numpy as np
 
-from swarmnav.models.parameters import above, param, within
+from swarmnav.models.parameters import above, check_declared, param, within
 from swarmnav.planners.errors import NoPathFound, check_parameters
 from swarmnav.planners.ompl_checks import CollisionChecks, motion_validator_type, ompl_modules
 from swarmnav.planners.problem import Path, Problem, check_endpoints, check_supported
@@ -120,18 +120,15 @@ class OmplPlanner:
         return dataclasses.replace(self, max_evaluations=None, time_s=float(budget.time_s))
 
     def __post_init__(self) -> None:
+        check_declared(self, "planner")  # every field's declared range, for a planner made directly in Python
         check_parameters(self, (
-            ("max_evaluations", self.max_evaluations is None or self.max_evaluations >= 0, "must be at least 0"),
-            ("time_s", self.time_s is None or (math.isfinite(self.time_s) and self.time_s >= 0),
-             "must be a finite number of seconds, at least 0"),
             ("max_evaluations", bool(self.max_evaluations) or bool(self.time_s),
              "must be positive unless time_s is (a sampling planner needs a budget)"),
-            ("round_evaluations", self.round_evaluations >= 1, "must be at least 1"),
         ))
         self.check_own_parameters()
 
     def check_own_parameters(self) -> None:
-        """Checks of a subclass's own parameters."""
+        """Checks of a subclass's own parameters that no declared range says (a rule between fields)."""
 
     def configure(self, planner) -> None:
         """Set a subclass's own parameters on the OMPL planner."""
@@ -280,12 +277,7 @@ class RRTStarPlanner(_TreePlanner):
     rewire_factor: float = param(1.1, above(0, 1e3))
 
     def check_own_parameters(self) -> None:
-        check_parameters(self, (
-            ("range_m", math.isfinite(self.range_m) and self.range_m >= 0, "must be a finite length >= 0"),
-            ("goal_bias", 0.0 <= self.goal_bias <= 1.0, "must lie in [0, 1]"),
-            ("rewire_factor", math.isfinite(self.rewire_factor) and self.rewire_factor >= 1.0,
-             "must be a finite number >= 1"),
-        ))
+        check_parameters(self, (("rewire_factor", self.rewire_factor >= 1.0, "must be a finite number >= 1"),))
 
     def configure(self, planner) -> None:
         if self.range_m:
@@ -323,11 +315,7 @@ class BITStarPlanner(_TreePlanner):
     rewire_factor: float = param(1.1, above(0, 1e3))
 
     def check_own_parameters(self) -> None:
-        check_parameters(self, (
-            ("samples_per_batch", self.samples_per_batch >= 1, "must be at least 1"),
-            ("rewire_factor", math.isfinite(self.rewire_factor) and self.rewire_factor >= 1.0,
-             "must be a finite number >= 1"),
-        ))
+        check_parameters(self, (("rewire_factor", self.rewire_factor >= 1.0, "must be a finite number >= 1"),))
 
     def configure(self, planner) -> None:
         planner.setSamplesPerBatch(self.samples_per_batch)
