@@ -255,7 +255,7 @@ def add_bench_odometry_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quick", action="store_true", help="20 simulated seconds per run (default 60)")
     parser.add_argument("--json", action="store_true", help="one JSON object per run")
     parser.add_argument("--write", action="store_true",
-                        help="also write models/suites/results/odometry.json and the README's table from it")
+                        help="also write models/suites/results/odometry.json and docs/sensing.md's table from it")
 
 
 def run_bench_odometry(args: argparse.Namespace) -> int:
