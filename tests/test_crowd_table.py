@@ -6,20 +6,21 @@ from pathlib import Path
 import pytest
 
 from swarmnav.benchmarks import crowd_table
-from swarmnav.benchmarks.crowd_table import PROTOCOL, RESULT, block, current_block
+from swarmnav.benchmarks.crowd_table import PAPER, PROTOCOL, RESULT, block, current_block
 from swarmnav.benchmarks.navigation_table import read_rows
 
 REPO = Path(__file__).resolve().parents[1]
 
 
 def test_the_readme_crowdnav_table_is_the_one_generated_from_the_committed_result(capsys):
-    assert crowd_table.main([str(RESULT)] + (["--protocol", str(PROTOCOL)] if PROTOCOL.is_file() else [])) == 0
+    assert crowd_table.main([str(RESULT)] + (["--protocol", str(PROTOCOL)] if PROTOCOL.is_file() else [])
+                            + (["--paper", str(PAPER)] if PAPER.is_file() else [])) == 0
     generated = capsys.readouterr().out.strip()
     assert current_block((REPO / "docs" / "crowds.md").read_text()) == generated, \
         "run `make readme-table` (docs/crowds.md and models/suites/results/crowdnav.json differ)"
 
 
-@pytest.mark.parametrize("path", [RESULT, PROTOCOL])
+@pytest.mark.parametrize("path", [RESULT, PROTOCOL, PAPER])
 def test_the_committed_result_has_both_settings_and_no_oracle_where_the_humans_see_the_robot(path):
     if not path.is_file():
         pytest.skip(f"{path.name} not committed")
@@ -27,7 +28,8 @@ def test_the_committed_result_has_both_settings_and_no_oracle_where_the_humans_s
     invisible = [r for r in rows if r["robot_visible"] is False]
     visible = [r for r in rows if r["robot_visible"] is True]
     assert {r["navigator"] for r in invisible} - {"oracle"} == {r["navigator"] for r in visible}
-    assert "oracle" in {r["navigator"] for r in invisible} and "oracle" not in {r["navigator"] for r in visible}
+    assert "oracle" not in {r["navigator"] for r in visible}
+    assert "oracle" in {r["navigator"] for r in invisible} or path == PAPER  # the paper file's oracle is not shown
     assert all(r["oracle_solvable_runs"] == 0 and r["yardstick"].startswith("none") for r in visible)
     assert len({r["runs"] for r in rows}) == 1
     assert all(r["discomfort_frequency"] is not None for r in rows)
@@ -59,3 +61,19 @@ def test_the_protocol_comes_first_with_the_published_figures_and_the_sample_afte
     assert text.count("| SARL, Chen et al. (2019)") == 2  # once per setting
     assert text.rindex("| SARL, Chen et al. (2019)") < text.index("**Every navigator** on")
     assert block(rows).count("| SARL, Chen et al. (2019)") == 2  # no protocol file: beside the sample
+
+
+def test_the_paper_navigators_rows_take_the_place_of_the_samples_of_the_same_label_and_setting(tmp_path, capsys):
+    rows = read_rows(RESULT)
+    paper = [dict(r, success_rate=0.654321) for r in rows if r["navigator"] in ("iaco_local", "oracle")]
+    paper.append(dict(paper[0], navigator="iaco_local+new", arm_of="iaco_local", arm_params={"evade": True}))
+    text = block(rows, None, paper)
+    assert text.count("| `iaco_local` †") == 2 and text.count("| `iaco_local` |") == 0  # replaced in each setting
+    assert text.count("| 0.654 |") == 3  # both iaco_local rows and the new arm, never the oracle's
+    assert text.index("| `iaco_local+new` (`iaco_local`: evade=True) †") < text.index("| oracle (clairvoyant")
+    assert "† From `models/suites/results/crowdnav-paper-navigators.json`" in text
+    assert "†" not in block(rows)
+    path = tmp_path / "paper.json"
+    path.write_text(json.dumps(paper))
+    assert crowd_table.main([str(RESULT), "--paper", str(path)]) == 0
+    assert "| `iaco_local` †" in capsys.readouterr().out

@@ -1,8 +1,10 @@
 """The README's CrowdNav table, generated from the committed ``bench navigation --suite crowdnav --json`` result.
 
-``python -m swarmnav.benchmarks.crowd_table [RESULT.json] [--protocol FULL.json] [--readme FILE]`` prints (or,
-with ``--readme``, writes between its markers) the full protocol's tables when there is one
-(``crowdnav-500.json``: 500 cases per setting), then every navigator's on a sample of the cases; per table one
+``python -m swarmnav.benchmarks.crowd_table [RESULT.json] [--protocol FULL.json] [--paper PAPER.json] [--readme FILE]``
+prints (or, with ``--readme``, writes between its markers) the full protocol's tables when there is one
+(``crowdnav-500.json``: 500 cases per setting), then every navigator's on a sample of the cases, the rows of the
+paper navigators' own result (``crowdnav-paper-navigators.json``: ``iaco_local`` and ``immas_stepwise``, run apart)
+in place of the sample's rows of the same label and setting, marked †; per table one
 table per setting (the robot invisible to the humans, then visible), our rows
 first, then the figures Chen, Liu, Kreiss and Alahi (2019) publish for the same setting (5 ORCA humans, circle
 crossing, 500 test cases), under :data:`PUBLISHED_SOURCE`.  ``make readme-table`` runs it; a test fails when the
@@ -22,6 +24,8 @@ from swarmnav.benchmarks.navigation_table import RESULTS_DIR, read_rows
 
 RESULT = RESULTS_DIR / "crowdnav.json"  # every navigator on a sample of the cases
 PROTOCOL = RESULTS_DIR / "crowdnav-500.json"  # CrowdNav's full protocol (500 cases per setting), where it was run
+PAPER = RESULTS_DIR / "crowdnav-paper-navigators.json"  # the paper navigators' rows on the sample, run apart
+FROM_PAPER = "from_paper_result"  # the key marking a row taken from PAPER
 BEGIN = ("<!-- crowdnav-table: generated from models/suites/results/crowdnav.json by `make readme-table`; "
          "do not edit by hand -->")
 END = "<!-- end of crowdnav-table -->"
@@ -54,6 +58,8 @@ def table_lines(rows: list[dict[str, Any]], seen: bool, published: bool = True) 
         name = f"{r['navigator']} (clairvoyant yardstick)" if r["navigator"] == ORACLE else f"`{r['navigator']}`"
         if r.get("arm_of"):
             name += f" (`{r['arm_of']}`: " + ", ".join(f"{k}={v}" for k, v in sorted(r["arm_params"].items())) + ")"
+        if r.get(FROM_PAPER):
+            name += " †"
         solved = r["success_on_solvable"] if r["navigator"] == ORACLE else r.get("solved_share")
         lines.append(f"| {name} | {r['runs']} | {_cell(r['success_rate'], '.3f')} | "
                      f"{_cell(r['collision_rate'], '.3f')} | {_cell(r['timeout_rate'], '.3f')} | "
@@ -133,9 +139,32 @@ def _cases(rows: list[dict[str, Any]]) -> str:
     return " or ".join(str(n) for n in runs)
 
 
-def block(rows: list[dict[str, Any]], protocol: list[dict[str, Any]] | None = None) -> str:
+def merged(rows: list[dict[str, Any]], paper: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """``rows`` with each of ``paper``'s rows (but its oracle's) in place of the row of the same label and
+    setting, or after the last navigator's row of its setting when there is none; taken rows are marked
+    (:data:`FROM_PAPER`)."""
+    out = list(rows)
+    for r in paper:
+        if r["navigator"] == ORACLE:
+            continue
+        taken = {**r, FROM_PAPER: True}
+        same = [i for i, o in enumerate(out) if o["navigator"] == r["navigator"]
+                and o.get("robot_visible") is r.get("robot_visible")]
+        if same:
+            out[same[0]] = taken
+            continue
+        last = [i for i, o in enumerate(out)
+                if o["navigator"] != ORACLE and o.get("robot_visible") is r.get("robot_visible")]
+        out.insert(last[-1] + 1 if last else len(out), taken)
+    return out
+
+
+def block(rows: list[dict[str, Any]], protocol: list[dict[str, Any]] | None = None,
+          paper: list[dict[str, Any]] | None = None) -> str:
     """The generated text: ``protocol`` (CrowdNav's 500 cases per setting, beside the published figures) first
-    when given, then ``rows`` (every navigator on a sample of the cases)."""
+    when given, then ``rows`` (every navigator on a sample of the cases) with ``paper``'s rows (see
+    :func:`merged`)."""
+    rows = merged(rows, paper or [])
     out = [BEGIN, ""]
     if protocol:
         out += [f"**CrowdNav's protocol**: {_cases(protocol)} test cases per setting "
@@ -150,6 +179,9 @@ def block(rows: list[dict[str, Any]], protocol: list[dict[str, Any]] | None = No
         part = [r for r in rows if r.get("robot_visible") is seen]
         if part:
             out += table_lines(part, seen, published=not protocol) + [""] + summary_lines(part, seen) + [""]
+    if any(r.get(FROM_PAPER) for r in rows):
+        out += [f"† From `{PAPER.relative_to(RESULTS_DIR.parents[2]).as_posix()}` (the paper navigators' rows on the "
+                "same cases, run apart), in place of this file's row of the same label.", ""]
     out += [f"Published figures: {PUBLISHED_SOURCE}; their robot is holonomic, ours a differential drive in "
             "MuJoCo.", "", END]
     return "\n".join(out)
@@ -166,16 +198,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--protocol", default=str(PROTOCOL) if PROTOCOL.is_file() else None,
                         help="the full protocol's result, shown first (default: models/suites/results/"
                              "crowdnav-500.json when it exists)")
+    parser.add_argument("--paper", default=str(PAPER) if PAPER.is_file() else None,
+                        help="the paper navigators' rows, in place of the sample's of the same label (default: "
+                             "models/suites/results/crowdnav-paper-navigators.json when it exists)")
     parser.add_argument("--readme", help="replace the table between the markers in this file")
     args = parser.parse_args(argv)
     try:
         rows = read_rows(FilePath(args.result))
         protocol = read_rows(FilePath(args.protocol)) if args.protocol else None
-        for name, found in ((args.result, rows), (args.protocol, protocol or [{"robot_visible": 0}])):
+        paper = read_rows(FilePath(args.paper)) if args.paper else None
+        for name, found in ((args.result, rows), (args.protocol, protocol or [{"robot_visible": 0}]),
+                            (args.paper, paper or [{"robot_visible": 0}])):
             if not any("robot_visible" in r for r in found):
                 raise ConfigError("crowdnav table", "has no robot_visible rows (not a --suite crowdnav result)",
                                   name)
-        generated = block(rows, protocol)
+        generated = block(rows, protocol, paper)
         if args.readme:
             path = FilePath(args.readme)
             path.write_text(MARKERS.replace(path.read_text(encoding="utf-8"), generated, args.readme),
