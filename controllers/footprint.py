@@ -168,3 +168,22 @@ def guarded_turn(command: ControlCommand, pose, controller, problem, box_m, latc
         return command, 0.0
     omega = sign * abs(command.angular_rad_s)
     return ControlCommand(wheel_speeds(0.0, omega, geometry), 0.0, omega, i), sign
+
+
+def covering_discs(setup) -> tuple[np.ndarray, float]:
+    """((n, 2) disc centres in the base frame, their radius): discs along the chassis box's long axis that
+    together cover it (n = ceil(half length / half width), each the circle about its 1/n of the box), the
+    collision model of the local navigators' ``footprint = "box"`` (two discs of 0.25 m for the Jackal's
+    0.508 x 0.430 m box, where its circumscribed circle is 0.333 m); one disc of the robot radius at the
+    origin for a round chassis (or no scenario)."""
+    box = chassis_box_m(setup)
+    if box is None:
+        return np.zeros((1, 2)), float(setup.problem.robot_radius_m)
+    x0, y0, x1, y1 = box
+    half_x, half_y = 0.5 * (x1 - x0), 0.5 * (y1 - y0)
+    long_half, short_half = max(half_x, half_y), min(half_x, half_y)
+    n = max(1, int(math.ceil(long_half / short_half - 1e-9)))
+    along = -long_half + (2.0 * np.arange(n) + 1.0) * long_half / n
+    centre = np.array([0.5 * (x0 + x1), 0.5 * (y0 + y1)])
+    offsets = np.column_stack([along, np.zeros(n)]) if half_x >= half_y else np.column_stack([np.zeros(n), along])
+    return centre + offsets, float(math.hypot(long_half / n, short_half))

@@ -14,6 +14,9 @@ fixed carrot and map obstacles, so that none of them has map code of its own.
   than the scenario's, so the local navigators' own margins fit beside it) whenever a publication blocks
   the rest of it, at most once per ``cooldown_s`` of simulated time (a failed replan keeps the old path and
   is retried at the next publication).  The new guidance paths are not logged (the navigators return none).
+  With a :class:`~controllers.centred_path.CentredPlanner` (the local navigators' ``footprint = "box"``
+  option) the guidance is its path instead (the chassis' inscribed circle, kept to the middle of passages),
+  replanned when the rest of the path enters its blocked cells; the run's planner is not asked.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from swarmnav.controllers.centred_path import CentredPlanner
 from swarmnav.controllers.guidance import PathCarrot
 from swarmnav.controllers.navigator import NavigationSetup
 from swarmnav.controllers.prediction import LocalObstacles
@@ -55,9 +59,10 @@ class SensedLocalObstacles(LocalObstacles):
 class GuidedCarrot(PathCarrot):
     """A :class:`~controllers.guidance.PathCarrot` whose path is replanned on the sensed map (see above)."""
 
-    def __init__(self, setup: NavigationSetup, lookahead_m: float, cooldown_s: float = GUIDANCE_COOLDOWN_S):
+    def __init__(self, setup: NavigationSetup, lookahead_m: float, cooldown_s: float = GUIDANCE_COOLDOWN_S,
+                 centred: CentredPlanner | None = None):
         super().__init__(setup.path.waypoints, lookahead_m)
-        self.setup, self.cooldown_s = setup, cooldown_s
+        self.setup, self.cooldown_s, self.centred = setup, cooldown_s, centred
         self.revision = setup.map_revision
         self.next_replan_s = 0.0
         self.time_s = 0.0
@@ -66,7 +71,7 @@ class GuidedCarrot(PathCarrot):
 
     def keep_in_sight(self, disc_centres_m, disc_radii_m, boxes_m, radius_m: float, samples: int = 8) -> None:
         # In sight for the robot with the same extra cell of clearance as the guidance path (see _replan).
-        self._sight_radius_m = float(radius_m) + self.setup.map_problem.cell_m
+        self._sight_radius_m = float(radius_m) + (0.0 if self.centred else self.setup.map_problem.cell_m)
         self._sight_samples = samples
         super().keep_in_sight(disc_centres_m, disc_radii_m, boxes_m, self._sight_radius_m, samples)
 
@@ -80,13 +85,25 @@ class GuidedCarrot(PathCarrot):
                 super().keep_in_sight(known.disc_centres_m, known.disc_radii_m, known.box_array_m,
                                       self._sight_radius_m, self._sight_samples)
             rest = np.vstack([[pose.x_m, pose.y_m], self.points[self._segment(self.progress_m) + 1:]])
-            if self.setup.world_map.blocks(rest):
+            if self.centred is not None:
+                blocked = self.centred.blocks(known, rest, self.centred.block_m + known.cell_m)
+            else:
+                blocked = self.setup.world_map.blocks(rest)
+            if blocked:
                 self.next_replan_s = self.time_s + self.cooldown_s
                 self._replan(known, pose)
         self.time_s += self.setup.control_dt_s
         return super().update(pose, window_m)
 
     def _replan(self, known, pose: Pose2D) -> None:
+        if self.centred is not None:
+            try:
+                waypoints = self.centred.plan(known, (pose.x_m, pose.y_m))
+            except PlanningError:
+                self.revision = -1
+                return
+            self._restart(waypoints)
+            return
         # A cell more clearance than the map asks for: the local navigators keep their own margin from the
         # cells' edges, and a guidance path that grazes them at exactly that margin leaves them no room.
         problem = replace(known, start=Pose2D(pose.x_m, pose.y_m, pose.heading_rad),
@@ -104,8 +121,12 @@ class GuidedCarrot(PathCarrot):
         if not problem.is_collision_free(path.waypoints, tolerance_m=1e-6):
             self.revision = -1
             return
+        self._restart(np.vstack([[pose.x_m, pose.y_m], path.waypoints]))
+
+    def _restart(self, waypoints: np.ndarray) -> None:
+        """Carry on along ``waypoints`` (from the robot), the sight test kept."""
         sight, samples = self.sight, getattr(self, "sight_samples", 8)
-        PathCarrot.__init__(self, np.vstack([[pose.x_m, pose.y_m], path.waypoints]), self.lookahead_m)
+        PathCarrot.__init__(self, waypoints, self.lookahead_m)
         self.sight, self.sight_samples = sight, samples
         self.replans += 1
 

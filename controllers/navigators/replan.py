@@ -41,6 +41,16 @@ are used; our choices:
   than the robot and walkers, after which the robot reached its goal (``evade = false``: the earlier
   behaviour; the before and after figures are in the README).
 
+**A box chassis** (named options, ours; all off by default, as ``dstar_replan``'s, :mod:`controllers.footprint`):
+``footprint = "box"`` replans with :class:`controllers.centred_path.CentredPlanner` on the map's obstacles (and
+the sweeps) grown by the chassis' inscribed circle instead of the robot radius (a Jackal's 0.215 m, not its
+0.333 m circumscribed circle, which closes BARN's 0.75 m passages), not with the run's planner (which plans
+for the robot radius), judges the path blocked on that planner's cells, and checks every turn on the spot
+against the box (:func:`controllers.footprint.guarded_turn`); ``cost_weight`` > 0 prices the cells near
+obstacles so that paths keep to the middle of passages; ``max_decel_m_s2`` > 0 caps the forward speed to stop
+before the path's next sharp turn and before the nearest mapped obstacle ahead (:func:`controllers.footprint.
+braked`).  BARN's configuration: ``footprint=box, cost_weight=10, max_decel_m_s2=2`` (docs/barn.md).
+
 Events: ``replan`` (reason, the obstacles' track ids, planning wall time is
 not logged: it is not deterministic), ``replan_failed``; the layer's ``evade`` and ``safety_trigger``.
 """
@@ -56,6 +66,9 @@ from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.prediction import path_ahead, polyline_gap_m, swept_discs
+from swarmnav.controllers.centred_path import CentredPlanner
+from swarmnav.controllers.footprint import (block_radius_m, braked, chassis_box_m, chassis_extent_m, free_ahead_m,
+                                            guarded_turn)
 from swarmnav.controllers.guided import free_start
 from swarmnav.models.world import Disc, Pose2D, rasterise
 from swarmnav.planners.errors import PlanningError, StartBlocked
@@ -106,6 +119,11 @@ class ReplanNavigator:
         cooldown_s: least simulated time between two replans.
         retry_s: wait after a failed replan before trying again (stopped meanwhile).
         planning_latency_s: simulated time before a new path takes effect.
+        footprint: ``"circle"`` (the run's planner, for the robot radius) or ``"box"`` (replans for the chassis'
+            inscribed circle by the centred planner, turns on the spot checked against the box).
+        cost_weight: with ``footprint = "box"``, the replans' penalty on cells near obstacles (0: none).
+        cost_reach_m: how far from a blocked cell the penalty reaches.
+        max_decel_m_s2: the braking the forward speed is capped by (0: no cap).
     """
 
     name: ClassVar[str] = "replan"
@@ -120,6 +138,10 @@ class ReplanNavigator:
     cooldown_s: float = param(0.5, within(0, 1e6))
     retry_s: float = param(0.5, above(0, 1e6))
     planning_latency_s: float = param(0.0, within(0, 1e6))
+    footprint: str = param("circle", choices=("circle", "box"))
+    cost_weight: float = param(0.0, within(0, 1000))
+    cost_reach_m: float = param(0.3, above(0, 100))
+    max_decel_m_s2: float = param(0.0, within(0, 1000))
 
     @property
     def known(self) -> Problem:
@@ -136,6 +158,12 @@ class ReplanNavigator:
         self.pending: tuple[float, Path] | None = None
         self.waiting_until_s: float | None = None
         self.replan_wall_s = 0.0
+        self.centred = None
+        if self.footprint == "box":
+            self.centred = CentredPlanner(block_radius_m(setup) + setup.map_problem.clearance_m, self.cost_weight,
+                                          self.cost_reach_m)
+        self.front_m, self.half_width_m = chassis_extent_m(setup)
+        self.box_m, self.turn_sign = chassis_box_m(setup), 0.0
 
     # -- the step ------------------------------------------------------------
     def step(self, observation: Observation) -> NavigationStep:
@@ -165,11 +193,20 @@ class ReplanNavigator:
         elif reason == "retry":
             self.waiting_until_s = None
         command = self.controller.command(observation.pose, observation.twist)
+        if self.max_decel_m_s2 > 0:
+            waypoints = [(float(x), float(y)) for x, y in self.path.waypoints]
+            ahead_m = free_ahead_m(self.known, observation.pose, self.front_m, self.half_width_m)
+            command = braked(command, observation.pose, self.controller, waypoints, self.max_decel_m_s2, ahead_m)
+        if self.footprint == "box":
+            command, self.turn_sign = guarded_turn(command, observation.pose, self.controller, self.known, self.box_m,
+                                                   self.turn_sign)
         return self._finish(observation, command, events, new_path)
 
     def blocked(self, observation: Observation) -> str:
         """A reason to replan ("blocked by sensed obstacle", "blocked on the sensed map") or ""."""
         pose = observation.pose
+        if self.centred is not None and self.setup.map_revision != self.checked_revision:
+            return "the sensed map changed"  # footprint = "box": replanned at every change (kept until it is)
         if self.setup.map_revision != self.checked_revision:  # the sensed map changed (never with a known map)
             self.checked_revision = self.setup.map_revision
             rest = path_ahead(pose, self.path.waypoints, self.controller.waypoint_index, math.inf)
@@ -181,13 +218,15 @@ class ReplanNavigator:
         # The same discs a replan would plan around (kept off the robot), so a fresh path is not blocked at once.
         sweeps = keep_outside(swept_discs(observation.detections, self.horizon_s), [(pose.x_m, pose.y_m)],
                               endpoint_room_m(self.known))
-        inflation = self.known.robot_radius_m + self.margin_m
+        inflation = (self.known.robot_radius_m if self.centred is None else self.centred.block_m) + self.margin_m
         return "blocked by sensed obstacle" if polyline_gap_m(ahead, sweeps, inflation) < 0.0 else ""
 
     # -- helpers -------------------------------------------------------------
     def _replan(self, observation: Observation, reason: str, events: list) -> Path | None:
         t = observation.time_s
         self.next_replan_s = t + self.cooldown_s
+        if self.centred is not None:
+            self.checked_revision = self.setup.map_revision
         problem = sensed_problem(self.setup.plan_problem, observation.pose,
                                  swept_discs(observation.detections, self.horizon_s))
         wall0 = time.perf_counter()
@@ -197,15 +236,10 @@ class ReplanNavigator:
         try:
             if on_goal:
                 raise PlanningError(f"the goal is inside sensed obstacle(s) {on_goal}: wait for it to leave")
-            try:
-                path = self.setup.planner.plan(problem, self.setup.rng)
-            except StartBlocked:
-                # The robot has cut within the clearance of a known obstacle: plan with no clearance
-                # (and, on a sensed map, whose cells are coarser than the obstacles, from the nearest free point).
-                problem = replace(problem, clearance_m=0.0) if self.setup.world_map is None else free_start(problem)
-                path = self.setup.planner.plan(problem, self.setup.rng)
-            ok = problem.is_collision_free(path.waypoints, tolerance_m=1e-6)
-            why = "" if ok else "the planner's path is not collision-free"
+            if self.centred is not None:
+                path, why = self._centred_path(problem, observation.pose), ""
+            else:
+                path, why = self._planned_path(problem)
         except PlanningError as exc:
             path, why = None, f"{type(exc).__name__}: {exc}"
         self.replan_wall_s += time.perf_counter() - wall0
@@ -216,6 +250,26 @@ class ReplanNavigator:
         events.append(("replan", {"reason": reason, "tracks": tracks, "length_m": round(path.stats.length_m, 6),
                                   "takes_effect_s": round(t + self.planning_latency_s, 6)}))
         return path
+
+    def _planned_path(self, problem: Problem) -> tuple[Path, str]:
+        """The run's planner's path on ``problem`` and why it is refused ("" if it is not)."""
+        try:
+            path = self.setup.planner.plan(problem, self.setup.rng)
+        except StartBlocked:
+            # The robot has cut within the clearance of a known obstacle: plan with no clearance
+            # (and, on a sensed map, whose cells are coarser than the obstacles, from the nearest free point).
+            problem = replace(problem, clearance_m=0.0) if self.setup.world_map is None else free_start(problem)
+            path = self.setup.planner.plan(problem, self.setup.rng)
+        ok = problem.is_collision_free(path.waypoints, tolerance_m=1e-6)
+        return path, "" if ok else "the planner's path is not collision-free"
+
+    def _centred_path(self, problem: Problem, pose: Pose2D) -> Path:
+        """``footprint = "box"``: the centred planner's path on the map (the sensed map's own cells, not the
+        planners' grown ones) plus the sweeps of ``problem``."""
+        known = self.known
+        sweeps = problem.obstacles[len(self.setup.plan_problem.obstacles):]
+        on_map = replace(known, obstacles=tuple(known.obstacles) + tuple(sweeps)) if sweeps else known
+        return Path.from_waypoints(self.centred.plan(on_map, (pose.x_m, pose.y_m)), 0.0)
 
     def _adopt(self, path: Path) -> Path:
         self.path = path
