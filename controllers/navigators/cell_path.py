@@ -16,6 +16,7 @@ import numpy as np
 from swarmnav.controllers.controller import ControlCommand, Controller, Twist
 from swarmnav.models.grid_map import inflated_map_grid
 from swarmnav.models.world import OccupancyGrid, Pose2D, rasterise
+from swarmnav.planners.grid_graph import grid_line_of_sight
 from swarmnav.planners.problem import Path, Problem
 
 Cell = tuple[int, int]  # (row, col); rows grow with y
@@ -69,6 +70,25 @@ def cells_of_path(path: Path, grid: OccupancyGrid) -> list[Cell]:
     return cells
 
 
+def pulled_corners(occupied: np.ndarray, cells: list[Cell]) -> list[Cell]:
+    """The cells where a cell path must turn: greedy line of sight over the free cells (first and last kept).
+
+    A cell of the path that is blocked (the map changed under it) keeps the path as it is there: a line of
+    sight from a blocked cell is never taken."""
+    if len(cells) <= 2:
+        return list(cells)
+    free = (~np.asarray(occupied, dtype=bool)).tolist()
+    out = [cells[0]]
+    anchor = 0
+    while anchor < len(cells) - 1:
+        nxt = anchor + 1
+        while nxt + 1 < len(cells) and grid_line_of_sight(free, cells[anchor], cells[nxt + 1]):
+            nxt += 1
+        out.append(cells[nxt])
+        anchor = nxt
+    return out
+
+
 def step_line(a: Cell, b: Cell) -> list[Cell]:
     """Cells from ``a`` to ``b`` by 8-neighbour steps, diagonal first then straight (both included)."""
     out = [a]
@@ -95,11 +115,19 @@ class CellWalker:
     ``index`` is the last cell of ``cells`` the robot has reached (within
     ``reach_m`` of its centre); :meth:`command` returns whether a new cell was
     reached this step.
+
+    ``pulled`` (ours, off by default: the papers' robot visits every cell centre): the controller is handed
+    the cells' corners (:func:`pulled_corners` on the grid) instead of every centre, and a cell counts as
+    reached when it is the furthest of the next ``PULLED_WINDOW`` cells within ``reach_m`` of the robot (the
+    robot cuts the staircase of an 8-neighbour path, so it passes beside some centres, not over them).
     """
 
     controller: Controller
     grid: OccupancyGrid
     reach_m: float
+    pulled: bool = False
+
+    PULLED_WINDOW = 12
 
     def start(self, cells: list[Cell], index: int = 0) -> Path:
         self.cells = list(cells)
@@ -107,8 +135,11 @@ class CellWalker:
         return self._hand_over()
 
     def _hand_over(self) -> Path:
-        rest = np.array(self.cells[self.index:])
-        waypoints = self.grid.centres_m(rest)
+        rest = self.cells[self.index:]
+        if self.pulled:
+            rest = pulled_corners(self.grid.occupied, rest)
+        waypoints = self.grid.centres_m(np.array(rest)).reshape(-1, 2)
+        self.waypoints = [(float(x), float(y)) for x, y in waypoints]
         path = Path.from_waypoints(waypoints, 0.0)
         self.controller.reset(path)
         return path
@@ -118,6 +149,15 @@ class CellWalker:
 
     def command(self, pose: Pose2D, twist: Twist) -> tuple[ControlCommand, bool]:
         reached = False
+        if self.pulled:
+            ahead = self.cells[self.index + 1:self.index + 1 + self.PULLED_WINDOW]
+            if ahead:
+                centres = self.grid.centres_m(np.array(ahead)).reshape(-1, 2)
+                near = np.flatnonzero(np.hypot(centres[:, 0] - pose.x_m, centres[:, 1] - pose.y_m) <= self.reach_m)
+                if near.size:
+                    self.index += int(near[-1]) + 1
+                    reached = True
+            return self.controller.command(pose, twist), reached
         while self.index + 1 < len(self.cells):
             x, y = self.centre(self.cells[self.index + 1])
             if math.hypot(x - pose.x_m, y - pose.y_m) > self.reach_m:

@@ -49,9 +49,13 @@ import numpy as np
 from scipy import ndimage
 
 from swarmnav.models.parameters import Range, above, param, within
+from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import (Cell, CellWalker, cells_of_path, grid_problem, heading_of,
-                                                       static_grid, step_line)
+                                                       step_line)
+from swarmnav.controllers.navigators.sensed_grid import (FOOTPRINTS, MAP_UPDATES, ChassisGuard, MapWatch,
+                                                         free_cell_near, navigator_grid)
+from swarmnav.planners.grid_graph import grid_line_of_sight
 from swarmnav.controllers.navigators.collision_types import (CATCHING_UP, CROSSING, NO_CONFLICT, Encounter, classify,
                                                              escape_moves, escape_offsets, first_band_index,
                                                              precondition_x_of_moves,
@@ -61,6 +65,7 @@ from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
 from swarmnav.planners.problem import Path
 
 STRATEGIES = ("paper", "wait_only")
+DRIVES = ("cells", "pulled")
 
 
 @dataclass
@@ -76,6 +81,9 @@ class IacoLocalNavigator:
         lead_steps: robot steps added to the escape's in Eq. (12) (ours; 0 = the paper), for the
             time our differential-drive robot needs to turn in place towards the escape cell,
             which the paper's grid robot does not spend.
+        map_updates, footprint, drive, max_decel_m_s2, replan_period_s: beyond the paper, off by default (its
+            robot plans once on a known map, a one-cell robot visiting every cell centre); what BARN's protocol
+            (map unknown, a box Jackal at 2 m/s) needs, see the module docstring's last section.
     """
 
     name: ClassVar[str] = "iaco_local"
@@ -90,13 +98,18 @@ class IacoLocalNavigator:
     horizon_cells: int = param(12, within(1, 1000))
     reach_m: float = param(0.1, above(0, 100))
     lead_steps: int = param(0, within(0, 1000))
+    map_updates: str = param("none", choices=MAP_UPDATES)
+    footprint: str = param("circle", choices=FOOTPRINTS)
+    drive: str = param("cells", choices=DRIVES)
+    max_decel_m_s2: float = param(0.0, within(0, 1000))
+    replan_period_s: float = param(0.5, within(0, 600))
     counts: dict[str, int] = field(default_factory=dict, init=False, repr=False)
 
     def reset(self, setup: NavigationSetup) -> None:
         self.setup = setup
         problem = setup.map_problem  # static obstacles only: the moving ones are sensed
         self.problem = problem
-        self.grid = static_grid(problem)
+        self.grid = navigator_grid(setup, self.footprint)
         self.planner = setup.planner if isinstance(setup.planner, ImprovedAntColonyPlanner) \
             else ImprovedAntColonyPlanner()
         self.inflation_m = problem.inflation_m
@@ -108,12 +121,12 @@ class IacoLocalNavigator:
         free = ~self.grid.occupied
         self.labels, _ = ndimage.label(free, structure=np.ones((3, 3), dtype=bool))
         replanned = not (setup.path.stats.extra.get("raw_cells") and len(setup.problem.obstacles) == len(problem.obstacles)
-                         and isinstance(setup.planner, ImprovedAntColonyPlanner))
+                         and isinstance(setup.planner, ImprovedAntColonyPlanner) and self.footprint == "circle")
         if replanned:  # Step 2: the IACO path on the static map (the first plan saw the moving obstacles at t = 0)
             cells = cells_of_path(self.planner.plan(grid_problem(problem, self.grid, start), setup.rng), self.grid)
         else:
             cells = cells_of_path(setup.path, self.grid)
-        self.walker = CellWalker(setup.controller, self.grid, self.reach_m)
+        self.walker = CellWalker(setup.controller, self.grid, self.reach_m, pulled=self.drive == "pulled")
         handed = self.walker.start(cells)
         self._pending_path = handed if replanned else None
         self.wait_index: int | None = None
@@ -121,9 +134,66 @@ class IacoLocalNavigator:
         self.waiting = False
         self.counts = {"type1": 0, "type2": 0, "type3": 0, "type4": 0, "waits": 0, "escapes": 0, "replans": 0}
         self._first = True
+        self.watch = MapWatch(setup)
+        self.guard = ChassisGuard(setup, self.footprint, self.max_decel_m_s2)
+        self.next_map_replan_s = 0.0
+        self.no_path = False  # map_updates: the last replan on the sensed map found no path (the robot holds)
+
+    # -- beyond the paper: the map built as the robot drives -------------------------------------------
+    def step(self, observation: Observation) -> NavigationStep:
+        """The paper's step (:meth:`paper_step`), after ``map_updates``' replanning and before ``footprint`` and
+        ``max_decel_m_s2``'s checks of its command (all off by default)."""
+        events: list[tuple[str, dict[str, Any]]] = []
+        replanned = None
+        if self.map_updates == "replan" and (self.watch.changed() or self.no_path) \
+                and observation.time_s >= self.next_map_replan_s - 1e-9:
+            replanned = self._follow_map(observation, events)
+        if self.no_path:
+            return NavigationStep(ControlCommand.stop(), replanned, tuple(events))
+        result = self.paper_step(observation)
+        command = self.guard.apply(result.command, observation.pose, self.setup.controller, self.walker.waypoints)
+        if replanned is None and not events and command is result.command:
+            return result
+        return NavigationStep(command, result.new_path or replanned, tuple(events) + result.events)
+
+    def _follow_map(self, observation: Observation, events: list) -> Path | None:
+        """The sensed map changed: the grid rebuilt; the path kept if its cells and its corners' lines of sight
+        stay free, else IACO (Step 2) again from the robot's cell on the map as now known."""
+        self.watch.take()
+        self.problem = problem = self.setup.map_problem
+        self.grid = self.walker.grid = navigator_grid(self.setup, self.footprint)
+        free = ~self.grid.occupied
+        self.labels, _ = ndimage.label(free, structure=np.ones((3, 3), dtype=bool))
+        rest = self.walker.cells[self.walker.index:]
+        if not self.no_path and not any(self.grid.occupied[c] for c in rest):
+            if self.drive == "pulled":
+                corners = [self.grid.cell_of(x, y) for x, y in self.walker.waypoints]
+                free_list = free.tolist()
+                if not all(grid_line_of_sight(free_list, a, b) for a, b in zip(corners[1:], corners[2:])):
+                    return self.walker.start(self.walker.cells, self.walker.index)
+            return None
+        self.next_map_replan_s = observation.time_s + self.replan_period_s
+        pose = observation.pose
+        here = free_cell_near(self.grid.occupied, self.grid.cell_of(pose.x_m, pose.y_m))
+        self.counts["replans"] += 1
+        try:
+            if here is None:
+                raise PlanningError("the robot's cells are all blocked")
+            path = self.planner.plan(grid_problem(problem, self.grid, here), self.setup.rng)
+        except PlanningError as exc:
+            if not self.no_path:
+                events.append(("replan_failed", {"reason": str(exc)[:120]}))
+            self.no_path = True
+            return None
+        self.no_path = False
+        self.escape_index = None
+        self.wait_index = None
+        self.waiting = False
+        events.append(("replan", {"reason": "blocked on the sensed map", "length_m": round(path.stats.length_m, 6)}))
+        return self.walker.start(cells_of_path(path, self.grid))
 
     # -- one control step -------------------------------------------------------------------------
-    def step(self, observation: Observation) -> NavigationStep:
+    def paper_step(self, observation: Observation) -> NavigationStep:
         """The paper's step (the safety layer's ``evade``, off by default, acts after it)."""
         events: list[tuple[str, dict[str, Any]]] = []
         new_path, self._pending_path = self._pending_path, None

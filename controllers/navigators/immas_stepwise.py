@@ -59,8 +59,11 @@ import numpy as np
 
 from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, static_grid
+from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker
 from swarmnav.controllers.navigators.immas_drive import DriveThrough, WalkTally
+from swarmnav.controllers.navigators.sensed_grid import (FOOTPRINTS, MAP_UPDATES, ChassisGuard, MapWatch,
+                                                         free_cell_near, navigator_grid)
+from swarmnav.planners.errors import PlanningError
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.improved_max_min_ant_system import ImprovedMaxMinAntSystemPlanner, tour_scores
@@ -227,6 +230,12 @@ class ImmasStepwiseNavigator:
             0.5 s ahead, so the walk, driven at top speed, went into the path of crossers twice the robot's
             speed and left the rest to ``evade`` (2 of the 5 ``fast2`` scenes of the 55-scene sample collided;
             with ``predict_s = 1`` none, and 0.87 -> 0.93 solved over the 55).
+        map_updates, footprint, max_decel_m_s2, replan_period_s: beyond the paper, off by default (its robot
+            analyses a known map once, a one-cell robot): ``map_updates = "replan"`` runs Algorithm 1 again on
+            the sensed map (map unknown) from the robot's cell when it has changed, at most every
+            ``replan_period_s``; ``footprint = "box"`` blocks cells by the chassis' inscribed circle and checks
+            turns on the spot against the box; ``max_decel_m_s2`` caps the speed to stop before the mapped
+            obstacles ahead (:mod:`controllers.navigators.sensed_grid`, after ``dstar_replan``'s options).
     """
 
     name: ClassVar[str] = "immas_stepwise"
@@ -241,6 +250,10 @@ class ImmasStepwiseNavigator:
     lookahead_cells: int = param(0, within(0, 1000))
     carrot_m: float = param(0.4, above(0, 100))
     predict_s: float = param(0.0, within(0, 600))
+    map_updates: str = param("none", choices=MAP_UPDATES)
+    footprint: str = param("circle", choices=FOOTPRINTS)
+    max_decel_m_s2: float = param(0.0, within(0, 1000))
+    replan_period_s: float = param(0.5, within(0, 600))
 
     def __post_init__(self) -> None:
         if self.predict_s and not self.lookahead_cells > 0:  # a rule between two fields (each one's range: param)
@@ -249,9 +262,10 @@ class ImmasStepwiseNavigator:
 
     def reset(self, setup: NavigationSetup) -> None:
         problem = setup.map_problem  # static obstacles only: the moving ones are sensed
-        self.grid = grid = static_grid(problem)
+        self.setup = setup
+        self.grid = grid = navigator_grid(setup, self.footprint)
         given = isinstance(setup.planner, ImprovedMaxMinAntSystemPlanner)
-        planner = setup.planner if given else ImprovedMaxMinAntSystemPlanner()
+        self.planner = planner = setup.planner if given else ImprovedMaxMinAntSystemPlanner()
         alpha = planner.alpha if self.alpha is None and given else (3.0 if self.alpha is None else self.alpha)
         beta = planner.beta if self.beta is None and given else (1.0 if self.beta is None else self.beta)
         start = grid.cell_of(problem.start.x_m, problem.start.y_m)
@@ -274,6 +288,10 @@ class ImmasStepwiseNavigator:
         self.drive = (DriveThrough(self.walk, grid, setup.controller, self.lookahead_cells, self.carrot_m, start,
                                    self.tally, self.predict_s > 0)
                       if self.lookahead_cells > 0 else None)
+        self.watch = MapWatch(setup)
+        self.guard = ChassisGuard(setup, self.footprint, self.max_decel_m_s2)
+        self.next_analysis_s = 0.0
+        self.analyses = 1
 
     def _dynamic(self, observation: Observation, ahead_s: Iterable[float]) -> np.ndarray:
         """Cells an obstacle occupies now and (``ahead_s`` > 0) on its way to its next node.
@@ -316,8 +334,40 @@ class ImmasStepwiseNavigator:
 
     def step(self, observation: Observation) -> NavigationStep:
         """The paper's step, or driving through the walk (the safety layer's ``evade``, off by default,
-        acts after it)."""
-        return self._paper_step(observation) if self.drive is None else self._drive_step(observation)
+        acts after it); ``map_updates`` before it and the ``footprint`` and ``max_decel_m_s2`` checks of its
+        command after it (all off by default)."""
+        events: tuple = ()
+        if self.map_updates == "replan" and self.watch.changed() and observation.time_s >= self.next_analysis_s - 1e-9:
+            events = self._follow_map(observation)
+        result = self._paper_step(observation) if self.drive is None else self._drive_step(observation)
+        if not self.guard.active and not events:
+            return result
+        waypoints = self.walker.waypoints if self.drive is None else []
+        command = self.guard.apply(result.command, observation.pose, self.setup.controller, waypoints)
+        return NavigationStep(command, result.new_path, events + result.events)
+
+    def _follow_map(self, observation: Observation) -> tuple:
+        """The sensed map changed: Algorithm 1 again on it, from the robot's cell (beyond the paper)."""
+        self.watch.take()
+        self.next_analysis_s = observation.time_s + self.replan_period_s
+        grid = navigator_grid(self.setup, self.footprint)
+        pose = observation.pose
+        here = free_cell_near(grid.occupied, grid.cell_of(pose.x_m, pose.y_m))
+        try:
+            if here is None:
+                raise PlanningError("the robot's cells are all blocked")
+            analysis = self.planner.analyse(grid.occupied, here, self.walk.goal)
+        except PlanningError as exc:
+            return (("replan_failed", {"reason": str(exc)[:120]}),)
+        self.analyses += 1
+        self.grid = self.walker.grid = grid
+        self.walk = StepwiseWalk(analysis, self.walk.goal, self.walk.alpha, self.walk.beta)
+        self.tally.route_cost = analysis.route_cost
+        if self.drive is not None:
+            self.drive.walk, self.drive.grid = self.walk, grid
+            if self.drive.cells:  # the walk ahead chosen again from where the robot stands, on the new field
+                self.drive.cells, self.drive.centres_m = self.drive.cells[:1], self.drive.centres_m[:1].copy()
+        return (("replan", {"reason": "the sensed map changed", "analyses": self.analyses}),)
 
     def _drive_step(self, observation: Observation) -> NavigationStep:
         """``lookahead_cells`` > 0: driving through the walk (:class:`~controllers.navigators.immas_drive.DriveThrough`)."""
