@@ -21,14 +21,15 @@ from swarmnav.models.world import Pose2D
 
 
 def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, carrot_in_sight: bool = False,
-                centred: "CentredPlanner | None" = None, radius_m: float | None = None, speed_cap_m_s: float = 0.0):
+                centred=None, radius_m: float | None = None, speed_cap_m_s: float = 0.0):
     """What the local navigators (``dwa``, ``velocity_obstacle``, ``mppi``) build alike at reset, from a
     :class:`~controllers.navigator.NavigationSetup`: (drive geometry, top speed in m/s, the radius kept from
     obstacle centres beyond theirs (``radius_m``, default the robot radius, + ``margin_m``), the known static
     obstacles, the path's carrot, the goal as an (x, y) array).  ``carrot_in_sight``: the carrot is kept
     where the robot can drive to it straight past the known map (:class:`PathCarrot`).  ``centred`` (their
-    ``footprint = "box"``): with the map unknown the guidance path is that planner's
-    (:class:`~controllers.guided.GuidedCarrot`), and the sight test is for a disc of its ``block_m``.
+    ``footprint = "box"``, :func:`controllers.guided.box_guidance`): with the map unknown the guidance path is
+    that :class:`~controllers.centred_path.CentredPlanner`'s (:class:`~controllers.guided.GuidedCarrot`), and the sight
+    test is for a disc of its ``block_m``.
     ``speed_cap_m_s`` > 0: the top speed returned is at most that (their ``speed_cap_m_s`` option)."""
     known = setup.map_problem
     geometry = setup.controller.geometry
@@ -36,30 +37,16 @@ def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, car
     if setup.world_map is None:
         carrot = PathCarrot(setup.path.waypoints, lookahead_m)
         local = LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m)
-    elif centred is not None:
-        from swarmnav.controllers.guided import GuidedCarrot, SensedLocalObstacles
-        carrot, local = GuidedCarrot(setup, lookahead_m, centred=centred), SensedLocalObstacles(setup)
     else:  # the map unknown: the sensed map's obstacles, and the path replanned on it (controllers.guided)
         carrot, local = setup.world_map.local_guidance(setup, lookahead_m)
+        if centred is not None:
+            carrot.centred = centred  # GuidedCarrot plans its guidance with it from now on
     if carrot_in_sight:
         sight_m = known.robot_radius_m if centred is None else centred.block_m
         carrot.keep_in_sight(known.disc_centres_m, known.disc_radii_m, known.box_array_m, sight_m)
     top_m_s = min(setup.max_speed_m_s, speed_cap_m_s) if speed_cap_m_s > 0 else setup.max_speed_m_s
     return (geometry, top_m_s, radius_m + margin_m, local,
             carrot, np.array([setup.goal.x_m, setup.goal.y_m]))
-
-
-def box_guidance(setup: NavigationSetup, footprint: str, cost_weight: float, cost_reach_m: float):
-    """(the :class:`~controllers.centred_path.CentredPlanner` of a local navigator's ``footprint = "box"``, the
-    chassis' covering discs in the base frame (:func:`controllers.footprint.covering_discs`), their radius);
-    (None, one disc at the origin, the robot radius) for ``footprint = "circle"``."""
-    from swarmnav.controllers.centred_path import CentredPlanner
-    from swarmnav.controllers.footprint import block_radius_m, covering_discs
-    if footprint != "box":
-        return None, np.zeros((1, 2)), float(setup.map_problem.robot_radius_m)
-    block_m = block_radius_m(setup) + setup.map_problem.clearance_m
-    discs, radius = covering_discs(setup)
-    return CentredPlanner(block_m, cost_weight, cost_reach_m), discs, radius
 
 
 class PathCarrot:

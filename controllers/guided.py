@@ -27,6 +27,7 @@ from dataclasses import replace
 import numpy as np
 
 from swarmnav.controllers.centred_path import CentredPlanner
+from swarmnav.controllers.footprint import block_radius_m, covering_discs
 from swarmnav.controllers.guidance import PathCarrot
 from swarmnav.controllers.navigator import NavigationSetup
 from swarmnav.controllers.prediction import LocalObstacles
@@ -129,6 +130,17 @@ class GuidedCarrot(PathCarrot):
         PathCarrot.__init__(self, waypoints, self.lookahead_m)
         self.sight, self.sight_samples = sight, samples
         self.replans += 1
+
+
+def box_guidance(setup: NavigationSetup, footprint: str, cost_weight: float, cost_reach_m: float):
+    """(the :class:`~controllers.centred_path.CentredPlanner` of a local navigator's ``footprint = "box"``, the
+    chassis' covering discs in the base frame (:func:`controllers.footprint.covering_discs`), their radius);
+    (None, one disc at the origin, the robot radius) for ``footprint = "circle"``."""
+    if footprint != "box":
+        return None, np.zeros((1, 2)), float(setup.map_problem.robot_radius_m)
+    block_m = block_radius_m(setup) + setup.map_problem.clearance_m
+    discs, radius = covering_discs(setup)
+    return CentredPlanner(block_m, cost_weight, cost_reach_m), discs, radius
 
 
 def free_start(problem: Problem, search_m: float = 0.4) -> Problem:

@@ -55,3 +55,37 @@ def unicycle_command(speed_m_s: float, heading_error_rad: float, heading_gain: f
     omega = min(max(heading_gain * heading_error_rad, -max_angular_rad_s), max_angular_rad_s)
     v = speed_m_s * math.cos(heading_error_rad) if abs(heading_error_rad) < turn_in_place_rad else 0.0
     return v, omega
+
+
+def footprint_candidate_times_s(pose: Pose2D, rotate: np.ndarray, candidates: np.ndarray, headings_rad: np.ndarray,
+                                discs_m: np.ndarray, centres: np.ndarray, velocities: np.ndarray,
+                                grown_radii_m: np.ndarray, boxes: np.ndarray, box_clearance_m: float,
+                                horizon_s: float) -> np.ndarray:
+    """(C,) time to collision of each robot-frame candidate velocity for a chassis of several discs
+    (``discs_m``, (n, 2) in the base frame), each candidate driven facing its own direction
+    (``headings_rad``, robot frame): the earliest over the discs of :func:`candidate_times_s`' test with the
+    disc's centre as the moving point (the grown radii are the obstacles' plus the discs' radius)."""
+    ttc = np.full(len(candidates), np.inf)
+    c, s = np.cos(headings_rad), np.sin(headings_rad)
+    local = (centres - (pose.x_m, pose.y_m)) @ rotate if len(centres) else centres
+    obstacle_v = velocities @ rotate if len(centres) else velocities
+    for dx, dy in np.asarray(discs_m, dtype=float).reshape(-1, 2):
+        start = np.column_stack([dx * c - dy * s, dx * s + dy * c])                       # (C, 2) robot frame
+        if len(centres):
+            d = local[None, :, :] - start[:, None, :]                                      # (C, N, 2)
+            q = obstacle_v[None, :, :] - candidates[:, None, :]
+            a = np.sum(q * q, axis=2)
+            b = 2.0 * np.sum(d * q, axis=2)
+            cc = np.sum(d * d, axis=2) - grown_radii_m[None, :] ** 2
+            disc = b * b - 4.0 * a * cc
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = (-b - np.sqrt(np.maximum(disc, 0.0))) / (2.0 * a)
+            t = np.where((disc >= 0.0) & (a > 1e-12) & (t >= 0.0), t, np.inf)
+            t = np.where(cc <= 0.0, np.where(b >= 0.0, np.inf, 0.0), t)
+            ttc = np.minimum(ttc, t.min(axis=1))
+        if len(boxes):
+            p = np.array([pose.x_m, pose.y_m]) + start @ rotate.T
+            ends = p + (candidates * horizon_s) @ rotate.T
+            gap = segment_box_distances(p, ends, boxes).min(axis=1)
+            ttc = np.where(gap < box_clearance_m, np.minimum(ttc, horizon_s * 0.5), ttc)
+    return ttc

@@ -36,3 +36,41 @@ def test_success_against_difficulty_reads_the_rows():
             for w in range(4)]
     table = success_against_difficulty(rows, "n")
     assert table["dispersion"] == {"spearman": -0.8944, "success_low_half": 1.0, "success_high_half": 0.0}
+
+
+def _protocol_result(path, navigator, worlds, runs, successes, params=None):
+    """A committed-result stand-in: per-run rows on ``worlds`` x ``runs``, the first ``successes`` succeeding."""
+    from swarmnav.benchmarks.barn import PROTOCOL_TEXT
+    per_run = []
+    for i, (w, j) in enumerate((w, j) for w in worlds for j in range(runs)):
+        ok = float(i < successes)
+        per_run.append({"scenario": f"barn-{w:03d}-r{j}", "navigator": navigator, "world": w, "run": j, "runs": 1,
+                        "success_rate": ok, "collision_rate": 1.0 - ok, "timeout_rate": 0.0, "barn_score": 0.2 * ok,
+                        "barn_setup": PROTOCOL_TEXT, "navigator_params": params or {}})
+    n = len(per_run)
+    overall = {"scenario": None, "navigator": navigator, "runs": n, "success_rate": successes / n,
+               "collision_rate": 1.0 - successes / n, "timeout_rate": 0.0, "barn_score": 0.2 * successes / n,
+               "barn_setup": PROTOCOL_TEXT, "navigator_params": params or {}, "mean_time_to_goal_s": 10.0}
+    path.write_text(json.dumps([overall] + per_run), encoding="utf-8")
+    return path
+
+
+def test_every_online_navigator_target_needs_the_500_runs_of_each(tmp_path):
+    from swarmnav.benchmarks.barn import TEST_WORLDS
+    names = barn_table.online_navigators()
+    assert "dwa" in names and "mppi" in names and "follow" not in names and "oracle" not in names
+    full = tuple(_protocol_result(tmp_path / f"barn-protocol-{n}.json", n, TEST_WORLDS, 10, 450) for n in names)
+    assert barn_table.online_lines(full)[-1].endswith(": met.")  # 450 / 500 = 0.90 each
+    # dwa's only a 50-run sample, however good: not met, and its row says it is a sample
+    sample = _protocol_result(tmp_path / "barn-protocol-dwa.json", "dwa", TEST_WORLDS, 1, 50, {"footprint": "box"})
+    lines = barn_table.online_lines(full[:names.index("dwa")] + (sample,) + full[names.index("dwa") + 1:])
+    assert any("dwa (footprint=box)" in line and "50 x 1" in line and "(sample: 50 of the protocol's 500)" in line
+               for line in lines)
+    assert "not met" in lines[-1] and "`dwa`" in lines[-1]
+    # one navigator below 0.88 on its 500: not met, named with its figure
+    low = _protocol_result(tmp_path / "barn-protocol-mppi.json", "mppi", TEST_WORLDS, 10, 430)
+    lines = barn_table.online_lines(full[:names.index("mppi")] + (low,) + full[names.index("mppi") + 1:])
+    assert "`mppi` 0.860 (500 runs)" in lines[-1]
+    # a row on worlds that are not all test worlds is not a protocol figure on the test worlds
+    off = _protocol_result(tmp_path / "barn-protocol-x.json", "replan", (1, 7), 250, 500)
+    assert "| replan | none |" in "\n".join(barn_table.online_lines((off,)))

@@ -61,7 +61,8 @@ import numpy as np
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
-from swarmnav.controllers.guidance import box_guidance, local_setup
+from swarmnav.controllers.guidance import local_setup
+from swarmnav.controllers.guided import box_guidance
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.models.world import wrap_angle_rad

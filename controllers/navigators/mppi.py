@@ -43,6 +43,7 @@ import numpy as np
 from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
+from swarmnav.controllers.guided import box_guidance
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.models.errors import ConfigError
@@ -83,6 +84,14 @@ class MppiNavigator:
             set for dyn300's 0.2 m/s, held a 1 m/s robot near 0.29 m/s (CrowdNav's circle crossing: 6.5 m in
             25 s, timeouts); scaled (0.2: sigma_v 0.5 m/s, carrot 5 m at 1 m/s) it drives near its top speed.
             At a top speed equal to it nothing changes.
+        footprint: "circle" (default: the robot radius about the base) or "box" (named option, ours; BARN's
+            Jackal): every rollout point is checked with the chassis box's covering discs at the rollout's
+            heading there (:func:`controllers.footprint.covering_discs`), and with the map unknown the
+            guidance path is planned for the chassis' inscribed circle and kept to the middle of passages
+            (:class:`controllers.centred_path.CentredPlanner`) instead of the run's planner's; the path term
+            then follows that guidance path as it is replanned (at the defaults it keeps the first path).
+        cost_weight, cost_reach_m: with ``footprint = "box"``, the guidance path's penalty near obstacles.
+        speed_cap_m_s: the top speed of the rollouts, at most the robot's (named option, ours; 0: the robot's).
     """
 
     name: ClassVar[str] = "mppi"
@@ -114,6 +123,10 @@ class MppiNavigator:
     optimise_period_s: float = param(0.1, within(0, 10))
     carrot_in_sight: bool = True
     reference_speed_m_s: float = param(0.0, within(0, 100))
+    footprint: str = param("circle", choices=("circle", "box"))
+    cost_weight: float = param(0.0, within(0, 1000))
+    cost_reach_m: float = param(0.3, above(0, 100))
+    speed_cap_m_s: float = param(0.0, within(0, 100))
 
     def __post_init__(self) -> None:
         # Each field's own range is declared with it (param); what no single field can say:
@@ -124,8 +137,11 @@ class MppiNavigator:
     def reset(self, setup: NavigationSetup) -> None:
         scale = setup.max_speed_m_s / self.reference_speed_m_s if self.reference_speed_m_s > 0 else 1.0
         scale = min(scale, 1000.0)  # a tiny reference speed: sigma_v and the carrot stay finite
+        self.centred, self.discs, radius = box_guidance(setup, self.footprint, self.cost_weight, self.cost_reach_m)
         (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(
-            setup, self.margin_m, self.lookahead_m * scale, self.carrot_in_sight)
+            setup, self.margin_m, self.lookahead_m * scale, self.carrot_in_sight, self.centred, radius,
+            self.speed_cap_m_s)
+        self.path_replans = 0
         self.rng = setup.rng
         self.optimised_at_s = -1.0
         self.nominal = np.zeros((self.horizon_steps, 2), dtype=np.float32)
@@ -163,11 +179,26 @@ class MppiNavigator:
         py += np.float32(y)
         return px, py
 
-    def costs(self, px: np.ndarray, py: np.ndarray, observation: Observation) -> np.ndarray:
-        """(K,) state cost of each rollout (float32)."""
+    def costs(self, px: np.ndarray, py: np.ndarray, observation: Observation,
+              heading: np.ndarray | None = None) -> np.ndarray:
+        """(K,) state cost of each rollout (float32); ``heading`` ((K, T), with ``footprint = "box"``): the
+        rollouts' headings, where the chassis' covering discs are checked instead of the base."""
         pose = observation.pose
         cost = np.zeros(len(px), dtype=np.float32)
         centres, velocities, radii, boxes = self.local.near(pose.x_m, pose.y_m, self.reach, observation.detections)
+        if heading is None:
+            gap = self._gap(px, py, centres, velocities, radii, boxes)
+        else:
+            c, s = np.cos(heading), np.sin(heading)
+            gap = None
+            for dx, dy in self.discs.astype(np.float32):
+                g = self._gap(px + dx * c - dy * s, py + dx * s + dy * c, centres, velocities, radii, boxes)
+                gap = g if gap is None else np.minimum(gap, g, out=gap)
+        cost = self._obstacle_cost(cost, gap)
+        return self._tracking_cost(cost, px, py, pose)
+
+    def _gap(self, px: np.ndarray, py: np.ndarray, centres, velocities, radii, boxes) -> np.ndarray | None:
+        """(K, T) gap of each rollout point to the nearest obstacle beyond the inflation (None: none near)."""
         gap = None
         if len(centres):
             # Obstacles predicted along their velocities at each step: (N, T) centres.
@@ -184,17 +215,27 @@ class MppiNavigator:
                 gy = np.maximum(np.maximum(b[1] - py, py - b[3]), 0.0)
                 d = np.hypot(gx, gy) - np.float32(self.inflation)
                 gap = d if gap is None else np.minimum(gap, d, out=gap)
+        return gap
+
+    def _obstacle_cost(self, cost: np.ndarray, gap: np.ndarray | None) -> np.ndarray:
         if gap is not None:
             hit = np.logical_or.accumulate(gap < 0.0, axis=1)            # after a collision the rollout stays collided
-            cost += np.float32(self.collision_cost / px.shape[1]) * np.count_nonzero(hit, axis=1)
+            cost += np.float32(self.collision_cost / gap.shape[1]) * np.count_nonzero(hit, axis=1)
             if np.float32(self.repulsion_m) > 0:                           # below float32's range: off, as 0
                 near = np.clip((self.repulsion_m - gap) / np.float32(self.repulsion_m), 0.0, 1.0)
                 cost += np.float32(self.repulsion_weight) * np.mean(near * near, axis=1)
+        return cost
+
+    def _tracking_cost(self, cost: np.ndarray, px: np.ndarray, py: np.ndarray, pose) -> np.ndarray:
         to_goal = math.hypot(self.goal[0] - pose.x_m, self.goal[1] - pose.y_m)
         if to_goal <= self.goal_radius_m:
             cost += np.float32(self.goal_weight) * np.mean(np.hypot(px - self.goal[0], py - self.goal[1]), axis=1)
             return cost
         target = self.carrot.update(pose)
+        if self.centred is not None and getattr(self.carrot, "replans", 0) != self.path_replans:
+            self.path_replans = self.carrot.replans  # footprint = "box": the path term follows the guidance
+            self.path_points = _resample(np.asarray(self.carrot.points, dtype=float), 0.1)
+            self.path_cum = np.arange(len(self.path_points)) * 0.1
         cost += np.float32(self.follow_weight) * np.hypot(px[:, -1] - target[0], py[:, -1] - target[1])
         if self.path_weight > 0:
             s0 = self.carrot.progress_m
@@ -227,7 +268,11 @@ class MppiNavigator:
         controls = noise + self.nominal[None]
         self._clip(controls)                                               # rolled out within the limits
         px, py = self.rollouts(pose.x_m, pose.y_m, pose.heading_rad, controls)
-        cost = self.costs(px, py, observation)
+        if self.centred is None:
+            cost = self.costs(px, py, observation)
+        else:  # the heading after each step
+            heading = np.cumsum(controls[:, :, 1] * np.float32(self.model_dt_s), axis=1) + np.float32(pose.heading_rad)
+            cost = self.costs(px, py, observation, heading)
         # Control cost gamma u^T Sigma^-1 eps (Williams et al. 2017, Eq. 30), summed over the sequence.
         if self.control_cost > 0:
             cost += np.tensordot(noise, self.nominal / (self.std * self.std), axes=([1, 2], [0, 1])) \

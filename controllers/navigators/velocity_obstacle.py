@@ -41,9 +41,11 @@ import numpy as np
 from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.guidance import local_setup
+from swarmnav.controllers.guided import box_guidance
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.velocity_candidates import candidate_times_s, chosen_candidate, unicycle_command
+from swarmnav.controllers.velocity_candidates import (candidate_times_s, chosen_candidate,
+                                                      footprint_candidate_times_s, unicycle_command)
 
 
 @dataclass
@@ -64,6 +66,14 @@ class VelocityObstacleNavigator:
             the known map (:meth:`controllers.guidance.PathCarrot.keep_in_sight`; ours, on by default: on
             dyn300's door scenes the carrot behind a wall held the robot still against it; false: the plain
             lookahead point).  The bundled dyn-* scenes have no static obstacle: there it changes nothing.
+        footprint: "circle" (default: the robot radius about the base) or "box" (named option, ours; BARN's
+            Jackal): each candidate is checked for the chassis box's covering discs
+            (:func:`controllers.footprint.covering_discs`) facing the candidate's direction
+            (:func:`controllers.velocity_candidates.footprint_candidate_times_s`), and with the map unknown the
+            guidance path is planned for the chassis' inscribed circle and kept to the middle of passages
+            (:class:`controllers.centred_path.CentredPlanner`) instead of the run's planner's.
+        cost_weight, cost_reach_m: with ``footprint = "box"``, the guidance path's penalty near obstacles.
+        speed_cap_m_s: the fastest candidate, at most the robot's top speed (named option, ours; 0: the robot's).
     """
 
     name: ClassVar[str] = "velocity_obstacle"
@@ -82,10 +92,15 @@ class VelocityObstacleNavigator:
     max_angular_rad_s: float = param(1.2, above(0, 100))
     turn_in_place_rad: float = param(math.radians(60.0), above(0, math.pi))
     carrot_in_sight: bool = True
+    footprint: str = param("circle", choices=("circle", "box"))
+    cost_weight: float = param(0.0, within(0, 1000))
+    cost_reach_m: float = param(0.3, above(0, 100))
+    speed_cap_m_s: float = param(0.0, within(0, 100))
 
     def reset(self, setup: NavigationSetup) -> None:
+        self.centred, self.discs, radius = box_guidance(setup, self.footprint, self.cost_weight, self.cost_reach_m)
         (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(
-            setup, self.margin_m, self.lookahead_m, self.carrot_in_sight)
+            setup, self.margin_m, self.lookahead_m, self.carrot_in_sight, self.centred, radius, self.speed_cap_m_s)
         speeds = np.linspace(self.max_speed / self.speed_samples, self.max_speed, self.speed_samples)
         offsets = np.linspace(-self.max_turn_rad, self.max_turn_rad, self.heading_samples)
         speed, offset = (a.ravel() for a in np.meshgrid(speeds, offsets, indexing="ij"))
@@ -107,7 +122,12 @@ class VelocityObstacleNavigator:
         candidates = self.candidates
         cost = np.hypot(candidates[:, 0] - preferred[0], candidates[:, 1] - preferred[1])
         centres, velocities, radii, boxes = self.local.near(pose.x_m, pose.y_m, self.reach, observation.detections)
-        if len(centres) or len(boxes):
+        if (len(centres) or len(boxes)) and self.centred is not None:
+            ttc = footprint_candidate_times_s(pose, np.array([[c, -s], [s, c]]), candidates, self.offsets, self.discs,
+                                              centres, velocities, radii + self.inflation, boxes, self.inflation,
+                                              self.time_horizon_s)
+            k = chosen_candidate(ttc, cost, self.time_horizon_s)
+        elif len(centres) or len(boxes):
             ttc = candidate_times_s(pose, np.array([[c, -s], [s, c]]), candidates, centres, velocities,
                                     radii + self.inflation, boxes, self.inflation, self.time_horizon_s)
             k = chosen_candidate(ttc, cost, self.time_horizon_s)

@@ -1,0 +1,66 @@
+"""The box-chassis options of ``replan``, ``dwa``, ``velocity_obstacle`` and ``mppi`` (issue 34: BARN's Jackal):
+the centred planner of :mod:`controllers.centred_path`, the chassis' covering discs, and real runs through a
+BARN passage (0.75 m) that the Jackal's circumscribed circle (0.333 m) cannot pass."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from swarmnav.controllers.centred_path import CentredPlanner
+from swarmnav.controllers.footprint import covering_discs
+from swarmnav.models.scenario import parse_scenario
+from swarmnav.models.world import Disc, Pose2D, Rect
+from swarmnav.planners.errors import NoPathFound
+from swarmnav.planners.problem import Problem
+from swarmnav.sim.episode import EpisodeSpec, run_episode
+
+from tests.test_footprint import GAP
+
+# a row of BARN's cylinders across the whole 5 m arena with one 0.75 m passage, x in (2.125, 2.875)
+ROW = [2.05 - 0.15 * k for k in range(14)] + [2.95 + 0.15 * k for k in range(14)]
+
+
+def gap_problem(**kw) -> Problem:
+    return Problem(bounds=Rect(0.0, 0.0, 5.0, 8.0), start=Pose2D(2.5, 1.5, 0.0), goal=Pose2D(2.5, 6.5, 0.0),
+                   obstacles=tuple(Disc(x, 4.0, 0.075) for x in ROW), robot_radius_m=0.333, cell_m=0.05, **kw)
+
+
+def test_the_centred_planner_keeps_to_the_middle_of_a_passage_the_circle_closes():
+    problem = gap_problem()
+    with pytest.raises(NoPathFound):
+        CentredPlanner(0.333, 10.0, 0.3).plan(problem, (2.5, 1.5))      # 2 x 0.333 m + the cells > 0.75 m
+    path = CentredPlanner(0.215, 10.0, 0.3).plan(problem, (1.2, 1.5))  # from off to the side
+    through = np.interp(4.0, path[:, 1], path[:, 0])                     # where it crosses the row
+    assert abs(through - 2.5) <= 0.05
+    bare = CentredPlanner(0.215, 0.0, 0.3).plan(problem, (1.2, 1.5))     # no penalty: it may graze the side
+    assert np.allclose(path[0], (1.2, 1.5)) and np.allclose(path[-1], (2.5, 6.5)) and len(bare) >= 2
+    planner = CentredPlanner(0.215, 10.0, 0.3)
+    assert not planner.blocks(problem, path, 0.0)
+    assert planner.blocks(problem, np.array([[1.2, 1.5], [1.2, 6.5]]), 0.0)  # straight through the cylinders
+
+
+def test_the_covering_discs_cover_the_jackal_box_and_are_smaller_than_its_circumscribed_circle():
+    setup = type("S", (), {})()
+    setup.scenario = parse_scenario(GAP, "<jackal gap>")
+    setup.problem = replace(gap_problem(), robot_radius_m=0.333)
+    centres, radius = covering_discs(setup)
+    assert centres.shape == (2, 2) and radius < 0.26
+    xs, ys = np.meshgrid(np.linspace(-0.254, 0.254, 41), np.linspace(-0.215, 0.215, 41))
+    pts = np.column_stack([xs.ravel(), ys.ravel()])
+    d = np.hypot(pts[:, None, 0] - centres[None, :, 0], pts[:, None, 1] - centres[None, :, 1]).min(axis=1)
+    assert d.max() <= radius + 1e-9
+
+
+BOX = {"replan": {"footprint": "box", "cost_weight": 10.0, "max_decel_m_s2": 2.0},
+       "dwa": {"footprint": "box", "cost_weight": 10.0, "aligned_within": "goal"},
+       "velocity_obstacle": {"footprint": "box", "cost_weight": 10.0, "margin_m": 0.05, "time_horizon_s": 1.5,
+                             "speed_cap_m_s": 1.0, "turn_in_place_rad": 0.35},
+       "mppi": {"footprint": "box", "cost_weight": 10.0, "reference_speed_m_s": 0.2, "samples": 300}}
+
+
+@pytest.mark.parametrize("navigator", sorted(BOX))
+def test_the_box_options_pass_a_barn_passage(navigator):
+    scenario = parse_scenario(GAP.replace("time_limit_s = 14.0", "time_limit_s = 25.0"), "<jackal gap>")
+    box = run_episode(EpisodeSpec(scenario, navigator=navigator, navigator_params=BOX[navigator])).result
+    assert box.reached and box.collisions == 0
