@@ -68,11 +68,19 @@ def test_evade_is_a_named_option_of_the_layer_with_a_bounded_trigger(navigator):
         make_navigator(navigator, {"evade_trigger_s": -1.0})
 
 
-@pytest.mark.parametrize("navigator", ["follow", "velocity_obstacle", "oracle"])
+@pytest.mark.parametrize("navigator", ["follow", "oracle"])
 def test_a_navigator_takes_only_the_layer_switches_it_offers(navigator):
-    """``evade`` is offered by the path followers (replan, dstar_replan, iaco_local, immas_stepwise) only."""
+    """``evade`` is offered by the path followers (replan, dstar_replan, iaco_local, immas_stepwise) and the
+    local planners (dwa, mppi, velocity_obstacle) only."""
     with pytest.raises(ConfigError, match="navigator.params.evade"):
         make_driver(navigator, {"evade": True})
+
+
+@pytest.mark.parametrize("navigator", ["dwa", "mppi", "velocity_obstacle"])
+def test_the_local_planners_offer_the_evasion_off_by_default(navigator):
+    assert not make_driver(navigator)[1].on  # their committed rows ran without it
+    layer = make_driver(navigator, {"evade": True, "evade_trigger_s": 3.0})[1]
+    assert layer.evade and layer.evade_trigger_s == 3.0 and not layer.safety_filter
 
 
 def test_no_navigator_imports_the_safety_filter_or_the_evasion():

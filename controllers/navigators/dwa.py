@@ -113,7 +113,7 @@ class DynamicWindowNavigator:
     """
 
     name: ClassVar[str] = "dwa"
-    safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False}  # controllers.safety_layer
+    safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False, "evade": False}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()

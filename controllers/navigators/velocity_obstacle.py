@@ -77,7 +77,7 @@ class VelocityObstacleNavigator:
     """
 
     name: ClassVar[str] = "velocity_obstacle"
-    safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False}  # controllers.safety_layer
+    safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False, "evade": False}  # controllers.safety_layer
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
