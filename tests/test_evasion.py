@@ -134,3 +134,15 @@ def test_dstar_replan_is_run_into_by_a_faster_crosser_unless_it_evades():
     assert plain.collisions >= 1
     evading = run_episode(EpisodeSpec(scenario, navigator="dstar_replan")).result
     assert evading.success and evading.collisions == 0, evading.summary()
+
+
+def test_velocity_obstacle_with_the_evasion_passes_a_crowd_it_runs_into_without():
+    """CrowdNav's validation case 712 (robot invisible): velocity_obstacle alone collides with a human; the
+    layer's evasion (``evade = true``, the option dwa, mppi and velocity_obstacle offer, off by default) gets
+    it through."""
+    from swarmnav.models.scenario_generator import GeneratorOptions, generate
+    scenario = parse_scenario(generate("crowdnav_circle", 712, GeneratorOptions()))
+    plain = run_episode(EpisodeSpec(scenario, navigator="velocity_obstacle"), stop_on_collision=True).result
+    assert plain.collisions >= 1
+    evading = run_episode(EpisodeSpec(scenario, navigator="velocity_obstacle", navigator_params={"evade": True})).result
+    assert evading.success and evading.collisions == 0, evading.summary()
