@@ -15,7 +15,7 @@ from typing import ClassVar
 import numpy as np
 
 from swarmnav.planners.errors import NoPathFound
-from swarmnav.planners.grid_graph import INF, SQRT2, Cell, check_cells, move_masks, moves_by_mask, octile_cells
+from swarmnav.planners.grid_graph import INF, Cell, check_cells, move_masks, moves_by_mask, octile_cells
 from swarmnav.planners.grid_search import GridPlanner
 
 
@@ -58,8 +58,8 @@ class DStarLite:
         n = self.rows * self.cols
         self.g = [INF] * n
         self._moves: list[list[tuple[int, float]] | None] = [None] * n  # see neighbours
-        self._h_start: Cell | None = None  # the start self._h_all was tabulated for (see _heuristic)
-        self._h_all: list[float] = []
+        self._h_start: Cell | None = None  # the start self._h_all is for (see _heuristic)
+        self._h_all = _OctileFrom(start, self.cols)
         self.rhs = [INF] * n
         self.start = start
         self.goal = goal
@@ -108,7 +108,7 @@ class DStarLite:
         """Expand until the start is locally consistent (Fig. 4 of Koenig & Likhachev, optimised).
 
         The paper's CalculateKey, TopKey (lazy deletion: a heap entry counts while it is the vertex's key in
-        ``open``), UpdateVertex and the rhs minimum are written out inline, with the heuristic tabulated per
+        ``open``), UpdateVertex and the rhs minimum are written out inline, with the heuristic kept per
         start (this loop is nearly all of ``dstar_replan``'s time; inline, 1.5-2x faster than as methods,
         measured): the same double operations in the same order, so the same keys, expansions and paths."""
         s = self._index(self.start)
@@ -169,13 +169,11 @@ class DStarLite:
                     elif p in open_:
                         del open_[p]
 
-    def _heuristic(self) -> list[float]:
-        """:meth:`_h` of every vertex for the current start (the octile distance in cells, the same double
-        operations as :func:`~planners.grid_graph.octile_cells`), computed once per start."""
+    def _heuristic(self) -> "_OctileFrom":
+        """:meth:`_h` of the vertices for the current start, each computed on first use and kept while the start
+        stays (a vertex's key is computed many times per plan)."""
         if self._h_start != self.start:
-            rows, cols = np.divmod(np.arange(self.rows * self.cols), self.cols)
-            dr, dc = np.abs(rows - self.start[0]), np.abs(cols - self.start[1])
-            self._h_all = ((SQRT2 - 1.0) * np.minimum(dr, dc) + np.maximum(dr, dc)).tolist()
+            self._h_all = _OctileFrom(self.start, self.cols)
             self._h_start = self.start
         return self._h_all
 
@@ -232,8 +230,22 @@ class DStarLite:
             self._occupied[r, c] = occupied
             flipped.append(r * self.cols + c)
         if flipped:
-            self._masks = move_masks(self._occupied).tolist()
+            self._refresh_masks(flipped)
         self._repair(self._blocks(flipped))
+
+    def _refresh_masks(self, flipped: list[int]) -> None:
+        """Recompute the move masks of the cells within one of a flipped cell (a mask depends on its cell's 3 x 3
+        block), over the flipped cells' bounding box grown by two cells."""
+        r, c = np.divmod(np.asarray(flipped, dtype=np.int64), self.cols)
+        r0, r1 = max(int(r.min()) - 2, 0), min(int(r.max()) + 3, self.rows)
+        c0, c1 = max(int(c.min()) - 2, 0), min(int(c.max()) + 3, self.cols)
+        window = move_masks(self._occupied[r0:r1, c0:c1]).reshape(r1 - r0, c1 - c0)
+        # The window's outer ring sees "blocked" beyond it; only cells within one of a flipped cell are written.
+        w0, w1 = max(int(r.min()) - 1, 0), min(int(r.max()) + 2, self.rows)
+        v0, v1 = max(int(c.min()) - 1, 0), min(int(c.max()) + 2, self.cols)
+        masks, cols = self._masks, self.cols
+        for row in range(w0, w1):
+            masks[row * cols + v0:row * cols + v1] = window[row - r0, v0 - c0:v1 - c0].tolist()
 
     def update_penalty(self, penalty: np.ndarray) -> int:
         """Replace the cell penalties (see ``__init__``) and repair the vertices whose moves changed cost
@@ -286,6 +298,21 @@ class DStarLite:
                 push(heap, (k1, m, v))
             elif v in open_:
                 del open_[v]
+
+
+class _OctileFrom(dict):
+    """Vertex -> its octile distance in cells from one start (:func:`~planners.grid_graph.octile_cells`), computed
+    on first use."""
+
+    def __init__(self, start: Cell, cols: int):
+        super().__init__()
+        self.start_row, self.start_col = start
+        self.cols = cols
+
+    def __missing__(self, v: int) -> float:
+        vr, vc = divmod(v, self.cols)
+        h = self[v] = octile_cells(vr - self.start_row, vc - self.start_col)
+        return h
 
 
 @dataclass

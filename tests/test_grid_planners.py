@@ -16,7 +16,7 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.models.geometry import segment_box_distance, segment_box_distances
 from swarmnav.planners.dstar_lite import DStarLite
-from swarmnav.planners.grid_graph import grid_line_of_sight
+from swarmnav.planners.grid_graph import grid_line_of_sight, move_masks
 from swarmnav.planners.grid_search import astar_cells, dijkstra_cells
 from swarmnav.planners.theta_star import theta_star_cells
 from swarmnav.planners.grid_shortcut import box_line_of_sight
@@ -473,6 +473,7 @@ def test_dstar_lite_repairs_match_a_fresh_search_over_many_changes_with_and_with
             for cell, blocked in changes.items():
                 occ[cell] = blocked
             planner.update_cells(changes)
+            assert planner._masks == move_masks(occ).tolist()  # refreshed over the changed cells' window only
             if penalised:
                 penalty = penalty.copy()
                 penalty[rng.integers(0, 25)] = rng.random(25) * 2
