@@ -37,6 +37,24 @@ Our choices where the paper is silent:
   :func:`~controllers.navigators.cell_path.static_grid`) from the escape cell.
 * Reach of an obstacle: its radius + the robot's inflation (radius and
   clearance) + ``margin_m``.
+
+Beyond the paper, each a named option off by default (the defaults are the paper's robot; ``docs/navigation.md``
+has the figures), what BARN's protocol (Perille et al. 2020: the map unknown, a 0.508 x 0.430 m Jackal at 2 m/s)
+needs, :mod:`controllers.navigators.sensed_grid`:
+
+* ``map_updates = "replan"``: the paper plans once on a known static map (Steps 1-2); with the map unknown the
+  robot starts with an empty one and drove straight into BARN's cylinders (0.94 of the 50 test worlds
+  collided).  When the sensed map republishes a change, the grid is rebuilt; if a cell still to visit is
+  blocked, IACO (Step 2) plans again from the robot's cell, at most every ``replan_period_s``; with no path
+  the robot stops and retries.
+* ``footprint = "box"``: cells blocked by the chassis' inscribed circle (0.215 m) instead of its circumscribed
+  one (0.333 m, which closes BARN's 0.75 m passages), every turn on the spot checked against the box
+  (``dstar_replan``'s option, :func:`controllers.footprint.guarded_turn`).
+* ``drive = "pulled"``: the controller is handed the corners of the cell path (line of sight on the grid),
+  not every cell centre: on 5-cm cells the robot turned at nearly every centre (3 m in 26 s on BARN world 1);
+  cells are still counted as reached (and Step 3 decided at each) when the robot passes beside them.
+* ``max_decel_m_s2``: the forward speed capped to stop before the nearest mapped obstacle ahead and the path's
+  next sharp turn (:func:`controllers.footprint.braked`).
 """
 
 from __future__ import annotations
@@ -83,7 +101,7 @@ class IacoLocalNavigator:
             which the paper's grid robot does not spend.
         map_updates, footprint, drive, max_decel_m_s2, replan_period_s: beyond the paper, off by default (its
             robot plans once on a known map, a one-cell robot visiting every cell centre); what BARN's protocol
-            (map unknown, a box Jackal at 2 m/s) needs, see the module docstring's last section.
+            (map unknown, a box Jackal at 2 m/s) needs: the module docstring's last section.
     """
 
     name: ClassVar[str] = "iaco_local"

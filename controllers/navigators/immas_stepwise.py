@@ -46,6 +46,10 @@ Beyond the paper, each a named option off by default (the defaults are the paper
 (the safety layer's evasion, :mod:`controllers.safety_layer`), ``lookahead_cells`` and ``carrot_m`` (drive
 through the walk instead of stopping at each cell, :mod:`controllers.navigators.immas_drive`) and ``predict_s`` (a longer Dobstacle for that walk);
 the next cell stays Eq. (3)'s choice at every cell reached.  The class docstring says why, with figures.
+For BARN's protocol (the map unknown, a box Jackal; :mod:`controllers.navigators.sensed_grid`), also off by
+default: ``map_updates`` (Algorithm 1 again on the sensed map when it changes: the paper analyses a known map
+once, and with the empty map it starts with the robot drove into BARN's cylinders), ``footprint`` and
+``max_decel_m_s2`` (``dstar_replan``'s box chassis and speed cap).
 """
 
 from __future__ import annotations
