@@ -181,8 +181,7 @@ def online_lines(results: tuple[FilePath, ...]) -> list[str]:
         for r in rows:
             if r.get("scenario") is not None or r.get("barn_setup") != PROTOCOL_TEXT:
                 continue
-            per_run = [x for x in rows if x.get("scenario") is not None and x["navigator"] == r["navigator"]
-                       and x.get("navigator_params") == r.get("navigator_params")]
+            per_run = [x for x in rows if x.get("scenario") is not None and x["navigator"] == r["navigator"]]
             worlds = {x["world"] for x in per_run}
             barn_worlds = all(x["scenario"].startswith("barn-") for x in per_run)  # not BARN-like seeds
             if not worlds or not worlds <= set(TEST_WORLDS) or not barn_worlds:
