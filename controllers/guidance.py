@@ -28,8 +28,8 @@ def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, car
     obstacles, the path's carrot, the goal as an (x, y) array).  ``carrot_in_sight``: the carrot is kept
     where the robot can drive to it straight past the known map (:class:`PathCarrot`).  ``centred`` (their
     ``footprint = "box"``, :func:`controllers.guided.box_guidance`): with the map unknown the guidance path is
-    that :class:`~controllers.centred_path.CentredPlanner`'s (:class:`~controllers.guided.GuidedCarrot`), and the sight
-    test is for a disc of its ``block_m``.
+    that :class:`~controllers.centred_path.CentredPlanner`'s (:class:`~controllers.guided.GuidedCarrot`), and
+    the sight test is for a disc of its ``block_m``.
     ``speed_cap_m_s`` > 0: the top speed returned is at most that (their ``speed_cap_m_s`` option)."""
     known = setup.map_problem
     geometry = setup.controller.geometry

@@ -74,3 +74,14 @@ def test_every_online_navigator_target_needs_the_500_runs_of_each(tmp_path):
     # a row on worlds that are not all test worlds is not a protocol figure on the test worlds
     off = _protocol_result(tmp_path / "barn-protocol-x.json", "replan", (1, 7), 250, 500)
     assert "| replan | none |" in "\n".join(barn_table.online_lines((off,)))
+
+
+def test_an_arm_counts_for_its_navigator(tmp_path):
+    from swarmnav.benchmarks.barn import TEST_WORLDS
+    path = _protocol_result(tmp_path / "barn-protocol-arm.json", "iaco_local+barn", TEST_WORLDS, 1, 48)
+    rows = json.loads(path.read_text(encoding="utf-8"))
+    rows[0].update(arm_of="iaco_local", arm_params={"footprint": "box"})
+    path.write_text(json.dumps(rows), encoding="utf-8")
+    lines = "\n".join(barn_table.online_lines((path,)))
+    assert "| iaco_local+barn (footprint=box) | `barn-protocol-arm.json` | 50 x 1 |" in lines
+    assert "| iaco_local | none |" not in lines

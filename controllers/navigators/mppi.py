@@ -91,7 +91,8 @@ class MppiNavigator:
             (:class:`controllers.centred_path.CentredPlanner`) instead of the run's planner's; the path term
             then follows that guidance path as it is replanned (at the defaults it keeps the first path).
         cost_weight, cost_reach_m: with ``footprint = "box"``, the guidance path's penalty near obstacles.
-        speed_cap_m_s: the top speed of the rollouts, at most the robot's (named option, ours; 0: the robot's).
+        speed_cap_m_s: the top speed of the rollouts, at most the robot's (named option, ours; 0: the robot's);
+            ``reference_speed_m_s`` then scales by it.
     """
 
     name: ClassVar[str] = "mppi"
@@ -135,7 +136,8 @@ class MppiNavigator:
                                                           f"got {self.samples * self.horizon_steps:,}")
 
     def reset(self, setup: NavigationSetup) -> None:
-        scale = setup.max_speed_m_s / self.reference_speed_m_s if self.reference_speed_m_s > 0 else 1.0
+        top_m_s = min(setup.max_speed_m_s, self.speed_cap_m_s) if self.speed_cap_m_s > 0 else setup.max_speed_m_s
+        scale = top_m_s / self.reference_speed_m_s if self.reference_speed_m_s > 0 else 1.0
         scale = min(scale, 1000.0)  # a tiny reference speed: sigma_v and the carrot stay finite
         self.centred, self.discs, radius = box_guidance(setup, self.footprint, self.cost_weight, self.cost_reach_m)
         (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(
