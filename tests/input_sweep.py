@@ -22,6 +22,7 @@ import math
 import os
 import signal
 import sys
+import sysconfig
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +36,7 @@ WRONG = ["", "x", "true", DEEP, LONG, "[1, 2]", "{a = 1}"]
 SPECIAL_PATHS: list[str] = []
 PATHISH = ["", "../../escaped", "nonexistent/file.toml", LONG, DEEP]
 OK_EXITS = {0, 2, 3, 5}
+STDLIB = sysconfig.get_paths()["stdlib"]  # the standard library's own files, where a budget stop waits (Sweep.guarded)
 
 
 class Stopped(BaseException):
@@ -96,8 +98,11 @@ class Sweep:
             # Never inside an import (a half-imported module would stay broken), and, for up to 2 s, never inside a
             # library's own Python code: an exception raised mid-draw left matplotlib's state broken for the next
             # invocation in this process ("Invalid affine transformation matrix" on a report that runs fine alone).
+            # The standard library likewise: raised inside a weakref callback run by the garbage collector, the
+            # exception is swallowed ("Exception ignored in WeakKeyDictionary...remove") and the stop is lost.
             inner = frame.f_code.co_filename if frame is not None else ""
-            if "site-packages" in inner and deferred[0] < 40:
+            library = "site-packages" in inner or inner.startswith(STDLIB)
+            if library and deferred[0] < 40:
                 deferred[0] += 1
                 arm(0.05)
                 return
