@@ -10,6 +10,7 @@ from swarmnav.controllers.footprint import box_hits, cell_penalty, free_ahead_m,
 from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.world import Pose2D
 from swarmnav.sim.episode import EpisodeSpec, run_episode
+from tests.jackal_gap import jackal_gap
 
 JACKAL_BOX = (-0.254, -0.215, 0.254, 0.215)
 
@@ -43,19 +44,8 @@ def test_cell_penalty_is_highest_beside_blocked_cells_and_zero_beyond_its_reach(
     assert np.all(np.diff(pen[2, 1:7]) < 0) and cell_penalty(occupied, 0.05, 0.0, 0.3) is None
 
 
-GAP = """
-name = "jackal-gap"
-time_limit_s = 14.0
-arena = { width_m = 5.0, height_m = 8.0, walls = false }
-start = { x = 2.5, y = 1.5, heading_deg = 90.0 }
-goal = { x = 2.5, y = 6.5, tolerance_m = 0.5 }
-robot = { model = "jackal" }
-sensors = { model = "rangefinder", count = 270, fov_deg = 270.0, range_m = 10.0 }
-knowledge = { map = "unknown" }
-sim = { stop_on_collision = true }
-""" + "".join(f"[[obstacles]]\nx = {x:.3f}\ny = 4.0\nradius_m = 0.075\n"
-              # a row of BARN's cylinders (0.15 m apart) with a 0.75 m free passage, x in (2.125, 2.875)
-              for x in [0.55 + 0.15 * k for k in range(11)] + [2.95 + 0.15 * k for k in range(11)])
+GAP = jackal_gap("jackal-gap", 14.0,  # a row of BARN's cylinders with a 0.75 m free passage, x in (2.125, 2.875)
+                 [0.55 + 0.15 * k for k in range(11)] + [2.95 + 0.15 * k for k in range(11)])
 
 
 def test_the_box_footprint_passes_a_barn_passage_the_circumscribed_circle_cannot():

@@ -13,21 +13,11 @@ from swarmnav.models.scenario import parse_scenario
 from swarmnav.models.world import Pose2D
 from swarmnav.planners.problem import scenario_problem
 from swarmnav.sim.episode import EpisodeSpec, run_episode
+from tests.jackal_gap import jackal_gap
 
 # A row of BARN's cylinders (0.15 m apart) across the straight line from start to goal, with one 0.75 m passage
 # off that line (x in (3.125, 3.875)): a robot planning on the empty map it starts with drives into the row.
-GAP = """
-name = "jackal-gap-aside"
-time_limit_s = 20.0
-arena = { width_m = 5.0, height_m = 8.0, walls = false }
-start = { x = 2.5, y = 1.5, heading_deg = 90.0 }
-goal = { x = 2.5, y = 6.5, tolerance_m = 0.5 }
-robot = { model = "jackal" }
-sensors = { model = "rangefinder", count = 270, fov_deg = 270.0, range_m = 10.0 }
-knowledge = { map = "unknown" }
-sim = { stop_on_collision = true }
-""" + "".join(f"[[obstacles]]\nx = {x:.3f}\ny = 4.0\nradius_m = 0.075\n"
-              for x in [0.05 + 0.15 * k for k in range(21)] + [3.95 + 0.15 * k for k in range(7)])
+GAP = jackal_gap("jackal-gap-aside", 20.0, [0.05 + 0.15 * k for k in range(21)] + [3.95 + 0.15 * k for k in range(7)])
 
 BARN_IACO = {"map_updates": "replan", "footprint": "box", "drive": "pulled", "max_decel_m_s2": 2.0}
 BARN_IMMAS = {"map_updates": "replan", "footprint": "box", "lookahead_cells": 20, "carrot_m": 0.6,
