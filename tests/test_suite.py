@@ -109,6 +109,19 @@ def test_arms_are_rows_under_their_own_labels_and_extend_a_kept_benchmark(tmp_pa
     assert {r["navigator"]: r["runs"] for r in first} == {"follow": 1, "follow-again": 1, ORACLE: 1}
 
 
+def test_arms_with_no_navigator_named_run_alone_beside_the_oracle(tmp_path):
+    """``--arm`` without ``--navigator``: only the arms (and the yardstick) run, not every default navigator."""
+    import pyarrow.parquet as pq
+    from swarmnav.benchmarks.navigation import parse_arm
+    path = tmp_path / "short.toml"
+    path.write_text(generate("crossing", 5, GeneratorOptions(obstacles=2, arena_m=5.0, sensor_model="detector")))
+    out = tmp_path / "out"
+    rows = benchmark_navigation(1, None, [str(path)], out_dir=str(out), speed=False,
+                                arms=[parse_arm("follow-again:follow")])
+    assert [r["navigator"] for r in rows] == ["follow-again", ORACLE]
+    assert pq.read_table(out / "runs.parquet").num_rows == 2
+
+
 @pytest.mark.parametrize("arm, message", [
     ("vo", "expected LABEL:NAVIGATOR"),
     ("a:nope", "unknown navigator 'nope'"),

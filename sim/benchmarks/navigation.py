@@ -197,7 +197,8 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     name.  With ``by_scenario`` one row per navigator and scenario after them (each with a ``scenario`` key;
     the overall rows have ``scenario`` None).  The runs are a study's rows, kept in ``out_dir`` when given;
     ``suite`` (e.g. ``dyn300``) runs a generated suite instead of ``scenarios``; ``arms``: more rows, each a
-    navigator under its own label with its own parameters (the rows are keyed by label); ``engine="ray"``:
+    navigator under its own label with its own parameters (the rows are keyed by label; with arms and no
+    ``navigators`` only the arms run); ``engine="ray"``:
     the runs on Ray (a local instance of ``workers`` CPUs, or the cluster at ``address``); ``suite="barn"``: the
     BARN worlds (:mod:`swarmnav.benchmarks.barn`; ``barn``: its ``worlds``, ``runs`` and ``dir``), with its score;
     ``knowledge``: the study axes ``maps`` / ``poses`` (``--map`` / ``--pose``), every row says its values."""
@@ -209,7 +210,9 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
     from swarmnav.study.execute import run_study_tables
 
     navigator_params = navigator_params or {}
-    contenders = [n for n in (navigators or default_navigators(navigator_params)) if not is_clairvoyant(n)]
+    # arms alone (no navigator named) run alone: the default navigators only when neither was given
+    named = navigators if navigators is not None or arms else default_navigators(navigator_params)
+    contenders = [n for n in (named or []) if not is_clairvoyant(n)]
     check_arms(contenders, list(arms))
     shipped: dict[str, dict[str, Any]] = {}
     barn_meta = None

@@ -141,7 +141,8 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
                         help="a parameter for every navigator that has it (repeatable), e.g. policy=module:function")
     parser.add_argument("--arm", action="append", metavar="LABEL:NAVIGATOR[:KEY=VALUE,...]",
                         help="one more row: a navigator under its own label with its own parameters (repeatable), "
-                             "e.g. iaco_local+evade:iaco_local:evade=true")
+                             "e.g. iaco_local+evade:iaco_local:evade=true; with no --navigator only the arms run "
+                             "(and the oracle)")
     parser.add_argument("--map", choices=("known", "unknown"),
                         help="every run's static map: given in advance (known) or built from the laser (unknown); "
                         "default: each scenario's knowledge.map")
