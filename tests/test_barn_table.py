@@ -85,3 +85,17 @@ def test_an_arm_counts_for_its_navigator(tmp_path):
     lines = "\n".join(barn_table.online_lines((path,)))
     assert "| iaco_local+barn (footprint=box) | `barn-protocol-arm.json` | 50 x 1 |" in lines
     assert "| iaco_local | none |" not in lines
+
+
+def test_all_worlds_target_needs_a_row_over_every_world_for_each_online_navigator(tmp_path):
+    from swarmnav.benchmarks.barn import TEST_WORLDS, WORLD_COUNT
+    names = barn_table.online_navigators()
+    every = tuple(_protocol_result(tmp_path / f"barn-protocol-all-{n}.json", n, range(WORLD_COUNT), 1, 290)
+                  for n in names)
+    lines = barn_table.all_worlds_lines(every)
+    assert lines[-1].endswith(": met.")
+    assert sum(line.startswith("| ") and "| 300 | 0.967 |" in line for line in lines) == len(names)
+    # the test worlds alone are not all the worlds: that navigator has none, named in the verdict
+    test50 = _protocol_result(tmp_path / "barn-protocol-replan.json", "replan", TEST_WORLDS, 10, 500)
+    lines = barn_table.all_worlds_lines(tuple(p for p in every if "replan" not in p.name) + (test50,))
+    assert "| replan | none |" in "\n".join(lines) and "`replan`" in lines[-1] and "not met" in lines[-1]

@@ -222,6 +222,46 @@ def online_lines(results: tuple[FilePath, ...]) -> list[str]:
     return lines
 
 
+def all_worlds_lines(results: tuple[FilePath, ...]) -> list[str]:
+    """Issue 34's "all 300 worlds run for every navigator": per online navigator (its own rows and its arms'), a
+    committed protocol row whose runs cover every one of BARN's worlds (the one with the most runs), and whether
+    every online navigator has one."""
+    from swarmnav.benchmarks.barn import PROTOCOL_TEXT, WORLD_COUNT
+    chosen: dict[str, tuple[FilePath, dict[str, Any]]] = {}
+    for path in results:
+        if not path.is_file():
+            continue
+        rows = read_result(path)
+        for r in rows:
+            if r.get("scenario") is not None or r.get("barn_setup") != PROTOCOL_TEXT:
+                continue
+            per_run = [x for x in rows if x.get("scenario") is not None and x["navigator"] == r["navigator"]
+                       and x["scenario"].startswith("barn-")]
+            if {x["world"] for x in per_run} != set(range(WORLD_COUNT)):
+                continue
+            base = r.get("arm_of") or r["navigator"]
+            if base not in chosen or r["runs"] >= chosen[base][1]["runs"]:
+                chosen[base] = (path, r)
+    names = online_navigators()
+    lines = [f"All {WORLD_COUNT} worlds under the protocol, per online navigator (its committed row whose runs "
+             "cover every world):", "",
+             "| navigator | result file | runs | success | collisions | timeouts | BARN score |",
+             "|---|---|---:|---:|---:|---:|---:|"]
+    for name in names:
+        if name not in chosen:
+            lines.append(f"| {name} | none | 0 | – | – | – | – |")
+            continue
+        path, r = chosen[name]
+        params = r.get("arm_params") or r.get("navigator_params")
+        label = r["navigator"] + (" (" + ", ".join(f"{k}={v}" for k, v in params.items()) + ")" if params else "")
+        lines.append(f"| {label} | `{path.name}` | {r['runs']} | {r['success_rate']:.3f} | {r['collision_rate']:.3f} "
+                     f"| {r['timeout_rate']:.3f} | {_f(r['barn_score'], '.4f')} |")
+    missing = [n for n in names if n not in chosen]
+    lines += ["", f"All {WORLD_COUNT} worlds run for every online navigator: " + (
+        "met." if not missing else "not met (none yet for " + ", ".join(f"`{n}`" for n in missing) + ").")]
+    return lines
+
+
 def block(results: tuple[FilePath, ...] = RESULTS) -> str:
     lines = [BEGIN, ""]
     for path in results:
@@ -230,7 +270,8 @@ def block(results: tuple[FilePath, ...] = RESULTS) -> str:
             lines += result_lines(path, rows) + [""]
             diff = difficulty_lines(rows)
             lines += (diff + [""]) if diff else []
-    lines += fresh_lines(results) + online_lines(results) + [""] + published_lines() + ["", END]
+    lines += (fresh_lines(results) + online_lines(results) + [""] + all_worlds_lines(results) + [""]
+              + published_lines() + ["", END])
     return "\n".join(lines)
 
 
