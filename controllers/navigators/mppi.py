@@ -46,6 +46,7 @@ from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.guided import box_guidance
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
+from swarmnav.controllers.navigators.rollout_gaps import disc_gaps
 from swarmnav.models.errors import ConfigError
 
 
@@ -206,11 +207,7 @@ class MppiNavigator:
             # Obstacles predicted along their velocities at each step: (N, T) centres.
             cx = (centres[:, 0:1] + velocities[:, 0:1] * self.step_times[None, :]).astype(np.float32)
             cy = (centres[:, 1:2] + velocities[:, 1:2] * self.step_times[None, :]).astype(np.float32)
-            for k in range(len(centres)):
-                dx, dy = px - cx[k], py - cy[k]
-                d = np.sqrt(dx * dx + dy * dy)
-                d -= np.float32(radii[k] + self.inflation)
-                gap = d if gap is None else np.minimum(gap, d, out=gap)
+            gap = disc_gaps(px, py, cx, cy, (np.asarray(radii, dtype=float) + self.inflation).astype(np.float32))
         if len(boxes):
             for b in boxes.astype(np.float32):
                 gx = np.maximum(np.maximum(b[0] - px, px - b[2]), 0.0)
