@@ -93,8 +93,19 @@ def test_all_worlds_target_needs_a_row_over_every_world_for_each_online_navigato
     every = tuple(_protocol_result(tmp_path / f"barn-protocol-all-{n}.json", n, range(WORLD_COUNT), 1, 290)
                   for n in names)
     lines = barn_table.all_worlds_lines(every)
-    assert lines[-1].endswith(": met.")
+    assert lines[-1].endswith(": met.")  # the stand-ins carry no CPU figure: no CPU line
     assert sum(line.startswith("| ") and "| 300 | 0.967 |" in line for line in lines) == len(names)
+    # with each run's simulated time and CPU real-time factor: 300 runs x 10 s / 5 = 10 min per navigator
+    timed = []
+    for path in every:
+        rows = json.loads(path.read_text(encoding="utf-8"))
+        for r in rows:
+            r.update(time_s=10.0, realtime_factor_cpu=5.0)
+        timed.append(tmp_path / ("timed-" + path.name))
+        timed[-1].write_text(json.dumps(rows), encoding="utf-8")
+    lines = barn_table.all_worlds_lines(tuple(timed))
+    assert lines[-1].startswith(f"Their runs' own CPU, every online navigator: {10.0 * len(names):.1f} min, so at "
+                                f"least {5.0 * len(names):.1f} min")
     # the test worlds alone are not all the worlds: that navigator has none, named in the verdict
     test50 = _protocol_result(tmp_path / "barn-protocol-replan.json", "replan", TEST_WORLDS, 10, 500)
     lines = barn_table.all_worlds_lines(tuple(p for p in every if "replan" not in p.name) + (test50,))

@@ -241,25 +241,40 @@ def all_worlds_lines(results: tuple[FilePath, ...]) -> list[str]:
                 continue
             base = r.get("arm_of") or r["navigator"]
             if base not in chosen or r["runs"] >= chosen[base][1]["runs"]:
-                chosen[base] = (path, r)
+                chosen[base] = (path, r, _cpu_min(per_run))
     names = online_navigators()
     lines = [f"All {WORLD_COUNT} worlds under the protocol, per online navigator (its committed row whose runs "
-             "cover every world):", "",
-             "| navigator | result file | runs | success | collisions | timeouts | BARN score |",
-             "|---|---|---:|---:|---:|---:|---:|"]
+             "cover every world; CPU: the runs' own, simulated time over each run's real-time factor on CPU, the "
+             "bench's overhead not counted):", "",
+             "| navigator | result file | runs | success | collisions | timeouts | BARN score | CPU min |",
+             "|---|---|---:|---:|---:|---:|---:|---:|"]
     for name in names:
         if name not in chosen:
-            lines.append(f"| {name} | none | 0 | – | – | – | – |")
+            lines.append(f"| {name} | none | 0 | – | – | – | – | – |")
             continue
-        path, r = chosen[name]
+        path, r, cpu = chosen[name]
         params = r.get("arm_params") or r.get("navigator_params")
         label = r["navigator"] + (" (" + ", ".join(f"{k}={v}" for k, v in params.items()) + ")" if params else "")
         lines.append(f"| {label} | `{path.name}` | {r['runs']} | {r['success_rate']:.3f} | {r['collision_rate']:.3f} "
-                     f"| {r['timeout_rate']:.3f} | {_f(r['barn_score'], '.4f')} |")
+                     f"| {r['timeout_rate']:.3f} | {_f(r['barn_score'], '.4f')} | {_f(cpu, '.1f')} |")
     missing = [n for n in names if n not in chosen]
     lines += ["", f"All {WORLD_COUNT} worlds run for every online navigator: " + (
         "met." if not missing else "not met (none yet for " + ", ".join(f"`{n}`" for n in missing) + ").")]
+    cpus = [chosen[n][2] for n in names if n in chosen]
+    if cpus and all(c is not None for c in cpus):
+        total = sum(cpus)
+        whole = "every online navigator" if not missing else f"the online navigators run so far ({len(cpus)} of {len(names)})"
+        lines.append(f"Their runs' own CPU, {whole}: {total:.1f} min, so at least {total / 2:.1f} min of wall time on "
+                     f"2 cores (issue 34's speed target: all {WORLD_COUNT} worlds x every online navigator within "
+                     "60 min on 2 cores; a lower bound, not a timed command).")
     return lines
+
+
+def _cpu_min(per_run: list[dict[str, Any]]) -> float | None:
+    """The runs' own CPU in minutes (simulated time over each run's real-time factor on CPU), None if unknown."""
+    if not per_run or any(not r.get("realtime_factor_cpu") or r.get("time_s") is None for r in per_run):
+        return None
+    return sum(r["time_s"] / r["realtime_factor_cpu"] for r in per_run) / 60.0
 
 
 def block(results: tuple[FilePath, ...] = RESULTS) -> str:
