@@ -42,15 +42,14 @@ class DStarLite:
     length in cells; symmetric, so the graph stays undirected, and >= w, so the octile heuristic stays
     admissible.  None: every move costs its length (the paper's grid).
 
-    Attributes:
-        free: per row, per column, whether the cell is free (as last set).
     """
 
     def __init__(self, occupied: np.ndarray, start: Cell, goal: Cell, penalty: np.ndarray | None = None):
         occ = np.asarray(occupied, dtype=bool)
         check_cells(occ, start, goal)
         self.rows, self.cols = occ.shape
-        self.free = (~occ).tolist()
+        self._occupied = occ.copy()
+        self._free: list[list[bool]] | None = None  # see free
         pen = None if penalty is None else self._checked_penalty(penalty)
         self.start = start
         self.goal = goal
@@ -61,6 +60,13 @@ class DStarLite:
 
     def _index(self, cell: Cell) -> int:
         return cell[0] * self.cols + cell[1]
+
+    @property
+    def free(self) -> list[list[bool]]:
+        """Per row, per column, whether the cell is free (as last set); rebuilt after a change, when read."""
+        if self._free is None:
+            self._free = (~self._occupied).tolist()
+        return self._free
 
     @property
     def expansions(self) -> int:
@@ -120,17 +126,24 @@ class DStarLite:
         moves that pass beside it, all within its 3 x 3 block, so those
         vertices get their rhs recomputed.
         """
-        flipped: list[int] = []
-        states: list[bool] = []
-        for (r, c), occupied in changes.items():
+        occupied = self._occupied.copy()
+        for (r, c), blocked in changes.items():
             if not (0 <= r < self.rows and 0 <= c < self.cols):
                 raise ValueError(f"cell {(r, c)} is outside the grid")
-            if self.free[r][c] == (not occupied):
-                continue
-            self.free[r][c] = not occupied
-            flipped.append(r * self.cols + c)
-            states.append(bool(occupied))
-        self._search.update_cells(np.array(flipped, dtype=np.int64), np.array(states, dtype=np.uint8),
+            occupied[r, c] = bool(blocked)
+        self.set_occupied(occupied)
+
+    def set_occupied(self, occupied: np.ndarray) -> None:
+        """:meth:`update_cells` with the whole grid: the cells that differ from the current ones are changed."""
+        occ = np.asarray(occupied, dtype=bool)
+        if occ.shape != (self.rows, self.cols):
+            raise ValueError(f"occupied must be a {self.rows} x {self.cols} array")
+        flipped = np.flatnonzero(occ != self._occupied)
+        if not len(flipped):
+            return
+        self._occupied = occ.copy()
+        self._free = None
+        self._search.update_cells(flipped.astype(np.int64), occ.reshape(-1)[flipped].astype(np.uint8),
                                   self._index(self.start), self.km)
 
     def update_penalty(self, penalty: np.ndarray) -> int:
