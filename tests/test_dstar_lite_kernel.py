@@ -61,3 +61,11 @@ def test_the_masks_follow_the_changed_cells_and_a_bad_cell_or_penalty_is_refused
         planner.update_penalty(np.full((6, 7), np.nan))
     with pytest.raises(ValueError, match="penalty"):
         planner.update_penalty(np.zeros((7, 6)))
+
+
+def test_the_repair_benchmark_compares_the_two_searches_on_the_same_sequence():
+    from swarmnav.benchmarks.grid import bench_dstar_repairs
+
+    result = bench_dstar_repairs(replans=6, size=30)
+    assert result["replans"] == 6 and result["disagreements"] == 0
+    assert result["ours_mean_s"] > 0 and result["reference_mean_s"] > 0
