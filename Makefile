@@ -16,7 +16,7 @@ STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c
 
 .PHONY: demo test bench install clean studies readme-table rerun-stale typing-path docs
 
-$(STAMP): pyproject.toml Makefile planners/_colony_walk.c planners/_grid_search.c
+$(STAMP): pyproject.toml Makefile planners/_colony_walk.c planners/_grid_search.c planners/_dstar_lite.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	@echo "installing swarmnav into $(VENV) (pip's output: $(VENV)/install.log)"
 	@$(BIN)/python -m pip install --quiet --upgrade pip > $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)

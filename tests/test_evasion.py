@@ -146,3 +146,23 @@ def test_velocity_obstacle_with_the_evasion_passes_a_crowd_it_runs_into_without(
     assert plain.collisions >= 1
     evading = run_episode(EpisodeSpec(scenario, navigator="velocity_obstacle", navigator_params={"evade": True})).result
     assert evading.success and evading.collisions == 0, evading.summary()
+
+
+def test_replan_sweeps_near_leaves_out_only_detections_whose_sweep_keeps_off_the_path():
+    from swarmnav.controllers.navigators.replan import sweeps_near
+    from swarmnav.controllers.prediction import polyline_gap_m, swept_discs
+
+    rng = np.random.default_rng(7)
+    kept = left_out = 0
+    for _ in range(300):
+        polyline = np.cumsum(rng.uniform(-1, 1, (int(rng.integers(2, 5)), 2)), axis=0)
+        detections = tuple(DetectedObstacle(*rng.uniform(-4, 4, 2), float(rng.uniform(0.1, 0.4)),
+                                            *rng.uniform(-1, 1, 2), k) for k in range(8))
+        near = sweeps_near(detections, polyline, 0.3, 3.0)
+        for d in detections:
+            if d in near:
+                kept += 1
+            else:
+                left_out += 1
+                assert polyline_gap_m(polyline, swept_discs((d,), 3.0), 0.3) > 0.0
+    assert kept and left_out  # both kinds occur

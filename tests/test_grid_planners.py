@@ -458,8 +458,8 @@ def test_dstar_lite_penalties_steer_the_path_and_their_repair_matches_a_fresh_se
 
 
 def test_dstar_lite_repairs_match_a_fresh_search_over_many_changes_with_and_without_penalties():
-    # The moves out of each vertex are kept between repairs and dropped when their 3 x 3 block changes: a
-    # stale list would show as a cost or a path through a blocked cell after some of these changes.
+    # Each cell's move mask is kept between repairs and recomputed over the changed cells' 3 x 3 blocks only: a
+    # stale mask would show as a cost or a path through a blocked cell after some of these changes.
     rng = np.random.default_rng(3)
     for penalised in (False, True):
         occ = rng.random((25, 25)) < 0.2
@@ -473,7 +473,7 @@ def test_dstar_lite_repairs_match_a_fresh_search_over_many_changes_with_and_with
             for cell, blocked in changes.items():
                 occ[cell] = blocked
             planner.update_cells(changes)
-            assert planner._masks == move_masks(occ).tolist()  # refreshed over the changed cells' window only
+            assert planner.masks == move_masks(occ).tolist()  # refreshed over the changed cells' blocks only
             if penalised:
                 penalty = penalty.copy()
                 penalty[rng.integers(0, 25)] = rng.random(25) * 2

@@ -226,11 +226,10 @@ class DStarReplanNavigator:
             marks = self._rasterise(self.inflation_m)
             if marks is not None:
                 occupied = occupied | marks
-        flips = np.argwhere(occupied != self.current)
-        if not len(flips):
+        if np.array_equal(occupied, self.current):
             return False
         self.current = occupied
-        self.dstar.update_cells({(int(r), int(c)): bool(occupied[r, c]) for r, c in flips})
+        self.dstar.set_occupied(occupied)
         if self.cost_weight > 0:
             self.penalty = cell_penalty(occupied, self.grid.cell_m, self.cost_weight, self.cost_reach_m)
             self.dstar.update_penalty(self.penalty)
@@ -253,6 +252,28 @@ class DStarReplanNavigator:
             return None
         marks = rasterise(self.known.bounds, tuple(self.sweeps), (), inflation_m, self.grid.cell_m).occupied
         return marks if marks.shape == self.static.shape else None
+
+    def _swept(self, cells: list[Cell], inflation_m: float) -> bool:
+        """Whether ``self._rasterise(inflation_m)`` marks any of ``cells``, tested on those cells only: the same
+        rule and double operations as :func:`models.world.rasterise` (a cell is marked when its centre's squared
+        distance to a sweep's centre is below the square of the sweep's radius + ``inflation_m`` + cell / sqrt 2;
+        a cell beyond a sweep's window is farther than that by half a cell), not the whole grid."""
+        if not self.sweeps or not cells:
+            return False
+        bounds, cell_m = self.known.bounds, self.grid.cell_m
+        cols = max(1, int(math.ceil(bounds.width_m / cell_m - 1e-9)))
+        rows = max(1, int(math.ceil(bounds.height_m / cell_m - 1e-9)))
+        if (rows, cols) != self.static.shape:  # as _rasterise: marks of another grid are not used
+            return False
+        at = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+        xs = bounds.x_min_m + (at[:, 1] + 0.5) * cell_m
+        ys = bounds.y_min_m + (at[:, 0] + 0.5) * cell_m
+        reach = inflation_m + cell_m / math.sqrt(2.0)
+        discs = np.array([(d.x_m, d.y_m, d.radius_m) for d in self.sweeps], dtype=float)
+        grown = discs[:, 2] + reach
+        dx = xs[:, None] - discs[None, :, 0]
+        dy = ys[:, None] - discs[None, :, 1]
+        return bool(np.any(dy ** 2 + dx ** 2 < grown * grown))
 
     def _free_cell_near(self, x_m: float, y_m: float) -> Cell:
         """The robot's cell, or the nearest free cell within two cells of it (NO_CELL if none)."""
@@ -295,8 +316,7 @@ class DStarReplanNavigator:
         if self.setup.world_map is not None and any(self.static[r, c] for r, c in rest):
             return "blocked on the sensed map"
         # Blocked: a sweep grown by the bare inflation (without margin_m) covers a cell still to come.
-        marks = self._rasterise(self.block_m)
-        if marks is not None and any(marks[r, c] for r, c in rest):
+        if self._swept(rest, self.block_m):
             return "sensed obstacle on the path"
         if _cells_length(rest) - _cells_length(cells) > self.improvement_m / self.grid.cell_m:
             return "shorter path"

@@ -13,6 +13,8 @@ Prints (or, with ``--json``, emits one object with):
   ratios to those optima on a sample (a study of scenario files, one per instance);
 * ``peers``: our A* against the PyPI ``pathfinding`` A* (``DiagonalMovement.only_when_no_obstacle``)
   on the same grids in this process, ``speedup`` = their time / ours;
+* ``dstar_lite_repairs``: D* Lite's repairs and replans on a CrowdNav-sized grid, compiled against its Python
+  reference, ``speedup`` = the reference's time / the compiled one's, ``disagreements`` (paths or costs that differ);
 * ``targets``: the issue's targets and whether they were met on this machine.
 
 Timings are wall-clock on a shared machine: noisy, printed, never asserted.
@@ -171,6 +173,45 @@ def bench_movingai_peer(per_map: int = 20) -> dict[str, Any]:
             "met": theirs_s / ours_s >= TARGETS["astar_movingai_speedup"]}
 
 
+def bench_dstar_repairs(replans: int = 60, size: int = 120) -> dict[str, Any]:
+    """D* Lite's repairs, compiled (``planners/_dstar_lite.c``) against its Python reference, on a CrowdNav-sized
+    grid (12 x 12 m at 0.1 m): the robot moves two cells along its path, about 60 cells change (blocked or freed
+    at random, as sweeps come and go), and both repair and replan; wall time of update + plan summed, the paths and
+    costs compared (they are equal by construction: the same search step for step)."""
+    from swarmnav.planners.dstar_lite import DStarLite
+    from swarmnav.planners.dstar_lite_reference import DStarLiteReference
+    from swarmnav.planners.errors import NoPathFound
+
+    rng = np.random.default_rng(0)
+    occupied = rng.random((size, size)) < 0.1
+    start, goal = (0, 0), (size - 1, size - 1)
+    occupied[start] = occupied[goal] = False
+    changes_by_replan = [{(int(r), int(c)): bool(rng.random() < 0.5) for r, c in rng.integers(0, size, (60, 2))}
+                         for _ in range(replans)]
+    times, answers = {}, {}
+    for label, cls in (("compiled", DStarLite), ("reference", DStarLiteReference)):
+        planner, spent, out = cls(occupied, start, goal), 0.0, []
+        for changes in changes_by_replan:
+            t = time.perf_counter()
+            try:
+                cells = planner.plan()
+            except NoPathFound:
+                cells = []
+            spent += time.perf_counter() - t
+            out.append((cells, planner.cost_cells))
+            if len(cells) > 2:
+                planner.move_start(cells[2])
+            changes = {cell: blocked for cell, blocked in changes.items() if cell not in (planner.start, goal)}
+            t = time.perf_counter()
+            planner.update_cells(changes)
+            spent += time.perf_counter() - t
+        times[label], answers[label] = spent, out
+    return {"planner": "dstar_lite", "peer": "its Python reference (planners/dstar_lite_reference.py)",
+            "grid": f"{size} x {size}", "replans": replans, "speedup": times["reference"] / times["compiled"],
+            "ours_mean_s": times["compiled"] / replans, "reference_mean_s": times["reference"] / replans,
+            "disagreements": sum(a != b for a, b in zip(answers["compiled"], answers["reference"]))}
+
+
 def quality_rows(args: argparse.Namespace, limit: int | None, out_dir: FilePath):
     """The map, restaurant and Moving AI quality studies (:mod:`swarmnav.benchmarks.grid_quality`)."""
     rows = maps_study(args, out_dir) + restaurant_study(args.runs, out_dir)
@@ -210,8 +251,9 @@ def run(args: argparse.Namespace) -> int:
     movingai = dict(bench_movingai(limit), swarm_ratio_to_optimum=swarm)
     peers = bench_peers(args.maps)
     movingai_peer = bench_movingai_peer(5 if getattr(args, "quick", False) else 20)
+    dstar = bench_dstar_repairs(20 if getattr(args, "quick", False) else 60)
     result = {"rows": rows, "movingai": movingai, "peers": peers, "movingai_peer": movingai_peer,
-              "targets": _targets(rows), "first_plan_s": first_plan}
+              "dstar_lite_repairs": dstar, "targets": _targets(rows), "first_plan_s": first_plan}
     if args.json:
         print(json.dumps(result))
         return 0
@@ -230,6 +272,7 @@ def run(args: argparse.Namespace) -> int:
     print("movingai:", json.dumps(movingai))
     print("peers:", json.dumps(peers))
     print("movingai_peer:", json.dumps(movingai_peer))
+    print("dstar_lite_repairs:", json.dumps(dstar))
     for key, value in result["targets"].items():
         print(f"target {key}: {value}")
     return 0
