@@ -48,6 +48,11 @@ Where we differ or the paper is silent (our choices):
   the window from standing held 0 alone and the robot never moved; at or
   below 0.75 m/s, dyn300's 0.2 m/s included, the lattice is the 7 speeds as
   before).
+* **Cost**: only whether each arc point's disc overlaps an obstacle matters (the first such point ends the
+  arc's ``dist``); the obstacles that stand still (on an unknown map, the sensed map's cells, thousands) are
+  tested through a k-d tree (:func:`controllers.disc_contacts.inside_any`), which decides every point as the
+  (points x obstacles) distances did, bit for bit: a BARN run's CPU fell from ~21-33 s to ~6 s, the same
+  trajectories.
 """
 
 from __future__ import annotations
@@ -61,6 +66,7 @@ import numpy as np
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.controller import ControlCommand
+from swarmnav.controllers.disc_contacts import inside_any
 from swarmnav.controllers.guidance import local_setup
 from swarmnav.controllers.guided import box_guidance
 from swarmnav.controllers.kinematics import wheel_speeds
@@ -183,19 +189,17 @@ class DynamicWindowNavigator:
         v, w, w_abs, theta_end = self.pair[vi, wi].reshape(-1, 4).T                     # (K,) each
         c, s = math.cos(pose.heading_rad), math.sin(pose.heading_rad)
         if self.centred is None:
-            gap = self._gaps(pose.x_m, pose.y_m, c, s, x, y, observation)               # (K, T) or None
+            arcs = [(x, y)]
         else:  # the chassis' covering discs along each arc, at the arc's heading there
             theta = w[:, None] * self.times[None, :]
             ct, st = np.cos(theta), np.sin(theta)
-            gaps = [self._gaps(pose.x_m, pose.y_m, c, s, x + dx * ct - dy * st, y + dx * st + dy * ct, observation)
-                    for dx, dy in self.discs]
-            gap = None if gaps[0] is None else np.minimum.reduce(gaps)
-        if gap is None:
+            arcs = [(x + dx * ct - dy * st, y + dx * st + dy * ct) for dx, dy in self.discs]
+        hit = self._hits(pose.x_m, pose.y_m, c, s, arcs, observation)                    # (K, T) or None
+        if hit is None:
             dist = np.full(len(v), self.dist_cap_m)
             admissible = (v <= math.sqrt(2.0 * self.dist_cap_m * self.accel_m_s2) + 1e-9) & \
                          (w_abs <= math.sqrt(2.0 * self.dist_cap_m * self.angular_accel_rad_s2) + 1e-9)
         else:
-            hit = gap < 0.0
             first = np.where(hit.any(axis=1), hit.argmax(axis=1), n_t)
             t_free = np.where(first > 0, self.times[np.maximum(first - 1, 0)], 0.0)
             driven = self.max_speed * t_free if self.clearance == "time" else v * t_free
@@ -234,30 +238,42 @@ class DynamicWindowNavigator:
         command = ControlCommand(wheel_speeds(v_cmd, w_cmd, self.geometry), v_cmd, w_cmd, 0)
         return NavigationStep(command, None, (), Belief(observation.detections, self.horizon_s))
 
-    def _gaps(self, x0: float, y0: float, c: float, s: float, x: np.ndarray, y: np.ndarray,
+    def _hits(self, x0: float, y0: float, c: float, s: float, arcs: list[tuple[np.ndarray, np.ndarray]],
               observation: Observation) -> np.ndarray | None:
-        """(K, T) smallest gap between the robot's disc on each arc (robot frame: x, y) and every
-        obstacle at that time (None: nothing within reach)."""
+        """(K, T) whether a robot disc on an arc (each of ``arcs``: the (K, T) x and y of one disc's centre,
+        robot frame) overlaps an obstacle at that time, its radius plus ``inflation`` from the obstacle's edge
+        (None: nothing within reach).  The obstacles that stand still (the map's and the sensed map's cells)
+        are tested through :func:`controllers.disc_contacts.inside_any`, exactly as the (points x obstacles)
+        distances would decide it; the moving ones are moved to each time of the arc."""
         centres, velocities, radii, boxes = self.local.near(x0, y0, self.reach, observation.detections)
         if not len(centres) and not len(boxes):
             return None
-        gap = np.full(x.shape, np.inf)
+        hit = np.zeros(arcs[0][0].shape, dtype=bool)
         if len(centres):
             rel_x, rel_y = centres[:, 0] - x0, centres[:, 1] - y0
             ox = c * rel_x + s * rel_y                                                   # (N,) robot frame
             oy = -s * rel_x + c * rel_y
-            ovx = c * velocities[:, 0] + s * velocities[:, 1]
-            ovy = -s * velocities[:, 0] + c * velocities[:, 1]
-            ox_t = ox[None, :] + ovx[None, :] * self.times[:, None]                     # (T, N)
-            oy_t = oy[None, :] + ovy[None, :] * self.times[:, None]
-            d = np.hypot(x[:, :, None] - ox_t[None], y[:, :, None] - oy_t[None]) - (radii + self.inflation)
-            gap = d.min(axis=2)
+            reach = radii + self.inflation
+            moving = (velocities[:, 0] != 0.0) | (velocities[:, 1] != 0.0)
+            still = ~moving
+            if moving.any():
+                ovx = c * velocities[moving, 0] + s * velocities[moving, 1]
+                ovy = -s * velocities[moving, 0] + c * velocities[moving, 1]
+                ox_t = ox[None, moving] + ovx[None, :] * self.times[:, None]            # (T, M)
+                oy_t = oy[None, moving] + ovy[None, :] * self.times[:, None]
+            for x, y in arcs:
+                if still.any():
+                    hit |= inside_any(x, y, ox[still], oy[still], reach[still])
+                if moving.any():
+                    d = np.hypot(x[:, :, None] - ox_t[None], y[:, :, None] - oy_t[None]) - reach[moving]
+                    hit |= d.min(axis=2) < 0.0
         if len(boxes):
-            wx, wy = x0 + c * x - s * y, y0 + s * x + c * y                               # boxes stay in the world
-            dx = np.maximum(np.maximum(boxes[:, 0] - wx[..., None], wx[..., None] - boxes[:, 2]), 0.0)
-            dy = np.maximum(np.maximum(boxes[:, 1] - wy[..., None], wy[..., None] - boxes[:, 3]), 0.0)
-            gap = np.minimum(gap, (np.hypot(dx, dy) - self.inflation).min(axis=2))
-        return gap
+            for x, y in arcs:
+                wx, wy = x0 + c * x - s * y, y0 + s * x + c * y                           # boxes stay in the world
+                dx = np.maximum(np.maximum(boxes[:, 0] - wx[..., None], wx[..., None] - boxes[:, 2]), 0.0)
+                dy = np.maximum(np.maximum(boxes[:, 1] - wy[..., None], wy[..., None] - boxes[:, 3]), 0.0)
+                hit |= (np.hypot(dx, dy) - self.inflation).min(axis=2) < 0.0
+        return hit
 
 
 def _window(lattice: np.ndarray, centre: float, half_width: float) -> slice:
