@@ -2,7 +2,9 @@
 the centred planner of :mod:`controllers.centred_path`, the chassis' covering discs, and real runs through a
 BARN passage (0.75 m) that the Jackal's circumscribed circle (0.333 m) cannot pass."""
 
+import os
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -64,3 +66,19 @@ def test_the_box_options_pass_a_barn_passage(navigator):
     scenario = parse_scenario(GAP.replace("time_limit_s = 14.0", "time_limit_s = 25.0"), "<jackal gap>")
     box = run_episode(EpisodeSpec(scenario, navigator=navigator, navigator_params=BOX[navigator])).result
     assert box.reached and box.collisions == 0
+
+
+DWA_RECOVERY = {**BOX["dwa"], "inside_margin": "shrink", "recovery_s": 1.0, "recovery_back_m": 0.3}
+
+
+@pytest.mark.skipif(not (Path(__file__).resolve().parents[2] / "shared/benchmarks/barn/worlds").is_dir()
+                    and not os.environ.get("SWARMNAV_BARN_DIR"), reason="the BARN data (../shared) is not here")
+def test_dwa_recovery_gets_out_where_the_window_stood_still(tmp_path):
+    """BARN world 265 (not a test world), run 0: with the BARN configuration alone dwa stood still facing away
+    from the carrot from ~40 s to the time limit (measured: timeout, 60.8 s standing); with the recovery and
+    inside_margin = "shrink" it turns / backs out and reaches the goal without touching a cylinder."""
+    from swarmnav.benchmarks.barn import write_barn_suite
+    from swarmnav.models.scenario import load_scenario
+    (path,), _, _ = write_barn_suite(str(tmp_path), False, worlds=(265,), runs=1)
+    result = run_episode(EpisodeSpec(load_scenario(path), navigator="dwa", navigator_params=DWA_RECOVERY)).result
+    assert result.reached and result.collisions == 0
