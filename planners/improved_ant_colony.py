@@ -264,17 +264,9 @@ class ImprovedAntColonyPlanner(GridColonyPlanner):
         # Eq. (6) split into its goal-guidance factor (per cell and move) and its bend
         # factor (per turn), each raised to beta once per iteration (alpha and beta are
         # fixed within one); Eq. (1)'s numerator is then their product with tau_j^alpha.
-        # Speed: the (N, 8) tables are written into buffers kept for the run (a fresh one each iteration
-        # cost its page faults: ~half of this method on BARN's 140 x 320 cells); the walk reads them only
-        # during its iteration.  The same operations in the same order: the same weights, bit for bit.
-        if "weight_buffers" not in data:
-            data["weight_buffers"] = (np.empty_like(data["guidance"]), np.empty_like(data["guidance"]),
-                                      data["legal"].astype(float))
-        cell_weights, gathered, legal = data["weight_buffers"]
-        np.power(data["guidance"], beta, out=cell_weights)
-        np.take(np.power(tau, alpha), data["safe_table"], out=gathered, mode="clip")  # safe_table: no index clips
-        cell_weights *= gathered
-        cell_weights *= legal
+        cell_weights = np.power(data["guidance"], beta)
+        cell_weights *= np.power(tau, alpha)[data["safe_table"]]
+        cell_weights *= data["legal"]
         bend_beta = np.power(cos + 1.0, beta)                          # (9, 8)
         rows, cols = problem.grid.shape
         limit = (max(self.prune_ratio * best_cells,
