@@ -170,6 +170,8 @@ def _propagate(occ: np.ndarray, start: Cell, goal: Cell, rho: float, diagonal_fa
     tau_min, tau_max = (limits.tau_min, limits.tau_max) if bounded else (0.0, 0.0)
     persistence = rho
     w = width
+    # CheckTightTunnelState's neighbours in ORTHOGONAL order, each with the two cells flanking it
+    tunnel_offsets = ((-w, -w - 1, -w + 1), (w, w - 1, w + 1), (-1, -w - 1, w - 1), (1, -w + 1, w + 1))
     while heap:
         kx, x = pop(heap)
         if closed[x] or blocked[x] or kx > k[x]:
@@ -184,10 +186,10 @@ def _propagate(occ: np.ndarray, start: Cell, goal: Cell, rho: float, diagonal_fa
             gates.append(x)
             continue
         expansions += 1
-        if close:  # _close_tight_tunnels: ORTHOGONAL's order, each neighbour with the two cells flanking it
-            for y, a, b in ((x - w, x - w - 1, x - w + 1), (x + w, x + w - 1, x + w + 1),
-                            (x - 1, x - w - 1, x + w - 1), (x + 1, x - w + 1, x + w + 1)):
-                if not blocked[y] and y not in keep and not closed[y] and blocked[a] and blocked[b]:
+        if close:  # _close_tight_tunnels
+            for dy, da, db in tunnel_offsets:
+                y = x + dy
+                if not blocked[y] and y not in keep and not closed[y] and blocked[x + da] and blocked[x + db]:
                     blocked[y] = True
                     tunnels.append(y)
         tx = tau[x]
@@ -202,8 +204,14 @@ def _propagate(occ: np.ndarray, start: Cell, goal: Cell, rho: float, diagonal_fa
                 k[y] = ky
                 if bounded:
                     # Eq. (2) by the iteration-best ant X (unit deposit), then "multiply by 1.4 or 1"
-                    # (§3.2), then the MMAS bounds (§2.1): TrailLimits.clamp_value written out.
-                    tau[y] = min(max(cost * (persistence * tx + 1.0), tau_min), tau_max)
+                    # (§3.2), then the MMAS bounds (§2.1): TrailLimits.clamp_value's min(max(v, lo), hi) written
+                    # out (each keeps v unless the bound lies strictly beyond it, as min and max do).
+                    value = cost * (persistence * tx + 1.0)
+                    if tau_min > value:
+                        value = tau_min
+                    if tau_max < value:
+                        value = tau_max
+                    tau[y] = value
                 else:
                     tau[y] = rho * tx + cost
                 if trace is not None:
