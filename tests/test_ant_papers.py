@@ -12,8 +12,9 @@ import pytest
 
 from swarmnav.models.errors import ConfigError
 from swarmnav.models.scenario import SCENARIO_DIR, load_scenario
-from swarmnav.planners.pheromone_propagation import analyse_environment, mmas_limits
+from swarmnav.planners.pheromone_propagation import analyse_environment, analyse_environment_reference, mmas_limits
 from swarmnav.planners.max_min_ant_system import MaxMinColonyPlanner
+from swarmnav.planners.errors import NoPathFound
 from swarmnav.planners.max_min_trails import check_limits, trail_limits
 from swarmnav.planners.registry import PLANNERS, make_planner
 from swarmnav.cli.main import main
@@ -61,6 +62,44 @@ def test_immas_trails_stay_within_the_bounds_after_every_update(name, doubling):
     assert written[0] == limits.tau_min and np.any(written == limits.tau_max)
     reached = np.isfinite(analysis.route_cost)
     assert check_limits(analysis.pheromone, limits, reached)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_flat_propagation_is_the_references_bit_for_bit(seed):
+    """``analyse_environment`` (flat lists, the tests written out) gives the reference's arrays, gates, tunnels and
+    trace on random grids with gates and tunnels to close, every reading, and on a bundled map."""
+    rng = np.random.default_rng(seed)
+    cases = []
+    for _ in range(40):
+        occ = rng.random(tuple(rng.integers(3, 25, 2))) < rng.uniform(0.1, 0.45)
+        start, goal = (tuple(int(v) for v in rng.integers(occ.shape)) for _ in range(2))
+        occ[start] = occ[goal] = False
+        cases.append((occ, start, goal))
+    _, grid, start, goal = endpoints(load_scenario(IMMAS_ENVS[seed % len(IMMAS_ENVS)]))
+    cases.append((grid.occupied, start, goal))
+    closed = 0
+    for i, (occ, start, goal) in enumerate(cases):
+        options = {"close": i % 3 != 0, "propagation": ("mmas", "route_cost")[i % 2], "evaporation_doubling": i % 5 == 1,
+                   "diagonal_factor": (1.4, 1.0)[i % 7 == 3]}
+        answers = []
+        for analyse in (analyse_environment_reference, analyse_environment):
+            trace = []
+            try:
+                answers.append((analyse(occ, start, goal, trace=trace, **options), trace))
+            except NoPathFound as exc:
+                answers.append((str(exc), trace))
+        (ref, ref_trace), (fast, fast_trace) = answers
+        assert ref_trace == fast_trace
+        if isinstance(ref, str):
+            assert ref == fast
+            continue
+        closed += len(ref.gates) + len(ref.tunnels)
+        for name in ("blocked", "route_cost", "pheromone", "clean", "parent"):
+            a, b = getattr(ref, name), getattr(fast, name)
+            assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), name
+        for name in ("gates", "tunnels", "expansions", "closing_reverted", "limits"):
+            assert getattr(ref, name) == getattr(fast, name), name
+    assert closed > 0  # the closing rules acted
 
 
 def test_the_route_cost_reading_has_no_limits():

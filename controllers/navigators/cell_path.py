@@ -51,6 +51,17 @@ def static_grid(problem: Problem) -> OccupancyGrid:
     return grid
 
 
+def occupied_cells(grid: OccupancyGrid, centres_m: np.ndarray, reach_m: np.ndarray) -> np.ndarray:
+    """(rows, cols) cells whose centres lie within ``reach_m[i]`` of obstacle centre ``i`` ("Dobstacle")."""
+    rows, cols = grid.shape
+    out = np.zeros((rows, cols), dtype=bool)
+    xs = grid.origin_m[0] + (np.arange(cols) + 0.5) * grid.cell_m
+    ys = grid.origin_m[1] + (np.arange(rows) + 0.5) * grid.cell_m
+    for (x, y), r in zip(np.asarray(centres_m, dtype=float).reshape(-1, 2), np.asarray(reach_m, dtype=float)):
+        out |= (ys[:, None] - y) ** 2 + (xs[None, :] - x) ** 2 < r * r
+    return out
+
+
 def grid_problem(problem: Problem, grid: OccupancyGrid, start_cell: Cell) -> Problem:
     """The problem from a cell's centre to the goal on ``grid`` (its discs are in the grid), for replanning."""
     x, y = grid.centres_m(np.array([start_cell]))[0]

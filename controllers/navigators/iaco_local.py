@@ -55,6 +55,23 @@ needs, :mod:`controllers.navigators.sensed_grid`:
   cells are still counted as reached (and Step 3 decided at each) when the robot passes beside them.
 * ``max_decel_m_s2``: the forward speed capped to stop before the nearest mapped obstacle ahead and the path's
   next sharp turn (:func:`controllers.footprint.braked`).
+
+Beyond the paper too, for crowds whose people do not see the robot (CrowdNav's circle crossing with the robot
+invisible, issue 35; diagnosed on validation cases 500-999 only), each off by default:
+
+* ``turn_in_place_deg``: the heading error above which the run's controller turns on the spot (its own 25
+  degrees by default).  With the safety layer's ``evade`` the evasion leaves the robot up to 60 degrees off its
+  path; the controller then stopped to turn back, the evasion took over again, and the robot stood turning in
+  the crowd, where people walked into it (10 of the 13 collisions of 50 cases had the robot at rest).
+* ``wait_guard``: type 1's wait (go to the cell before the crossing point and stop) is taken only when no sensed
+  obstacle is predicted to come within reach of the robot standing on that cell within the horizon (the paper
+  waits for the one crossing obstacle; the others walked into the waiting robot); else the robot goes on, and a
+  wait whose cell becomes unsafe ends.
+* ``rejoin_m``: IACO (Step 2) again from the robot's cell when the robot stands further than ``rejoin_m`` from
+  its path's next ``horizon_cells`` cells (the evasion took it off; it then drove back to a stale path, or stood
+  behind people who had stopped on it) or when a sensed obstacle slower than ``standing_m_s`` stands on them;
+  such obstacles' cells are blocked for that plan (their reach plus :data:`STANDING_CLEARANCE_M`), at most every
+  ``replan_period_s``.
 """
 
 from __future__ import annotations
@@ -70,7 +87,7 @@ from swarmnav.models.parameters import Range, above, param, within
 from swarmnav.controllers.controller import ControlCommand
 from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.navigators.cell_path import (Cell, CellWalker, cells_of_path, grid_problem, heading_of,
-                                                       step_line)
+                                                       occupied_cells, step_line)
 from swarmnav.controllers.navigators.sensed_grid import (FOOTPRINTS, MAP_UPDATES, ChassisGuard, MapWatch,
                                                          free_cell_near, navigator_grid)
 from swarmnav.planners.grid_graph import grid_line_of_sight
@@ -78,12 +95,17 @@ from swarmnav.controllers.navigators.collision_types import (CATCHING_UP, CROSSI
                                                              escape_moves, escape_offsets, first_band_index,
                                                              precondition_x_of_moves,
                                                              predicted_meeting_s, timing)
+from swarmnav.models.errors import ConfigError
+from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.errors import PlanningError
 from swarmnav.planners.improved_ant_colony import ImprovedAntColonyPlanner
 from swarmnav.planners.problem import Path
 
 STRATEGIES = ("paper", "wait_only")
 DRIVES = ("cells", "pulled")
+# rejoin_m: a standing obstacle's cells are blocked this much beyond its reach (radius, inflation, margin_m), so
+# that the path round it passes outside the evasion's own margin (0.1 m; it held the robot on a path 0.05 m off).
+STANDING_CLEARANCE_M = 0.15
 
 
 @dataclass
@@ -101,7 +123,10 @@ class IacoLocalNavigator:
             which the paper's grid robot does not spend.
         map_updates, footprint, drive, max_decel_m_s2, replan_period_s: beyond the paper, off by default (its
             robot plans once on a known map, a one-cell robot visiting every cell centre); what BARN's protocol
-            (map unknown, a box Jackal at 2 m/s) needs: the module docstring's last section.
+            (map unknown, a box Jackal at 2 m/s) needs: the module docstring's BARN section.
+        turn_in_place_deg, wait_guard, rejoin_m, standing_m_s: beyond the paper, off by default (0, False, 0;
+            ``standing_m_s`` acts only with ``rejoin_m``): for crowds that do not see the robot, the module
+            docstring's last section.
     """
 
     name: ClassVar[str] = "iaco_local"
@@ -121,6 +146,10 @@ class IacoLocalNavigator:
     drive: str = param("cells", choices=DRIVES)
     max_decel_m_s2: float = param(0.0, within(0, 1000))
     replan_period_s: float = param(0.5, within(0, 600))
+    turn_in_place_deg: float = param(0.0, within(0, 180))
+    rejoin_m: float = param(0.0, within(0, 100))
+    standing_m_s: float = param(0.1, within(0, 100))
+    wait_guard: bool = False
     counts: dict[str, int] = field(default_factory=dict, init=False, repr=False)
 
     def reset(self, setup: NavigationSetup) -> None:
@@ -156,6 +185,12 @@ class IacoLocalNavigator:
         self.guard = ChassisGuard(setup, self.footprint, self.max_decel_m_s2)
         self.next_map_replan_s = 0.0
         self.no_path = False  # map_updates: the last replan on the sensed map found no path (the robot holds)
+        self.next_rejoin_s = 0.0
+        if self.turn_in_place_deg > 0:
+            if not hasattr(setup.controller, "turn_in_place_rad"):
+                raise ConfigError("navigator.params.turn_in_place_deg",
+                                  f"the run's controller ({type(setup.controller).__name__}) has no turn on the spot")
+            setup.controller.turn_in_place_rad = math.radians(self.turn_in_place_deg)
 
     # -- beyond the paper: the map built as the robot drives -------------------------------------------
     def step(self, observation: Observation) -> NavigationStep:
@@ -168,6 +203,9 @@ class IacoLocalNavigator:
             replanned = self._follow_map(observation, events)
         if self.no_path:
             return NavigationStep(ControlCommand.stop(), replanned, tuple(events))
+        if self.rejoin_m > 0 and observation.time_s >= self.next_rejoin_s - 1e-9 and not self.waiting \
+                and self.escape_index is None and not self.walker.at_end:
+            replanned = self._rejoin(observation, events) or replanned
         result = self.paper_step(observation)
         command = self.guard.apply(result.command, observation.pose, self.setup.controller, self.walker.waypoints)
         if replanned is None and not events and command is result.command:
@@ -210,13 +248,48 @@ class IacoLocalNavigator:
         events.append(("replan", {"reason": "blocked on the sensed map", "length_m": round(path.stats.length_m, 6)}))
         return self.walker.start(cells_of_path(path, self.grid))
 
+    # -- beyond the paper: back to a path after the evasion, round people standing on it -------------
+    def _rejoin(self, observation: Observation, events: list) -> Path | None:
+        """``rejoin_m``: IACO (Step 2) again from the robot's cell when the robot stands further than ``rejoin_m``
+        from the cells ahead (the evasion took it off its path) or a sensed obstacle slower than ``standing_m_s``
+        stands on them; those obstacles' cells are blocked for that plan only."""
+        pose = observation.pose
+        ahead = self.walker.cells[self.walker.index:self.walker.index + self.horizon_cells + 1]
+        centres = self.grid.centres_m(np.array(ahead)).reshape(-1, 2)
+        off_m = float(np.min(np.hypot(centres[:, 0] - pose.x_m, centres[:, 1] - pose.y_m)))
+        standing = [d for d in observation.detections if math.hypot(d.vx_m_s, d.vy_m_s) < self.standing_m_s]
+        blocked = self.grid.occupied
+        if standing:
+            blocked = blocked | occupied_cells(self.grid, np.array([[d.x_m, d.y_m] for d in standing]),
+                                               np.array([self._reach_m(d) + STANDING_CLEARANCE_M for d in standing]))
+        on_path = any(blocked[c] for c in ahead[1:])
+        if off_m <= self.rejoin_m and not on_path:
+            return None
+        self.next_rejoin_s = observation.time_s + self.replan_period_s
+        here = free_cell_near(blocked, self.grid.cell_of(pose.x_m, pose.y_m))
+        grid = OccupancyGrid(blocked, self.grid.cell_m, self.grid.origin_m)
+        try:
+            if here is None or blocked[self.goal_cell]:
+                raise PlanningError("the robot's or the goal's cells are blocked")
+            path = self.planner.plan(grid_problem(self.problem, grid, here), self.setup.rng)
+        except PlanningError as exc:
+            events.append(("rejoin_failed", {"reason": str(exc)[:120]}))
+            return None
+        self.counts["replans"] += 1
+        self.wait_index = None
+        self._first = True
+        events.append(("rejoin", {"off_path_m": round(off_m, 4), "standing_on_path": on_path,
+                                  "length_m": round(path.stats.length_m, 6)}))
+        self.walker.grid = grid  # the corners pulled round the standing obstacles too (until the next plan)
+        return self.walker.start(cells_of_path(path, grid))
+
     # -- one control step -------------------------------------------------------------------------
     def paper_step(self, observation: Observation) -> NavigationStep:
         """The paper's step (the safety layer's ``evade``, off by default, acts after it)."""
         events: list[tuple[str, dict[str, Any]]] = []
         new_path, self._pending_path = self._pending_path, None
         if self.waiting:
-            if self._conflicts(observation, self.walker.index):
+            if self._conflicts(observation, self.walker.index) and not self._wait_unsafe(observation, self.walker.index):
                 # Hold on the wait cell's centre (a stop would leave the robot up to reach_m short).
                 centre = self.walker.centre(self.walker.cell)
                 self.setup.controller.reset(Path.from_waypoints(np.array([centre, centre]), 0.0))
@@ -259,6 +332,16 @@ class IacoLocalNavigator:
         return any(predicted_meeting_s(path, self.speed_m_s, (d.x_m, d.y_m), (d.vx_m_s, d.vy_m_s),
                                        self._reach_m(d), horizon) is not None for d in observation.detections)
 
+    def _wait_unsafe(self, observation: Observation, index: int) -> bool:
+        """``wait_guard`` (beyond the paper): would a sensed obstacle come within reach of the robot standing on
+        cell ``index`` within the horizon?  Always False with the option off (the paper's wait)."""
+        if not self.wait_guard:
+            return False
+        here = self._path_xy(index)[:1]
+        horizon = self.horizon_cells * self.step_s * math.sqrt(2.0)
+        return any(predicted_meeting_s(here, self.speed_m_s, (d.x_m, d.y_m), (d.vx_m_s, d.vy_m_s), self._reach_m(d),
+                                       horizon) is not None for d in observation.detections)
+
     def _decide(self, observation: Observation, events: list) -> Any:
         """Classify every sensed obstacle at this cell; act on the nearest conflict."""
         index = self.walker.index
@@ -296,6 +379,8 @@ class IacoLocalNavigator:
             band = first_band_index(path, (det.x_m, det.y_m), (det.vx_m_s, det.vy_m_s), self._reach_m(det),
                                     self.horizon_cells * self.step_s * math.sqrt(2.0))
             stop = index + max(0, (band if band is not None else 0) - 1)
+            if self._wait_unsafe(observation, stop):
+                return "go_on", {"unsafe_wait_cell": list(self.walker.cells[stop])}
             self.wait_index = stop
             return ("wait" if stop == index else "go_to_wait"), {"wait_cell": list(self.walker.cells[stop])}
         if enc.kind == CATCHING_UP:

@@ -63,7 +63,7 @@ import numpy as np
 
 from swarmnav.models.parameters import above, param, within
 from swarmnav.controllers.navigator import NavigationSetup, NavigationStep, Observation
-from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker
+from swarmnav.controllers.navigators.cell_path import MOVES, Cell, CellWalker, occupied_cells
 from swarmnav.controllers.navigators.immas_drive import DriveThrough, WalkTally
 from swarmnav.controllers.navigators.sensed_grid import (FOOTPRINTS, MAP_UPDATES, ChassisGuard, MapWatch,
                                                          free_cell_near, navigator_grid)
@@ -72,17 +72,6 @@ from swarmnav.models.errors import ConfigError
 from swarmnav.models.world import OccupancyGrid
 from swarmnav.planners.improved_max_min_ant_system import ImprovedMaxMinAntSystemPlanner, tour_scores
 from swarmnav.planners.pheromone_propagation import EnvironmentAnalysis, analyse_environment
-
-
-def occupied_cells(grid: OccupancyGrid, centres_m: np.ndarray, reach_m: np.ndarray) -> np.ndarray:
-    """(rows, cols) cells whose centres lie within ``reach_m[i]`` of obstacle centre ``i`` ("Dobstacle")."""
-    rows, cols = grid.shape
-    out = np.zeros((rows, cols), dtype=bool)
-    xs = grid.origin_m[0] + (np.arange(cols) + 0.5) * grid.cell_m
-    ys = grid.origin_m[1] + (np.arange(rows) + 0.5) * grid.cell_m
-    for (x, y), r in zip(np.asarray(centres_m, dtype=float).reshape(-1, 2), np.asarray(reach_m, dtype=float)):
-        out |= (ys[:, None] - y) ** 2 + (xs[None, :] - x) ** 2 < r * r
-    return out
 
 
 def time_to_next_node_s(grid: OccupancyGrid, centres_m: np.ndarray, velocities_m_s: np.ndarray,
