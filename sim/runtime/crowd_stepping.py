@@ -14,15 +14,34 @@ import numpy as np
 from swarmnav.models.crowd_agents import AgentMotion, Crowd, CrowdSession
 
 
-class ReactiveCrowd:
-    """The agents among a stepper's moving obstacles (``columns`` of its track) and their episode."""
+def rollout_unneeded(crowd: Crowd) -> bool:
+    """Whether a stepper can do without the no-robot rollout of this crowd (see :class:`ReactiveCrowd`)."""
+    return all(spec.kind == "orca" for spec in crowd.specs)
 
-    def __init__(self, crowd: Crowd, columns: np.ndarray, robot_radius_m: float, dt_s: float):
+
+class ReactiveCrowd:
+    """The agents among a stepper's moving obstacles (``columns`` of its track) and their episode.
+
+    ``lazy``: the stepper need not roll the agents out without a robot over the whole time limit (their
+    columns of its track are written by :meth:`advance` before anything reads them).  That rollout gave two
+    things, both kept: a bound on each step's hop, never above :meth:`max_hop_m` for ORCA agents (RVO2 caps
+    a velocity at ``v_pref``, below the bound by at least ``PERTURB_M_S``, while its float32 positions round
+    by micrometres), so the stepper's bound is ``max_hop_m`` either way; and the detector's velocity at the
+    last step (a backward difference of rows the episode never writes at that step), which :meth:`advance`
+    then computes from the same rollout, made only for a run that reaches its last step.  Social-force agents
+    (capped at exactly the bound) keep the rollout.
+    """
+
+    def __init__(self, crowd: Crowd, columns: np.ndarray, robot_radius_m: float, dt_s: float,
+                 motions: list[AgentMotion] | None = None):
         self.crowd = crowd
         self.columns = columns
         self.robot_radius_m = float(robot_radius_m)
         self.dt_s = dt_s
         self.session: CrowdSession | None = None
+        self.motions = motions  # each column's motion (its rollout without a robot); None: not lazy
+        self.lazy = motions is not None and rollout_unneeded(crowd)
+        self._written = 0  # the last row of the track any episode's advance wrote (the rows after: the rollout's)
 
     @classmethod
     def of(cls, scenario, moving: list, dt_s: float) -> "ReactiveCrowd | None":
@@ -31,29 +50,49 @@ class ReactiveCrowd:
         agents = [(col, m) for col, m in enumerate(motions) if isinstance(m, AgentMotion)]
         if not agents or not agents[0][1].crowd.sees_robot:
             return None
-        columns = np.array([col for col, m in sorted(agents, key=lambda a: a[1].index)], dtype=np.int64)
-        return cls(agents[0][1].crowd, columns, scenario.robot_radius_m, dt_s)
+        ordered = sorted(agents, key=lambda a: a[1].index)
+        return cls(agents[0][1].crowd, np.array([col for col, _ in ordered], dtype=np.int64),
+                   scenario.robot_radius_m, dt_s, [m for _, m in ordered])
 
     def max_hop_m(self) -> float:
         """How far an agent can move in one control period."""
         return self.crowd.max_speed_m_s * self.dt_s
 
-    def reset(self, track_m: np.ndarray, velocity_m_s: np.ndarray) -> None:
-        """A new episode writing into the stepper's ``track_m`` (T, M, 2) and the sensing's ``velocity_m_s``."""
+    def reset(self, track_m: np.ndarray, velocity_m_s: np.ndarray, times_s: np.ndarray) -> None:
+        """A new episode writing into the stepper's ``track_m`` (T, M, 2) and the sensing's ``velocity_m_s``
+        (made from ``track_m`` as it is now); ``times_s``: the track's times."""
         self.session = CrowdSession(self.crowd)
         self.track_m = track_m
         self.velocity_m_s = velocity_m_s
+        if self.lazy and len(track_m) > 1:  # the last two rows as the sensing's last velocity saw them
+            self._last_rows = track_m[-2:, self.columns].copy()
+            self._last_unwritten = [len(track_m) - 2 > self._written, len(track_m) - 1 > self._written]
+            self._last_times_s = np.asarray(times_s, dtype=float)[-2:]
         track_m[0, self.columns] = self.session.positions_m
 
     def advance(self, step: int, base_qpos: np.ndarray, base_qvel: np.ndarray) -> None:
         """The agents from step ``step`` to ``step + 1``, seeing the robot where the physics has it now."""
         if step + 1 >= len(self.track_m):
+            if self.lazy and len(self.track_m) > 1 and step == len(self.track_m) - 1:
+                self._last_velocity(step)
             return
+        self._written = max(self._written, step + 1)
         robot = (float(base_qpos[0]), float(base_qpos[1]), float(base_qvel[0]), float(base_qvel[1]),
                  self.robot_radius_m)
         now = self.session.positions_m.copy()
         self.track_m[step + 1, self.columns] = self.session.advance(step, robot)
         self.velocity_m_s[step, self.columns] = (self.track_m[step + 1, self.columns] - now) / self.dt_s
+
+    def _last_velocity(self, step: int) -> None:
+        """The sensing's velocity at the last step, as a stepper that rolled the agents out without a robot
+        has it (ObstacleSensing: the backward difference of the track's last two rows as they were at reset)."""
+        rows = self._last_rows
+        if any(self._last_unwritten):
+            alone = np.stack([m.positions_at(self._last_times_s) for m in self.motions], axis=1)
+            for k, unwritten in enumerate(self._last_unwritten):
+                if unwritten:
+                    rows[k] = alone[k]
+        self.velocity_m_s[step, self.columns] = np.diff(rows, axis=0)[0] / self.dt_s
 
 
 def human_columns(scenario, moving: list) -> np.ndarray:
