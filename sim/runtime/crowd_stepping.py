@@ -95,6 +95,79 @@ class ReactiveCrowd:
         self.velocity_m_s[step, self.columns] = np.diff(rows, axis=0)[0] / self.dt_s
 
 
+class RolledCrowd:
+    """Agents that do not see the robot, rolled out as the episode goes instead of over the whole time limit.
+
+    Their motion is a pure function of the world seed (:attr:`Crowd.track_m`, one
+    :class:`~models.crowd_agents.CrowdSession` without a robot); a run that ends early needs only its
+    beginning.  :meth:`extend` writes the same rows into the stepper's track (its columns ``columns``), the
+    sensing's velocities (forward differences, the last step's backward) and the stepper's hop bounds
+    (``obstacle_shift_m``: the largest hop over every moving obstacle, summed in order).  Only when the
+    track's times are the rollout's own control steps (the interpolation then gives its rows exactly) and
+    nothing has rolled the crowd out already (a cached rollout costs nothing).
+    """
+
+    def __init__(self, crowd: Crowd, columns: np.ndarray, dt_s: float):
+        self.crowd = crowd
+        self.columns = columns
+        self.dt_s = dt_s
+        self.session = CrowdSession(crowd)
+        self.rows = 0  # the track's rows written: 0 ..rows - 1 (row 0, the start, by obstacle_positions)
+
+    @classmethod
+    def of(cls, scenario, moving: list, dt_s: float, n_max: int) -> "RolledCrowd | None":
+        """The scenario's crowd when it is blind to the robot and can be rolled out step by step (else None)."""
+        motions = [scenario.obstacles[ob.scenario_index].motion for ob in moving]
+        agents = [(col, m) for col, m in enumerate(motions) if isinstance(m, AgentMotion)]
+        if not agents:
+            return None
+        crowd = agents[0][1].crowd
+        if crowd.sees_robot or crowd.dt_s != dt_s or crowd.steps < n_max or "track_m" in crowd.__dict__ \
+                or any(m.crowd is not crowd for _, m in agents):
+            return None
+        ordered = sorted(agents, key=lambda a: a[1].index)
+        if [m.index for _, m in ordered] != list(range(len(crowd.specs))):
+            return None
+        return cls(crowd, np.array([col for col, _ in ordered], dtype=np.int64), dt_s)
+
+    def attach(self, track_m: np.ndarray, velocity_m_s: np.ndarray, other_hops_m: np.ndarray,
+               shift_m: list[float]) -> None:
+        """Write into a stepper's ``track_m`` (its agent columns holding their start), a new sensing's
+        ``velocity_m_s`` (its agent columns re-written for the rows already rolled out), with the other
+        obstacles' hops ``other_hops_m`` (T - 1,) and the hop bounds ``shift_m`` (extended in place)."""
+        if self.rows == 0:
+            self.rows = 1
+        self.track_m, self.velocity_m_s, self.other_hops_m, self.shift_m = track_m, velocity_m_s, other_hops_m, shift_m
+        if self.rows > 1:
+            self._velocities(0, self.rows - 1)
+
+    def extend(self, row: int) -> None:
+        """Roll the agents out up to the track's row ``row`` (at most its last)."""
+        row = min(row, len(self.track_m) - 1)
+        if row < self.rows:
+            return
+        first = self.rows
+        cols = self.columns
+        for k in range(first - 1, row):
+            self.track_m[k + 1, cols] = self.session.advance(k, None)
+        self.rows = row + 1
+        self._velocities(first - 1, row)
+
+    def _velocities(self, first: int, last: int) -> None:
+        """Velocities at steps ``first`` ..``last - 1`` (and the backward one at the last step), hop bounds."""
+        cols, track = self.columns, self.track_m
+        part = track[first:last + 1, cols]
+        step = np.diff(part, axis=0)
+        self.velocity_m_s[first:last, cols] = step / self.dt_s
+        if last == len(track) - 1:
+            self.velocity_m_s[last, cols] = step[-1] / self.dt_s
+        hops = np.maximum(np.hypot(*np.moveaxis(step, 2, 0)).max(axis=1), self.other_hops_m[first:last])
+        shift = self.shift_m
+        for k, hop in enumerate(hops.tolist(), start=first):
+            if k + 1 == len(shift):
+                shift.append(shift[-1] + hop)
+
+
 def human_columns(scenario, moving: list) -> np.ndarray:
     """The columns of the stepper's track that are agents (CrowdNav's humans), in track order."""
     return np.array([col for col, ob in enumerate(moving)
