@@ -45,6 +45,9 @@ from swarmnav.controllers.velocity_candidates import (candidate_times_s, chosen_
 from swarmnav.models.world import Pose2D
 
 
+ORIGIN = np.zeros(2)  # the robot, in its own frame (read only)
+
+
 @dataclass
 class Evasion:
     """Overrides a command whose predicted time to collision with a sensed obstacle is below ``trigger_s``.
@@ -97,8 +100,13 @@ class Evasion:
         grown = radii + self.robot_radius_m + self.margin_m
         moving = np.hypot(velocities[:, 0], velocities[:, 1]) > 1e-9
         own = np.array([[max(command.linear_m_s, 0.0), 0.0]])
-        if not moving.any() or time_to_collision_s(np.zeros(2), own, local[moving], local_v[moving],
-                                                   grown[moving]).min() >= self.trigger_s:
+        if not moving.any():
+            threat_s = math.inf
+        elif moving.all():  # the usual case (every sensed obstacle moves): the arrays as they are
+            threat_s = time_to_collision_s(ORIGIN, own, local, local_v, grown).min()
+        else:
+            threat_s = time_to_collision_s(ORIGIN, own, local[moving], local_v[moving], grown[moving]).min()
+        if threat_s >= self.trigger_s:
             self.active = False
             return command, False
         ttc = candidate_times_s(pose, rotate, self.candidates, centres, velocities, grown, boxes,

@@ -33,10 +33,39 @@ def swept_discs(detections: tuple[DetectedObstacle, ...], horizon_s: float) -> l
     Consecutive discs are at most half a radius apart, so the chain covers the
     swept capsule but for scallops no deeper than r (1 - sqrt(15/16)) ~ 3 % of r.
     """
+    counts = [min(MAX_SWEEP_DISCS, int(math.ceil(math.hypot(d.vx_m_s, d.vy_m_s) * horizon_s
+                                                  / max(0.5 * d.radius_m, 1e-6))) + 1) for d in detections]
+    if not horizon_s > 0.0 or max(counts, default=1) == 1:
+        return swept_discs_reference(detections, horizon_s, counts)
+    # All chains' times at once, as np.linspace(0, horizon_s, count) makes each: k * (horizon_s / (count - 1))
+    # + 0.0, the last one horizon_s exactly.
+    many = np.array([c for c in counts if c > 1])
+    ends = np.cumsum(many)
+    k = np.arange(ends[-1]) - np.repeat(ends - many, many)
+    t = k * np.repeat(horizon_s / (many - 1), many) + 0.0
+    t[ends - 1] = horizon_s
+    moving = [(d.x_m, d.y_m, d.vx_m_s, d.vy_m_s) for d, c in zip(detections, counts) if c > 1]
+    x, y, vx, vy = np.repeat(np.array(moving, dtype=float), many, axis=0).T
+    xs, ys = x + vx * t, y + vy * t
     out: list[Disc] = []
-    for d in detections:
+    at = 0
+    for d, count in zip(detections, counts):
+        if count > 1:
+            out.extend(Disc(px, py, d.radius_m) for px, py in zip(xs[at:at + count], ys[at:at + count]))
+            at += count
+        else:
+            out.append(Disc(d.x_m + d.vx_m_s * 0.0, d.y_m + d.vy_m_s * 0.0, d.radius_m))
+    return out
+
+
+def swept_discs_reference(detections: tuple[DetectedObstacle, ...], horizon_s: float,
+                          counts: list[int] | None = None) -> list[Disc]:
+    """:func:`swept_discs` one detection at a time (its reference, and its path for a zero horizon)."""
+    out: list[Disc] = []
+    for i, d in enumerate(detections):
         travel = math.hypot(d.vx_m_s, d.vy_m_s) * horizon_s
-        count = min(MAX_SWEEP_DISCS, int(math.ceil(travel / max(0.5 * d.radius_m, 1e-6))) + 1)
+        count = min(MAX_SWEEP_DISCS, int(math.ceil(travel / max(0.5 * d.radius_m, 1e-6))) + 1) \
+            if counts is None else counts[i]
         for t in np.linspace(0.0, horizon_s, count) if count > 1 else (0.0,):
             out.append(Disc(d.x_m + d.vx_m_s * t, d.y_m + d.vy_m_s * t, d.radius_m))
     return out
@@ -80,13 +109,18 @@ def time_to_collision_s(position_m: np.ndarray, velocities_m_s: np.ndarray, cent
     point and q = w - u the relative velocity (the velocity obstacle's defining test,
     Fiorini & Shiller 1998, Eq. 4, with a time horizon applied by the caller).
     """
-    u = np.asarray(velocities_m_s, dtype=float).reshape(-1, 1, 2)
-    d = (np.asarray(centres_m, dtype=float) - np.asarray(position_m, dtype=float)).reshape(1, -1, 2)
-    q = np.asarray(obstacle_velocities_m_s, dtype=float).reshape(1, -1, 2) - u
+    # By components: the values of the sums over x and y by ``np.sum(axis=2)``, which is (0.0 + x) + y (only the
+    # sign of a zero sum can differ from x + y, and a sum of squares has none) (tests/test_prediction_identity.py).
+    u = np.asarray(velocities_m_s, dtype=float).reshape(-1, 2)
+    d = (np.asarray(centres_m, dtype=float) - np.asarray(position_m, dtype=float)).reshape(-1, 2)
+    w = np.asarray(obstacle_velocities_m_s, dtype=float).reshape(-1, 2)
     r = np.asarray(radii_m, dtype=float).reshape(1, -1)
-    a = np.sum(q * q, axis=2)
-    b = 2.0 * np.sum(d * q, axis=2)
-    c = np.sum(d * d, axis=2) - r * r
+    dx, dy = d[:, 0], d[:, 1]
+    qx = w[:, 0] - u[:, 0:1]                                                   # (V, N)
+    qy = w[:, 1] - u[:, 1:2]
+    a = qx * qx + qy * qy
+    b = 2.0 * ((0.0 + dx * qx) + dy * qy)
+    c = (dx * dx + dy * dy) - r * r                                            # (1, N)
     disc = b * b - 4.0 * a * c
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (-b - np.sqrt(np.maximum(disc, 0.0))) / (2.0 * a)

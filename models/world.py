@@ -137,12 +137,8 @@ def rasterise(bounds: Rect, discs: tuple[Disc, ...], boxes: tuple[Box, ...],
         r1 = min(rows, int(math.ceil((y_hi - bounds.y_min_m) / cell_m)) + 1)
         return slice(r0, max(r0, r1)), slice(c0, max(c0, c1))
 
-    for disc in discs:
-        grown = disc.radius_m + reach
-        rs, cs = window(disc.x_m - grown, disc.x_m + grown, disc.y_m - grown, disc.y_m + grown)
-        dx = xs[cs] - disc.x_m
-        dy = ys[rs] - disc.y_m
-        occupied[rs, cs] |= dy[:, None] ** 2 + dx[None, :] ** 2 < grown * grown
+    if discs:
+        _mark_discs(occupied, xs, ys, bounds, discs, reach, cell_m)
     for box in boxes:
         rs, cs = window(box.x_min_m - reach, box.x_max_m + reach, box.y_min_m - reach, box.y_max_m + reach)
         dx = np.maximum(np.maximum(box.x_min_m - xs[cs], xs[cs] - box.x_max_m), 0.0)
@@ -150,6 +146,46 @@ def rasterise(bounds: Rect, discs: tuple[Disc, ...], boxes: tuple[Box, ...],
         occupied[rs, cs] |= dy[:, None] ** 2 + dx[None, :] ** 2 < reach * reach
     return OccupancyGrid(occupied=occupied, cell_m=float(cell_m),
                          origin_m=(bounds.x_min_m, bounds.y_min_m))
+
+
+RASTER_CHUNK_CELLS = 1 << 14  # cells tested per NumPy pass of _mark_discs (bounds its memory; fastest here)
+
+
+def _mark_discs(occupied: np.ndarray, xs: np.ndarray, ys: np.ndarray, bounds: Rect, discs: tuple[Disc, ...],
+                reach_m: float, cell_m: float) -> None:
+    """Mark the cells of :func:`rasterise`'s discs, many discs per NumPy pass.
+
+    Each disc is tested on a square box of cells from the first row and column of its window (a cell of the
+    box beyond the window is farther than the grown radius by more than half a cell, so it fails the test;
+    indices clipped into the grid repeat cells of the window), with the same test per cell as one disc at a
+    time: ``dy**2 + dx**2 < grown**2``.  All discs go in one pass when their boxes, sized by the largest,
+    hold at most ``RASTER_CHUNK_CELLS`` cells; otherwise in groups of a box size (powers of two, each box its
+    group's largest), at most that many cells per pass (one disc at least), so one large disc among many
+    small ones costs its own box, not theirs.
+    """
+    rows, cols = occupied.shape
+    arr = np.array([(d.x_m, d.y_m, d.radius_m) for d in discs], dtype=float)
+    grown = arr[:, 2] + reach_m
+    c0 = np.floor((arr[:, 0] - grown - bounds.x_min_m) / cell_m)
+    r0 = np.floor((arr[:, 1] - grown - bounds.y_min_m) / cell_m)
+    spans = np.ceil(2.0 * grown / cell_m).astype(np.int64) + 3    # the window's width, at most
+    top = int(spans.max())
+    size_class = np.zeros(len(spans), dtype=np.int64) if len(spans) * top * top <= RASTER_CHUNK_CELLS \
+        else np.ceil(np.log2(spans)).astype(np.int64)               # all in one pass when that is small
+    for size in np.unique(size_class).tolist():
+        members = np.flatnonzero(size_class == size)
+        box = int(spans[members].max())
+        per_pass = max(1, RASTER_CHUNK_CELLS // (box * box))
+        for first in range(0, len(members), per_pass):
+            k = members[first:first + per_pass]
+            span = np.arange(int(spans[k].max()))
+            cc = np.clip(c0[k, None] + span, 0, cols - 1).astype(np.int64)
+            rr = np.clip(r0[k, None] + span, 0, rows - 1).astype(np.int64)
+            dx = xs[cc] - arr[k, 0:1]
+            dy = ys[rr] - arr[k, 1:2]
+            g = grown[k]
+            d, i, j = np.nonzero(dy[:, :, None] ** 2 + dx[:, None, :] ** 2 < (g * g)[:, None, None])
+            occupied[rr[d, i], cc[d, j]] = True
 
 
 def nearest_obstacle(x_m: float, y_m: float, disc_centres_m: np.ndarray, disc_radii_m: np.ndarray,

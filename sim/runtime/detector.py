@@ -124,10 +124,11 @@ class ObstacleSensing:
             return ()
         centres = self.track_m[step]
         gap = np.hypot(centres[:, 0] - pose.x_m, centres[:, 1] - pose.y_m) - self.radii_m - self.robot_radius_m
-        out = []
-        for i in np.flatnonzero(gap <= self.range_m):
-            vx, vy = self.velocity_m_s[step, i]
-            out.append(DetectedObstacle(float(centres[i, 0]), float(centres[i, 1]), float(self.radii_m[i]),
-                                        float(vx), float(vy), int(i)))
-        return tuple(out)
+        seen = np.flatnonzero(gap <= self.range_m)
+        if not len(seen):
+            return ()
+        # One conversion to Python floats for all of them (the values float() gives one by one).
+        xy, radii, velocity = centres[seen].tolist(), self.radii_m[seen].tolist(), self.velocity_m_s[step, seen].tolist()
+        return tuple(DetectedObstacle(x, y, r, vx, vy, i)
+                     for (x, y), r, (vx, vy), i in zip(xy, radii, velocity, seen.tolist()))
 

@@ -47,7 +47,7 @@ from swarmnav.planners.problem import Path
 from swarmnav.sim.clearance import CLEARANCE_HORIZON_M, ClearanceProbe
 from swarmnav.sim.contact import ContactMonitor
 from swarmnav.sim.control_period import control_periods, steps_per_control
-from swarmnav.sim.crowd_stepping import ReactiveCrowd, crowd_metrics, human_columns
+from swarmnav.sim.crowd_stepping import ReactiveCrowd, RolledCrowd, crowd_metrics, human_columns
 from swarmnav.sim.detector import ObstacleSensing
 from swarmnav.sim.laser import LaserCaster
 from swarmnav.controllers.odometry import WheelOdometry
@@ -63,13 +63,19 @@ def moving_obstacles(scene: CompiledScene) -> list:
     return [ob for ob in scene.obstacles if ob.mocap_index >= 0]
 
 
-def obstacle_positions(scenario: Scenario, scene: CompiledScene, times_s: np.ndarray) -> np.ndarray:
-    """(T, M, 2) positions of the moving obstacles at the given times."""
+def obstacle_positions(scenario: Scenario, scene: CompiledScene, times_s: np.ndarray,
+                       held: np.ndarray | None = None) -> np.ndarray:
+    """(T, M, 2) positions of the moving obstacles at the given times; the columns ``held`` (indices into
+    the moving obstacles) only at the first time, repeated (the stepper writes them as the episode goes)."""
     moving = moving_obstacles(scene)
     if not moving:
         return np.zeros((len(times_s), 0, 2))
-    return np.stack([scenario.obstacles[ob.scenario_index].trajectory().positions_at(times_s) for ob in moving],
-                    axis=1)
+    held_set = set() if held is None else set(np.asarray(held).tolist())
+    first = np.asarray(times_s, dtype=float).reshape(-1)[:1]
+    return np.stack([scenario.obstacles[ob.scenario_index].trajectory().positions_at(times_s) if col not in held_set
+                     else np.repeat(scenario.obstacles[ob.scenario_index].trajectory().positions_at(first),
+                                    len(times_s), axis=0)
+                     for col, ob in enumerate(moving)], axis=1)
 
 
 def reset_data(scenario: Scenario, scene: CompiledScene, data: mujoco.MjData | None = None) -> mujoco.MjData:
@@ -154,7 +160,16 @@ class EpisodeStepper:
         moving = moving_obstacles(scene)
         self.mocap_index = np.array([ob.mocap_index for ob in moving], dtype=np.int64)
         self._moves = bool(moving)
-        self.obstacle_track_m = obstacle_positions(scenario, scene, self.times_s)  # (T, M, 2)
+        self._crowd = ReactiveCrowd.of(scenario, moving, self.dt_s) if moving else None  # agents that see the robot
+        # Agents blind to it, rolled out as the episode goes (RolledCrowd), when they can be.
+        self._rolled = RolledCrowd.of(scenario, moving, self.dt_s, self.n_max) \
+            if moving and self._crowd is None else None
+        # (T, M, 2). Agents that see the robot are written step by step (ReactiveCrowd.advance): their rollout
+        # without a robot is not made when nothing reads it (ReactiveCrowd.lazy; it then holds their start);
+        # nor, beyond the steps run, the rollout of blind ones (RolledCrowd.extend writes it).
+        held = self._crowd.columns if self._crowd is not None and self._crowd.lazy else \
+            self._rolled.columns if self._rolled is not None else None
+        self.obstacle_track_m = obstacle_positions(scenario, scene, self.times_s, held)
         self._radii_m = np.array([scenario.obstacles[ob.scenario_index].radius_m for ob in moving])
         self._humans = human_columns(scenario, moving)  # agents: the crowd metrics of the result
         # How far the moving obstacles can have moved: obstacle_shift_m[j] - obstacle_shift_m[i]
@@ -162,9 +177,9 @@ class EpisodeStepper:
         track = self.obstacle_track_m
         hops = np.hypot(*np.moveaxis(np.diff(track, axis=0), 2, 0)).max(axis=1) if track.shape[1] else \
             np.zeros(max(len(track) - 1, 0))
-        self._crowd = ReactiveCrowd.of(scenario, moving, self.dt_s) if moving else None  # agents that see the robot
         hops = hops if self._crowd is None else np.maximum(hops, self._crowd.max_hop_m())  # bounded by top speed
-        self.obstacle_shift_m = np.concatenate([[0.0], np.cumsum(hops)]).tolist()
+        self._other_hops_m = hops  # with a RolledCrowd: the other obstacles' (it extends obstacle_shift_m)
+        self.obstacle_shift_m = np.concatenate([[0.0], np.cumsum(hops)]).tolist() if self._rolled is None else [0.0]
         # Farther than this from every obstacle, no contact can begin within one control period:
         # twice the distance the base covers at full wheel speed, plus a centimetre.
         top_speed_m_s = scene.drive.max_wheel_speed_rad_s * scene.drive.wheel_radius_m
@@ -298,7 +313,10 @@ class EpisodeStepper:
         self.sensing = ObstacleSensing(self.scenario, self.obstacle_track_m, self._radii_m, self.dt_s,
                                        scene.range_angles_rad, scene.range_offset_m)
         if self._crowd is not None:
-            self._crowd.reset(self.obstacle_track_m, self.sensing.velocity_m_s)
+            self._crowd.reset(self.obstacle_track_m, self.sensing.velocity_m_s, self.times_s)
+        if self._rolled is not None:
+            self._rolled.attach(self.obstacle_track_m, self.sensing.velocity_m_s, self._other_hops_m,
+                                self.obstacle_shift_m)
         self._shift_at_measure_m = 0.0
         self._observed_step = -1
         self.poses = np.zeros((self.n_max + 1, 3))
@@ -336,6 +354,8 @@ class EpisodeStepper:
         if self._moves:
             if self._crowd is not None:  # agents that see the robot: their step s -> s + 1 from its state now
                 self._crowd.advance(step, self._base_qpos, self._base_qvel)
+            elif self._rolled is not None:  # blind ones: their rollout to s + 1 (the velocity at s needs it)
+                self._rolled.extend(step + 1)
             self._mocap_pos[self.mocap_index, :2] = self.obstacle_track_m[step]
         self.observation = observation = self._observe()
         pose = self._truth  # the goal, the arena and the result judge the true pose (odometry is the robot's)
