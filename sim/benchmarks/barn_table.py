@@ -160,6 +160,24 @@ def _fresh_against_barn(fresh_path: FilePath, results: tuple[FilePath, ...]) -> 
     return lines + [""] if lines else []
 
 
+def _protocol_rows(results: tuple[FilePath, ...]):
+    """Each committed protocol row (``scenario`` None) with its result file and its navigator's per-run rows."""
+    from swarmnav.benchmarks.barn import PROTOCOL_TEXT
+    for path in results:
+        if not path.is_file():
+            continue
+        rows = read_result(path)
+        for r in rows:
+            if r.get("scenario") is None and r.get("barn_setup") == PROTOCOL_TEXT:
+                yield path, r, [x for x in rows if x.get("scenario") is not None and x["navigator"] == r["navigator"]]
+
+
+def _label(r: dict[str, Any]) -> str:
+    """The row's navigator with the parameters it ran (an arm's, else the row's own)."""
+    params = r.get("arm_params") or r.get("navigator_params")
+    return r["navigator"] + (" (" + ", ".join(f"{k}={v}" for k, v in params.items()) + ")" if params else "")
+
+
 def online_navigators() -> list[str]:
     """The online navigators (they act on what they sense: ``uses_detections``), but :data:`NOT_ONLINE`."""
     from swarmnav.controllers.navigators import NAVIGATORS
@@ -172,20 +190,12 @@ def online_lines(results: tuple[FilePath, ...]) -> list[str]:
     online navigator (its own rows and its arms') the row with the most runs (the higher success on a tie, then
     the later), its worlds x runs and whether it is the protocol's full 500; the target is met only when every
     one has a 500-run row at 0.88 or more."""
-    from swarmnav.benchmarks.barn import PROTOCOL_TEXT, TEST_WORLDS
+    from swarmnav.benchmarks.barn import TEST_WORLDS
     chosen: dict[str, tuple[FilePath, dict[str, Any], int, int]] = {}
-    for path in results:
-        if not path.is_file():
-            continue
-        rows = read_result(path)
-        for r in rows:
-            if r.get("scenario") is not None or r.get("barn_setup") != PROTOCOL_TEXT:
-                continue
-            per_run = [x for x in rows if x.get("scenario") is not None and x["navigator"] == r["navigator"]]
-            worlds = {x["world"] for x in per_run}
-            barn_worlds = all(x["scenario"].startswith("barn-") for x in per_run)  # not BARN-like seeds
-            if not worlds or not worlds <= set(TEST_WORLDS) or not barn_worlds:
-                continue
+    for path, r, per_run in _protocol_rows(results):
+        worlds = {x["world"] for x in per_run}
+        barn_worlds = all(x["scenario"].startswith("barn-") for x in per_run)  # not BARN-like seeds
+        if worlds and worlds <= set(TEST_WORLDS) and barn_worlds:
             base = r.get("arm_of") or r["navigator"]  # an arm (--arm LABEL:NAV:...) counts for its navigator
             if base not in chosen or (r["runs"], r["success_rate"]) >= (chosen[base][1]["runs"],
                                                                          chosen[base][1]["success_rate"]):
@@ -202,8 +212,7 @@ def online_lines(results: tuple[FilePath, ...]) -> list[str]:
             lines.append(f"| {name} | none | – | 0 | – | – | – | – |")
             continue
         path, r, worlds, runs = chosen[name]
-        params = r.get("arm_params") or r.get("navigator_params")
-        label = r["navigator"] + (" (" + ", ".join(f"{k}={v}" for k, v in params.items()) + ")" if params else "")
+        label = _label(r)
         sample = "" if r["runs"] >= PROTOCOL_RUNS else f" (sample: {r['runs']} of the protocol's {PROTOCOL_RUNS})"
         lines.append(f"| {label} | `{path.name}` | {worlds} x {runs} | {r['runs']}{sample} | "
                      f"{r['success_rate']:.3f} | {r['collision_rate']:.3f} | {r['timeout_rate']:.3f} | "
@@ -226,19 +235,11 @@ def all_worlds_lines(results: tuple[FilePath, ...]) -> list[str]:
     """Issue 34's "all 300 worlds run for every navigator": per online navigator (its own rows and its arms'), a
     committed protocol row whose runs cover every one of BARN's worlds (the one with the most runs), and whether
     every online navigator has one."""
-    from swarmnav.benchmarks.barn import PROTOCOL_TEXT, WORLD_COUNT
-    chosen: dict[str, tuple[FilePath, dict[str, Any]]] = {}
-    for path in results:
-        if not path.is_file():
-            continue
-        rows = read_result(path)
-        for r in rows:
-            if r.get("scenario") is not None or r.get("barn_setup") != PROTOCOL_TEXT:
-                continue
-            per_run = [x for x in rows if x.get("scenario") is not None and x["navigator"] == r["navigator"]
-                       and x["scenario"].startswith("barn-")]
-            if {x["world"] for x in per_run} != set(range(WORLD_COUNT)):
-                continue
+    from swarmnav.benchmarks.barn import WORLD_COUNT
+    chosen: dict[str, tuple[FilePath, dict[str, Any], float | None]] = {}
+    for path, r, per_run in _protocol_rows(results):
+        per_run = [x for x in per_run if x["scenario"].startswith("barn-")]
+        if {x["world"] for x in per_run} == set(range(WORLD_COUNT)):
             base = r.get("arm_of") or r["navigator"]
             if base not in chosen or r["runs"] >= chosen[base][1]["runs"]:
                 chosen[base] = (path, r, _cpu_min(per_run))
@@ -253,8 +254,7 @@ def all_worlds_lines(results: tuple[FilePath, ...]) -> list[str]:
             lines.append(f"| {name} | none | 0 | – | – | – | – | – |")
             continue
         path, r, cpu = chosen[name]
-        params = r.get("arm_params") or r.get("navigator_params")
-        label = r["navigator"] + (" (" + ", ".join(f"{k}={v}" for k, v in params.items()) + ")" if params else "")
+        label = _label(r)
         lines.append(f"| {label} | `{path.name}` | {r['runs']} | {r['success_rate']:.3f} | {r['collision_rate']:.3f} "
                      f"| {r['timeout_rate']:.3f} | {_f(r['barn_score'], '.4f')} | {_f(cpu, '.1f')} |")
     missing = [n for n in names if n not in chosen]
