@@ -14,7 +14,7 @@ export MUJOCO_GL ?= egl
 
 STUDIES ?= $(shell $(BIN)/swarmnav studies --json 2>/dev/null | $(BIN)/python -c "import json,sys; print(' '.join(s['name'] for s in json.load(sys.stdin)))")
 
-.PHONY: demo test bench install clean studies readme-table rerun-stale typing-path docs
+.PHONY: demo test bench bench-barn-all install clean studies readme-table rerun-stale typing-path docs
 
 $(STAMP): pyproject.toml Makefile planners/_colony_walk.c planners/_grid_search.c planners/_dstar_lite.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -68,6 +68,16 @@ bench: $(STAMP)
 	$(BIN)/swarmnav bench study $(BENCH_FLAGS)
 	$(BIN)/swarmnav bench cli $(BENCH_FLAGS)
 	$(BIN)/swarmnav bench odometry $(BENCH_FLAGS)
+
+# BARN's speed line (issue 34): all 300 BARN worlds x every online navigator in its BARN configuration
+# (models/suites/barn-navigators.toml), one run each, on 2 workers; the target is 60 minutes of wall time on
+# 2 cores. The rows go to logs/barn-all.json (`python -m swarmnav.benchmarks.barn_table` reads such files),
+# the wall time to the last line.
+bench-barn-all: $(STAMP)
+	mkdir -p logs
+	start=$$(date +%s); $(BIN)/swarmnav bench navigation --suite barn --barn-runs 1 \
+		--arms models/suites/barn-navigators.toml --by-scenario --workers 2 --json > logs/barn-all.json && \
+	echo "bench-barn-all: $$(( $$(date +%s) - start )) s of wall time for 300 BARN worlds x every configuration (target 3600 s on 2 cores)"
 
 # Every bundled study into studies/<name>/ (rows resume if interrupted), with report.html and report.md.
 # Quick by default (each study's quick_seeds, about 10 min on 2 cores); `make studies STUDY_RUN=` runs them in full

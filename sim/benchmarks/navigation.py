@@ -125,6 +125,30 @@ def parse_arm(text: str) -> Arm:
     return Arm(label, name, params)
 
 
+def read_arms(path: str) -> list[Arm]:
+    """``--arms FILE.toml``: rows from a data file, each ``[[navigators]]`` entry written as a study file writes
+    it (``name``, ``label``, ``params``), one value per parameter (a list, a study's sweep, is refused here: one
+    row is one configuration). A parameter that names code is refused (data is not code: ``--arm`` on the
+    command line is the way to opt in). Every problem is one ConfigError naming the file and the field."""
+    from swarmnav.controllers.navigators import make_navigator
+    from swarmnav.models.toml_table import parse_toml, read_text
+    from swarmnav.study.spec_sections import read_components
+    top = parse_toml(read_text(path, "--arms"), str(path))
+    top.only({"navigators", "description"})
+    if top.has("description"):
+        top.string("description")
+    components = read_components(top, "navigators", "navigator", make_navigator, False)
+    arms = []
+    for i, component in enumerate(components):
+        if component.swept:
+            top.fail(f"navigators[{i}].params.{component.swept[0]}",
+                     "a list (a study's sweep): an arm takes one value per parameter")
+        if is_clairvoyant(component.name):
+            top.fail(f"navigators[{i}].name", f"{component.name!r} is the yardstick, run beside every contender already")
+        arms.append(Arm(component.label, component.name, dict(component.params)))
+    return arms
+
+
 def check_arms(contenders: list[str], arms: list[Arm]) -> None:
     """Each row's label is its own: an arm's label is neither a default row's name, the oracle's, nor another
     arm's."""
@@ -367,6 +391,8 @@ def run(args: argparse.Namespace) -> int:
     if suite is None and getattr(args, "per_group", None):
         raise ConfigError("--per-group", "applies to a generated suite (--suite dyn300) only")
     arms = [parse_arm(text) for text in getattr(args, "arm", None) or []]
+    if getattr(args, "arms", None):
+        arms += read_arms(args.arms)
     rows = benchmark_navigation(args.seeds, args.navigator, args.scenario,
                                 progress=not args.json and sys.stderr.isatty(), navigator_params=settings,
                                 by_scenario=args.by_scenario, out_dir=args.out, suite=suite,

@@ -143,6 +143,10 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
                         help="one more row: a navigator under its own label with its own parameters (repeatable), "
                              "e.g. iaco_local+evade:iaco_local:evade=true; with no --navigator only the arms run "
                              "(and the oracle)")
+    parser.add_argument("--arms", metavar="FILE.toml",
+                        help="more rows from a data file: its [[navigators]] entries (name, label, params, as in a "
+                             "study file), e.g. models/suites/barn-navigators.toml, BARN's configurations; a "
+                             "parameter naming code is refused there")
     parser.add_argument("--map", choices=("known", "unknown"),
                         help="every run's static map: given in advance (known) or built from the laser (unknown); "
                         "default: each scenario's knowledge.map")
