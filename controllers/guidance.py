@@ -19,6 +19,8 @@ from swarmnav.controllers.prediction import LocalObstacles
 from swarmnav.models.geometry import segment_box_distances, segment_disc_distances
 from swarmnav.models.world import Pose2D
 
+SIGHT_SLACK_M = 1e-6  # PathCarrot._visible: discs this much beyond a segment's reach are still measured
+
 
 def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, carrot_in_sight: bool = False,
                 centred=None, radius_m: float | None = None, speed_cap_m_s: float = 0.0):
@@ -131,7 +133,16 @@ class PathCarrot:
         starts = np.repeat(origin[None, :], len(points), axis=0)
         ok = np.ones(len(points), dtype=bool)
         if len(centres):
-            ok &= np.all(segment_disc_distances(starts, points, centres) >= radii[None, :] + radius, axis=1)
+            # Only the discs that could be within the radius of a segment: one farther from the origin than the
+            # longest segment plus both radii (and SIGHT_SLACK_M) passes every test (a segment's distance is at
+            # least that from its start less its length).  Why (speed): on a sensed map every cell was measured
+            # against every segment, ~10 % of a BARN run's CPU; the answer is the same.
+            longest_m = float(np.hypot(points[:, 0] - origin[0], points[:, 1] - origin[1]).max())
+            near = np.hypot(centres[:, 0] - origin[0], centres[:, 1] - origin[1]) - radii \
+                <= longest_m + radius + SIGHT_SLACK_M
+            if near.any():
+                ok &= np.all(segment_disc_distances(starts, points, centres[near]) >= radii[near][None, :] + radius,
+                             axis=1)
         if len(boxes):
             ok &= np.all(segment_box_distances(starts, points, boxes) >= radius, axis=1)
         return ok
