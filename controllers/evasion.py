@@ -28,7 +28,7 @@ architecture, e.g. Nav2's planner and controller servers; the avoidance is
 
 An ``evade`` event marks each step at which the evasion starts to override (a rising edge).
 
-Two options, off by default (ours; measured among CrowdNav's ORCA humans for ``dstar_replan``, docs/crowds.md):
+Three options, off by default (ours; measured among CrowdNav's ORCA humans for ``dstar_replan``, docs/navigation.md):
 
 * ``still_m_s`` > 0: a sensed obstacle no faster than this does not trigger the evasion (as the map's discs do
   not: a standing obstacle is the planner's, whose cells mark it).  ORCA humans that have reached their goals
