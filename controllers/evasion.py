@@ -27,6 +27,23 @@ architecture, e.g. Nav2's planner and controller servers; the avoidance is
   controller heads for its next waypoint again; ``dstar_replan`` sees that the robot left its path).
 
 An ``evade`` event marks each step at which the evasion starts to override (a rising edge).
+
+Three options, off by default (ours; measured among CrowdNav's ORCA humans for ``dstar_replan``, docs/navigation.md):
+
+* ``still_m_s`` > 0: a sensed obstacle no faster than this does not trigger the evasion (as the map's discs do
+  not: a standing obstacle is the planner's, whose cells mark it).  ORCA humans that have reached their goals
+  jitter at 0.01 m/s (RVO2's perturbation), so they counted as moving: the trigger extrapolates the robot
+  straight along its heading, past the bend of a path that goes round such a human, fired, the evasion pushed
+  the robot off the path, the controller turned it back, and the two alternated until the time limit.
+* ``reverse``: a chosen candidate behind the robot (more than 90 degrees off its heading) is driven backwards
+  (the rear turned toward it, the speed negative) instead of by a turn on the spot first: a differential drive
+  can back away from a person walking at its front at once, where turning round to face the escape took
+  1-2.6 s at 1.2 rad/s, in which the person walked into it.
+* ``turn_cost_m_s_rad`` > 0: each candidate's cost (its distance to the navigator's velocity, m/s) grows by this
+  much per radian the robot must turn to drive it (to its front, or with ``reverse`` to the nearer of front and
+  rear; DWA's heading term in spirit, Fox et al. 1997).  With the navigator's command a stop or a turn on the spot
+  every candidate of one speed costs the same, the tie went to the first in the robot-frame order, and that
+  direction turned with the robot: the evasion turned on the spot for 1.5 s (validation case 688) and never left.
 """
 
 from __future__ import annotations
@@ -42,7 +59,7 @@ from swarmnav.controllers.navigator import DetectedObstacle, NavigationSetup, Na
 from swarmnav.controllers.prediction import LocalObstacles, time_to_collision_s
 from swarmnav.controllers.velocity_candidates import (candidate_times_s, chosen_candidate, unicycle_command,
                                                      world_to_robot)
-from swarmnav.models.world import Pose2D
+from swarmnav.models.world import Pose2D, wrap_angle_rad
 
 
 ORIGIN = np.zeros(2)  # the robot, in its own frame (read only)
@@ -62,6 +79,9 @@ class Evasion:
         margin_m: extra distance kept beyond the robot radius.
         speed_samples, heading_samples: the candidate grid.
         heading_gain, max_angular_rad_s, turn_in_place_rad: the (v, omega) conversion.
+        still_m_s: sensed obstacles no faster than this do not trigger (0: only those exactly still).
+        reverse: drive a candidate behind the robot backwards rather than turning round to it first.
+        turn_cost_m_s_rad: a candidate's cost grows by this per radian of turn it needs (0: off).
     """
 
     geometry: DriveGeometry
@@ -76,6 +96,9 @@ class Evasion:
     heading_gain: float = 2.5
     max_angular_rad_s: float = 1.2
     turn_in_place_rad: float = math.radians(60.0)
+    still_m_s: float = 0.0
+    reverse: bool = False
+    turn_cost_m_s_rad: float = 0.0
 
     def __post_init__(self) -> None:
         speeds = np.linspace(self.max_speed_m_s / self.speed_samples, self.max_speed_m_s, self.speed_samples)
@@ -84,6 +107,8 @@ class Evasion:
         self.speeds = np.append(speed, 0.0)
         self.offsets = np.append(offset, 0.0)
         self.candidates = np.column_stack([self.speeds * np.cos(self.offsets), self.speeds * np.sin(self.offsets)])
+        turn = np.abs(self.offsets)
+        self.turn_rad = np.minimum(turn, math.pi - turn) if self.reverse else turn
         self.reach_m = self.max_speed_m_s * self.horizon_s + 1.0
         self.active = False
 
@@ -98,7 +123,7 @@ class Evasion:
         local = (centres - (pose.x_m, pose.y_m)) @ rotate
         local_v = velocities @ rotate
         grown = radii + self.robot_radius_m + self.margin_m
-        moving = np.hypot(velocities[:, 0], velocities[:, 1]) > 1e-9
+        moving = np.hypot(velocities[:, 0], velocities[:, 1]) > max(1e-9, self.still_m_s)
         own = np.array([[max(command.linear_m_s, 0.0), 0.0]])
         if not moving.any():
             threat_s = math.inf
@@ -112,20 +137,30 @@ class Evasion:
         ttc = candidate_times_s(pose, rotate, self.candidates, centres, velocities, grown, boxes,
                                 self.robot_radius_m + self.margin_m, self.horizon_s)
         cost = np.hypot(self.candidates[:, 0] - own[0, 0], self.candidates[:, 1])
+        if self.turn_cost_m_s_rad > 0.0:
+            cost = cost + self.turn_cost_m_s_rad * self.turn_rad
         k = chosen_candidate(ttc, cost, self.horizon_s)
         self.chosen_m_s = self.candidates[k]                                  # robot frame, for the record
-        v, omega = unicycle_command(float(self.speeds[k]), float(self.offsets[k]), self.heading_gain,
-                                    self.max_angular_rad_s, self.turn_in_place_rad)
+        offset = float(self.offsets[k])
+        if self.reverse and math.cos(offset) < 0.0:  # behind: back toward it, the rear turned onto it
+            v, omega = unicycle_command(float(self.speeds[k]), wrap_angle_rad(offset - math.pi), self.heading_gain,
+                                        self.max_angular_rad_s, self.turn_in_place_rad)
+            v = -v
+        else:
+            v, omega = unicycle_command(float(self.speeds[k]), offset, self.heading_gain,
+                                        self.max_angular_rad_s, self.turn_in_place_rad)
         rising = not self.active
         self.active = True
         return ControlCommand(wheel_speeds(v, omega, self.geometry), v, omega, command.waypoint_index), rising
 
 
-def evasion_for(setup: NavigationSetup, trigger_s: float) -> Evasion:
+def evasion_for(setup: NavigationSetup, trigger_s: float, still_m_s: float = 0.0, reverse: bool = False,
+                turn_cost_m_s_rad: float = 0.0) -> Evasion:
     """The evasion layer for a run, from its :class:`~controllers.navigator.NavigationSetup`."""
     known = setup.map_problem
     return Evasion(setup.controller.geometry, known.robot_radius_m, setup.max_speed_m_s,
-                   LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m), trigger_s=trigger_s)
+                   LocalObstacles(known.disc_centres_m, known.disc_radii_m, known.box_array_m), trigger_s=trigger_s,
+                   still_m_s=still_m_s, reverse=reverse, turn_cost_m_s_rad=turn_cost_m_s_rad)
 
 
 def evaded(evasion: Evasion | None, observation: Observation, answer: NavigationStep) -> NavigationStep:

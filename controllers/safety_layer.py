@@ -16,7 +16,10 @@ through :meth:`SafetyLayer.after` before the stepper applies it.  Two stages, in
 The layer is configured per run with the navigator's parameters (``navigator.params`` in a scenario,
 ``--navigator-set``, an ``--arm``): a navigator class offers the switches it takes, with its defaults,
 in ``safety_layer: ClassVar[dict[str, bool]]`` (``replan``: ``{"safety_filter": False, "evade": True}``);
-each switch brings its threshold (:data:`SWITCHES`).  A navigator that offers none takes none.
+each switch brings its threshold (:data:`SWITCHES`).  A navigator that offers none takes none.  A switch's
+further options (:data:`OPTIONS`, all off by default) are taken only by a navigator that lists them in
+``safety_layer_options: ClassVar[tuple[str, ...]]`` (``dstar_replan``: ``evade_still_m_s``, ``evade_reverse``,
+``evade_turn_cost_m_s_rad``), so the others' parameters stay as they were.
 """
 
 from __future__ import annotations
@@ -30,12 +33,16 @@ from swarmnav.controllers.safety_filter import SafetyFilter
 from swarmnav.models.parameters import above, param, within
 
 SWITCHES = {"safety_filter": "time_before_collision_s", "evade": "evade_trigger_s"}  # switch -> its threshold
+# switch -> its further options (a navigator takes those it lists in safety_layer_options)
+OPTIONS = {"evade": ("evade_still_m_s", "evade_reverse", "evade_turn_cost_m_s_rad")}
 
 
 def offered(navigator_class: type) -> tuple[str, ...]:
     """The layer parameters a navigator class takes: each switch it offers, then that switch's threshold."""
     switches = getattr(navigator_class, "safety_layer", {})
-    return tuple(key for switch in switches for key in (switch, SWITCHES[switch]))
+    options = getattr(navigator_class, "safety_layer_options", ())
+    return tuple(key for switch in switches
+                 for key in (switch, SWITCHES[switch], *(o for o in OPTIONS.get(switch, ()) if o in options)))
 
 
 @dataclass
@@ -47,6 +54,9 @@ class SafetyLayer:
         time_before_collision_s: the filter's smallest allowed predicted time to collision.
         evade: the velocity-obstacle evasion on every command.
         evade_trigger_s: the predicted time to collision below which the evasion takes over.
+        evade_still_m_s: sensed obstacles no faster than this do not trigger the evasion (0: off).
+        evade_reverse: the evasion backs toward a candidate behind the robot instead of turning round first.
+        evade_turn_cost_m_s_rad: the evasion's cost of a candidate grows by this per radian of turn it needs.
     """
 
     name: ClassVar[str] = "safety"
@@ -54,6 +64,9 @@ class SafetyLayer:
     time_before_collision_s: float = param(1.0, above(0, 600))
     evade: bool = False
     evade_trigger_s: float = param(2.0, within(0, 600))
+    evade_still_m_s: float = param(0.0, within(0, 5))
+    evade_reverse: bool = False
+    evade_turn_cost_m_s_rad: float = param(0.0, within(0, 10))
 
     def __post_init__(self) -> None:
         self.filter: SafetyFilter | None = None
@@ -69,7 +82,8 @@ class SafetyLayer:
         known = setup.map_problem
         self.filter = SafetyFilter(setup.controller.geometry, known.robot_radius_m,
                                    self.time_before_collision_s) if self.safety_filter else None
-        self.evasion = evasion_for(setup, self.evade_trigger_s) if self.evade else None
+        self.evasion = evasion_for(setup, self.evade_trigger_s, self.evade_still_m_s, self.evade_reverse,
+                                   self.evade_turn_cost_m_s_rad) if self.evade else None
 
     def after(self, observation: Observation, answer: NavigationStep) -> NavigationStep:
         """The navigator's answer with the evasion, then the filter, applied to its command (the answer
@@ -94,4 +108,4 @@ def layer_settings(navigator_class: type, params: dict[str, Any] | None) -> tupl
     return own, layer
 
 
-__all__ = ["SWITCHES", "SafetyLayer", "layer_settings", "offered"]
+__all__ = ["OPTIONS", "SWITCHES", "SafetyLayer", "layer_settings", "offered"]

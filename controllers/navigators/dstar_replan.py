@@ -66,6 +66,15 @@ passages (and string pulling never cuts nearer the obstacles than the cells); ``
 forward speed to stop before the path's next sharp turn and before the nearest mapped obstacle in the
 chassis' corridor ahead.  BARN's configuration: ``footprint=box, cost_weight=10, max_decel_m_s2=2`` (docs/barn.md).
 
+**Crowd options** (ours; all off by default, docs/navigation.md, measured among CrowdNav's ORCA humans on
+validation cases): ``blocked_horizon_s`` > 0: when the sweeps over ``horizon_s`` leave no path (every human
+converging on the centre of a circle crossing), they are marked over this shorter horizon and D* Lite plans again
+instead of stopping there (the freezing robot problem, Trautman & Krause 2010); ``corner_merge_m`` > 0: corners
+of the string-pulled path closer than this to the last one kept are dropped (a path adopted round sweeps pulls
+into a staircase of corners a cell apart, at each of which the controller turned on the spot).  The evasion's
+options ``evade_still_m_s``, ``evade_turn_cost_m_s_rad`` and ``evade_reverse`` (:mod:`controllers.evasion`) are
+offered by this navigator alone (``safety_layer_options``).
+
 ``cell_m`` = 0 uses the scenario's ``sim.cell_m`` (a map scenario's own cells
 always).  The optional safety filter (``safety_filter``) is the same layer's.
 Planning wall time (``replan_wall_s``) counts the D* Lite repairs only.
@@ -115,10 +124,15 @@ class DStarReplanNavigator:
         cost_weight: D* Lite's penalty on cells beside blocked ones (0: none).
         cost_reach_m: how far from a blocked cell the penalty reaches.
         max_decel_m_s2: the braking the forward speed is capped by (0: no cap).
+        blocked_horizon_s: when the sweeps over ``horizon_s`` leave no path, plan on sweeps over this shorter
+            horizon instead of stopping (0: off, stop and retry; see the module docstring).
+        corner_merge_m: string-pulled corners closer than this to the previous one kept are dropped (0: none).
     """
 
     name: ClassVar[str] = "dstar_replan"
     safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False, "evade": True}  # controllers.safety_layer
+    safety_layer_options: ClassVar[tuple[str, ...]] = ("evade_still_m_s", "evade_reverse",  # off by default
+                                                       "evade_turn_cost_m_s_rad")
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: float = field(default=0.0, init=False, repr=False)
@@ -133,6 +147,8 @@ class DStarReplanNavigator:
     cost_weight: float = param(0.0, within(0, 1000))
     cost_reach_m: float = param(0.3, above(0, 100))
     max_decel_m_s2: float = param(0.0, within(0, 1000))
+    blocked_horizon_s: float = param(0.0, within(0, 600))
+    corner_merge_m: float = param(0.0, within(0, 100))
 
     def reset(self, setup: NavigationSetup) -> None:
         known = setup.map_problem
@@ -194,6 +210,8 @@ class DStarReplanNavigator:
                 cells = self.dstar.plan()
             except NoPathFound:
                 cells = None
+            if cells is None and self.blocked_horizon_s > 0 and observation.detections:
+                cells, start = self._plan_short(observation, pose)
             self.replan_wall_s += time.perf_counter() - wall0
             if cells is None:
                 self.cells = []
@@ -214,14 +232,31 @@ class DStarReplanNavigator:
                                                    self.turn_sign)
         return self._finish(observation, command, events, new_path)
 
+    def _plan_short(self, observation: Observation, pose) -> tuple[list[Cell] | None, Cell]:
+        """``blocked_horizon_s``: the sweeps over ``horizon_s`` close every way, so mark them over the shorter
+        horizon and plan again (the cells stay so marked until the next marking, which tries ``horizon_s``
+        first again); (the cell path or None, the start used)."""
+        self._mark(observation, self.blocked_horizon_s)
+        start = self._free_cell_near(pose.x_m, pose.y_m)
+        if start == NO_CELL:
+            return None, start
+        if start != self.dstar.start:
+            self.dstar.move_start(start)
+        try:
+            return self.dstar.plan(), start
+        except NoPathFound:
+            return None, start
+
     # -- cells ---------------------------------------------------------------
-    def _mark(self, observation: Observation) -> bool:
-        """Mark this step's sweeps; True when any cell changed (and D* Lite was told)."""
+    def _mark(self, observation: Observation, horizon_s: float | None = None) -> bool:
+        """Mark this step's sweeps (over ``horizon_s``, else the navigator's); True when any cell changed (and
+        D* Lite was told)."""
         pose = observation.pose
         occupied = self._map_cells()
         self.sweeps = []
         if observation.detections:
-            self.sweeps = keep_outside(swept_discs(observation.detections, self.horizon_s),
+            self.sweeps = keep_outside(swept_discs(observation.detections,
+                                                   self.horizon_s if horizon_s is None else horizon_s),
                                        [(pose.x_m, pose.y_m), self.goal_xy], self.room_m)
             marks = self._rasterise(self.inflation_m)
             if marks is not None:
@@ -327,6 +362,8 @@ class DStarReplanNavigator:
         self.cells, self.at = cells, 0
         corners = self._string_pull(cells)
         middle = self.grid.centres_m(np.array(corners[1:-1])).reshape(-1, 2)
+        if self.corner_merge_m > 0 and len(middle):
+            middle = _merged(middle, (pose.x_m, pose.y_m), self.corner_merge_m)
         waypoints = np.vstack([[pose.x_m, pose.y_m], middle, [self.goal_xy]])
         path = Path.from_waypoints(waypoints, 0.0)
         self.waypoints = [(float(x), float(y)) for x, y in waypoints]
@@ -370,6 +407,17 @@ class DStarReplanNavigator:
     def _finish(self, observation: Observation, command: ControlCommand, events: list,
                 new_path: Path | None) -> NavigationStep:
         return NavigationStep(command, new_path, tuple(events), Belief(observation.detections, self.horizon_s))
+
+
+def _merged(corners_m: np.ndarray, start_m: tuple[float, float], merge_m: float) -> np.ndarray:
+    """``corner_merge_m``: the corners without those closer than ``merge_m`` to the last one kept (the robot's
+    position the first), so that a staircase of corners a cell apart becomes one turn."""
+    kept, last = [], np.asarray(start_m, dtype=float)
+    for corner in corners_m:
+        if math.hypot(corner[0] - last[0], corner[1] - last[1]) >= merge_m:
+            kept.append(corner)
+            last = corner
+    return np.array(kept, dtype=float).reshape(-1, 2)
 
 
 def _cells_length(cells: list[Cell]) -> float:
