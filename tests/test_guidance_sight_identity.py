@@ -100,3 +100,28 @@ def test_first_visible_at_the_edge_of_each_segment_reach():
         wrong += want != 0
         assert carrot._first_visible(origin, points) == want, trial
     assert wrong > 10
+
+
+def test_first_visible_at_the_edge_of_the_other_samples_reach():
+    """The first sample blocked (a disc on its segment), a disc just beyond the reach of the farthest of the
+    others: the others, tested together, keep it (a bound without the slack drops some)."""
+    rng = np.random.default_rng(75)
+    wrong = 0
+    for trial in range(400):
+        origin = rng.uniform(0, 10, 2)
+        points = origin + rng.uniform(-1.0, 1.0, size=(9, 2))
+        angle = rng.uniform(0, 2 * np.pi)
+        points[1] = origin + 1.6 * np.array([np.cos(angle), np.sin(angle)])  # the farthest of the others
+        k = 1
+        direction = (points[k] - origin) / np.hypot(*(points[k] - origin))
+        length = float(np.hypot(*(points[k] - origin)))
+        radius, r = float(rng.uniform(0.1, 0.4)), float(rng.choice([0.0, 0.035]))
+        edge = origin + (length + radius + r + rng.integers(-2, 3, size=(5, 1)) * 1e-16) * direction
+        blocker = (origin + 0.5 * (points[0] - origin))[None, :]
+        centres = np.vstack([blocker, edge])
+        carrot = carrot_with(centres, np.full(6, r), np.zeros((0, 4)), radius)
+        want = first_reference(carrot, origin, points)
+        wrong += want != k  # the edge disc (or the blocker's) hides sample 1
+        assert carrot._first_visible(origin, points) == want, trial
+    assert wrong > 10
+
