@@ -86,29 +86,32 @@ def footprint_candidate_times_s(pose: Pose2D, rotate: np.ndarray, candidates: np
         speeds = np.hypot(candidates[:, 0], candidates[:, 1])
         groups = [np.flatnonzero(speeds == v) for v in np.unique(speeds)]
         lx, ly, ovx, ovy, r2 = local[:, 0], local[:, 1], obstacle_v[:, 0], obstacle_v[:, 1], grown_radii_m ** 2
-    for dx, dy in np.asarray(discs_m, dtype=float).reshape(-1, 2):
-        start = np.column_stack([dx * c - dy * s, dx * s + dy * c])                       # (C, 2) robot frame
-        if len(centres):
-            offset_m = math.hypot(dx, dy)
-            for group in groups:
-                speed = float(speeds[group].max())
-                near = np.flatnonzero(moving | (gap <= speed * horizon_s + offset_m + PRUNE_SLACK_M))
-                if not len(near):
-                    continue
-                sx, sy = start[group, 0:1], start[group, 1:2]                               # (G, 1)
-                ux, uy = candidates[group, 0:1], candidates[group, 1:2]
-                ddx, ddy = lx[near] - sx, ly[near] - sy                                       # (G, M)
-                qx, qy = ovx[near] - ux, ovy[near] - uy
-                a = qx * qx + qy * qy
-                b = 2.0 * ((0.0 + ddx * qx) + ddy * qy)
-                cc = (ddx * ddx + ddy * ddy) - r2[near]
-                disc = b * b - 4.0 * a * cc
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    t = (-b - np.sqrt(np.maximum(disc, 0.0))) / (2.0 * a)
-                t = np.where((disc >= 0.0) & (a > 1e-12) & (t >= 0.0), t, np.inf)
-                t = np.where(cc <= 0.0, np.where(b >= 0.0, np.inf, 0.0), t)
-                ttc[group] = np.minimum(ttc[group], t.min(axis=1))
-        if len(boxes):
+    discs = np.asarray(discs_m, dtype=float).reshape(-1, 2)
+    starts = [np.column_stack([dx * c - dy * s, dx * s + dy * c]) for dx, dy in discs]   # (C, 2) each, robot frame
+    if len(centres):  # every disc at once: its rows below the others'
+        offset_m = float(np.hypot(discs[:, 0], discs[:, 1]).max())
+        sx_all, sy_all = np.stack([st[:, 0] for st in starts]), np.stack([st[:, 1] for st in starts])  # (D, C)
+        for group in groups:
+            speed = float(speeds[group].max())
+            near = np.flatnonzero(moving | (gap <= speed * horizon_s + offset_m + PRUNE_SLACK_M))
+            if not len(near):
+                continue
+            sx, sy = sx_all[:, group].reshape(-1, 1), sy_all[:, group].reshape(-1, 1)            # (D G, 1)
+            ux = np.tile(candidates[group, 0], len(discs))[:, None]
+            uy = np.tile(candidates[group, 1], len(discs))[:, None]
+            ddx, ddy = lx[near] - sx, ly[near] - sy                                           # (D G, M)
+            qx, qy = ovx[near] - ux, ovy[near] - uy
+            a = qx * qx + qy * qy
+            b = 2.0 * ((0.0 + ddx * qx) + ddy * qy)
+            cc = (ddx * ddx + ddy * ddy) - r2[near]
+            disc = b * b - 4.0 * a * cc
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = (-b - np.sqrt(np.maximum(disc, 0.0))) / (2.0 * a)
+            t = np.where((disc >= 0.0) & (a > 1e-12) & (t >= 0.0), t, np.inf)
+            t = np.where(cc <= 0.0, np.where(b >= 0.0, np.inf, 0.0), t)
+            ttc[group] = np.minimum(ttc[group], t.min(axis=1).reshape(len(discs), -1).min(axis=0))
+    if len(boxes):
+        for start in starts:
             p = np.array([pose.x_m, pose.y_m]) + start @ rotate.T
             ends = p + (candidates * horizon_s) @ rotate.T
             box_gap = segment_box_distances(p, ends, boxes).min(axis=1)
