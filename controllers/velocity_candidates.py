@@ -16,6 +16,7 @@ from swarmnav.controllers.prediction import time_to_collision_s
 from swarmnav.models.geometry import segment_box_distances
 from swarmnav.models.world import Pose2D
 
+SPEED_GROUPS = 2  # footprint_candidate_times_s: candidates tested together, each group against its fastest's reach
 PRUNE_SLACK_M = 1e-3  # footprint_candidate_times_s: obstacles this much beyond a candidate's reach are still tested
 
 
@@ -84,7 +85,9 @@ def footprint_candidate_times_s(pose: Pose2D, rotate: np.ndarray, candidates: np
         moving = (obstacle_v[:, 0] != 0.0) | (obstacle_v[:, 1] != 0.0)
         gap = np.hypot(local[:, 0], local[:, 1]) - grown_radii_m                         # (N,) from the base
         speeds = np.hypot(candidates[:, 0], candidates[:, 1])
-        groups = [np.flatnonzero(speeds == v) for v in np.unique(speeds)]
+        # The candidates in SPEED_GROUPS groups of consecutive speeds (fewer NumPy calls, a little more work each).
+        groups = [np.flatnonzero(np.isin(speeds, part)) for part in np.array_split(np.unique(speeds), SPEED_GROUPS)
+                  if len(part)]
         lx, ly, ovx, ovy, r2 = local[:, 0], local[:, 1], obstacle_v[:, 0], obstacle_v[:, 1], grown_radii_m ** 2
     discs = np.asarray(discs_m, dtype=float).reshape(-1, 2)
     starts = [np.column_stack([dx * c - dy * s, dx * s + dy * c]) for dx, dy in discs]   # (C, 2) each, robot frame
