@@ -8,6 +8,11 @@ each point's nearest centre (:class:`scipy.spatial.cKDTree`, one query per disti
 points whose nearest distance lies within :data:`BAND_M` of the radius by the brute-force expression itself,
 so the answer is the brute-force answer bit for bit (the tree's distances differ from ``np.hypot``'s by a few
 units in the last place, far inside the band).
+
+:class:`LatticeDiscs` / :func:`lattice_inside_any`: when the discs are a sensed map's cells (one radius, centred
+on its grid's cells), a distance transform of the grid with each cell's nearest disc, kept while the map is,
+decides almost every point from its cell and the eight around (with the same band) and leaves the rest to
+:func:`inside_any`: the same answer, without a tree built at every step.
 """
 
 from __future__ import annotations

@@ -72,7 +72,8 @@ def footprint_candidate_times_s(pose: Pose2D, rotate: np.ndarray, candidates: np
     Exact below ``horizon_s``; a time at or beyond it may read later (``inf``), which
     :func:`chosen_candidate` cannot tell apart: it reads only which times reach the horizon and, when none
     does, the times themselves.  Why (speed): a candidate is tested only against the obstacles that stand
-    still and lie within its reach over the horizon (its speed x ``horizon_s``, plus the disc's offset and
+    still and lie within the reach over the horizon of the fastest candidate of its group (:data:`SPEED_GROUPS`
+    groups of consecutive speeds; that speed x ``horizon_s``, plus the discs' largest offset and
     :data:`PRUNE_SLACK_M`: from farther, ``|d + q t| >= |d| - |q| t`` keeps the disc out until after the
     horizon) and every moving one; the sums over x and y are written out as :func:`time_to_collision_s`
     writes them, the values of ``np.sum(axis=2)``.  The (C, N, 2) arrays over every obstacle cost 58 % of a

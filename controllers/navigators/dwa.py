@@ -52,7 +52,10 @@ Where we differ or the paper is silent (our choices):
   arc's ``dist``); the obstacles that stand still (on an unknown map, the sensed map's cells, thousands) are
   tested through a k-d tree (:func:`controllers.disc_contacts.inside_any`), which decides every point as the
   (points x obstacles) distances did, bit for bit: a BARN run's CPU fell from ~21-33 s to ~6 s, the same
-  trajectories.
+  trajectories.  On a sensed map without detections (BARN) the map's cells are tested through a lattice kept
+  per map revision (:class:`controllers.disc_contacts.LatticeDiscs`: a distance transform with the nearest
+  cells, in the world frame), which settles almost every point and leaves the rest to ``inside_any``, the same
+  answer bit for bit (a further ~25 % of a BARN run's CPU).
 """
 
 from __future__ import annotations
