@@ -410,10 +410,11 @@ class DynamicWindowNavigator:
         """The sensed map's cells as a :class:`~controllers.disc_contacts.LatticeDiscs` (kept while the map's
         revision is), or None: the map is known, or its discs are not its grid's cells of one radius."""
         revision = getattr(self.local, "revision", None)
-        if self.world_map is None or revision is None:
+        grid = getattr(self.world_map, "grid", None)  # a SensedMap's log-odds grid
+        if grid is None or revision is None:
             return None
         if self._lattice is None or self._lattice[0] != revision:
-            grid, radii = self.world_map.grid, self.local.radii
+            radii = self.local.radii
             lattice = LatticeDiscs.of(self.local.centres, grid.origin_m, grid.cell_m, grid.rows, grid.cols) \
                 if len(radii) and bool((radii == radii[0]).all()) else None
             self._lattice = (revision, lattice)
