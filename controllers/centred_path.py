@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from swarmnav.controllers.footprint import cell_penalty, no_costlier
+from swarmnav.models.geometry import segment_disc_distances
 from swarmnav.models.world import OccupancyGrid, rasterise
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.planners.grid_graph import Cell, grid_line_of_sight
@@ -29,6 +30,7 @@ from swarmnav.planners.problem import Problem
 from swarmnav.planners.unknown_cost import weighted_cells
 
 START_SEARCH_CELLS = 4  # a blocked start cell is replaced by the nearest free cell within this many cells
+PATH_SLACK_M = 1e-6  # CentredPlanner._path_grid: discs this much farther from the polyline are rasterised too
 
 
 @dataclass
@@ -54,6 +56,22 @@ class CentredPlanner:
             self._cache = (problem, grid, cell_penalty(occupied, grid.cell_m, self.weight, self.reach_m))
         return self._cache[1], self._cache[2]
 
+    def _path_grid(self, problem: Problem, pts: np.ndarray) -> OccupancyGrid:
+        """:meth:`cells`' blocked grid as far as :meth:`blocks` reads it (the cells of points on the polyline
+        ``pts``): only the discs whose grown radius (``block_m`` and half a cell diagonal, as
+        :func:`models.world.rasterise` grows them) plus another half diagonal (a point lies within that of its
+        cell's centre) and :data:`PATH_SLACK_M` reaches the polyline are rasterised; a disc marks its cells
+        whatever the others, so every cell of the polyline reads as in the whole grid.  Why (speed): the whole
+        sensed map was rasterised at each of its changes only to ask this (a replan, rare, still rasterises it
+        all): ~7 % of a BARN run's CPU for ``dwa``."""
+        discs = problem.obstacles
+        if discs:
+            half_diagonal = problem.cell_m / math.sqrt(2.0)
+            reach = problem.disc_radii_m + self.block_m + 2.0 * half_diagonal + PATH_SLACK_M
+            near = (segment_disc_distances(pts[:-1], pts[1:], problem.disc_centres_m) <= reach[None, :]).any(axis=0)
+            discs = tuple(discs[i] for i in np.flatnonzero(near).tolist())
+        return rasterise(problem.bounds, discs, problem.boxes, self.block_m, problem.cell_m)
+
     def plan(self, problem: Problem, start_xy: tuple[float, float]) -> np.ndarray:
         """(n, 2) waypoints from ``start_xy`` to ``problem``'s goal.
 
@@ -77,10 +95,10 @@ class CentredPlanner:
     def blocks(self, problem: Problem, waypoints_m: np.ndarray, skip_m: float) -> bool:
         """Whether the polyline (from the robot on), sampled every half cell, enters a blocked cell farther
         than ``skip_m`` from its first point (the robot's own surroundings are not judged)."""
-        grid, _ = self.cells(problem)
         pts = np.asarray(waypoints_m, dtype=float).reshape(-1, 2)
         if len(pts) < 2:
             return False
+        grid = self._cache[1] if self._cache and self._cache[0] is problem else self._path_grid(problem, pts)
         samples = [pts[:1]]
         for a, b in zip(pts[:-1], pts[1:]):
             n = max(1, int(math.ceil(float(np.hypot(*(b - a))) / (0.5 * grid.cell_m))))

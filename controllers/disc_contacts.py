@@ -8,9 +8,16 @@ each point's nearest centre (:class:`scipy.spatial.cKDTree`, one query per disti
 points whose nearest distance lies within :data:`BAND_M` of the radius by the brute-force expression itself,
 so the answer is the brute-force answer bit for bit (the tree's distances differ from ``np.hypot``'s by a few
 units in the last place, far inside the band).
+
+:class:`LatticeDiscs` / :func:`lattice_inside_any`: when the discs are a sensed map's cells (one radius, centred
+on its grid's cells), a distance transform of the grid with each cell's nearest disc, kept while the map is,
+decides almost every point from its cell and the eight around (with the same band) and leaves the rest to
+:func:`inside_any`: the same answer, without a tree built at every step.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -63,6 +70,7 @@ class LatticeDiscs:
         self._distance = (cells * self.cell_m).reshape(-1)
         self._nearest_x = ((nearest[1] + 0.5) * self.cell_m + self.origin_m[0]).reshape(-1)
         self._nearest_y = ((nearest[0] + 0.5) * self.cell_m + self.origin_m[1]).reshape(-1)
+        self._bounds: dict[float, tuple[np.ndarray, np.ndarray]] = {}  # _cell_bounds' tables by radius
 
     @classmethod
     def of(cls, centres_m: np.ndarray, origin_m: tuple[float, float], cell_m: float, rows: int, cols: int
@@ -84,11 +92,12 @@ class LatticeDiscs:
     def settled(self, wx: np.ndarray, wy: np.ndarray, radius_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                                                                                   np.ndarray]:
         """For points (world frame, flat): (surely outside every disc's ``radius_m``, surely inside the nearest
-        one's, that nearest centre's x and y): outside when a cell's distance less the point's offset from the
-        cell's centre (a lower bound of the distance to any centre) exceeds the radius by :data:`BAND_M`, inside
-        when the distance to a cell's nearest centre (an upper bound) falls short of it by as much; the point's
-        own cell first, then for the points it leaves open the eight around it.  Points off the grid are
-        neither."""
+        one's, that nearest centre's x and y where inside): outside when a cell's distance less the point's
+        offset from the cell's centre (a lower bound of the distance to any centre) exceeds the radius by
+        :data:`BAND_M`, inside when the distance to a cell's nearest centre (an upper bound) falls short of it by
+        as much.  First by the point's cell alone, the offset taken at its largest (half a cell diagonal: a
+        table per radius), then for the points left with their own offset, then with the eight cells around.
+        Points off the grid are neither."""
         x0, y0 = self.origin_m
         cell = self.cell_m
         col = np.floor((wx - x0) / cell)
@@ -99,18 +108,24 @@ class LatticeDiscs:
         else:
             on = (col >= 0) & (col < self.cols) & (row >= 0) & (row < self.rows)
             index = np.where(on, row, 0).astype(np.int64) * self.cols + np.where(on, col, 0).astype(np.int64)
-        offset = np.hypot(wx - ((col + 0.5) * cell + x0), wy - ((row + 0.5) * cell + y0))
-        outside = self._distance.take(index) - offset > radius_m + BAND_M
-        nx, ny = self._nearest_x.take(index), self._nearest_y.take(index)
-        inside = np.hypot(wx - nx, wy - ny) < radius_m - BAND_M
-        inside &= ~outside
+        far, close = self._cell_bounds(radius_m)
+        outside, inside = far.take(index), close.take(index)
         if on is not None:
             outside &= on
             inside &= on
-            rest = np.flatnonzero(on & ~outside & ~inside)
-        else:
-            rest = np.flatnonzero(~(outside | inside))
-        if len(rest):
+        nx, ny = np.zeros(len(index)), np.zeros(len(index))
+        sure = np.flatnonzero(inside)
+        nx[sure], ny[sure] = self._nearest_x.take(index[sure]), self._nearest_y.take(index[sure])
+        rest = np.flatnonzero(~(outside | inside) if on is None else on & ~outside & ~inside)
+        if len(rest):  # the point's own offset and its cell's nearest centre
+            px, py, at = wx[rest], wy[rest], index[rest]
+            offset = np.hypot(px - ((col[rest] + 0.5) * cell + x0), py - ((row[rest] + 0.5) * cell + y0))
+            out = self._distance.take(at) - offset > radius_m + BAND_M
+            ax, ay = self._nearest_x.take(at), self._nearest_y.take(at)
+            into = ~out & (np.hypot(px - ax, py - ay) < radius_m - BAND_M)
+            outside[rest], inside[rest], nx[rest], ny[rest] = out, into, ax, ay
+            rest = rest[~out & ~into]
+        if len(rest):  # the eight cells around too
             px, py = wx[rest, None], wy[rest, None]
             rc = np.clip(row[rest, None].astype(np.int64) + _AROUND[0], 0, self.rows - 1)     # (U, 9)
             cc = np.clip(col[rest, None].astype(np.int64) + _AROUND[1], 0, self.cols - 1)
@@ -125,6 +140,20 @@ class LatticeDiscs:
             inside[rest] = d[rows, k] < radius_m - BAND_M
             nx[rest], ny[rest] = ax[rows, k], ay[rows, k]
         return outside, inside, nx, ny
+
+    def _cell_bounds(self, radius_m: float) -> tuple[np.ndarray, np.ndarray]:
+        """Per cell (flat): every point in it is surely outside ``radius_m`` of every centre (its distance less half
+        a diagonal exceeds the radius by :data:`BAND_M`), or surely inside its nearest centre's (its distance plus
+        half a diagonal falls short by as much).  Kept for the last two radii asked."""
+        bounds = self._bounds.get(radius_m)
+        if bounds is None:
+            half_diagonal = self.cell_m * math.sqrt(0.5)
+            bounds = (self._distance - half_diagonal > radius_m + BAND_M,
+                      self._distance + half_diagonal < radius_m - BAND_M)
+            if len(self._bounds) >= 2:
+                self._bounds.pop(next(iter(self._bounds)))
+            self._bounds[radius_m] = bounds
+        return bounds
 
 
 def lattice_inside_any(lattice: LatticeDiscs, x0: float, y0: float, c: float, s: float, px: np.ndarray,

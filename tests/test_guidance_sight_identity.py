@@ -59,3 +59,69 @@ def test_visible_at_the_edge_of_the_reach():
         differ += bool(not want[k])
         assert np.array_equal(carrot._visible(origin, points), want), trial
     assert differ > 10  # the edge is reached: some segments are blocked by a disc at exactly the reach
+
+
+def first_reference(carrot: PathCarrot, origin: np.ndarray, points: np.ndarray):
+    """update()'s choice as it was: the first visible point of the whole array's test, None if none."""
+    visible = visible_reference(carrot, origin, points)
+    return int(np.argmax(visible)) if visible.any() else None
+
+
+def test_first_visible_is_the_first_of_the_reference():
+    rng = np.random.default_rng(73)
+    for trial in range(300):
+        n = int(rng.integers(0, 2000))
+        centres = (rng.integers(0, 100, size=(n, 2)) + 0.5) * 0.05
+        radii = np.zeros(n) if rng.random() < 0.7 else rng.uniform(0.0, 0.3, n)
+        boxes = np.array([[2.0, 2.0, 3.0, 2.5]]) if rng.random() < 0.3 else np.zeros((0, 4))
+        if not n and not len(boxes):
+            continue
+        carrot = carrot_with(centres, radii, boxes, float(rng.uniform(0.1, 0.4)))
+        origin = rng.uniform(0, 5, 2)
+        points = origin + rng.uniform(-1.5, 1.5, size=(9, 2))
+        assert carrot._first_visible(origin, points) == first_reference(carrot, origin, points), trial
+
+
+def test_first_visible_at_the_edge_of_each_segment_reach():
+    """A disc just beyond the first point's own reach (its segment's length plus both radii): dropped by a bound
+    without the slack though its measured distance rounds below the radii, the first point is then taken as
+    visible where the reference has a later one."""
+    rng = np.random.default_rng(74)
+    wrong = 0
+    for trial in range(400):
+        origin = rng.uniform(0, 10, 2)
+        points = origin + rng.uniform(-1.5, 1.5, size=(9, 2))
+        direction = (points[0] - origin) / np.hypot(*(points[0] - origin))
+        length = float(np.hypot(*(points[0] - origin)))
+        radius, r = float(rng.uniform(0.1, 0.4)), float(rng.choice([0.0, 0.035]))
+        centres = origin + (length + radius + r + rng.integers(-2, 3, size=(6, 1)) * 1e-16) * direction
+        carrot = carrot_with(centres, np.full(6, r), np.zeros((0, 4)), radius)
+        want = first_reference(carrot, origin, points)
+        wrong += want != 0
+        assert carrot._first_visible(origin, points) == want, trial
+    assert wrong > 10
+
+
+def test_first_visible_at_the_edge_of_the_other_samples_reach():
+    """The first sample blocked (a disc on its segment), a disc just beyond the reach of the farthest of the
+    others: the others, tested together, keep it (a bound without the slack drops some)."""
+    rng = np.random.default_rng(75)
+    wrong = 0
+    for trial in range(400):
+        origin = rng.uniform(0, 10, 2)
+        points = origin + rng.uniform(-1.0, 1.0, size=(9, 2))
+        angle = rng.uniform(0, 2 * np.pi)
+        points[1] = origin + 1.6 * np.array([np.cos(angle), np.sin(angle)])  # the farthest of the others
+        k = 1
+        direction = (points[k] - origin) / np.hypot(*(points[k] - origin))
+        length = float(np.hypot(*(points[k] - origin)))
+        radius, r = float(rng.uniform(0.1, 0.4)), float(rng.choice([0.0, 0.035]))
+        edge = origin + (length + radius + r + rng.integers(-2, 3, size=(5, 1)) * 1e-16) * direction
+        blocker = (origin + 0.5 * (points[0] - origin))[None, :]
+        centres = np.vstack([blocker, edge])
+        carrot = carrot_with(centres, np.full(6, r), np.zeros((0, 4)), radius)
+        want = first_reference(carrot, origin, points)
+        wrong += want != k  # the edge disc (or the blocker's) hides sample 1
+        assert carrot._first_visible(origin, points) == want, trial
+    assert wrong > 10
+

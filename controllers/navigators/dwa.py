@@ -52,7 +52,10 @@ Where we differ or the paper is silent (our choices):
   arc's ``dist``); the obstacles that stand still (on an unknown map, the sensed map's cells, thousands) are
   tested through a k-d tree (:func:`controllers.disc_contacts.inside_any`), which decides every point as the
   (points x obstacles) distances did, bit for bit: a BARN run's CPU fell from ~21-33 s to ~6 s, the same
-  trajectories.
+  trajectories.  On a sensed map without detections (BARN) the map's cells are tested through a lattice kept
+  per map revision (:class:`controllers.disc_contacts.LatticeDiscs`: a distance transform with the nearest
+  cells, in the world frame), which settles almost every point and leaves the rest to ``inside_any``, the same
+  answer bit for bit (a further ~25 % of a BARN run's CPU).
 """
 
 from __future__ import annotations
@@ -407,10 +410,11 @@ class DynamicWindowNavigator:
         """The sensed map's cells as a :class:`~controllers.disc_contacts.LatticeDiscs` (kept while the map's
         revision is), or None: the map is known, or its discs are not its grid's cells of one radius."""
         revision = getattr(self.local, "revision", None)
-        if self.world_map is None or revision is None:
+        grid = getattr(self.world_map, "grid", None)  # a SensedMap's log-odds grid
+        if grid is None or revision is None:
             return None
         if self._lattice is None or self._lattice[0] != revision:
-            grid, radii = self.world_map.grid, self.local.radii
+            radii = self.local.radii
             lattice = LatticeDiscs.of(self.local.centres, grid.origin_m, grid.cell_m, grid.rows, grid.cols) \
                 if len(radii) and bool((radii == radii[0]).all()) else None
             self._lattice = (revision, lattice)

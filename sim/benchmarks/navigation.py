@@ -352,6 +352,8 @@ def _plain_row(navigator: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
         "realtime_factor": sum(r["sim_time_s"] for r in drove) / max(sum(r["wall_time_s"] for r in drove), 1e-9),
         "realtime_factor_cpu": (sum(r["sim_time_s"] for r in drove) / max(sum(r["run_cpu_s"] for r in drove), 1e-9)
                                 if drove and all(r.get("run_cpu_s") is not None for r in drove) else None),
+        "cpu_s_per_run": (_mean([r["run_cpu_s"] for r in drove])
+                          if drove and all(r.get("run_cpu_s") is not None for r in drove) else None),
     }
 
 

@@ -11,6 +11,8 @@
 * **Real-time factors** per navigator, from the benchmark's rows: simulated over wall time and over the runs'
   own CPU time (``run_cpu_s``: what the run costs whatever else loads the machine); target at least 30x.
 * **The oracle's physics success** on the scenes it called solvable (target at least 95 %), from its row.
+* **CPU per run** on the BARN suites (``cpu_s_per_run``: the mean ``run_cpu_s``, each run's own thread CPU),
+  per navigator, and what all 300 worlds x 1 run would cost at those means (CPU minutes, and minutes on 2 cores).
 
 Each figure goes with the machine's load average (``os.getloadavg``), since the wall times of a shared
 machine say as much about the other jobs as about swarmnav.
@@ -30,6 +32,7 @@ ORACLE_TARGET_S = 2.0
 MPPI_TARGET_US = 1000.0
 REALTIME_TARGET = 30.0
 ORACLE_SUCCESS_TARGET = 0.95
+BARN_WORLDS = 300  # the BARN line's projection: every world once (the issue's budget: 60 min on 2 cores)
 
 
 def load_average() -> float:
@@ -129,6 +132,12 @@ def speed_lines(rows: list[dict[str, Any]], oracle: dict[str, Any], mppi: dict[s
     lines.append("real-time factor: " + "; ".join(factors) + f" (target >= {REALTIME_TARGET:g}x; "
                  + (f"below it on CPU: {', '.join(slow)}" if slow else "every navigator meets it on CPU")
                  + f"; load average {load_average()})")
+    barn = [r for r in rows if "barn_score" in r and r.get("cpu_s_per_run") is not None]
+    if barn:
+        total_min = BARN_WORLDS * sum(r["cpu_s_per_run"] for r in barn) / 60.0
+        lines.append("CPU per run: " + ", ".join(f"{r['navigator']} {r['cpu_s_per_run']:.2f} s" for r in barn)
+                     + f" (BARN's {BARN_WORLDS} worlds x 1 run at these means: {total_min:.1f} CPU-min, "
+                     f"{total_min / 2.0:.1f} min on 2 cores; load average {load_average()})")
     for r in rows:
         if r.get("success_on_solvable") is not None:
             lines.append(f"oracle physics success on its solvable scenes: {r['success_on_solvable']:.3f} of "
