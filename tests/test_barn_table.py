@@ -110,3 +110,19 @@ def test_all_worlds_target_needs_a_row_over_every_world_for_each_online_navigato
     test50 = _protocol_result(tmp_path / "barn-protocol-replan.json", "replan", TEST_WORLDS, 10, 500)
     lines = barn_table.all_worlds_lines(tuple(p for p in every if "replan" not in p.name) + (test50,))
     assert "| replan | none |" in "\n".join(lines) and "`replan`" in lines[-1] and "not met" in lines[-1]
+
+
+def test_on_equal_runs_the_row_of_the_barn_configuration_stands_for_its_navigator_whatever_its_success(tmp_path):
+    """A second configuration run as often never replaces the one models/suites/barn-navigators.toml declares
+    for the navigator, even with a higher success: the row shown is not picked by its test result."""
+    from swarmnav.benchmarks.barn import TEST_WORLDS
+    declared = barn_table.configurations()["mppi"]
+    other = dict(declared, samples=declared["samples"] + 1)
+    mine = _protocol_result(tmp_path / "barn-protocol-a.json", "mppi", TEST_WORLDS, 10, 420, declared)
+    better = _protocol_result(tmp_path / "barn-protocol-b.json", "mppi", TEST_WORLDS, 10, 480, other)
+    for order in ((mine, better), (better, mine)):
+        text = "\n".join(barn_table.online_lines(order))
+        assert "`barn-protocol-a.json` | 50 x 10 | 500 | 0.840" in text, order
+    # more runs still win: the declared configuration's 50-run sample gives way to another's 500 runs
+    sample = _protocol_result(tmp_path / "barn-protocol-c.json", "mppi", TEST_WORLDS, 1, 50, declared)
+    assert "`barn-protocol-b.json`" in "\n".join(barn_table.online_lines((better, sample)))

@@ -35,6 +35,7 @@ ORACLE = "oracle"
 ONLINE_TARGET = 0.88  # issue 34: every online navigator's success, the published move_base DWA's
 PROTOCOL_RUNS = 500   # the challenge's 50 test worlds x 10 runs
 NOT_ONLINE = ("policy",)  # runs a policy the user supplies (--trust-code): no navigator of its own
+CONFIGURATIONS = RESULTS_DIR.parent / "barn-navigators.toml"  # each navigator's BARN configuration, one entry each
 # Published, on the same 50 test worlds x 10 runs (the challenge's report_test.py): the challenge repository's
 # README (Daffan/the-barn-challenge at bf5a226f), as quoted in ../shared/benchmarks/barn/README.md.
 PUBLISHED = [{"entry": "move_base + DWA, Gazebo, Jackal, map unknown (the challenge's baseline)",
@@ -178,6 +179,18 @@ def _label(r: dict[str, Any]) -> str:
     return r["navigator"] + (" (" + ", ".join(f"{k}={v}" for k, v in params.items()) + ")" if params else "")
 
 
+def configurations() -> dict[str, dict[str, Any]]:
+    """navigator -> its BARN configuration's parameters (:data:`CONFIGURATIONS`)."""
+    from swarmnav.benchmarks.navigation import read_arms
+    return {arm.navigator: arm.params for arm in read_arms(str(CONFIGURATIONS))}
+
+
+def _is_configuration(r: dict[str, Any], wanted: dict[str, dict[str, Any]]) -> bool:
+    """Whether the row ran its navigator's BARN configuration (:func:`configurations`)."""
+    base = r.get("arm_of") or r["navigator"]
+    return base in wanted and (r.get("arm_params") or r.get("navigator_params") or {}) == wanted[base]
+
+
 def online_navigators() -> list[str]:
     """The online navigators (they act on what they sense: ``uses_detections``), but :data:`NOT_ONLINE`."""
     from swarmnav.controllers.navigators import NAVIGATORS
@@ -187,23 +200,24 @@ def online_navigators() -> list[str]:
 
 def online_lines(results: tuple[FilePath, ...]) -> list[str]:
     """Issue 34's "every online navigator" target from every committed protocol result on the test worlds: per
-    online navigator (its own rows and its arms') the row with the most runs (the higher success on a tie, then
-    the later), its worlds x runs and whether it is the protocol's full 500; the target is met only when every
+    online navigator (its own rows and its arms') the row with the most runs (on a tie, the row of its BARN
+    configuration, :func:`configurations`, then the later), its worlds x runs and whether it is the protocol's full 500; the target is met only when every
     one has a 500-run row at 0.88 or more."""
     from swarmnav.benchmarks.barn import TEST_WORLDS
+    wanted = configurations()
     chosen: dict[str, tuple[FilePath, dict[str, Any], int, int]] = {}
     for path, r, per_run in _protocol_rows(results):
         worlds = {x["world"] for x in per_run}
         barn_worlds = all(x["scenario"].startswith("barn-") for x in per_run)  # not BARN-like seeds
         if worlds and worlds <= set(TEST_WORLDS) and barn_worlds:
             base = r.get("arm_of") or r["navigator"]  # an arm (--arm LABEL:NAV:...) counts for its navigator
-            if base not in chosen or (r["runs"], r["success_rate"]) >= (chosen[base][1]["runs"],
-                                                                         chosen[base][1]["success_rate"]):
+            if base not in chosen or _rank(r, wanted) >= _rank(chosen[base][1], wanted):
                 chosen[base] = (path, r, len(worlds), r["runs"] // len(worlds))
     names = online_navigators()
     lines = ["Every online navigator under the protocol (map unknown, Jackal, its laser) on the challenge's test "
-             "worlds: for each, its committed row (its own or an arm's) with the most runs (the higher success on a "
-             "tie); the challenge's "
+             "worlds: for each, its committed row (its own or an arm's) with the most runs; on a tie, the row of its "
+             "configuration in `models/suites/barn-navigators.toml` (chosen on non-test worlds, never by these "
+             "results), then the later file; the challenge's "
              f"protocol is 50 worlds x 10 runs = {PROTOCOL_RUNS} runs, and a smaller sample is marked so:", "",
              "| navigator | result file | worlds x runs | runs | success | collisions | timeouts | BARN score |",
              "|---|---|---:|---:|---:|---:|---:|---:|"]
@@ -231,17 +245,24 @@ def online_lines(results: tuple[FilePath, ...]) -> list[str]:
     return lines
 
 
+def _rank(r: dict[str, Any], wanted: dict[str, dict[str, Any]]) -> tuple[int, bool]:
+    """A row's claim to stand for its navigator: more runs first, then its BARN configuration's (a later file
+    wins a full tie: the caller's ``>=``). Never its success: the row shown is not picked by its result."""
+    return r["runs"], _is_configuration(r, wanted)
+
+
 def all_worlds_lines(results: tuple[FilePath, ...]) -> list[str]:
     """Issue 34's "all 300 worlds run for every navigator": per online navigator (its own rows and its arms'), a
     committed protocol row whose runs cover every one of BARN's worlds (the one with the most runs), and whether
     every online navigator has one."""
     from swarmnav.benchmarks.barn import WORLD_COUNT
+    wanted = configurations()
     chosen: dict[str, tuple[FilePath, dict[str, Any], float | None]] = {}
     for path, r, per_run in _protocol_rows(results):
         per_run = [x for x in per_run if x["scenario"].startswith("barn-")]
         if {x["world"] for x in per_run} == set(range(WORLD_COUNT)):
             base = r.get("arm_of") or r["navigator"]
-            if base not in chosen or r["runs"] >= chosen[base][1]["runs"]:
+            if base not in chosen or _rank(r, wanted) >= _rank(chosen[base][1], wanted):
                 chosen[base] = (path, r, _cpu_min(per_run))
     names = online_navigators()
     lines = [f"All {WORLD_COUNT} worlds under the protocol, per online navigator (its committed row whose runs "
