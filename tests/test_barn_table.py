@@ -126,3 +126,24 @@ def test_on_equal_runs_the_row_of_the_barn_configuration_stands_for_its_navigato
     # more runs still win: the declared configuration's 50-run sample gives way to another's 500 runs
     sample = _protocol_result(tmp_path / "barn-protocol-c.json", "mppi", TEST_WORLDS, 1, 50, declared)
     assert "`barn-protocol-b.json`" in "\n".join(barn_table.online_lines((better, sample)))
+
+
+def test_fresh_worlds_are_compared_with_the_300_of_the_same_navigator_and_parameters(tmp_path, monkeypatch):
+    """A BARN-like row (an arm, under any label) is set against the all-300 protocol row of its own navigator with
+    the same parameters, whichever file holds it; another configuration of that navigator is not compared."""
+    from swarmnav.benchmarks.barn import PROTOCOL_TEXT, WORLD_COUNT
+    params = {"footprint": "box", "cost_weight": 10}
+    all300 = _protocol_result(tmp_path / "barn-protocol-all-replan.json", "replan", range(WORLD_COUNT), 1, 294, params)
+    fresh = tmp_path / "barn-like-protocol-navigators.json"
+
+    def row(label, arm_params, success):
+        return {"scenario": None, "navigator": label, "arm_of": "replan", "arm_params": arm_params,
+                "navigator_params": arm_params, "runs": 50, "success_rate": success, "barn_score": 0.4,
+                "barn_setup": PROTOCOL_TEXT}
+    fresh.write_text(json.dumps([row("replan+barn", params, 0.90), row("replan+other", {"cost_weight": 3}, 0.5)]))
+    monkeypatch.setattr(barn_table, "BARN_300", (all300,))
+    monkeypatch.setattr(barn_table, "BARN_50", ())
+    lines = [x for x in barn_table._fresh_against_barn(fresh, (all300, fresh)) if x.startswith("BARN-like")]
+    assert lines == ["BARN-like worlds (`barn-like-protocol-navigators.json`) against BARN's "
+                     "(`barn-protocol-all-replan.json`), `replan`: success 0.900 vs 0.980 (-0.080), score 0.4000 vs "
+                     "0.1960 (+0.2040): NOT within 0.05."]

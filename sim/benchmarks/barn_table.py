@@ -23,12 +23,14 @@ RESULTS_DIR = FilePath(__file__).resolve().parents[2] / "models" / "suites" / "r
 LISTED = (RESULTS_DIR / "barn-test50.json", RESULTS_DIR / "barn-test10-dwa-vo.json", RESULTS_DIR / "barn.json",
           RESULTS_DIR / "barn-like.json", RESULTS_DIR / "barn-jackal-test10.json",
           RESULTS_DIR / "barn-protocol-test10.json", RESULTS_DIR / "barn-protocol-test10-more.json",
-          RESULTS_DIR / "barn-protocol-test50.json", RESULTS_DIR / "barn-like-protocol.json")
+          RESULTS_DIR / "barn-protocol-test50.json", RESULTS_DIR / "barn-like-protocol.json",
+          RESULTS_DIR / "barn-like-protocol-navigators.json")
 # then every other committed protocol result (barn-protocol-<navigator or label>.json), by name
 RESULTS = LISTED + tuple(sorted(p for p in RESULTS_DIR.glob("barn-protocol-*.json") if p not in LISTED))
-# compared: each BARN-like result (fresh worlds) against BARN's in its own setup (the 300 first, then 50 test worlds)
-BARN_300, BARN_50 = (RESULTS[2],), (RESULTS[0], RESULTS[7])
-FRESH = (RESULTS[3], RESULTS[8])
+# compared: each BARN-like result (fresh worlds) against BARN's in its own setup (the 300 first: barn.json, then
+# every navigator's all-300 protocol result; then 50 test worlds)
+BARN_300, BARN_50 = (RESULTS[2],) + tuple(p for p in RESULTS if p.name.startswith("barn-protocol-all-")), (RESULTS[0], RESULTS[7])
+FRESH = (RESULTS[3], RESULTS[8], RESULTS[9])
 BEGIN = "<!-- barn-table: generated from models/suites/results/barn*.json by `make readme-table`; do not edit by hand -->"
 END = "<!-- end of barn-table -->"
 ORACLE = "oracle"
@@ -125,22 +127,29 @@ def fresh_lines(results: tuple[FilePath, ...]) -> list[str]:
 
 
 def _key(row: dict[str, Any]) -> tuple[str, str]:
-    return row["navigator"], json.dumps(row.get("navigator_params") or {}, sort_keys=True)
+    """A row's navigator (an arm's own navigator, whatever its label) and its parameters."""
+    return (row.get("arm_of") or row["navigator"],
+            json.dumps(row.get("arm_params") or row.get("navigator_params") or {}, sort_keys=True))
 
 
 def _fresh_against_barn(fresh_path: FilePath, results: tuple[FilePath, ...]) -> list[str]:
     fresh_rows = read_result(fresh_path)
     setups = {r["barn_setup"] for r in fresh_rows}
-    against = next((p for p in BARN_300 + BARN_50 if p in results and p.is_file()
-                    and setups & {r["barn_setup"] for r in read_result(p)}), None)  # the same setup only
-    if against is None:
+    files = [p for p in BARN_300 + BARN_50 if p in results and p.is_file()
+             and setups & {r["barn_setup"] for r in read_result(p)}]  # the same setup only
+    if not files:
         return []
-    base_rows = read_result(against)
-    base = {_key(r): r for r in base_rows if r.get("scenario") is None}
+    whole = [p for p in files if p in BARN_300] or files[:1]  # the 300 worlds where run, else the 50 test worlds
+    base: dict[tuple[str, str], tuple[FilePath, dict[str, Any]]] = {}
+    for path in whole:
+        for r in read_result(path):
+            if r.get("scenario") is None:
+                base.setdefault(_key(r), (path, r))
+    base_rows = read_result(whole[0])
     fresh = {_key(r): r for r in fresh_rows if r.get("scenario") is None}
     lines = []
     for key in [k for k in fresh if k in base]:
-        b, f = base[key], fresh[key]
+        (against, b), f = base[key], fresh[key]
         ds, dsc = f["success_rate"] - b["success_rate"], (f["barn_score"] or 0.0) - (b["barn_score"] or 0.0)
         if f["barn_setup"] != b["barn_setup"]:
             continue
