@@ -93,8 +93,11 @@ class Sweep:
             timer.start()
 
         deferred = [0]
+        over = [False]  # the body has returned: a timer firing now has nothing left to stop
 
         def stop(_signal, frame):
+            if over[0]:
+                return
             # Never inside an import (a half-imported module would stay broken), and, for up to 2 s, never inside a
             # library's own Python code: an exception raised mid-draw left matplotlib's state broken for the next
             # invocation in this process ("Invalid affine transformation matrix" on a report that runs fine alone).
@@ -116,8 +119,13 @@ class Sweep:
         arm(budget_s or self.budget_s)
         try:
             with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-                yield err
+                try:
+                    yield err
+                except Stopped:  # landed as the body returned, before the flag below (a late timer): nothing to stop
+                    pass
+                over[0] = True
         finally:
+            over[0] = True
             for timer in timers:
                 timer.cancel()
             signal.signal(signal.SIGUSR1, previous)
