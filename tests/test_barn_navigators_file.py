@@ -40,6 +40,8 @@ def test_every_configuration_of_the_file_is_one_the_committed_results_ran():
     ('[[navigators]]\nname = "policy"\nparams = { policy = "os:system" }\n', "navigators[0].params.policy: names code"),
     ('[[navigators]]\nname = "dwa"\n[[navigators]]\nname = "dwa"\n', "navigators[1].label: label 'dwa' is used twice"),
     ('navigator = 1\n', "navigator"),
+    ('[[navigators]]\nname = "dwa"\nlabel = "' + "x" * 100_000 + '"\n', "navigators[0].label: must be at most"),
+    ('[[navigators]]\nname = "dwa"\nlabel = "../up"\n', "navigators[0].label:"),
 ])
 def test_a_bad_arms_file_is_one_line_naming_the_file_and_the_field(tmp_path, capsys, text, field):
     path = tmp_path / "arms.toml"

@@ -131,6 +131,7 @@ def read_arms(path: str) -> list[Arm]:
     row is one configuration). A parameter that names code is refused (data is not code: ``--arm`` on the
     command line is the way to opt in). Every problem is one ConfigError naming the file and the field."""
     from swarmnav.controllers.navigators import make_navigator
+    from swarmnav.models.contained_files import name_problem
     from swarmnav.models.toml_table import parse_toml, read_text
     from swarmnav.study.spec_sections import read_components
     top = parse_toml(read_text(path, "--arms"), str(path))
@@ -145,6 +146,9 @@ def read_arms(path: str) -> list[Arm]:
                      "a list (a study's sweep): an arm takes one value per parameter")
         if is_clairvoyant(component.name):
             top.fail(f"navigators[{i}].name", f"{component.name!r} is the yardstick, run beside every contender already")
+        problem = name_problem(component.label)  # a row's label is a name: bounded, printable, never a path
+        if problem:
+            top.fail(f"navigators[{i}].label", problem)
         arms.append(Arm(component.label, component.name, dict(component.params)))
     return arms
 
