@@ -81,6 +81,20 @@ def test_evade_reverse_gets_through_validation_case_563_where_turning_round_is_r
     assert result.success, result.summary()
 
 
+CROWD = {"evade_still_m_s": 0.1, "blocked_horizon_s": 1.0, "evade_turn_cost_m_s_rad": 0.3, "corner_merge_m": 0.3,
+         "evade_trigger_s": 3.0}  # the arm dstar_replan+crowd (docs/navigation.md)
+
+
+def test_evade_reverse_backs_out_of_the_centre_where_dstar_replan_crowd_is_pinched_in_case_739():
+    # Case 739, robot invisible: at 3.6 s D* Lite's repaired path leads back, away from the humans converging on
+    # the centre; with the robot's command a turn on the spot, the evasion (every candidate's cost its distance to
+    # a standing robot, the least turn winning the tie) drove on into the centre at 0.24 m/s, where two humans
+    # pinched it at 6.8 s.  Backing toward the escape, it leaves the centre and reaches the goal.
+    assert _run(739, stop=True, **CROWD).collisions >= 1
+    result = _run(739, **CROWD, evade_reverse=True)
+    assert result.success, result.summary()
+
+
 def test_blocked_horizon_s_keeps_the_robot_moving_where_the_sweeps_close_every_way():
     # Case 545, robot invisible (the collision every earlier dstar_replan configuration had): the 3 s sweeps of
     # the humans converging on the centre leave no path, the robot stands there and is pinched at 7.6 s.
