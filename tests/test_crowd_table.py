@@ -77,3 +77,21 @@ def test_the_paper_navigators_rows_take_the_place_of_the_samples_of_the_same_lab
     path.write_text(json.dumps(paper))
     assert crowd_table.main([str(RESULT), "--paper", str(path)]) == 0
     assert "| `iaco_local` †" in capsys.readouterr().out
+
+
+def test_the_protocols_every_online_navigator_line_counts_each_navigator_at_its_best_and_names_the_missing():
+    from swarmnav.benchmarks.crowd_table import coverage_line, online_navigators
+    sample = [{"navigator": "follow", "success_rate": 0.5}, {"navigator": "dwa", "success_rate": 0.2},
+              {"navigator": "mppi", "success_rate": 0.0}, {"navigator": "mppi+x", "arm_of": "mppi", "success_rate": 0.9},
+              {"navigator": "oracle", "success_rate": 1.0}]
+    names = online_navigators(sample)
+    assert names == ["dwa", "mppi"]  # follow senses no human; an arm counts as its navigator; no oracle
+    protocol = [{"navigator": "mppi", "success_rate": 0.5}, {"navigator": "mppi+x", "arm_of": "mppi",
+                                                             "success_rate": 0.95}]
+    line = coverage_line(protocol, names)
+    assert ": not met;" in line and "`mppi+x` 0.950" in line and "not run on them: `dwa`" in line
+    assert "`mppi` 0.500" not in line  # its best configuration stands for it
+    line = coverage_line(protocol + [{"navigator": "dwa", "success_rate": 0.9}], names)
+    assert ": met;" in line and "not run" not in line
+    line = coverage_line(protocol + [{"navigator": "dwa", "success_rate": 0.89}], names)
+    assert ": not met;" in line and "`dwa` 0.890" in line
