@@ -29,10 +29,10 @@ def _evasion(**options) -> Evasion:
     return Evasion(GEOMETRY, robot_radius_m=0.3, max_speed_m_s=1.0, local=NO_MAP, trigger_s=2.0, **options)
 
 
-def _run(case: int, visible: bool = False, stop: bool = False, **params):
+def _run(case: int, visible: bool = False, stop: bool = False, navigator: str = "dstar_replan", **params):
     scenario = parse_scenario(generate("crowdnav_circle", case, GeneratorOptions(robot_visible=visible)),
                               f"<crowdnav {case}>")
-    return run_episode(EpisodeSpec(scenario, navigator="dstar_replan", navigator_params=params),
+    return run_episode(EpisodeSpec(scenario, navigator=navigator, navigator_params=params),
                        stop_on_collision=stop).result
 
 
@@ -95,6 +95,18 @@ def test_evade_reverse_backs_out_of_the_centre_where_dstar_replan_crowd_is_pinch
     assert result.success, result.summary()
 
 
+def test_the_evasions_options_get_immas_stepwise_out_of_a_turn_on_the_spot_walked_into_in_case_744():
+    # Case 744, robot invisible, immas_stepwise driving through its walk with the evasion (its best configuration
+    # on the 50-case sample): from 2.8 s the evasion turned the robot on the spot, at 1.2 rad/s one way then the
+    # other, for 2.4 s, until a human walked into it at 5.2 s.  Backing toward an escape behind, the least turn
+    # winning a tie and standing humans left to the walk, it reaches the goal.
+    drive = {"evade": True, "evade_trigger_s": 4.0, "lookahead_cells": 6, "predict_s": 1.0}
+    assert _run(744, stop=True, navigator="immas_stepwise", **drive).collisions >= 1
+    result = _run(744, navigator="immas_stepwise", **drive, evade_reverse=True, evade_turn_cost_m_s_rad=0.3,
+                  evade_still_m_s=0.1)
+    assert result.success, result.summary()
+
+
 def test_blocked_horizon_s_keeps_the_robot_moving_where_the_sweeps_close_every_way():
     # Case 545, robot invisible (the collision every earlier dstar_replan configuration had): the 3 s sweeps of
     # the humans converging on the centre leave no path, the robot stands there and is pinched at 7.6 s.
@@ -153,11 +165,19 @@ def test_the_options_are_bounded_and_offered_by_dstar_replan_alone():
         make_driver("dstar_replan", {"blocked_horizon_s": -1})
     with pytest.raises(ConfigError, match=r"navigator\.params\.evade_still_m_s: must be in \[0, 5\], got 6"):
         make_driver("dstar_replan", {"evade_still_m_s": 6})
-    for other in ("replan", "velocity_obstacle", "dwa", "mppi", "iaco_local", "immas_stepwise"):
+    for other in ("replan", "velocity_obstacle", "dwa", "mppi"):
         names = {row["name"] for row in navigator_table(other)}
         assert not names & {"evade_still_m_s", "evade_reverse", "evade_turn_cost_m_s_rad", "blocked_horizon_s",
                             "corner_merge_m"}, other
         with pytest.raises(ConfigError, match=r"evade_reverse: unknown parameter"):
             make_driver(other, {"evade_reverse": True})
+    for paper_navigator in ("iaco_local", "immas_stepwise"):  # the evasion's options, not dstar_replan's own
+        names = {row["name"] for row in navigator_table(paper_navigator)}
+        assert {"evade_still_m_s", "evade_reverse", "evade_turn_cost_m_s_rad"} <= names, paper_navigator
+        assert not names & {"blocked_horizon_s", "corner_merge_m"}, paper_navigator
+        _, layer = make_driver(paper_navigator, {"evade": True, "evade_reverse": True, "evade_still_m_s": 0.1})
+        assert (layer.evade, layer.evade_reverse, layer.evade_still_m_s) == (True, True, 0.1)
+        with pytest.raises(ConfigError, match=r"navigator\.params\.evade_still_m_s: must be in \[0, 5\], got 6"):
+            make_driver(paper_navigator, {"evade_still_m_s": 6})
     _, layer = make_driver("dstar_replan", {"evade_still_m_s": 0.1, "evade_reverse": True})
     assert (layer.evade_still_m_s, layer.evade_reverse) == (0.1, True)

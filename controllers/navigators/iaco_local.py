@@ -132,6 +132,8 @@ class IacoLocalNavigator:
     name: ClassVar[str] = "iaco_local"
     # The safety layer's evasion (controllers.safety_layer, after the step): off by default, not the paper's.
     safety_layer: ClassVar[dict[str, bool]] = {"evade": False}
+    # The evasion's options (controllers.evasion), off by default, as dstar_replan offers them (docs/navigation.md).
+    safety_layer_options: ClassVar[tuple[str, ...]] = ("evade_still_m_s", "evade_reverse", "evade_turn_cost_m_s_rad")
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = True
     replan_wall_s: ClassVar[float] = 0.0  # its replanning time is not measured
