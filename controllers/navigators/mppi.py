@@ -47,8 +47,9 @@ from swarmnav.controllers.guided import box_guidance
 from swarmnav.controllers.kinematics import wheel_speeds
 from swarmnav.controllers.navigator import Belief, NavigationSetup, NavigationStep, Observation
 from swarmnav.controllers.footprint import chassis_box_m
-from swarmnav.controllers.navigators.rollout_gaps import disc_gaps
+from swarmnav.controllers.navigators.rollout_gaps import box_gaps, disc_gaps
 from swarmnav.models.errors import ConfigError
+from swarmnav.models.world import wrap_angle_rad
 
 
 @dataclass
@@ -108,6 +109,20 @@ class MppiNavigator:
             it stands now; else the cheapest sampled sequence that does replaces it, else the sequence is reset to
             standing still (Nav2's fail flag when every trajectory collides).  A collision becomes a stop, and
             a stop can last until the time limit.
+        box_rollouts: with ``footprint = "box"`` (named option, ours; default false: the covering discs), every
+            rollout point is checked with the chassis box itself at the rollout's heading there, ``margin_m``
+            beyond its edges (:func:`controllers.navigators.rollout_gaps.box_gaps`).  Why (BARN, non-test
+            worlds): the two 0.25 m covering discs bulge 0.12 m past the Jackal's front face and 0.035 m past its
+            sides, so with ``margin_m`` they called a cylinder 3-6 cm from the box a collision; the robot stood
+            wedged there until every rollout collided from its first step, then drove off into it.
+        recovery_s, recovery_back_m, recovery_margin_m: ``recovery_s`` > 0 (named option, ours, as move_base's
+            recoveries and ``dwa``'s ``recovery_s``; default 0: none): once the robot and the sequence's first
+            speed have stood (below 0.05 m/s) that long, turn on the spot toward the carrot at 0.6 rad/s (the
+            other way if that way is blocked) until within 0.1 rad of it, else back straight off
+            ``recovery_back_m`` at 0.2 m/s, each while the chassis (its box, else the robot's disc) keeps
+            ``recovery_margin_m`` from the obstacles near over the next 0.5 s of the motion, or no less than it
+            has now; then the sequence restarts from standing still.  The rollouts drive forward only, so a
+            robot facing a pocket it cannot turn in has no way out without it.
     """
 
     name: ClassVar[str] = "mppi"
@@ -146,12 +161,18 @@ class MppiNavigator:
     max_accel_m_s2: float = param(0.0, within(0, 1000))
     hard_check_s: float = param(0.0, within(0, 10))
     hard_margin_m: float = param(0.035, within(0, 1))
+    box_rollouts: bool = False
+    recovery_s: float = param(0.0, within(0, 1000))
+    recovery_back_m: float = param(0.3, within(0, 10))
+    recovery_margin_m: float = param(0.035, within(0, 1))
 
     def __post_init__(self) -> None:
         # Each field's own range is declared with it (param); what no single field can say:
         if self.samples * self.horizon_steps > 1_000_000:
             raise ConfigError("navigator.params.samples", f"samples x horizon_steps must be at most 1,000,000, "
                                                           f"got {self.samples * self.horizon_steps:,}")
+        if self.box_rollouts and self.footprint != "box":
+            raise ConfigError("navigator.params.box_rollouts", "needs footprint = \"box\"")
 
     def reset(self, setup: NavigationSetup) -> None:
         top_m_s = min(setup.max_speed_m_s, self.speed_cap_m_s) if self.speed_cap_m_s > 0 else setup.max_speed_m_s
@@ -169,6 +190,8 @@ class MppiNavigator:
                                                                          max(abs(box[1]), abs(box[3])))
         self.hard_steps = min(self.horizon_steps, int(math.ceil(self.hard_check_s / self.model_dt_s - 1e-9)))
         self.optimised_at_s = -1.0
+        self.stopped_s, self.last_time_s, self.last_v, self.recovering = 0.0, None, 0.0, None
+        self.target = None
         self.nominal = np.zeros((self.horizon_steps, 2), dtype=np.float32)
         self.std = np.array([self.linear_std_m_s * scale, self.angular_std_rad_s], dtype=np.float32)
         self.lo = np.array([0.0, -self.max_angular_rad_s], dtype=np.float32)
@@ -230,12 +253,29 @@ class MppiNavigator:
         """(K, T) gap of each rollout point's footprint: the base's, or (``heading`` given) the covering discs'."""
         if heading is None:
             return self._gap(px, py, centres, velocities, radii, boxes)
+        if self.box_rollouts and self.chassis[0] is not None:
+            return self._box_gap(px, py, heading, centres, velocities, radii, boxes)
         c, s = np.cos(heading), np.sin(heading)
         gap = None
         for dx, dy in self.discs.astype(np.float32):
             g = self._gap(px + dx * c - dy * s, py + dx * s + dy * c, centres, velocities, radii, boxes)
             gap = g if gap is None else np.minimum(gap, g, out=gap)
         return gap
+
+    def _box_gap(self, px, py, heading, centres, velocities, radii, boxes) -> np.ndarray | None:
+        """``box_rollouts``: (K, T) gap of the chassis box itself at each rollout point and heading, ``margin_m``
+        beyond it (the map's boxes by their circumscribed discs), exact below ``repulsion_m``."""
+        cx = [centres[:, 0:1] + velocities[:, 0:1] * self.step_times[None, :]]
+        cy = [centres[:, 1:2] + velocities[:, 1:2] * self.step_times[None, :]]
+        r = [np.asarray(radii, dtype=float)]
+        if len(boxes):
+            cx.append(np.repeat(0.5 * (boxes[:, 0:1] + boxes[:, 2:3]), len(self.step_times), axis=1))
+            cy.append(np.repeat(0.5 * (boxes[:, 1:2] + boxes[:, 3:4]), len(self.step_times), axis=1))
+            r.append(0.5 * np.hypot(boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]))
+        cx, cy, r = np.vstack(cx), np.vstack(cy), np.concatenate(r)
+        if not len(r):
+            return None
+        return box_gaps(px, py, heading, self.chassis[0], cx, cy, r + self.margin_m, float(self.repulsion_m))
 
     def _gap(self, px: np.ndarray, py: np.ndarray, centres, velocities, radii, boxes) -> np.ndarray | None:
         """(K, T) gap of each rollout point to the nearest obstacle beyond the inflation (None: none near)."""
@@ -268,6 +308,7 @@ class MppiNavigator:
             cost += np.float32(self.goal_weight) * np.mean(np.hypot(px - self.goal[0], py - self.goal[1]), axis=1)
             return cost
         target = self.carrot.update(pose)
+        self.target = target
         if self.centred is not None and getattr(self.carrot, "replans", 0) != self.path_replans:
             self.path_replans = self.carrot.replans  # footprint = "box": the path term follows the guidance
             self.path_points = _resample(np.asarray(self.carrot.points, dtype=float), 0.1)
@@ -287,6 +328,10 @@ class MppiNavigator:
 
     def step(self, observation: Observation) -> NavigationStep:
         pose = observation.pose
+        if self.recovery_s > 0.0:
+            recovery = self._recovery(observation)
+            if recovery is not None:
+                return self._answer(pose, recovery[0], recovery[1], observation)
         elapsed = observation.time_s - self.optimised_at_s
         index = min(int(elapsed / self.model_dt_s + 1e-9), self.horizon_steps - 1)  # the sequence's step now
         if self.optimised_at_s >= 0.0 and elapsed < self.optimise_period_s - 1e-9:
@@ -378,10 +423,79 @@ class MppiNavigator:
         d -= r[None, :, None]
         return d.min(axis=1)
 
+    def _recovery(self, observation: Observation) -> tuple[float, float] | None:
+        """``recovery_s`` > 0 (ours, as move_base's recoveries and ``dwa``'s): after the robot and the sequence's
+        first speed have stood (below ``STILL_M_S``) that long, turn on the spot toward the carrot (the other way
+        if that way is blocked), else back straight off ``recovery_back_m`` at ``BACK_M_S``, each while the
+        chassis keeps ``recovery_margin_m`` from the obstacles near, or no less than it has now; (v, omega) to
+        command, or None (the optimiser's step).  After a recovery the sequence restarts from standing still."""
+        now_s = observation.time_s
+        dt = 0.0 if self.last_time_s is None else max(0.0, now_s - self.last_time_s)
+        self.last_time_s = now_s
+        pose = observation.pose
+        if self.recovering is None:
+            still = abs(observation.twist.linear_m_s) < STILL_M_S and abs(self.last_v) < STILL_M_S
+            self.stopped_s = self.stopped_s + dt if still else 0.0
+            if self.stopped_s < self.recovery_s or self.target is None or not hasattr(self, "near"):
+                return None
+            self.stopped_s = 0.0
+            err = wrap_angle_rad(math.atan2(self.target[1] - pose.y_m, self.target[0] - pose.x_m) - pose.heading_rad)
+            turns = (math.copysign(1.0, err), -math.copysign(1.0, err)) if abs(err) > TURN_SWEEP_RAD else ()
+            for sign in turns:
+                if self._recovery_free(pose, 0.0, sign * self._turn_rate()):
+                    self.recovering = ["turn", sign]
+                    break
+            else:
+                if self.recovery_back_m > 0.0 and self._recovery_free(pose, -BACK_M_S, 0.0):
+                    self.recovering = ["back", self.recovery_back_m]
+            if self.recovering is None:
+                return None
+            self.recoveries = getattr(self, "recoveries", 0) + 1
+        else:
+            self.recovering[1] = self.recovering[1] - (BACK_M_S * dt if self.recovering[0] == "back" else 0.0)
+        if self.recovering[0] == "turn":
+            err = wrap_angle_rad(math.atan2(self.target[1] - pose.y_m, self.target[0] - pose.x_m) - pose.heading_rad)
+            omega = self.recovering[1] * self._turn_rate()
+            if abs(err) > 0.1 and self._recovery_free(pose, 0.0, omega):
+                return self._recovered(0.0, omega)
+            if self.recovery_back_m > 0.0 and abs(err) > 0.1 and self._recovery_free(pose, -BACK_M_S, 0.0):
+                self.recovering = ["back", self.recovery_back_m]
+        if self.recovering[0] == "back" and self.recovering[1] > 0.0 and self._recovery_free(pose, -BACK_M_S, 0.0):
+            return self._recovered(-BACK_M_S, 0.0)
+        self.recovering, self.stopped_s, self.last_v = None, 0.0, 0.0
+        self.nominal = np.zeros_like(self.nominal)
+        self.optimised_at_s = -1.0                                          # optimise at once, from standing
+        return None
+
+    def _recovered(self, v: float, omega: float) -> tuple[float, float]:
+        self.last_v = v
+        return v, omega
+
+    def _turn_rate(self) -> float:
+        return min(RECOVERY_TURN_RAD_S, self.max_angular_rad_s)
+
+    def _recovery_free(self, pose, v: float, omega: float) -> bool:
+        """Whether the chassis driven at (v, omega) for ``RECOVERY_CHECK_S`` keeps ``recovery_margin_m`` from the
+        obstacles near (:meth:`_chassis_gaps`), or no less than it has now (less 1 mm)."""
+        n = max(1, int(math.ceil(RECOVERY_CHECK_S / self.model_dt_s - 1e-9)))
+        controls = np.zeros((1, n, 2), dtype=np.float32)
+        controls[0, :, 0], controls[0, :, 1] = v, omega
+        now = self._chassis_gaps(pose, np.zeros((1, 1, 2), dtype=np.float32))[0, 0]
+        return bool(self._chassis_gaps(pose, controls).min() >= min(self.recovery_margin_m, now - 1e-3))
+
     def _answer(self, pose, v: float, omega: float, observation: Observation) -> NavigationStep:
+        if self.recovery_s > 0.0 and self.recovering is None:
+            self.last_v = v
         command = ControlCommand(wheel_speeds(v, omega, self.geometry), v, omega, 0)
         horizon = self.model_dt_s * self.horizon_steps
         return NavigationStep(command, None, (), Belief(observation.detections, horizon))
+
+
+STILL_M_S = 0.05           # recovery_s: the robot stands while its measured and commanded speeds are below this
+BACK_M_S = 0.2             # recovery_s: the speed it backs off at
+RECOVERY_TURN_RAD_S = 0.6  # recovery_s: the rate it turns on the spot at (at most max_angular_rad_s)
+RECOVERY_CHECK_S = 0.5     # recovery_s: each recovery motion is checked this far ahead (0.3 rad, 0.1 m)
+TURN_SWEEP_RAD = 0.3       # recovery_s: a turn toward the carrot only when it is off by more than this
 
 
 def _resample(points: np.ndarray, spacing_m: float) -> np.ndarray:

@@ -63,3 +63,56 @@ def _nearest_distance(x: np.ndarray, y: np.ndarray, ox: np.ndarray, oy: np.ndarr
     dx = x[:, None] - ox[index]
     dy = y[:, None] - oy[index]
     return np.sqrt(dx * dx + dy * dy).min(axis=1)
+
+
+BOX_NEAREST = 16            # cells kept per rollout point by box_gaps before its exactness check
+
+
+def box_gaps(px: np.ndarray, py: np.ndarray, heading: np.ndarray, box_m: np.ndarray, cx: np.ndarray,
+             cy: np.ndarray, clearance: np.ndarray, within_m: float) -> np.ndarray:
+    """(K, T) float32 gap of the chassis box ``box_m`` ((x_min, y_min, x_max, y_max) in the base frame) at each
+    rollout point (``px``, ``py``) and ``heading`` ((K, T)) to the nearest of N discs (centres ``cx``, ``cy``
+    (N, T) at each step, ``clearance`` (N,): radius plus margin): the box's own distance to a disc centre less
+    the clearance, not its covering discs'.  Exact wherever it is below ``within_m``; elsewhere at least
+    ``within_m`` (the repulsion band ends there, so the cost is the same).  Discs that stand still are searched
+    with a k-d tree about the box's centre (a centre farther than the box's circumscribed radius + its clearance
+    + ``within_m`` cannot come within ``within_m``), the moving ones one by one."""
+    box_m = np.asarray(box_m, dtype=np.float64)
+    half = 0.5 * (box_m[2:] - box_m[:2])
+    mid = 0.5 * (box_m[:2] + box_m[2:])
+    c, s = np.cos(heading).astype(np.float64), np.sin(heading).astype(np.float64)
+    bx = px.astype(np.float64) + mid[0] * c - mid[1] * s                 # the box's centre at each point
+    by = py.astype(np.float64) + mid[0] * s + mid[1] * c
+    gap = np.full(px.shape, np.inf)
+    static = np.all(cx == cx[:, :1], axis=1) & np.all(cy == cy[:, :1], axis=1)
+    clearance = clearance.astype(np.float64)
+
+    def edge(dx, dy, cc, ss):  # distance from the box to offsets (dx, dy) from its centre, in its frame
+        lon, lat = np.abs(dx * cc + dy * ss), np.abs(-dx * ss + dy * cc)
+        return np.hypot(np.maximum(lon - half[0], 0.0), np.maximum(lat - half[1], 0.0))
+
+    index = np.flatnonzero(static)
+    if len(index):
+        ox, oy, oc = cx[index, 0].astype(np.float64), cy[index, 0].astype(np.float64), clearance[index]
+        bound = float(np.hypot(*half) + oc.max() + within_m)
+        tree = cKDTree(np.column_stack([ox, oy]))
+        x, y, cc, ss = bx.ravel(), by.ravel(), c.ravel(), s.ravel()
+        k = min(BOX_NEAREST, len(ox))
+        dist, near = tree.query(np.column_stack([x, y]), k=k, distance_upper_bound=bound)
+        dist, near = dist.reshape(len(x), k), near.reshape(len(x), k)
+        found = near < len(ox)
+        safe = np.where(found, near, 0)
+        g = edge(ox[safe] - x[:, None], oy[safe] - y[:, None], cc[:, None], ss[:, None]) - oc[safe]
+        flat = np.where(found, g, np.inf).min(axis=1)
+        # a centre beyond the k nearest is at least dist[:, -1] from the box's centre: its gap is at least that
+        # less the circumscribed radius and the largest clearance; points where that could be lower search all
+        unsure = np.flatnonzero(np.isfinite(dist[:, -1])
+                                & (dist[:, -1] - np.hypot(*half) - oc.max() < np.minimum(flat, within_m)))
+        for i in unsure:
+            every = np.array(tree.query_ball_point([x[i], y[i]], bound), dtype=int)
+            flat[i] = (edge(ox[every] - x[i], oy[every] - y[i], cc[i], ss[i]) - oc[every]).min()
+        gap = flat.reshape(px.shape)
+    for n in np.flatnonzero(~static):
+        g = edge(cx[n][None, :] - bx, cy[n][None, :] - by, c, s) - clearance[n]
+        np.minimum(gap, g, out=gap)
+    return np.minimum(gap, max(within_m, 0.0) + 1.0).astype(np.float32)
