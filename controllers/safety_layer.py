@@ -18,7 +18,7 @@ The layer is configured per run with the navigator's parameters (``navigator.par
 in ``safety_layer: ClassVar[dict[str, bool]]`` (``replan``: ``{"safety_filter": False, "evade": True}``);
 each switch brings its threshold (:data:`SWITCHES`).  A navigator that offers none takes none.  A switch's
 further options (:data:`OPTIONS`, all off by default) are taken only by a navigator that lists them in
-``safety_layer_options: ClassVar[tuple[str, ...]]`` (``dstar_replan``, ``iaco_local`` and ``immas_stepwise``:
+``safety_layer_options: ClassVar[tuple[str, ...]]`` (``dstar_replan``, ``dwa``, ``iaco_local`` and ``immas_stepwise``:
 ``evade_still_m_s``, ``evade_reverse``, ``evade_turn_cost_m_s_rad``), so the others' parameters stay as they were.
 """
 

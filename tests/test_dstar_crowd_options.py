@@ -165,13 +165,13 @@ def test_the_options_are_bounded_and_offered_by_dstar_replan_alone():
         make_driver("dstar_replan", {"blocked_horizon_s": -1})
     with pytest.raises(ConfigError, match=r"navigator\.params\.evade_still_m_s: must be in \[0, 5\], got 6"):
         make_driver("dstar_replan", {"evade_still_m_s": 6})
-    for other in ("replan", "velocity_obstacle", "dwa", "mppi"):
+    for other in ("replan", "velocity_obstacle", "mppi"):
         names = {row["name"] for row in navigator_table(other)}
         assert not names & {"evade_still_m_s", "evade_reverse", "evade_turn_cost_m_s_rad", "blocked_horizon_s",
                             "corner_merge_m"}, other
         with pytest.raises(ConfigError, match=r"evade_reverse: unknown parameter"):
             make_driver(other, {"evade_reverse": True})
-    for paper_navigator in ("iaco_local", "immas_stepwise"):  # the evasion's options, not dstar_replan's own
+    for paper_navigator in ("iaco_local", "immas_stepwise", "dwa"):  # the evasion's options, not dstar_replan's own
         names = {row["name"] for row in navigator_table(paper_navigator)}
         assert {"evade_still_m_s", "evade_reverse", "evade_turn_cost_m_s_rad"} <= names, paper_navigator
         assert not names & {"blocked_horizon_s", "corner_merge_m"}, paper_navigator

@@ -73,7 +73,7 @@ instead of stopping there (the freezing robot problem, Trautman & Krause 2010); 
 of the string-pulled path closer than this to the last one kept are dropped (a path adopted round sweeps pulls
 into a staircase of corners a cell apart, at each of which the controller turned on the spot).  The evasion's
 options ``evade_still_m_s``, ``evade_turn_cost_m_s_rad`` and ``evade_reverse`` (:mod:`controllers.evasion`) are
-offered by this navigator (``safety_layer_options``; ``iaco_local`` and ``immas_stepwise`` offer them too).
+offered by this navigator (``safety_layer_options``; ``dwa``, ``iaco_local`` and ``immas_stepwise`` offer them too).
 
 ``cell_m`` = 0 uses the scenario's ``sim.cell_m`` (a map scenario's own cells
 always).  The optional safety filter (``safety_filter``) is the same layer's.

@@ -144,6 +144,8 @@ class DynamicWindowNavigator:
 
     name: ClassVar[str] = "dwa"
     safety_layer: ClassVar[dict[str, bool]] = {"safety_filter": False, "evade": False}  # controllers.safety_layer
+    # The evasion's options (controllers.evasion), off by default, as dstar_replan offers them (docs/navigation.md).
+    safety_layer_options: ClassVar[tuple[str, ...]] = ("evade_still_m_s", "evade_reverse", "evade_turn_cost_m_s_rad")
     uses_detections: ClassVar[bool] = True
     uses_planner: ClassVar[bool] = False
     replan_wall_s: ClassVar[float] = 0.0  # plans nothing in step()
