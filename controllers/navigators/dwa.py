@@ -311,8 +311,9 @@ class DynamicWindowNavigator:
     def _recover(self, observation: Observation, target: np.ndarray) -> tuple[float, float] | None:
         """``recovery_s`` > 0: after the window's best pair has stood still that long, turn on the spot toward
         the carrot (the other way if that way is blocked), else back off ``recovery_back_m`` straight, each
-        while :meth:`_free`; (v, omega) to command, or None when aligned or nothing is free (the window decides
-        again, standing still left out)."""
+        while :meth:`_free`; with ``recovery_back = "carrot"`` a carrot behind that the robot has no room to turn
+        to is first reversed toward (rear steered to it); (v, omega) to command, or None when aligned or nothing is
+        free (the window decides again, standing still left out)."""
         pose = observation.pose
         c, s = math.cos(pose.heading_rad), math.sin(pose.heading_rad)
         err = wrap_angle_rad(math.atan2(target[1] - pose.y_m, target[0] - pose.x_m) - pose.heading_rad)
