@@ -20,6 +20,7 @@ from swarmnav.models.geometry import segment_box_distances, segment_disc_distanc
 from swarmnav.models.world import Pose2D
 
 SIGHT_SLACK_M = 1e-6  # PathCarrot._visible: discs this much beyond a segment's reach are still measured
+SIGHT_SHRINK_M = 1e-6  # PathCarrot.sight_shrink: the lowered radius is this much below the robot's clearance
 
 
 def local_setup(setup: NavigationSetup, margin_m: float, lookahead_m: float, carrot_in_sight: bool = False,
@@ -58,6 +59,11 @@ class PathCarrot:
     a handful of segments, for which a loop costs a few microseconds where NumPy's
     per-call overhead cost a hundred or more.
     """
+
+    # Whether the sight test's radius is lowered to the robot's clearance now while the robot stands within it
+    # of a disc (:meth:`_first_visible`; set by ``dwa``'s ``sight_inside = "shrink"``; a class default, so that
+    # a replanned path (:meth:`~controllers.guided.GuidedCarrot._restart`) keeps the instance's choice).
+    sight_shrink: bool = False
 
     def __init__(self, waypoints: np.ndarray, lookahead_m: float):
         pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
@@ -136,6 +142,8 @@ class PathCarrot:
         lengths = np.hypot(points[:, 0] - origin[0], points[:, 1] - origin[1])
         if len(centres):
             gap = np.hypot(centres[:, 0] - origin[0], centres[:, 1] - origin[1]) - radii
+            if self.sight_shrink and len(gap):  # the robot stands within the radius of a disc: no nearer than now
+                radius = max(0.0, min(radius, float(gap.min()) - SIGHT_SHRINK_M))
             near = np.flatnonzero(gap <= float(lengths.max()) + radius + SIGHT_SLACK_M)
             centres, radii, gap = centres[near], radii[near], gap[near]
         for k in range(len(points)):

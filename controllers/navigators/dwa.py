@@ -140,6 +140,23 @@ class DynamicWindowNavigator:
         recovery_turn_rad_s, recovery_back_m, recovery_margin_m: the recovery's turn rate, how far it backs off
             (0: it does not), and the clearance its motions keep (0.035 m: half a 0.05 m sensed cell's diagonal,
             below ``margin_m``, which is what the robot stands inside).
+        sight_inside: what the carrot's sight test (``carrot_in_sight``) does while the robot stands within the
+            sight radius of an obstacle: ``"block"`` (default, as before: every segment from the robot starts
+            blocked, no sample is in sight and the carrot is the robot's own projection on the path) or
+            ``"shrink"`` (named option, ours): the sight radius is lowered to the clearance the robot has now, so
+            a sample counts as in sight when the straight way to it comes no nearer to any obstacle than the robot
+            stands (as ``inside_margin = "shrink"`` does for the arcs).  Why: on BARN (``footprint = "box"``, the
+            sight radius 0.265 m) the robot stood beside a cylinder, its carrot a few centimetres from itself,
+            and turned back and forth on the spot until the time limit.
+        recovery_back: how the recovery backs off: ``"straight"`` (default, as before: only when no turn toward the
+            carrot is free, straight along the chassis' axis) or ``"carrot"`` (named option, ours): when the carrot
+            is behind the robot (more than 90 degrees off) and the whole turn on the spot to face it is not free,
+            the recovery first reverses ``recovery_back_m`` at 0.1 m/s with its rear steered toward the carrot
+            (turn rate 2 x the rear's bearing error, at most ``recovery_turn_rad_s``; straight if that arc is not
+            free), each second of it kept free as the other motions are.  Why: on BARN the guidance path, replanned
+            from a robot that had driven into a pocket, led back behind it; the Jackal's box could not turn on the
+            spot there, the recovery turned ~30 degrees either way, the window stood still (every forward arc met
+            a cylinder within centimetres) and the robot stayed until the time limit (worlds 118, 256, 260).
     """
 
     name: ClassVar[str] = "dwa"
@@ -177,6 +194,8 @@ class DynamicWindowNavigator:
     recovery_turn_rad_s: float = param(0.6, above(0, 100))
     recovery_back_m: float = param(0.0, within(0, 10))
     recovery_margin_m: float = param(0.035, within(0, 100))
+    sight_inside: str = param("block", choices=("block", "shrink"))
+    recovery_back: str = param("straight", choices=("straight", "carrot"))
 
     def __post_init__(self) -> None:
         if self.horizon_s < self.sim_step_s:  # no rollout step at all
@@ -188,12 +207,14 @@ class DynamicWindowNavigator:
         self.centred, self.discs, radius = box_guidance(setup, self.footprint, self.cost_weight, self.cost_reach_m)
         (self.geometry, self.max_speed, self.inflation, self.local, self.carrot, self.goal) = local_setup(
             setup, self.margin_m, self.lookahead_m, self.carrot_in_sight, self.centred, radius, self.speed_cap_m_s)
+        if self.sight_inside == "shrink":
+            self.carrot.sight_shrink = True
         self.goal_tolerance_m = setup.goal.tolerance_m
         self.world_map = setup.world_map
         self._lattice: tuple[int, LatticeDiscs | None] | None = None  # (the sensed map's revision, its cells)
         self.control_dt_s = setup.control_dt_s
         self.stopped_s = 0.0          # how long the window's best pair has been standing still
-        self.recovering: tuple[str, float] | None = None  # ("turn", +-1) or ("back", metres left)
+        self.recovering: tuple[str, float] | None = None  # ("turn", +-1), ("back" / "reverse", metres left)
         self.times = np.arange(1, int(round(self.horizon_s / self.sim_step_s)) + 1) * self.sim_step_s  # (T,)
         self.reach = self.max_speed * self.horizon_s + 1.0
         # The lattice V_s and its arcs in the robot's frame (start at the origin facing +x).
@@ -292,12 +313,27 @@ class DynamicWindowNavigator:
     def _recover(self, observation: Observation, target: np.ndarray) -> tuple[float, float] | None:
         """``recovery_s`` > 0: after the window's best pair has stood still that long, turn on the spot toward
         the carrot (the other way if that way is blocked), else back off ``recovery_back_m`` straight, each
-        while :meth:`_free`; (v, omega) to command, or None when aligned or nothing is free (the window decides
-        again, standing still left out)."""
+        while :meth:`_free`; with ``recovery_back = "carrot"`` a carrot behind that the robot has no room to turn
+        to is first reversed toward (rear steered to it); (v, omega) to command, or None when aligned or nothing is
+        free (the window decides again, standing still left out)."""
         pose = observation.pose
         c, s = math.cos(pose.heading_rad), math.sin(pose.heading_rad)
         err = wrap_angle_rad(math.atan2(target[1] - pose.y_m, target[0] - pose.x_m) - pose.heading_rad)
         n_t, step_rad = len(self.times), 0.3
+        if self.recovering is None and self.recovery_back == "carrot" and self.recovery_back_m > 0.0 \
+                and abs(err) > 0.5 * math.pi and not self._free(  # the carrot behind, no room to turn to face it
+                    pose, c, s, observation, np.linspace(0.0, err, max(n_t, math.ceil(abs(err) / 0.05)) + 1)[1:], 0.0):
+            self.recovering = ("reverse", self.recovery_back_m)
+        if self.recovering is not None and self.recovering[0] == "reverse":
+            left = self.recovering[1] - 0.1 * self.control_dt_s
+            rear_err = wrap_angle_rad(err - math.pi)  # the carrot's bearing from the rear
+            w_back = float(np.clip(2.0 * rear_err, -self.recovery_turn_rad_s, self.recovery_turn_rad_s))
+            w_back = float(np.clip(w_back, -self.max_angular_rad_s, self.max_angular_rad_s))
+            for w_try in dict.fromkeys((w_back, 0.0)):  # the rear steered toward the carrot, else straight
+                if left > 0.0 and self._free(pose, c, s, observation, w_try * np.arange(1, n_t + 1) / n_t, -0.1):
+                    self.recovering = ("reverse", left)
+                    return -0.1, w_try
+            self.recovering = None
         if self.recovering is None:
             turns = (math.copysign(1.0, err), -math.copysign(1.0, err)) if abs(err) > step_rad else ()
             for sign in turns:
