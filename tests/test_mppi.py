@@ -46,7 +46,10 @@ def test_mppi_reaches_the_goal_without_collision_and_repeats_itself(kind):
 
 @pytest.mark.parametrize("field, value", [("max_accel_m_s2", -1.0), ("max_accel_m_s2", 2000.0),
                                           ("hard_check_s", -0.1), ("hard_check_s", 11.0),
-                                          ("hard_margin_m", -0.01), ("hard_margin_m", 2.0)])
+                                          ("hard_margin_m", -0.01), ("hard_margin_m", 2.0),
+                                          ("recovery_s", -1.0), ("recovery_s", 2000.0),
+                                          ("recovery_back_m", -0.1), ("recovery_back_m", 11.0),
+                                          ("recovery_margin_m", -0.01), ("recovery_margin_m", 2.0)])
 def test_the_barn_options_are_bounded_and_name_the_field(field, value):
     with pytest.raises(ConfigError, match=f"navigator.params.{field}"):
         make_navigator("mppi", {field: value})
@@ -93,14 +96,6 @@ def test_the_acceleration_limit_keeps_mppi_off_the_cylinder_it_hit_on_barn_world
     limited = run_episode(EpisodeSpec(scenario, navigator="mppi",
                                       navigator_params={**BARN_MPPI, "max_accel_m_s2": 2.0})).result
     assert limited.reached and limited.collisions == 0
-
-
-@pytest.mark.parametrize("field, value", [("recovery_s", -1.0), ("recovery_s", 2000.0),
-                                          ("recovery_back_m", -0.1), ("recovery_back_m", 11.0),
-                                          ("recovery_margin_m", -0.01), ("recovery_margin_m", 2.0)])
-def test_the_recovery_options_are_bounded_and_name_the_field(field, value):
-    with pytest.raises(ConfigError, match=f"navigator.params.{field}"):
-        make_navigator("mppi", {field: value})
 
 
 def test_box_rollouts_need_the_box_footprint():

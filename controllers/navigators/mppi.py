@@ -191,7 +191,7 @@ class MppiNavigator:
         self.hard_steps = min(self.horizon_steps, int(math.ceil(self.hard_check_s / self.model_dt_s - 1e-9)))
         self.optimised_at_s = -1.0
         self.stopped_s, self.last_time_s, self.last_v, self.recovering = 0.0, None, 0.0, None
-        self.target = None
+        self.target, self.near = None, None  # the carrot and the obstacles near, once the optimiser has run
         self.nominal = np.zeros((self.horizon_steps, 2), dtype=np.float32)
         self.std = np.array([self.linear_std_m_s * scale, self.angular_std_rad_s], dtype=np.float32)
         self.lo = np.array([0.0, -self.max_angular_rad_s], dtype=np.float32)
@@ -436,7 +436,7 @@ class MppiNavigator:
         if self.recovering is None:
             still = abs(observation.twist.linear_m_s) < STILL_M_S and abs(self.last_v) < STILL_M_S
             self.stopped_s = self.stopped_s + dt if still else 0.0
-            if self.stopped_s < self.recovery_s or self.target is None or not hasattr(self, "near"):
+            if self.stopped_s < self.recovery_s or self.target is None or self.near is None:
                 return None
             self.stopped_s = 0.0
             err = wrap_angle_rad(math.atan2(self.target[1] - pose.y_m, self.target[0] - pose.x_m) - pose.heading_rad)
@@ -450,7 +450,6 @@ class MppiNavigator:
                     self.recovering = ["back", self.recovery_back_m]
             if self.recovering is None:
                 return None
-            self.recoveries = getattr(self, "recoveries", 0) + 1
         else:
             self.recovering[1] = self.recovering[1] - (BACK_M_S * dt if self.recovering[0] == "back" else 0.0)
         if self.recovering[0] == "turn":
