@@ -1,5 +1,8 @@
 """Bounds before work (issue 36): every count, size and duration has a stated maximum in
-models/scenario_limits.py, checked before anything of that size is allocated or run."""
+models/scenario_limits.py, checked before anything of that size is allocated or run.
+
+The time bounds below are on this process's CPU time (time.process_time), the work done, not on wall time: a
+run that took 53 s of wall time beside three benchmarks (load ~5) was not a run that did unbounded work."""
 
 from __future__ import annotations
 
@@ -53,10 +56,10 @@ def discs_text(count: int, side_m: float = 150.0) -> str:
 
 def test_more_static_obstacles_than_the_maximum_are_refused_before_they_are_placed():
     text = discs_text(limits.MAX_STATIC_OBSTACLES + 1)
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     with pytest.raises(ConfigError, match="MAX_STATIC_OBSTACLES"):
         parse_scenario(text, "many.toml")
-    assert time.perf_counter() - t0 < 30
+    assert time.process_time() - t0 < 30
 
 
 def test_an_exact_tangent_graph_beyond_its_maximum_is_refused_and_a_run_takes_theta_star_for_spl(capsys, tmp_path):
@@ -64,10 +67,10 @@ def test_an_exact_tangent_graph_beyond_its_maximum_is_refused_and_a_run_takes_th
     path.write_text(discs_text(limits.MAX_TANGENT_GRAPH_DISCS + 1, side_m=60.0))
     err = refused(capsys, ["plan", str(path), "--planner", "optimal"])
     assert "MAX_TANGENT_GRAPH_DISCS" in err
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     code, err = exit_and_line(capsys, ["run", str(path), "--planner", "straight", "--no-log", "--json"])
     out = exit_and_line.out
-    assert code == 0 and time.perf_counter() - t0 < 30, err
+    assert code == 0 and time.process_time() - t0 < 30, err
     import json
     # L* from Theta* beyond the exact graph's maximum (sim.reference), not the refused tangent graph
     assert json.loads(out)["spl"] is not None
