@@ -389,13 +389,13 @@ def run(args: argparse.Namespace) -> int:
     suite = None if args.suite == "dyn" else args.suite
     barn = _barn_options(args, suite)
     if suite is None and getattr(args, "sensor_model", None):
-        raise ConfigError("--sensor-model", "applies to a generated suite (--suite dyn300) only")
+        raise ConfigError("--sensor-model", "applies to a generated suite (--suite dyn300, crowdnav) only")
     if getattr(args, "address", None) and getattr(args, "engine", "local") != "ray":
         raise ConfigError("--address", "applies to --engine ray only")
     if suite is None and getattr(args, "seed_offset", 0):
-        raise ConfigError("--seed-offset", "applies to a generated suite (--suite dyn300) only")
+        raise ConfigError("--seed-offset", "applies to a generated suite (--suite dyn300, crowdnav) only")
     if suite is None and getattr(args, "per_group", None):
-        raise ConfigError("--per-group", "applies to a generated suite (--suite dyn300) only")
+        raise ConfigError("--per-group", "applies to a generated suite (--suite dyn300, crowdnav) only")
     arms = [parse_arm(text) for text in getattr(args, "arm", None) or []]
     if getattr(args, "arms", None):
         arms += read_arms(args.arms)
@@ -456,7 +456,7 @@ def _barn_options(args: argparse.Namespace, suite: str | None) -> dict[str, Any]
         return None
     for option in ("sensor_model", "per_group", "seed_offset"):
         if getattr(args, option, None):
-            raise ConfigError(f"--{option.replace('_', '-')}", "applies to --suite dyn300 only")
+            raise ConfigError(f"--{option.replace('_', '-')}", "applies to a generated suite (--suite dyn300, crowdnav) only")
     from swarmnav.benchmarks.barn import barn_dir, parse_planner, parse_worlds
     if suite == "barn":
         barn_dir(given["dir"])  # no data: one line before anything runs

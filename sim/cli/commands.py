@@ -186,12 +186,15 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"1 world seed on {', '.join(BENCH_NAVIGATION_QUICK_SCENARIOS)} (under a minute); "
                              "with --suite dyn300: a stratified sample, 2 scenes per group")
     parser.add_argument("--per-group", type=SEEDS, metavar="N",
-                        help="--suite dyn300 only: a stratified sample of N scenes per group (--quick: 2)")
+                        help="a generated suite only (--suite dyn300, crowdnav): a stratified sample of N scenes per "
+                             "group, spread over the group (--quick: 2)")
     parser.add_argument("--seed-offset", type=options.int_in(0, 2**62), default=0, metavar="N",
-                        help="--suite dyn300 only: every group's seeds shifted by N, a held-out set of the same "
+                        help="a generated suite only (--suite dyn300, crowdnav): every group's seeds shifted by N, a "
+                             "held-out set of the same "
                              "families (no shipped verdicts: the oracle decides each scene in the run)")
     parser.add_argument("--sensor-model", choices=("detector", "rangefinder"),
-                        help="--suite dyn300 only: every scene with this sensing (rangefinder: 12 at 1 m)")
+                        help="a generated suite only (--suite dyn300, crowdnav): every scene with this sensing "
+                             "(rangefinder: 12 at 1 m)")
     parser.add_argument("--workers", type=WORKERS, default=1,
                         help="local worker processes for the runs (default 1: in this process); with --engine "
                              "ray: the local instance's CPUs")
