@@ -183,3 +183,26 @@ def test_bench_navigation_map_and_pose_reach_every_run_and_row(tmp_path, capsys)
     import pandas as pd
     runs = pd.read_parquet(tmp_path / "out" / "runs.parquet")
     assert set(runs.map_knowledge) == {"unknown"} and set(runs.pose_source) == {"odometry"} and len(runs) == 2
+
+
+def test_a_group_slice_is_each_groups_contiguous_seeds_so_a_validation_range_is_exact():
+    # CrowdNav's validation cases 500-749 in both settings: --seed-offset 500 --per-group 0:250
+    suite = load_suite("crowdnav", seed_offset=500)
+    scenes = stratified_sample(suite, (0, 250))
+    by_group = {g: [s.seed for s in scenes if s.group == g] for g in ("circle-invisible", "circle-visible")}
+    assert by_group["circle-invisible"] == by_group["circle-visible"] == list(range(500, 750))
+    assert [s.seed for s in stratified_sample(suite, (490, 600)) if s.group == "circle-visible"] == list(range(990, 1000))
+    # the spread sample it does not replace: every other case of 500-999
+    spread = [s.seed for s in stratified_sample(suite, 250) if s.group == "circle-invisible"]
+    assert spread[:3] == [501, 503, 505] and len(spread) == 250
+
+
+@pytest.mark.parametrize("value", ["5:5", "7:3", "-1:4", "0:99999999999", "a:b", ":3"])
+def test_a_bad_group_slice_is_one_line_exit_2(capsys, value):
+    from swarmnav.cli.main import main
+    try:
+        code = main(["bench", "navigation", "--suite", "crowdnav", "--per-group", value])
+    except SystemExit as exc:
+        code = exc.code
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "--per-group" in err, err

@@ -130,8 +130,14 @@ def _seed_range(group: TomlTable) -> tuple[int, int]:
     return seeds[0], seeds[1]
 
 
-def stratified_sample(suite: Suite, per_group: int = 2) -> tuple[SuiteScene, ...]:
-    """``per_group`` scenes of each group, spread over the group's order (``bench navigation --quick``)."""
+def stratified_sample(suite: Suite, per_group: int | tuple[int, int] = 2) -> tuple[SuiteScene, ...]:
+    """``per_group`` scenes of each group, spread over the group's order (``bench navigation --quick``); or, with
+    ``per_group = (first, end)``, each group's scenes ``first`` to ``end - 1`` in seed order (a contiguous slice:
+    with ``seed_offset`` 500, ``(0, 250)`` of ``crowdnav`` are CrowdNav's cases 500-749 in both settings)."""
+    if isinstance(per_group, tuple):
+        first, end = per_group
+        return tuple(scene for group in dict.fromkeys(s.group for s in suite.scenes)
+                     for scene in sorted((s for s in suite.scenes if s.group == group), key=lambda s: s.seed)[first:end])
     out = []
     for group in dict.fromkeys(s.group for s in suite.scenes):
         members = [s for s in suite.scenes if s.group == group]

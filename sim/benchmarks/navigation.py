@@ -194,9 +194,10 @@ def oracle_verdicts(rows: list[dict[str, Any]]) -> dict[tuple[str, int], dict[st
 
 
 def write_suite(suite_name: str, quick: bool, sensor_model: str | None, folder: str,
-                per_group: int | None = None, seed_offset: int = 0) -> tuple[list[str], Any]:
+                per_group: int | tuple[int, int] | None = None, seed_offset: int = 0) -> tuple[list[str], Any]:
     """The suite's scenes as TOML files under ``folder`` (paths, in order of difficulty) and the suite;
-    ``quick``: a stratified sample of 2 scenes per group, ``per_group``: of that many; ``seed_offset``: the
+    ``quick``: a stratified sample of 2 scenes per group, ``per_group``: of that many (or, ``(first, end)``, each
+    group's scenes first to end - 1 in seed order: :func:`models.suites.stratified_sample`); ``seed_offset``: the
     held-out scenes of the same groups (:func:`models.suites.load_suite`)."""
     import os
     from swarmnav.models.suites import load_suite, stratified_sample
@@ -217,7 +218,7 @@ def benchmark_navigation(seeds: int = 5, navigators: list[str] | None = None, sc
                          progress: bool = False, navigator_params: dict[str, dict[str, Any]] | None = None,
                          by_scenario: bool = False, out_dir: str | None = None, suite: str | None = None,
                          quick: bool = False, sensor_model: str | None = None,
-                         workers: int = 1, speed: bool = True, per_group: int | None = None,
+                         workers: int = 1, speed: bool = True, per_group: int | tuple[int, int] | None = None,
                          arms: list[Arm] = (), engine: str = "local", address: str | None = None,
                          seed_offset: int = 0, barn: dict[str, Any] | None = None,
                          knowledge: dict[str, Any] | None = None) -> list[dict[str, Any]]:

@@ -29,6 +29,21 @@ RUNS = options.int_in(1, MAX_BENCH_RUNS)
 SEEDS = options.int_in(1, MAX_BENCH_SEEDS)
 WORKERS = options.int_in(1, MAX_WORKERS)
 
+
+def per_group_type(text: str) -> int | tuple[int, int]:
+    """``--per-group``: ``N`` (N scenes spread over each group) or ``A:B`` (each group's scenes A to B-1, in seed
+    order), every count within MAX_BENCH_SEEDS."""
+    if ":" not in text:
+        return SEEDS(text)
+    first_text, _, end_text = text.partition(":")
+    first, end = options.int_in(0, MAX_BENCH_SEEDS)(first_text), options.int_in(1, MAX_BENCH_SEEDS)(end_text)
+    if end <= first:
+        raise argparse.ArgumentTypeError(f"A:B needs A < B, got {text[:40]}")
+    return first, end
+
+
+per_group_type.__name__ = "N or A:B"
+
 Adder = Callable[[argparse.ArgumentParser], None]
 Runner = Callable[[argparse.Namespace], int]
 
@@ -185,9 +200,11 @@ def add_bench_navigation_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quick", action="store_true",
                         help=f"1 world seed on {', '.join(BENCH_NAVIGATION_QUICK_SCENARIOS)} (under a minute); "
                              "with --suite dyn300: a stratified sample, 2 scenes per group")
-    parser.add_argument("--per-group", type=SEEDS, metavar="N",
+    parser.add_argument("--per-group", type=per_group_type, metavar="N|A:B",
                         help="a generated suite only (--suite dyn300, crowdnav): a stratified sample of N scenes per "
-                             "group, spread over the group (--quick: 2)")
+                             "group, spread over the group (--quick: 2); A:B: each group's scenes A to B-1 in seed "
+                             "order (with --seed-offset 500, --per-group 0:250 runs CrowdNav's validation cases "
+                             "500-749)")
     parser.add_argument("--seed-offset", type=options.int_in(0, 2**62), default=0, metavar="N",
                         help="a generated suite only (--suite dyn300, crowdnav): every group's seeds shifted by N, a "
                              "held-out set of the same "
