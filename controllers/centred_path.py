@@ -17,13 +17,13 @@ No MuJoCo here.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from swarmnav.controllers.footprint import cell_penalty, no_costlier
 from swarmnav.models.geometry import segment_disc_distances
-from swarmnav.models.world import OccupancyGrid, rasterise
+from swarmnav.models.world import Disc, OccupancyGrid, rasterise
 from swarmnav.planners.errors import NoPathFound
 from swarmnav.planners.grid_graph import Cell, grid_line_of_sight
 from swarmnav.planners.problem import Problem
@@ -41,15 +41,31 @@ class CentredPlanner:
         block_m: cells whose centre lies within this (plus half a cell diagonal) of an obstacle are blocked.
         weight: the penalty's weight (0: shortest paths on the blocked cells).
         reach_m: how far from a blocked cell the penalty reaches.
+        pockets: discs planned around as obstacles besides the problem's (none at first): where a navigator that
+            uses it stood stuck (``mppi``'s ``recovery_block_m``); :meth:`plan` forgets them when no path
+            passes them.
     """
 
     block_m: float
     weight: float
     reach_m: float
+    pockets: tuple[Disc, ...] = ()
     _cache: tuple = field(default=(), init=False, repr=False)
+    _with_pockets: tuple = field(default=(), init=False, repr=False)
+
+    def _problem(self, problem: Problem) -> Problem:
+        """``problem`` with :attr:`pockets` among its obstacles (itself when there are none); the same object
+        while neither changes, so that :meth:`cells`' cache holds."""
+        if not self.pockets:
+            return problem
+        if not self._with_pockets or self._with_pockets[0] is not problem or self._with_pockets[1] != self.pockets:
+            self._with_pockets = (problem, self.pockets,
+                                  replace(problem, obstacles=tuple(problem.obstacles) + self.pockets))
+        return self._with_pockets[2]
 
     def cells(self, problem: Problem) -> tuple[OccupancyGrid, np.ndarray | None]:
         """(the blocked cells, their penalty or None) of ``problem``'s obstacles; kept while the problem is."""
+        problem = self._problem(problem)
         if not self._cache or self._cache[0] is not problem:
             grid = rasterise(problem.bounds, problem.obstacles, problem.boxes, self.block_m, problem.cell_m)
             occupied = np.asarray(grid.occupied, dtype=bool)
@@ -76,8 +92,17 @@ class CentredPlanner:
         """(n, 2) waypoints from ``start_xy`` to ``problem``'s goal.
 
         Raises:
-            NoPathFound: no free cell near the start, or none of its paths reaches the goal's cell.
+            NoPathFound: no free cell near the start, or none of its paths reaches the goal's cell (with
+                :attr:`pockets`, first planned with them, then, forgetting them, without).
         """
+        if self.pockets:
+            try:
+                return self._plan(problem, start_xy)
+            except NoPathFound:
+                self.pockets = ()
+        return self._plan(problem, start_xy)
+
+    def _plan(self, problem: Problem, start_xy: tuple[float, float]) -> np.ndarray:
         grid, penalty = self.cells(problem)
         occupied = np.asarray(grid.occupied, dtype=bool)
         start = _free_cell_near(occupied, grid, start_xy)
@@ -98,6 +123,7 @@ class CentredPlanner:
         pts = np.asarray(waypoints_m, dtype=float).reshape(-1, 2)
         if len(pts) < 2:
             return False
+        problem = self._problem(problem)
         grid = self._cache[1] if self._cache and self._cache[0] is problem else self._path_grid(problem, pts)
         samples = [pts[:1]]
         for a, b in zip(pts[:-1], pts[1:]):

@@ -31,7 +31,7 @@ from swarmnav.controllers.footprint import block_radius_m, covering_discs
 from swarmnav.controllers.guidance import PathCarrot
 from swarmnav.controllers.navigator import NavigationSetup
 from swarmnav.controllers.prediction import LocalObstacles
-from swarmnav.models.world import OccupancyGrid, Pose2D
+from swarmnav.models.world import Disc, OccupancyGrid, Pose2D
 from swarmnav.planners.errors import PlanningError, StartBlocked
 from swarmnav.planners.problem import Problem
 
@@ -95,6 +95,15 @@ class GuidedCarrot(PathCarrot):
                 self._replan(known, pose)
         self.time_s += self.setup.control_dt_s
         return super().update(pose, window_m)
+
+    def block_pocket(self, pocket: Disc, pose: Pose2D) -> None:
+        """Plan the guidance path from ``pose`` around ``pocket`` as well from now on, at once (with a
+        :class:`~controllers.centred_path.CentredPlanner` only, which forgets its pockets when no path passes
+        them); ``mppi``'s ``recovery_block_m``."""
+        if self.centred is None:
+            return
+        self.centred.pockets = self.centred.pockets + (pocket,)
+        self._replan(self.setup.map_problem, pose)
 
     def _replan(self, known, pose: Pose2D) -> None:
         if self.centred is not None:

@@ -42,6 +42,22 @@ def test_the_centred_planner_keeps_to_the_middle_of_a_passage_the_circle_closes(
     assert planner.blocks(problem, np.array([[1.2, 1.5], [1.2, 6.5]]), 0.0)  # straight through the cylinders
 
 
+def test_a_pocket_closes_the_passage_it_stands_in_and_is_forgotten_when_no_other_way_passes():
+    """``CentredPlanner.pockets`` (mppi's ``recovery_block_m``): with a second passage in the row, a pocket in the
+    first sends the path through the second; with the first passage the only one, the pocket is forgotten and the
+    path goes through it as before."""
+    two = replace(gap_problem(), obstacles=tuple(Disc(x, 4.0, 0.075) for x in ROW if not 0.9 < x < 1.7))
+    planner = CentredPlanner(0.215, 10.0, 0.3)
+    assert abs(np.interp(4.0, *planner.plan(two, (2.5, 1.5))[:, ::-1].T) - 2.5) <= 0.05   # the middle one, nearest
+    planner.pockets = (Disc(2.5, 3.9, 0.1),)
+    path = planner.plan(two, (2.5, 1.5))
+    assert abs(np.interp(4.0, *path[:, ::-1].T) - 1.3) <= 0.2 and planner.pockets          # the other one, kept
+    assert planner.blocks(two, np.array([[2.5, 1.5], [2.5, 6.5]]), 0.0)                       # the pocket blocks
+    alone = CentredPlanner(0.215, 10.0, 0.3, pockets=(Disc(2.5, 3.9, 0.1),))
+    path = alone.plan(gap_problem(), (2.5, 1.5))
+    assert alone.pockets == () and abs(np.interp(4.0, *path[:, ::-1].T) - 2.5) <= 0.05
+
+
 def test_the_covering_discs_cover_the_jackal_box_and_are_smaller_than_its_circumscribed_circle():
     setup = type("S", (), {})()
     setup.scenario = parse_scenario(GAP, "<jackal gap>")

@@ -49,10 +49,19 @@ def test_mppi_reaches_the_goal_without_collision_and_repeats_itself(kind):
                                           ("hard_margin_m", -0.01), ("hard_margin_m", 2.0),
                                           ("recovery_s", -1.0), ("recovery_s", 2000.0),
                                           ("recovery_back_m", -0.1), ("recovery_back_m", 11.0),
-                                          ("recovery_margin_m", -0.01), ("recovery_margin_m", 2.0)])
+                                          ("recovery_margin_m", -0.01), ("recovery_margin_m", 2.0),
+                                          ("recovery_block_m", -0.01), ("recovery_block_m", 1.5)])
 def test_the_barn_options_are_bounded_and_name_the_field(field, value):
     with pytest.raises(ConfigError, match=f"navigator.params.{field}"):
         make_navigator("mppi", {field: value})
+
+
+@pytest.mark.parametrize("params", [{"recovery_block_m": 0.1, "recovery_s": 1.0},
+                                    {"recovery_block_m": 0.1, "footprint": "box"}])
+def test_the_pocket_block_needs_the_box_and_the_recovery(params):
+    with pytest.raises(ConfigError, match="navigator.params.recovery_block_m"):
+        make_navigator("mppi", params)
+    make_navigator("mppi", {**params, "footprint": "box", "recovery_s": 1.0})
 
 
 def test_the_hard_check_replaces_a_sequence_that_drives_the_box_into_a_cylinder():
@@ -188,3 +197,20 @@ def test_box_rollouts_with_the_recovery_reach_the_goal_on_barn_world_99(tmp_path
     params = {**BARN_MPPI, "box_rollouts": True, "margin_m": 0.035, "recovery_s": 1.0, "hard_check_s": 0.5}
     result = run_episode(EpisodeSpec(load_scenario(path), navigator="mppi", navigator_params=params)).result
     assert result.reached and result.collisions == 0
+
+
+@pytest.mark.skipif(not (Path(__file__).resolve().parents[2] / "shared/benchmarks/barn/worlds").is_dir()
+                    and not os.environ.get("SWARMNAV_BARN_DIR"), reason="the BARN data (../shared) is not here")
+def test_blocking_the_pocket_it_backed_out_of_reaches_the_goal_on_barn_world_140(tmp_path):
+    """BARN world 140 (not a test world), run 1: with the box rollouts, the hard check and the recovery, the robot
+    backs out of a gap the box cannot turn in and drives into it again until the time limit (measured: timeout at
+    100 s, 44 s of CPU, so not rerun here); with ``recovery_block_m = 0.1`` the guidance is replanned around that
+    pocket and it reaches the goal untouched."""
+    from swarmnav.benchmarks.barn import write_barn_suite
+    from swarmnav.models.scenario import load_scenario
+    paths, _, _ = write_barn_suite(str(tmp_path), False, worlds=(140,), runs=2)
+    params = {**BARN_MPPI, "box_rollouts": True, "margin_m": 0.035, "recovery_s": 1.0, "hard_check_s": 0.5,
+              "recovery_block_m": 0.1}
+    episode = run_episode(EpisodeSpec(load_scenario(paths[1]), navigator="mppi", navigator_params=params))
+    assert episode.result.reached and episode.result.collisions == 0
+    assert episode.navigator.pockets >= 1                                # the guidance went round a pocket
