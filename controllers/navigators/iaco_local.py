@@ -72,6 +72,10 @@ invisible, issue 35; diagnosed on validation cases 500-999 only), each off by de
   behind people who had stopped on it) or when a sensed obstacle slower than ``standing_m_s`` stands on them;
   such obstacles' cells are blocked for that plan (their reach plus :data:`STANDING_CLEARANCE_M`), at most every
   ``replan_period_s``.
+* ``arc_cap``: the run's controller holds its forward speed to what reaches the active waypoint on an arc at its
+  top turn rate (:class:`~controllers.point_to_point.PointToPointController`'s ``arc_cap``).  With
+  ``turn_in_place_deg = 60`` the robot drove at up to 0.5 m/s, 1.2 rad/s (a 0.42 m circle) round a corner left
+  beside it by the evasion or a replan, never within the controller's 0.05 m, until the time limit.
 """
 
 from __future__ import annotations
@@ -124,9 +128,9 @@ class IacoLocalNavigator:
         map_updates, footprint, drive, max_decel_m_s2, replan_period_s: beyond the paper, off by default (its
             robot plans once on a known map, a one-cell robot visiting every cell centre); what BARN's protocol
             (map unknown, a box Jackal at 2 m/s) needs: the module docstring's BARN section.
-        turn_in_place_deg, wait_guard, rejoin_m, standing_m_s: beyond the paper, off by default (0, False, 0;
-            ``standing_m_s`` acts only with ``rejoin_m``): for crowds that do not see the robot, the module
-            docstring's last section.
+        turn_in_place_deg, wait_guard, rejoin_m, standing_m_s, arc_cap: beyond the paper, off by default (0, False,
+            0, -, False; ``standing_m_s`` acts only with ``rejoin_m``): for crowds that do not see the robot, the
+            module docstring's last section.
     """
 
     name: ClassVar[str] = "iaco_local"
@@ -152,6 +156,7 @@ class IacoLocalNavigator:
     rejoin_m: float = param(0.0, within(0, 100))
     standing_m_s: float = param(0.1, within(0, 100))
     wait_guard: bool = False
+    arc_cap: bool = False
     counts: dict[str, int] = field(default_factory=dict, init=False, repr=False)
 
     def reset(self, setup: NavigationSetup) -> None:
@@ -193,6 +198,11 @@ class IacoLocalNavigator:
                 raise ConfigError("navigator.params.turn_in_place_deg",
                                   f"the run's controller ({type(setup.controller).__name__}) has no turn on the spot")
             setup.controller.turn_in_place_rad = math.radians(self.turn_in_place_deg)
+        if self.arc_cap:
+            if not hasattr(setup.controller, "arc_cap"):
+                raise ConfigError("navigator.params.arc_cap",
+                                  f"the run's controller ({type(setup.controller).__name__}) has no arc cap")
+            setup.controller.arc_cap = True
 
     # -- beyond the paper: the map built as the robot drives -------------------------------------------
     def step(self, observation: Observation) -> NavigationStep:
