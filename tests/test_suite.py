@@ -197,7 +197,7 @@ def test_a_group_slice_is_each_groups_contiguous_seeds_so_a_validation_range_is_
     assert spread[:3] == [501, 503, 505] and len(spread) == 250
 
 
-@pytest.mark.parametrize("value", ["5:5", "7:3", "-1:4", "0:99999999999", "a:b", ":3"])
+@pytest.mark.parametrize("value", ["5:5", "7:3", "-1:4", "0:99999999999", "a:b", ":3", "600:700"])
 def test_a_bad_group_slice_is_one_line_exit_2(capsys, value):
     from swarmnav.cli.main import main
     try:

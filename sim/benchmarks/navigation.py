@@ -204,6 +204,11 @@ def write_suite(suite_name: str, quick: bool, sensor_model: str | None, folder: 
     suite = load_suite(suite_name, sensor_model, seed_offset)
     scenes = (stratified_sample(suite, per_group) if per_group is not None
               else stratified_sample(suite) if quick else suite.scenes)
+    if not scenes and isinstance(per_group, tuple):
+        from swarmnav.models.errors import ConfigError
+        largest = max(sum(s.group == g for s in suite.scenes) for g in {s.group for s in suite.scenes})
+        raise ConfigError("--per-group", f"{per_group[0]}:{per_group[1]} selects no scene (a group of "
+                                         f"{suite_name} has at most {largest:,})")
     os.makedirs(os.path.join(folder, "scenarios"), exist_ok=True)
     paths = []
     for scene in scenes:
